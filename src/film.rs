@@ -1,0 +1,172 @@
+//! The image being rendered (linear RGB floats) and how it is written.
+//!
+//! Every file is written whole or not at all: the bytes go to a temporary file in the same
+//! directory, which is renamed over the target only once it is complete.
+
+use anyhow::{Context, Result, bail};
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+use std::io::{BufWriter, Write};
+use std::path::Path;
+
+/// Linear RGB pixels, row-major from the top-left.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Film {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// `width × height` colours.
+    pub pixels: Vec<Vec3>,
+}
+
+/// How linear values become 8-bit pixels.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum ToneMap {
+    /// The lab's look: clamp to [0, 1], no gamma.
+    Clamp,
+    /// The lab's key 'h': 1 − exp(−3x).
+    Exp,
+}
+
+impl Film {
+    /// A black image.
+    pub fn new(width: u32, height: u32) -> Film {
+        Film {
+            width,
+            height,
+            pixels: vec![Vec3::ZERO; width as usize * height as usize],
+        }
+    }
+
+    /// 8-bit RGB after tone mapping.
+    pub fn to_rgb8(&self, tone: ToneMap) -> image::RgbImage {
+        let mut img = image::RgbImage::new(self.width, self.height);
+        for (px, c) in img.pixels_mut().zip(&self.pixels) {
+            let c = match tone {
+                ToneMap::Clamp => *c,
+                ToneMap::Exp => Vec3::ONE - (-3.0 * *c).exp(),
+            };
+            let q = |x: f32| (x.clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
+            *px = image::Rgb([q(c.x), q(c.y), q(c.z)]);
+        }
+        img
+    }
+
+    /// Writes an 8-bit image; the format follows the extension (png, ppm).
+    pub fn write_ldr(&self, path: &Path, tone: ToneMap) -> Result<()> {
+        let format = ldr_format(path)?;
+        let img = self.to_rgb8(tone);
+        write_atomically(path, |w| {
+            img.write_to(w, format).map_err(anyhow::Error::from)
+        })
+    }
+
+    /// Writes linear floats: `.pfm` (portable float map) or `.exr`.
+    pub fn write_hdr(&self, path: &Path) -> Result<()> {
+        match hdr_extension(path)? {
+            HdrFormat::Pfm => write_atomically(path, |w| {
+                write!(w, "PF\n{} {}\n-1.0\n", self.width, self.height)?;
+                // PFM stores rows bottom to top, little-endian (the negative scale says so).
+                for row in self.pixels.chunks(self.width as usize).rev() {
+                    for c in row {
+                        for x in c.to_array() {
+                            w.write_all(&x.to_le_bytes())?;
+                        }
+                    }
+                }
+                Ok(())
+            }),
+            HdrFormat::Exr => {
+                let data: Vec<f32> = self.pixels.iter().flat_map(|c| c.to_array()).collect();
+                let img = image::Rgb32FImage::from_raw(self.width, self.height, data)
+                    .context("image buffer size")?;
+                write_atomically(path, |w| {
+                    image::DynamicImage::ImageRgb32F(img.clone())
+                        .write_to(w, image::ImageFormat::OpenExr)
+                        .map_err(anyhow::Error::from)
+                })
+            }
+        }
+    }
+}
+
+/// The 8-bit format for an output path, or an error naming what is accepted.
+pub fn ldr_format(path: &Path) -> Result<image::ImageFormat> {
+    match extension(path).as_deref() {
+        Some("png") => Ok(image::ImageFormat::Png),
+        Some("ppm") => Ok(image::ImageFormat::Pnm),
+        _ => bail!(
+            "cannot write {}: expected an output file ending in .png or .ppm (use --hdr for .pfm or .exr)",
+            path.display()
+        ),
+    }
+}
+
+enum HdrFormat {
+    Pfm,
+    Exr,
+}
+
+/// Checks that an `--hdr` path has a float format's extension.
+pub fn check_hdr_path(path: &Path) -> Result<()> {
+    hdr_extension(path).map(|_| ())
+}
+
+fn hdr_extension(path: &Path) -> Result<HdrFormat> {
+    match extension(path).as_deref() {
+        Some("pfm") => Ok(HdrFormat::Pfm),
+        Some("exr") => Ok(HdrFormat::Exr),
+        _ => bail!(
+            "cannot write {}: expected an --hdr file ending in .pfm or .exr",
+            path.display()
+        ),
+    }
+}
+
+fn extension(path: &Path) -> Option<String> {
+    path.extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+}
+
+/// Checks, before a long render, that the directory of `path` exists.
+pub fn check_output_dir(path: &Path) -> Result<()> {
+    let dir = parent_dir(path);
+    if !dir.is_dir() {
+        bail!(
+            "cannot write {}: directory {} does not exist",
+            path.display(),
+            dir.display()
+        );
+    }
+    Ok(())
+}
+
+fn parent_dir(path: &Path) -> &Path {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    }
+}
+
+/// Writes through `fill` into a temporary file beside `path`, then renames it into place.
+pub fn write_atomically(
+    path: &Path,
+    fill: impl FnOnce(&mut BufWriter<&mut std::fs::File>) -> Result<()>,
+) -> Result<()> {
+    let dir = parent_dir(path);
+    let mut tmp = tempfile::Builder::new()
+        .prefix(".raywave-")
+        .tempfile_in(dir)
+        .with_context(|| format!("cannot create a temporary file in {}", dir.display()))?;
+    {
+        let mut w = BufWriter::new(tmp.as_file_mut());
+        fill(&mut w).with_context(|| format!("cannot write {}", path.display()))?;
+        w.flush()
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    tmp.persist(path)
+        .with_context(|| format!("cannot move the finished image to {}", path.display()))?;
+    Ok(())
+}

@@ -1,0 +1,225 @@
+//! Scalar ray–primitive intersection: the reference kernels. The SIMD kernels of the wavefront
+//! engine are tested against these functions, lane by lane.
+//!
+//! Conventions (the lab's): faces are one-sided, hit only from the front (n·d < 0, n from the
+//! counter-clockwise winding) unless `two_sided`; spheres are hit from both sides and report the
+//! outward normal; a hit needs t > `T_MIN`. A miss returns `f32::INFINITY`, never `None`, and any
+//! NaN in the input makes a miss (every test is written so that NaN compares false).
+
+use crate::scene::{NO_HIT, Scene, Sphere, Triangle};
+use glam::{Vec3, Vec3A};
+use obvhs::{BvhBuildParams, cwbvh::CwBvh, ray::RayHit};
+use std::time::Duration;
+
+/// The lab's self-intersection epsilon: a hit needs t > 1e-4.
+pub const T_MIN: f32 = 1e-4;
+
+/// Below this many triangles the reference tests every primitive; above it, it uses a BVH.
+pub const BVH_MIN_TRIANGLES: usize = 64;
+
+/// A ray with a half-open interval (T_MIN, tmax).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ray {
+    /// Start point.
+    pub origin: Vec3,
+    /// Direction (unit length for camera, reflection and shadow rays).
+    pub direction: Vec3,
+}
+
+/// The closest hit along a ray.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    /// Distance along the ray; `f32::INFINITY` for a miss.
+    pub t: f32,
+    /// Global primitive id (triangles, then spheres); `NO_HIT` for a miss.
+    pub prim: u32,
+}
+
+impl Hit {
+    /// No hit.
+    pub const MISS: Hit = Hit {
+        t: f32::INFINITY,
+        prim: NO_HIT,
+    };
+    /// True when something was hit.
+    pub fn is_hit(&self) -> bool {
+        self.prim != NO_HIT
+    }
+}
+
+/// Möller–Trumbore. Returns t in (T_MIN, tmax) or infinity.
+///
+/// det = e1·(d × e2) = −d·n, so det > 0 means the ray meets the front.
+#[inline]
+pub fn intersect_triangle(tri: &Triangle, ray: &Ray, tmax: f32, two_sided: bool) -> f32 {
+    let pvec = ray.direction.cross(tri.e2);
+    let det = tri.e1.dot(pvec);
+    let facing = if two_sided { det != 0.0 } else { det > 0.0 };
+    if !facing {
+        return f32::INFINITY;
+    }
+    let inv_det = 1.0 / det;
+    let tvec = ray.origin - tri.v0;
+    let u = tvec.dot(pvec) * inv_det;
+    let qvec = tvec.cross(tri.e1);
+    let v = ray.direction.dot(qvec) * inv_det;
+    let t = tri.e2.dot(qvec) * inv_det;
+    if u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t > T_MIN && t < tmax {
+        t
+    } else {
+        f32::INFINITY
+    }
+}
+
+/// Nearest root of |o + t·d − c|² = r² with t in (T_MIN, tmax), or infinity.
+#[inline]
+pub fn intersect_sphere(sphere: &Sphere, ray: &Ray, tmax: f32) -> f32 {
+    let oc = ray.origin - sphere.center;
+    let a = ray.direction.length_squared();
+    let b = oc.dot(ray.direction);
+    let c = oc.length_squared() - sphere.radius * sphere.radius;
+    let disc = b * b - a * c;
+    if !(disc >= 0.0) {
+        return f32::INFINITY;
+    }
+    let root = disc.sqrt();
+    let near = (-b - root) / a;
+    let far = (-b + root) / a;
+    let t = if near > T_MIN { near } else { far };
+    if t > T_MIN && t < tmax {
+        t
+    } else {
+        f32::INFINITY
+    }
+}
+
+/// Unit normal at a hit, before any flipping for two-sided faces.
+pub fn geometric_normal(scene: &Scene, prim: u32, point: Vec3) -> Vec3 {
+    let p = prim as usize;
+    if p < scene.triangles.len() {
+        scene.triangles[p].normal
+    } else {
+        let s = &scene.spheres[p - scene.triangles.len()];
+        (point - s.center) / s.radius
+    }
+}
+
+/// How the reference finds hits: every primitive in turn, or a BVH over the triangles.
+pub struct Accel {
+    bvh: Option<CwBvh>,
+    /// BVH build time, for reporting (zero without a BVH).
+    pub build_time: Duration,
+}
+
+impl Accel {
+    /// Builds a CWBVH over the triangles when there are at least `BVH_MIN_TRIANGLES` of them.
+    pub fn new(scene: &Scene) -> Accel {
+        if scene.triangles.len() < BVH_MIN_TRIANGLES {
+            return Accel {
+                bvh: None,
+                build_time: Duration::ZERO,
+            };
+        }
+        let start = std::time::Instant::now();
+        let tris: Vec<obvhs::triangle::Triangle> = scene
+            .triangles
+            .iter()
+            .map(|t| obvhs::triangle::Triangle {
+                v0: t.v0.into(),
+                v1: (t.v0 + t.e1).into(),
+                v2: (t.v0 + t.e2).into(),
+            })
+            .collect();
+        let mut core = Duration::ZERO;
+        let bvh = obvhs::cwbvh::builder::build_cwbvh_from_tris(
+            &tris,
+            BvhBuildParams::medium_build(),
+            &mut core,
+        );
+        Accel {
+            bvh: Some(bvh),
+            build_time: start.elapsed(),
+        }
+    }
+
+    /// True when a BVH is in use.
+    pub fn uses_bvh(&self) -> bool {
+        self.bvh.is_some()
+    }
+
+    /// Closest hit in (T_MIN, tmax).
+    pub fn closest(&self, scene: &Scene, ray: &Ray, tmax: f32, two_sided: bool) -> Hit {
+        let mut best = Hit {
+            t: tmax,
+            prim: NO_HIT,
+        };
+        match &self.bvh {
+            None => {
+                for (i, tri) in scene.triangles.iter().enumerate() {
+                    let t = intersect_triangle(tri, ray, best.t, two_sided);
+                    if t < best.t {
+                        best = Hit { t, prim: i as u32 };
+                    }
+                }
+            }
+            Some(bvh) => {
+                let bray = obvhs_ray(ray, best.t);
+                let mut hit = RayHit::none();
+                if bvh.ray_traverse(bray, &mut hit, |r, id| {
+                    let tri = &scene.triangles[bvh.primitive_indices[id] as usize];
+                    intersect_triangle(tri, ray, r.tmax, two_sided)
+                }) {
+                    best = Hit {
+                        t: hit.t,
+                        prim: bvh.primitive_indices[hit.primitive_id as usize],
+                    };
+                }
+            }
+        }
+        let base = scene.triangles.len() as u32;
+        for (i, sphere) in scene.spheres.iter().enumerate() {
+            let t = intersect_sphere(sphere, ray, best.t);
+            if t < best.t {
+                best = Hit {
+                    t,
+                    prim: base + i as u32,
+                };
+            }
+        }
+        if best.prim == NO_HIT { Hit::MISS } else { best }
+    }
+
+    /// True when anything blocks the ray in (T_MIN, tmax): stops at the first blocker.
+    pub fn occluded(&self, scene: &Scene, ray: &Ray, tmax: f32, two_sided: bool) -> bool {
+        if scene
+            .spheres
+            .iter()
+            .any(|s| intersect_sphere(s, ray, tmax) < tmax)
+        {
+            return true;
+        }
+        match &self.bvh {
+            None => scene
+                .triangles
+                .iter()
+                .any(|tri| intersect_triangle(tri, ray, tmax, two_sided) < tmax),
+            Some(bvh) => !bvh.ray_traverse_miss(obvhs_ray(ray, tmax), |_, id| {
+                intersect_triangle(
+                    &scene.triangles[bvh.primitive_indices[id] as usize],
+                    ray,
+                    tmax,
+                    two_sided,
+                )
+            }),
+        }
+    }
+}
+
+fn obvhs_ray(ray: &Ray, tmax: f32) -> obvhs::ray::Ray {
+    obvhs::ray::Ray::new(
+        Vec3A::from(ray.origin),
+        Vec3A::from(ray.direction),
+        T_MIN,
+        tmax,
+    )
+}

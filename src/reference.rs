@@ -1,0 +1,211 @@
+//! The scalar reference renderer: the lab's recursive `trace`, one ray at a time.
+//!
+//! It is the whole-image twin of the wavefront engine, so it is written to be obviously right
+//! rather than clever, while staying a fair baseline for timing: no allocation per ray, no
+//! dynamic dispatch per primitive, a BVH for meshes, rayon over rows.
+//!
+//! ```text
+//! trace(ray, bounce):
+//!   no hit -> background
+//!   hit    -> 0.2·kd
+//!           + kr ⊙ trace(reflected ray, bounce + 1)        if kr ≠ 0 and bounce < max bounces
+//!           + Σ lights Σ j<N  Shade(l_j) / N                if n·l_j > 0 and p_j is visible
+//! ```
+
+use crate::camera::CameraRays;
+use crate::film::Film;
+use crate::geometry::{Accel, Hit, Ray, T_MIN, geometric_normal};
+use crate::sampling::{SampleKey, pixel_offset, square_sample};
+use crate::scene::Scene;
+use crate::settings::{RenderSettings, ShadowMode};
+use crate::shading::{AMBIENT, reflect, shade};
+use crate::stats::RayCounts;
+use glam::Vec3;
+use rayon::prelude::*;
+
+/// Receives every ray the tracer casts; `()` ignores them at no cost. Used by the one-pixel
+/// debug view.
+pub trait TraceLog {
+    /// A camera or reflection ray and what it hit.
+    fn path_ray(&mut self, _bounce: u32, _ray: &Ray, _hit: &Hit) {}
+    /// A shadow ray from `from` towards `to` on light `light`; `blocked` tells the outcome
+    /// (`None` when shadows are off and no ray was cast).
+    fn shadow_ray(
+        &mut self,
+        _bounce: u32,
+        _light: u32,
+        _from: Vec3,
+        _to: Vec3,
+        _blocked: Option<bool>,
+    ) {
+    }
+}
+
+impl TraceLog for () {}
+
+/// The reference renderer for one scene and one set of settings.
+pub struct Reference<'a> {
+    scene: &'a Scene,
+    settings: &'a RenderSettings,
+    accel: Accel,
+    camera: CameraRays,
+}
+
+impl<'a> Reference<'a> {
+    /// Prepares the acceleration structure and camera.
+    pub fn new(scene: &'a Scene, settings: &'a RenderSettings) -> Self {
+        Reference {
+            scene,
+            settings,
+            accel: Accel::new(scene),
+            camera: CameraRays::new(&scene.camera, settings.width, settings.height),
+        }
+    }
+
+    /// The acceleration structure in use.
+    pub fn accel(&self) -> &Accel {
+        &self.accel
+    }
+
+    /// Renders the image on the current rayon pool; `on_row` is called after each row.
+    pub fn render(&self, on_row: &(dyn Fn() + Sync)) -> (Film, RayCounts) {
+        let (w, h) = (self.settings.width as usize, self.settings.height as usize);
+        let mut film = Film::new(self.settings.width, self.settings.height);
+        let counts = film
+            .pixels
+            .par_chunks_mut(w)
+            .enumerate()
+            .map(|(row, out)| {
+                let mut counts = RayCounts::default();
+                for (i, px) in out.iter_mut().enumerate() {
+                    *px = self.pixel((row * w + i) as u32, &mut counts, &mut ());
+                }
+                on_row();
+                counts
+            })
+            .reduce(RayCounts::default, |a, b| a + b);
+        debug_assert_eq!(film.pixels.len(), w * h);
+        (film, counts)
+    }
+
+    /// The colour of one pixel: the mean over its antialiasing samples.
+    pub fn pixel(&self, pixel: u32, counts: &mut RayCounts, log: &mut impl TraceLog) -> Vec3 {
+        let n = self.settings.aa_samples.max(1);
+        let mut sum = Vec3::ZERO;
+        for sample in 0..n {
+            let key = SampleKey {
+                pixel,
+                sample,
+                bounce: 0,
+                light: 0,
+                seed: self.settings.seed,
+            };
+            let (ox, oy) = pixel_offset(&key, sample, n);
+            let (x, y) = self.camera.screen(pixel, ox, oy);
+            counts.camera += 1;
+            sum += self.trace(&self.camera.ray(x, y), key, counts, log);
+        }
+        sum / n as f32
+    }
+
+    fn trace(
+        &self,
+        ray: &Ray,
+        key: SampleKey,
+        counts: &mut RayCounts,
+        log: &mut impl TraceLog,
+    ) -> Vec3 {
+        let hit = self
+            .accel
+            .closest(self.scene, ray, f32::INFINITY, self.settings.two_sided);
+        log.path_ray(key.bounce, ray, &hit);
+        if !hit.is_hit() {
+            return self.settings.background();
+        }
+        let point = ray.origin + hit.t * ray.direction;
+        let mut n = geometric_normal(self.scene, hit.prim, point);
+        if self.settings.two_sided
+            && (hit.prim as usize) < self.scene.triangles.len()
+            && n.dot(ray.direction) > 0.0
+        {
+            n = -n;
+        }
+        let material = self.scene.material_of(hit.prim);
+        let mut color = AMBIENT * material.diffuse;
+        if material.is_reflective() && key.bounce < self.settings.bounces {
+            let next = Ray {
+                origin: point,
+                direction: reflect(ray.direction, n),
+            };
+            counts.reflection += 1;
+            let bounced = SampleKey {
+                bounce: key.bounce + 1,
+                ..key
+            };
+            color += material.reflective * self.trace(&next, bounced, counts, log);
+        }
+        color + self.direct(point, n, -ray.direction, material, key, counts, log)
+    }
+
+    /// Σ over lights and their N points of Shade / N for the visible points.
+    #[allow(clippy::too_many_arguments)]
+    fn direct(
+        &self,
+        point: Vec3,
+        n: Vec3,
+        e: Vec3,
+        material: &crate::scene::Material,
+        key: SampleKey,
+        counts: &mut RayCounts,
+        log: &mut impl TraceLog,
+    ) -> Vec3 {
+        let settings = self.settings;
+        let count = settings.points_per_light();
+        let weight = 1.0 / count as f32;
+        let mut sum = Vec3::ZERO;
+        for (li, light) in self.scene.lights.iter().enumerate() {
+            let light_key = SampleKey {
+                light: li as u32,
+                ..key
+            };
+            for j in 0..count {
+                let target = match settings.shadows {
+                    ShadowMode::Soft => {
+                        let (u, v) = square_sample(settings.sampler, &light_key, j, count);
+                        light.point(u, v)
+                    }
+                    _ => light.centroid,
+                };
+                let to_light = target - point;
+                let dist = to_light.length();
+                let l = to_light / dist;
+                let n_dot_l = n.dot(l);
+                if !(n_dot_l > 0.0) {
+                    continue;
+                }
+                let visible = match settings.shadows {
+                    ShadowMode::Off => {
+                        log.shadow_ray(key.bounce, li as u32, point, target, None);
+                        true
+                    }
+                    _ => {
+                        counts.shadow += 1;
+                        let ray = Ray {
+                            origin: point,
+                            direction: l,
+                        };
+                        let blocked =
+                            self.accel
+                                .occluded(self.scene, &ray, dist - T_MIN, settings.two_sided);
+                        log.shadow_ray(key.bounce, li as u32, point, target, Some(blocked));
+                        !blocked
+                    }
+                };
+                if visible {
+                    sum += shade(material, n, e, l, n_dot_l, light.color) * weight;
+                }
+            }
+        }
+        sum
+    }
+}

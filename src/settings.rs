@@ -1,0 +1,87 @@
+//! Render settings, with presets that say what they are for.
+
+use crate::sampling::LightSampler;
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+
+/// How shadows are computed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum ShadowMode {
+    /// The lab's starting point: every light counts as visible (no shadow rays).
+    Off,
+    /// One shadow ray per light, to its centroid.
+    Hard,
+    /// `shadow_samples` shadow rays per light, to points chosen by `sampler`.
+    Soft,
+}
+
+/// Everything that decides the image, apart from the scene.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RenderSettings {
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// Maximum number of mirror bounces after the camera hit.
+    pub bounces: u32,
+    /// Shadow mode.
+    pub shadows: ShadowMode,
+    /// Points per light in `Soft` mode (N).
+    pub shadow_samples: u32,
+    /// How those points are placed.
+    pub sampler: LightSampler,
+    /// Camera rays per pixel (1 = through the centre; more = jittered strata).
+    pub aa_samples: u32,
+    /// Colour of rays that hit nothing.
+    pub background: [f32; 3],
+    /// Seed of every random number.
+    pub seed: u32,
+    /// Let faces be hit from behind too (normals then face the ray).
+    pub two_sided: bool,
+}
+
+impl Default for RenderSettings {
+    /// The lab's third run line at 512×512: soft shadows (16 stratified points), 5 bounces.
+    fn default() -> Self {
+        RenderSettings {
+            width: 512,
+            height: 512,
+            bounces: 5,
+            shadows: ShadowMode::Soft,
+            shadow_samples: 16,
+            sampler: LightSampler::Stratified,
+            aa_samples: 1,
+            background: [1.0, 1.0, 1.0],
+            seed: 0,
+            two_sided: false,
+        }
+    }
+}
+
+impl RenderSettings {
+    /// Small and quick, for tests and a first look: 64×64, hard shadows, 2 bounces.
+    pub fn preview() -> Self {
+        RenderSettings {
+            width: 64,
+            height: 64,
+            bounces: 2,
+            shadows: ShadowMode::Hard,
+            shadow_samples: 1,
+            ..Self::default()
+        }
+    }
+
+    /// The background as a vector.
+    pub fn background(&self) -> Vec3 {
+        Vec3::from_array(self.background)
+    }
+
+    /// Shadow rays (points) per light per shading point: 1 unless soft.
+    pub fn points_per_light(&self) -> u32 {
+        match self.shadows {
+            ShadowMode::Soft => self.shadow_samples.max(1),
+            _ => 1,
+        }
+    }
+}
