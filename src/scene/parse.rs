@@ -26,7 +26,7 @@ pub struct ParseError {
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
     /// The file could not be opened or read.
-    #[error("cannot read scene file {path}: {source}")]
+    #[error("cannot read scene file {path}")]
     Io {
         /// The path as given.
         path: String,
