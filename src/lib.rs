@@ -11,6 +11,7 @@ pub mod cli;
 pub mod debug_view;
 pub mod film;
 pub mod geometry;
+pub mod meshgen;
 pub mod reference;
 pub mod sampling;
 pub mod scene;
