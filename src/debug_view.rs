@@ -74,10 +74,29 @@ impl TraceLog for RayRecorder {
 }
 
 impl RayRecorder {
+    /// The rays in tree order. The tracer logs a mirror ray before the shadow rays of the hit
+    /// that spawned it (the recursion returns first), so each camera ray's chain (one hit per
+    /// depth) is sorted stably by (depth, path ray before shadow rays).
+    pub fn tree_order(&self) -> Vec<&LoggedRay> {
+        let mut out = Vec::with_capacity(self.rays.len());
+        let mut chain: Vec<&LoggedRay> = Vec::new();
+        let key = |r: &&LoggedRay| (r.bounce, matches!(r.kind, LoggedKind::Shadow { .. }));
+        for r in &self.rays {
+            if r.bounce == 0 && matches!(r.kind, LoggedKind::Path { .. }) && !chain.is_empty() {
+                chain.sort_by_key(key);
+                out.append(&mut chain);
+            }
+            chain.push(r);
+        }
+        chain.sort_by_key(key);
+        out.append(&mut chain);
+        out
+    }
+
     /// A readable tree, indented by bounce.
     pub fn report(&self, scene: &crate::scene::Scene) -> String {
         let mut s = String::new();
-        for r in &self.rays {
+        for r in self.tree_order() {
             let indent = "  ".repeat(r.bounce as usize);
             let _ = match r.kind {
                 LoggedKind::Path { hit } => {
@@ -128,6 +147,22 @@ impl RayRecorder {
                 LoggedKind::Shadow { .. } => [40, 255, 40],
             };
             draw_segment(img, camera, r.from, r.to, colour);
+            // A camera ray runs along the line of sight and projects to a dot: mark its hit.
+            if r.bounce == 0 && matches!(r.kind, LoggedKind::Path { .. }) {
+                if let Some((x, y)) = project(camera, r.to) {
+                    for d in -4i64..=4 {
+                        for (px, py) in [(x as i64 + d, y as i64), (x as i64, y as i64 + d)] {
+                            if px >= 0
+                                && py >= 0
+                                && (px as u32) < img.width()
+                                && (py as u32) < img.height()
+                            {
+                                img.put_pixel(px as u32, py as u32, image::Rgb(colour));
+                            }
+                        }
+                    }
+                }
+            }
         }
     }
 }

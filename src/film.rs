@@ -166,6 +166,18 @@ pub fn write_atomically(
         w.flush()
             .with_context(|| format!("cannot write {}", path.display()))?;
     }
+    // Temporary files are created private (0600); an image is not a secret. Keep the mode of
+    // the file being replaced, or use the usual 0644 for a new one.
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let mode = std::fs::metadata(path)
+            .map(|m| m.permissions().mode())
+            .unwrap_or(0o644);
+        tmp.as_file()
+            .set_permissions(std::fs::Permissions::from_mode(mode))
+            .with_context(|| format!("cannot set the permissions of {}", path.display()))?;
+    }
     tmp.persist(path)
         .with_context(|| format!("cannot move the finished image to {}", path.display()))?;
     Ok(())
