@@ -96,7 +96,12 @@ pub fn cornell_box_mesh_spheres(bands: u32) -> String {
     let (lat, lon) = (bands, 2 * bands);
     let mut s = String::with_capacity(BOX.len() + triangle_count(bands) * 40);
     s.push_str(BOX);
-    let _ = writeln!(s, "# {} triangles ({} latitude bands per sphere)", triangle_count(bands), bands);
+    let _ = writeln!(
+        s,
+        "# {} triangles ({} latitude bands per sphere)",
+        triangle_count(bands),
+        bands
+    );
     let mut next_vertex = 9u32; // 1-based: the box used 1..=8
     for (centre, radius, material) in SPHERES {
         let _ = writeln!(s, "m {material}");
@@ -116,7 +121,10 @@ pub fn cornell_box_mesh_spheres(bands: u32) -> String {
         for i in 1..lat {
             let theta = std::f64::consts::PI * i as f64 / lat as f64;
             for k in 0..lon {
-                push(point(theta, 2.0 * std::f64::consts::PI * k as f64 / lon as f64));
+                push(point(
+                    theta,
+                    2.0 * std::f64::consts::PI * k as f64 / lon as f64,
+                ));
             }
         }
         push(point(std::f64::consts::PI, 0.0));
@@ -127,11 +135,24 @@ pub fn cornell_box_mesh_spheres(bands: u32) -> String {
         }
         for i in 1..lat - 1 {
             for k in 0..lon {
-                let _ = writeln!(s, "f {} {} {} {}", ring(i, k), ring(i + 1, k), ring(i + 1, k + 1), ring(i, k + 1));
+                let _ = writeln!(
+                    s,
+                    "f {} {} {} {}",
+                    ring(i, k),
+                    ring(i + 1, k),
+                    ring(i + 1, k + 1),
+                    ring(i, k + 1)
+                );
             }
         }
         for k in 0..lon {
-            let _ = writeln!(s, "f {} {} {}", ring(lat - 1, k), south, ring(lat - 1, k + 1));
+            let _ = writeln!(
+                s,
+                "f {} {} {}",
+                ring(lat - 1, k),
+                south,
+                ring(lat - 1, k + 1)
+            );
         }
         next_vertex = south + 1;
     }
@@ -147,7 +168,11 @@ mod tests {
     fn generated_scene_parses_with_the_promised_triangle_count() {
         for bands in [2, 3, 8] {
             let scene = parse_scene_str(&cornell_box_mesh_spheres(bands), "gen").unwrap();
-            assert_eq!(scene.triangles.len(), triangle_count(bands), "bands {bands}");
+            assert_eq!(
+                scene.triangles.len(),
+                triangle_count(bands),
+                "bands {bands}"
+            );
             assert_eq!(scene.lights.len(), 1);
             assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
         }
@@ -168,7 +193,10 @@ mod tests {
     fn budget_maps_to_bands_near_the_target() {
         for target in [12_000usize, 1_000_000] {
             let n = triangle_count(bands_for(target));
-            assert!((n as f64 / target as f64 - 1.0).abs() < 0.1, "{target} -> {n}");
+            assert!(
+                (n as f64 / target as f64 - 1.0).abs() < 0.1,
+                "{target} -> {n}"
+            );
         }
     }
 }
