@@ -80,6 +80,39 @@ pub struct RenderArgs {
     /// No progress bar and no summary.
     #[arg(short, long)]
     pub quiet: bool,
+    /// Which engine renders the image.
+    #[arg(long, value_enum, default_value = "wavefront")]
+    pub engine: Engine,
+    /// Camera samples per wavefront tile: the unit of work and of memory.
+    #[arg(long, default_value_t = crate::wavefront::DEFAULT_BATCH_SIZE as u32,
+          value_parser = clap::value_parser!(u32).range(1..=1 << 20))]
+    pub batch_size: u32,
+    /// Print rays and rays/s per kind, and per stage for the wavefront engine.
+    #[arg(long)]
+    pub stats: bool,
+    /// Write the same figures as JSON, with the machine, SIMD path and thread count.
+    #[arg(long, value_name = "FILE")]
+    pub stats_json: Option<PathBuf>,
+}
+
+/// The renderers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Engine {
+    /// Structure-of-arrays batches through 8-wide SIMD stages (the default).
+    Wavefront,
+    /// The scalar recursive renderer, one ray at a time: the whole-image twin.
+    Reference,
+}
+
+impl Engine {
+    /// The name used on the command line and in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Engine::Wavefront => "wavefront",
+            Engine::Reference => "reference",
+        }
+    }
 }
 
 fn parse_colour_component(s: &str) -> Result<f32, String> {

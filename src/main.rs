@@ -4,13 +4,16 @@
 use anyhow::{Context, Result, bail};
 use clap::Parser;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use raywave::cli::{Cli, Command, RenderArgs};
+use raywave::cli::{Cli, Command, Engine, RenderArgs};
 use raywave::debug_view::RayRecorder;
 use raywave::film::{check_hdr_path, check_output_dir, ldr_format};
 use raywave::reference::Reference;
 use raywave::scene::Scene;
 use raywave::settings::{RenderSettings, ShadowMode};
 use raywave::stats::RayCounts;
+use raywave::wavefront::Wavefront;
+use raywave::wavefront::stats::RenderStats;
+use std::io::Write;
 use std::process::ExitCode;
 use std::time::Instant;
 
@@ -76,15 +79,33 @@ fn render(args: &RenderArgs) -> Result<()> {
             );
         }
     }
+    if let Some(path) = &args.stats_json {
+        check_output_dir(path)?;
+    }
     let pool = thread_pool(args.threads)?;
     let threads = pool.current_num_threads();
 
     let reference = Reference::new(&scene, &settings);
-    let progress = progress_bar(settings.height as u64, args.quiet);
-    let start = Instant::now();
-    let (film, counts) = pool.install(|| reference.render(&|| progress.inc(1)));
-    let seconds = start.elapsed().as_secs_f64();
-    progress.finish_and_clear();
+    let (film, report) = match args.engine {
+        Engine::Reference => {
+            let progress = progress_bar(settings.height as u64, "rows", args.quiet);
+            let start = Instant::now();
+            let (film, counts) = pool.install(|| reference.render(&|| progress.inc(1)));
+            let seconds = start.elapsed().as_secs_f64();
+            progress.finish_and_clear();
+            (film, Report::new(counts, seconds, None))
+        }
+        Engine::Wavefront => {
+            let engine = Wavefront::new(&scene, &settings, args.batch_size as usize);
+            let progress = progress_bar(engine.tile_count() as u64, "tiles", args.quiet);
+            let start = Instant::now();
+            let (film, stats) = pool.install(|| engine.render(&|| progress.inc(1)));
+            let seconds = start.elapsed().as_secs_f64();
+            progress.finish_and_clear();
+            let bvh = engine.context().accel.is_some();
+            (film, Report::new(stats.counts, seconds, Some((stats, bvh))))
+        }
+    };
 
     let mut img = film.to_rgb8(args.tonemap);
     if let Some(px) = &args.debug_pixel {
@@ -110,8 +131,20 @@ fn render(args: &RenderArgs) -> Result<()> {
     if let Some(hdr) = &args.hdr {
         film.write_hdr(hdr)?;
     }
+    let run = RunInfo {
+        engine: args.engine,
+        threads,
+        batch_size: args.batch_size,
+    };
+    if let Some(path) = &args.stats_json {
+        let json = stats_json(&scene, &settings, &run, &report);
+        raywave::film::write_atomically(path, |w| {
+            serde_json::to_writer_pretty(&mut *w, &json)?;
+            Ok(writeln!(w)?)
+        })?;
+    }
     if !args.quiet {
-        summary(&scene, &settings, threads, &counts, seconds);
+        summary(&scene, &settings, &run, &report);
         let extra = args
             .hdr
             .as_ref()
@@ -119,26 +152,29 @@ fn render(args: &RenderArgs) -> Result<()> {
             .unwrap_or_default();
         println!("wrote   {}{extra}", args.output.display());
     }
+    if args.stats {
+        print_stats(&report);
+    }
     Ok(())
 }
 
-fn progress_bar(rows: u64, quiet: bool) -> ProgressBar {
+fn progress_bar(len: u64, unit: &str, quiet: bool) -> ProgressBar {
     if quiet {
         return ProgressBar::hidden();
     }
     // indicatif draws nothing when stderr is not a terminal.
-    let bar = ProgressBar::with_draw_target(Some(rows), ProgressDrawTarget::stderr());
+    let bar = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::stderr());
     bar.set_style(
-        ProgressStyle::with_template(
-            "{spinner} rendering [{bar:40}] {pos}/{len} rows, {elapsed} (eta {eta})",
-        )
+        ProgressStyle::with_template(&format!(
+            "{{spinner}} rendering [{{bar:40}}] {{pos}}/{{len}} {unit}, {{elapsed}} (eta {{eta}})"
+        ))
         .expect("valid template")
         .progress_chars("=> "),
     );
     bar
 }
 
-fn summary(scene: &Scene, s: &RenderSettings, threads: usize, counts: &RayCounts, seconds: f64) {
+fn summary(scene: &Scene, s: &RenderSettings, run: &RunInfo, report: &Report) {
     let shadows = match s.shadows {
         ShadowMode::Off => "off (every light visible)".to_string(),
         ShadowMode::Hard => "hard (light centroids)".to_string(),
@@ -149,9 +185,11 @@ fn summary(scene: &Scene, s: &RenderSettings, threads: usize, counts: &RayCounts
         ),
     };
     println!(
-        "raywave {} · engine reference · simd {} · {threads} thread(s)",
+        "raywave {} · engine {} · simd {} · {} thread(s)",
         env!("CARGO_PKG_VERSION"),
-        raywave::simd_path()
+        run.engine.name(),
+        raywave::simd_path(),
+        run.threads
     );
     println!(
         "scene   {}: {} faces ({} triangles), {} spheres, {} light(s), {} camera",
@@ -170,6 +208,7 @@ fn summary(scene: &Scene, s: &RenderSettings, threads: usize, counts: &RayCounts
         "render  {}×{}, {} bounces, shadows {shadows}, {} aa sample(s), seed {}",
         s.width, s.height, s.bounces, s.aa_samples, s.seed
     );
+    let counts = &report.counts;
     println!(
         "rays    {} total: {} camera, {} shadow, {} reflection",
         counts.total(),
@@ -178,7 +217,130 @@ fn summary(scene: &Scene, s: &RenderSettings, threads: usize, counts: &RayCounts
         counts.reflection
     );
     println!(
-        "time    {seconds:.3} s, {:.2} Mrays/s",
-        counts.total() as f64 / seconds.max(1e-9) / 1e6
+        "time    {:.3} s, {:.2} Mrays/s",
+        report.seconds,
+        report.rays_per_second() / 1e6
     );
+}
+
+/// How the render ran, for the summary and the JSON.
+struct RunInfo {
+    engine: Engine,
+    threads: usize,
+    batch_size: u32,
+}
+
+/// What a render measured.
+struct Report {
+    counts: RayCounts,
+    seconds: f64,
+    /// Wavefront only: per-stage figures, and whether a BVH was used.
+    stages: Option<(RenderStats, bool)>,
+}
+
+impl Report {
+    fn new(counts: RayCounts, seconds: f64, stages: Option<(RenderStats, bool)>) -> Report {
+        Report {
+            counts,
+            seconds,
+            stages,
+        }
+    }
+
+    fn rays_per_second(&self) -> f64 {
+        self.counts.total() as f64 / self.seconds.max(1e-9)
+    }
+
+    /// (kind, rays, rays per wall-clock second).
+    fn kinds(&self) -> [(&'static str, u64, f64); 4] {
+        let c = &self.counts;
+        let per_s = |n: u64| n as f64 / self.seconds.max(1e-9);
+        [
+            ("camera", c.camera, per_s(c.camera)),
+            ("shadow", c.shadow, per_s(c.shadow)),
+            ("reflection", c.reflection, per_s(c.reflection)),
+            ("total", c.total(), per_s(c.total())),
+        ]
+    }
+}
+
+fn print_stats(report: &Report) {
+    println!("{:<12} {:>14} {:>14}", "kind", "rays", "Mrays/s");
+    for (kind, rays, per_s) in report.kinds() {
+        println!("{kind:<12} {rays:>14} {:>14.2}", per_s / 1e6);
+    }
+    if let Some((stats, _)) = &report.stages {
+        println!(
+            "{:<12} {:>14} {:>14} {:>20}",
+            "stage", "rays", "thread-s", "Mrays/thread-s"
+        );
+        for row in stats.stage_rows() {
+            println!(
+                "{:<12} {:>14} {:>14.3} {:>20.2}",
+                row.stage,
+                row.rays,
+                row.thread_seconds,
+                row.rays_per_thread_second / 1e6
+            );
+        }
+    }
+}
+
+/// The CPU's model name from /proc/cpuinfo, where there is one.
+fn cpu_model() -> String {
+    std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|text| {
+            text.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split_once(':'))
+                .map(|(_, v)| v.trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown".to_string())
+}
+
+fn stats_json(
+    scene: &Scene,
+    settings: &RenderSettings,
+    run: &RunInfo,
+    report: &Report,
+) -> serde_json::Value {
+    let kinds: serde_json::Map<String, serde_json::Value> = report
+        .kinds()
+        .iter()
+        .map(|&(kind, rays, per_s)| {
+            (
+                kind.to_string(),
+                serde_json::json!({ "rays": rays, "rays_per_second": per_s }),
+            )
+        })
+        .collect();
+    let (stages, bvh) = match &report.stages {
+        Some((stats, bvh)) => (serde_json::to_value(stats.stage_rows()).ok(), Some(*bvh)),
+        None => (None, None),
+    };
+    serde_json::json!({
+        "raywave": env!("CARGO_PKG_VERSION"),
+        "machine": {
+            "cpu": cpu_model(),
+            "logical_cpus": std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1),
+            "os": std::env::consts::OS,
+            "arch": std::env::consts::ARCH,
+        },
+        "simd": raywave::simd_path(),
+        "threads": run.threads,
+        "engine": run.engine,
+        "batch_size": run.batch_size,
+        "scene": {
+            "source": scene.source,
+            "triangles": scene.triangles.len(),
+            "spheres": scene.spheres.len(),
+            "lights": scene.lights.len(),
+            "bvh": bvh,
+        },
+        "settings": settings,
+        "seconds": report.seconds,
+        "rays": kinds,
+        "stages": stages,
+    })
 }

@@ -1,0 +1,154 @@
+//! What every stage reads: the scene, the settings, and per-render tables derived from them
+//! once (material and light terms, the strata grid, the acceleration choice).
+
+use crate::camera::CameraRays;
+use crate::geometry::Accel;
+use crate::sampling::{LightSampler, strata_grid};
+use crate::scene::{LightShape, Scene};
+use crate::settings::{RenderSettings, ShadowMode};
+use crate::shading::AMBIENT;
+use glam::Vec3;
+use std::time::Duration;
+
+/// At or above this many triangles, rays go through obvhs's CWBVH one at a time; below it, the
+/// 8-wide kernels test every primitive. It equals the reference's `BVH_MIN_TRIANGLES`, so both
+/// engines find hits the same way; see docs/PERFORMANCE.md for the measurements behind it.
+pub const BVH_MIN_TRIANGLES: usize = crate::geometry::BVH_MIN_TRIANGLES;
+
+/// A material's terms of the lab's Shade, computed once with the reference's operations.
+#[derive(Clone, Copy, Debug)]
+pub struct MaterialTerms {
+    /// kd.
+    pub diffuse: Vec3,
+    /// kr.
+    pub reflective: Vec3,
+    /// AMBIENT · kd: what every hit gets.
+    pub ambient: Vec3,
+    /// AMBIENT · ke: Shade's first term.
+    pub ambient_emitted: Vec3,
+    /// 0.8 · kr: the specular colour.
+    pub specular: Vec3,
+    /// 5 / (g + 0.01).
+    pub shininess: f32,
+    /// kr ≠ 0: spawns mirror rays and has a highlight.
+    pub is_reflective: bool,
+}
+
+/// A light's terms, with the parallelogram (all the lab's lights) kept apart for the SIMD path.
+#[derive(Clone, Debug)]
+pub struct LightTerms {
+    /// Lc = 0.2 · ke · area.
+    pub color: Vec3,
+    /// Centroid (hard shadows).
+    pub centroid: Vec3,
+    /// (corner, edge_u, edge_v) when the light is a parallelogram.
+    pub parallelogram: Option<(Vec3, Vec3, Vec3)>,
+}
+
+/// Scene, settings and derived tables for one render.
+pub struct Context<'a> {
+    /// The scene.
+    pub scene: &'a Scene,
+    /// The settings.
+    pub settings: &'a RenderSettings,
+    /// Camera set up for the image size.
+    pub camera: CameraRays,
+    /// The CWBVH when the scene has at least `BVH_MIN_TRIANGLES` triangles.
+    pub accel: Option<Accel>,
+    /// BVH build time (zero without one).
+    pub bvh_build_time: Duration,
+    /// One entry per material.
+    pub materials: Vec<MaterialTerms>,
+    /// One entry per light.
+    pub lights: Vec<LightTerms>,
+    /// Points per light (N).
+    pub points_per_light: u32,
+    /// Stratum column of every point index (padded to a multiple of 8), as floats.
+    pub cell_x: Vec<f32>,
+    /// Stratum row of every point index.
+    pub cell_y: Vec<f32>,
+    /// The strata grid (nx, ny) as floats.
+    pub grid: (f32, f32),
+}
+
+impl<'a> Context<'a> {
+    /// Derives the tables and builds the BVH if the scene needs one.
+    pub fn new(scene: &'a Scene, settings: &'a RenderSettings) -> Self {
+        let accel = (scene.triangles.len() >= BVH_MIN_TRIANGLES).then(|| Accel::new(scene));
+        let bvh_build_time = accel.as_ref().map_or(Duration::ZERO, |a| a.build_time);
+        let materials = scene
+            .materials
+            .iter()
+            .map(|m| MaterialTerms {
+                diffuse: m.diffuse,
+                reflective: m.reflective,
+                ambient: AMBIENT * m.diffuse,
+                ambient_emitted: AMBIENT * m.emitted,
+                specular: 0.8 * m.reflective,
+                shininess: m.shininess(),
+                is_reflective: m.is_reflective(),
+            })
+            .collect();
+        let lights = scene
+            .lights
+            .iter()
+            .map(|l| LightTerms {
+                color: l.color,
+                centroid: l.centroid,
+                parallelogram: match l.shape {
+                    LightShape::Parallelogram {
+                        origin,
+                        edge_u,
+                        edge_v,
+                    } => Some((origin, edge_u, edge_v)),
+                    LightShape::Fan { .. } => None,
+                },
+            })
+            .collect();
+        let points_per_light = settings.points_per_light();
+        let (nx, ny) = strata_grid(points_per_light);
+        let padded = (points_per_light as usize).div_ceil(8) * 8;
+        let cell_x = (0..padded as u32).map(|j| (j % nx) as f32).collect();
+        let cell_y = (0..padded as u32).map(|j| (j / nx) as f32).collect();
+        Context {
+            scene,
+            settings,
+            camera: CameraRays::new(&scene.camera, settings.width, settings.height),
+            accel,
+            bvh_build_time,
+            materials,
+            lights,
+            points_per_light,
+            cell_x,
+            cell_y,
+            grid: (nx as f32, ny as f32),
+        }
+    }
+
+    /// True when shadow rays are cast (hard or soft shadows).
+    pub fn casts_shadow_rays(&self) -> bool {
+        self.settings.shadows != ShadowMode::Off
+    }
+
+    /// True when light points are sampled (soft shadows) rather than the centroid.
+    pub fn samples_lights(&self) -> bool {
+        self.settings.shadows == ShadowMode::Soft
+    }
+
+    /// True for stratified light sampling.
+    pub fn stratified(&self) -> bool {
+        self.settings.sampler == LightSampler::Stratified
+    }
+
+    /// Material index of a primitive.
+    #[inline]
+    pub fn material_index(&self, prim: u32) -> u32 {
+        let p = prim as usize;
+        let tris = &self.scene.triangles;
+        if p < tris.len() {
+            tris[p].material
+        } else {
+            self.scene.spheres[p - tris.len()].material
+        }
+    }
+}

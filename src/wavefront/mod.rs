@@ -1,0 +1,140 @@
+//! The wavefront engine: rays in structure-of-arrays batches flowing through stages, 8 lanes
+//! at a time, tiles spread over cores.
+//!
+//! ```text
+//! for each tile (rayon; a fixed range of pixels, independent of the thread count):
+//!     generate   camera rays, one per (pixel, aa sample)          generate.rs
+//!     for bounce in 0..=max bounces, while rays are left:
+//!         intersect  closest hit of every ray                      intersect.rs
+//!         shadow     shadow rays, occlusion, Shade sums             shadow.rs
+//!         film       radiance += throughput · (0.2·kd + direct)     film.rs
+//!         reflect    mirror rays into the next batch                reflect.rs
+//!         swap the two ray batches
+//!     film       pixel = mean of its samples, in sample order        film.rs
+//! ```
+//!
+//! Every random number comes from `sampling`'s pure hash of (pixel, sample, bounce, light,
+//! dimension, seed), and each pixel is summed inside one tile in a fixed order, so the image
+//! does not depend on scheduling: `--threads 1` and `--threads 2` give the same bytes. Memory
+//! is the film plus one `Workspace` per worker, bounded by the batch size.
+
+pub mod batch;
+pub mod context;
+pub mod film;
+pub mod generate;
+pub mod intersect;
+pub mod reflect;
+pub mod shadow;
+pub mod simd;
+pub mod stats;
+
+use crate::film::Film;
+use crate::scene::Scene;
+use crate::settings::RenderSettings;
+use batch::{HitBatch, Radiance, RayBatch, ShadowQueue};
+use context::Context;
+use glam::Vec3;
+use rayon::prelude::*;
+use stats::{RenderStats, Stage};
+
+/// Camera samples per tile unless told otherwise (measured in docs/PERFORMANCE.md).
+pub const DEFAULT_BATCH_SIZE: usize = 4096;
+
+/// Buffers one worker reuses from tile to tile.
+#[derive(Default)]
+pub struct Workspace {
+    rays: RayBatch,
+    next: RayBatch,
+    hits: HitBatch,
+    shadow: ShadowQueue,
+    radiance: Radiance,
+}
+
+/// The wavefront renderer for one scene and one set of settings.
+pub struct Wavefront<'a> {
+    ctx: Context<'a>,
+    /// Pixels per tile: the batch size divided by the antialiasing samples.
+    tile_pixels: usize,
+    /// Shadow rays queued before an occlusion pass.
+    queue_capacity: usize,
+}
+
+impl<'a> Wavefront<'a> {
+    /// Prepares the tables (and the BVH for meshes); `batch_size` is camera samples per tile.
+    pub fn new(scene: &'a Scene, settings: &'a RenderSettings, batch_size: usize) -> Self {
+        let ctx = Context::new(scene, settings);
+        let batch_size = batch_size.max(1);
+        Wavefront {
+            tile_pixels: (batch_size / settings.aa_samples.max(1) as usize).max(1),
+            queue_capacity: batch_size.max(simd::LANES),
+            ctx,
+        }
+    }
+
+    /// The derived tables, BVH included.
+    pub fn context(&self) -> &Context<'a> {
+        &self.ctx
+    }
+
+    /// Number of tiles (for progress reporting).
+    pub fn tile_count(&self) -> usize {
+        self.pixel_count().div_ceil(self.tile_pixels)
+    }
+
+    fn pixel_count(&self) -> usize {
+        self.ctx.settings.width as usize * self.ctx.settings.height as usize
+    }
+
+    /// Renders on the current rayon pool; `on_tile` is called after each tile.
+    pub fn render(&self, on_tile: &(dyn Fn() + Sync)) -> (Film, RenderStats) {
+        let s = self.ctx.settings;
+        let mut film = Film::new(s.width, s.height);
+        let stats = film
+            .pixels
+            .par_chunks_mut(self.tile_pixels)
+            .enumerate()
+            .map_init(Workspace::default, |ws, (tile, out)| {
+                let mut stats = RenderStats::default();
+                self.render_tile((tile * self.tile_pixels) as u32, out, ws, &mut stats);
+                on_tile();
+                stats
+            })
+            .reduce(RenderStats::default, |a, b| a + b);
+        (film, stats)
+    }
+
+    /// Renders pixels `first..first + out.len()` into `out`: the architecture diagram.
+    pub fn render_tile(
+        &self,
+        first: u32,
+        out: &mut [Vec3],
+        ws: &mut Workspace,
+        st: &mut RenderStats,
+    ) {
+        let ctx = &self.ctx;
+        st.time(Stage::Generate, || {
+            generate::camera_rays(ctx, first, out.len() as u32, &mut ws.rays);
+            ws.radiance.reset(ws.rays.len());
+        });
+        st.counts.camera += ws.rays.len() as u64;
+        while !ws.rays.is_empty() {
+            st.time(Stage::Intersect, || {
+                intersect::closest(ctx, &ws.rays, &mut ws.hits);
+            });
+            st.counts.shadow += st.time(Stage::Shadow, || {
+                let capacity = self.queue_capacity;
+                shadow::direct_light(ctx, &ws.rays, &mut ws.hits, &mut ws.shadow, capacity)
+            });
+            st.time(Stage::Film, || {
+                film::accumulate(ctx, &ws.rays, &ws.hits, &mut ws.radiance);
+            });
+            st.counts.reflection += st.time(Stage::Reflect, || {
+                reflect::mirror_rays(ctx, &ws.rays, &ws.hits, &mut ws.next)
+            });
+            std::mem::swap(&mut ws.rays, &mut ws.next);
+        }
+        st.time(Stage::Film, || {
+            film::resolve(&ws.radiance, ctx.settings.aa_samples, out);
+        });
+    }
+}

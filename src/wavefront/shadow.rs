@@ -1,0 +1,235 @@
+//! Stage 3, shadow: direct light at every hit.
+//!
+//! ```text
+//! for each group of hits whose shadow rays fit the queue:
+//!     spawn:   for hit, for light, for point j < N:  l, dist, n·l;  queue it if n·l > 0
+//!     occlude: 8 queued rays at a time, stop at the first blocker (obvhs `ray_traverse_miss`
+//!              for meshes)
+//!     shade:   in queue order, direct[hit] += Shade(l) / N for the rays not blocked
+//! ```
+//!
+//! Queue order is the reference's loop order, so each hit's sum is added in the same order and
+//! comes out bit-identical. Soft shadows on a parallelogram light (every lab light) generate 8
+//! points at a time with the SIMD hash; hard shadows and other light shapes call the scalar
+//! sampling code one point at a time.
+
+use super::batch::{HitBatch, RayBatch, ShadowQueue};
+use super::context::{Context, MaterialTerms};
+use super::simd::{self, LANES, LightBlock, RayColumns};
+use crate::geometry::{Ray, T_MIN};
+use crate::sampling::{SampleKey, mix32, square_sample};
+use crate::scene::NO_HIT;
+use glam::Vec3;
+
+/// The hash state of a SampleKey before its dimension is mixed in: `sampling::hash(key, dim)`
+/// is `mix32(key_prefix(key) ^ dim)`, so a (hit, light) stream is hashed once, not once per
+/// point. Tested against `sampling::uniform`.
+#[inline]
+pub fn key_prefix(key: &SampleKey) -> u32 {
+    let mut h = mix32(key.seed ^ 0x9e37_79b9);
+    h = mix32(h ^ key.pixel);
+    h = mix32(h ^ key.sample);
+    h = mix32(h ^ key.bounce);
+    mix32(h ^ key.light)
+}
+
+/// Fills every hit's `direct` column; returns the number of shadow rays cast (queued rays: a
+/// point behind the surface casts none, and no ray is cast with shadows off).
+pub fn direct_light(
+    ctx: &Context,
+    rays: &RayBatch,
+    hits: &mut HitBatch,
+    queue: &mut ShadowQueue,
+    capacity: usize,
+) -> u64 {
+    let n = rays.len();
+    for c in [&mut hits.direct_r, &mut hits.direct_g, &mut hits.direct_b] {
+        c[..n].fill(0.0);
+    }
+    // Room for one hit's rays at least, each light's points padded to whole 8-lane blocks.
+    let per_hit = ctx.lights.len() * (ctx.points_per_light as usize).div_ceil(LANES) * LANES;
+    queue.reset(capacity.max(per_hit));
+    let mut cast = 0;
+    let mut next = 0;
+    while next < n {
+        queue.len = 0;
+        while next < n && queue.room() >= per_hit {
+            cast += spawn(ctx, rays, hits, next, queue);
+            next += 1;
+        }
+        queue.blocked[..queue.len].fill(false);
+        if ctx.casts_shadow_rays() {
+            occlude(ctx, queue);
+        }
+        shade(ctx, rays, hits, queue);
+    }
+    if ctx.casts_shadow_rays() { cast } else { 0 }
+}
+
+/// Queues the shadow rays of hit `i`, in (light, point) order.
+/// Returns the number of live rays queued.
+fn spawn(
+    ctx: &Context,
+    rays: &RayBatch,
+    hits: &HitBatch,
+    i: usize,
+    queue: &mut ShadowQueue,
+) -> u64 {
+    if hits.prim[i] == NO_HIT {
+        return 0;
+    }
+    let mut cast = 0;
+    let point = hits.point(i);
+    let n = hits.normal(i);
+    let count = ctx.points_per_light;
+    for (li, light) in ctx.lights.iter().enumerate() {
+        let key = SampleKey {
+            pixel: rays.pixel[i],
+            sample: rays.sample[i],
+            bounce: rays.bounce,
+            light: li as u32,
+            seed: ctx.settings.seed,
+        };
+        match (ctx.samples_lights(), light.parallelogram) {
+            (true, Some((origin, edge_u, edge_v))) => {
+                let prefix = key_prefix(&key);
+                for j0 in (0..count).step_by(LANES) {
+                    let block = LightBlock {
+                        prefix,
+                        j0,
+                        strata: ctx.stratified().then_some((
+                            &ctx.cell_x[..],
+                            &ctx.cell_y[..],
+                            ctx.grid.0,
+                            ctx.grid.1,
+                        )),
+                        origin,
+                        edge_u,
+                        edge_v,
+                    };
+                    let target = simd::light_points8(&block);
+                    let lanes = ((count - j0) as usize).min(LANES);
+                    let (l, tmax, n_dot_l, live) = simd::shadow_rays8(point, n, &target, lanes);
+                    if live != 0 {
+                        queue.push_block(point, &l, &tmax, &n_dot_l, i as u32, li as u32);
+                        cast += live.count_ones() as u64;
+                    }
+                }
+            }
+            _ => {
+                for j in 0..count {
+                    let target = if ctx.samples_lights() {
+                        let (u, v) = square_sample(ctx.settings.sampler, &key, j, count);
+                        ctx.scene.lights[li].point(u, v)
+                    } else {
+                        light.centroid
+                    };
+                    let to_light = target - point;
+                    let dist = to_light.length();
+                    let l = to_light / dist;
+                    let n_dot_l = n.dot(l);
+                    if n_dot_l > 0.0 {
+                        queue.push(point, l, dist - T_MIN, n_dot_l, i as u32, li as u32);
+                        cast += 1;
+                    }
+                }
+            }
+        }
+    }
+    cast
+}
+
+/// Sets `queue.blocked` for every queued ray.
+fn occlude(ctx: &Context, queue: &mut ShadowQueue) {
+    let scene = ctx.scene;
+    let two_sided = ctx.settings.two_sided;
+    match &ctx.accel {
+        None => {
+            let n = queue.len;
+            let cols = RayColumns {
+                origin: [
+                    &queue.origin_x[..n],
+                    &queue.origin_y[..n],
+                    &queue.origin_z[..n],
+                ],
+                direction: [
+                    &queue.direction_x[..n],
+                    &queue.direction_y[..n],
+                    &queue.direction_z[..n],
+                ],
+                tmax: &queue.tmax[..n],
+            };
+            simd::occluded(
+                &scene.triangles,
+                &scene.spheres,
+                &cols,
+                two_sided,
+                &mut queue.blocked[..n],
+            );
+        }
+        Some(accel) => {
+            for i in 0..queue.len {
+                if !(queue.n_dot_l[i] > 0.0) {
+                    continue;
+                }
+                let ray = Ray {
+                    origin: Vec3::new(queue.origin_x[i], queue.origin_y[i], queue.origin_z[i]),
+                    direction: queue.direction(i),
+                };
+                queue.blocked[i] = accel.occluded(scene, &ray, queue.tmax[i], two_sided);
+            }
+        }
+    }
+}
+
+/// Adds Shade / N of every unblocked queued ray to its hit, in queue order.
+fn shade(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch, queue: &ShadowQueue) {
+    let weight = 1.0 / ctx.points_per_light as f32;
+    for q in 0..queue.len {
+        if queue.blocked[q] || !(queue.n_dot_l[q] > 0.0) {
+            continue;
+        }
+        let i = queue.path[q] as usize;
+        let m = &ctx.materials[hits.material[i] as usize];
+        let light_color = ctx.lights[queue.light[q] as usize].color;
+        let c = shade_terms(
+            m,
+            hits.normal(i),
+            -rays.direction(i),
+            queue.direction(q),
+            queue.n_dot_l[q],
+            light_color,
+        ) * weight;
+        hits.direct_r[i] += c.x;
+        hits.direct_g[i] += c.y;
+        hits.direct_b[i] += c.z;
+    }
+}
+
+/// The lab's Shade, twin of `shading::shade` with the same operations in the same order, minus
+/// the work whose result is exactly zero: no highlight (and no `powf`) when kr = 0 or when
+/// e·r ≤ 0 (with a positive exponent), since the reference then adds `±0.0`, which changes
+/// nothing. Tested bit-equal.
+#[inline]
+pub fn shade_terms(
+    m: &MaterialTerms,
+    n: Vec3,
+    e: Vec3,
+    l: Vec3,
+    n_dot_l: f32,
+    light_color: Vec3,
+) -> Vec3 {
+    let c = m.ambient_emitted + light_color * m.diffuse * n_dot_l;
+    // With a positive exponent, base^s is finite, so kr = 0 makes the highlight ±0 ...
+    let positive = m.shininess > 0.0;
+    if positive && !m.is_reflective {
+        return c;
+    }
+    let r = (2.0 * n_dot_l * n - l).normalize();
+    let base = e.dot(r).max(0.0);
+    // ... and so does base = 0 (0^s = 0).
+    if positive && !(base > 0.0) {
+        return c;
+    }
+    c + light_color * m.specular * (base.powf(m.shininess) * n_dot_l)
+}

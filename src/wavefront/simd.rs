@@ -1,0 +1,421 @@
+//! The 8-wide kernels: the only module that names `wide` types.
+//!
+//! Every kernel here is a lane-by-lane copy of a scalar twin, with the same operations in the
+//! same order, so that with IEEE arithmetic (no FMA contraction: Rust never fuses `a * b + c`,
+//! and neither does `wide`) each lane gives the same bits as the twin:
+//!
+//! | kernel               | scalar twin                                              |
+//! |----------------------|----------------------------------------------------------|
+//! | [`triangle8`]        | `geometry::intersect_triangle`                           |
+//! | [`sphere8`]          | `geometry::intersect_sphere`                             |
+//! | [`closest_hits`]     | `Accel::closest` without a BVH                           |
+//! | [`occluded`]         | `Accel::occluded` without a BVH                          |
+//! | [`light_points8`]    | `sampling::square_sample` then `Light::point`            |
+//! | [`shadow_rays8`]     | the start of `Reference::direct` (l, dist, n·l)          |
+//!
+//! Branches become masks: a lane that misses gets `f32::INFINITY`, exactly like the twins'
+//! sentinel. Batches whose length is not a multiple of 8 are padded with lanes that cannot hit
+//! (tmax = 0, NaN directions), and the padding is never stored back.
+
+use crate::geometry::T_MIN;
+use crate::scene::{NO_HIT, Sphere, Triangle};
+use glam::Vec3;
+use wide::{f32x8, i32x8, u32x8};
+
+/// The SIMD width.
+pub const LANES: usize = 8;
+
+/// Ray columns of a batch, borrowed: origin, direction and tmax.
+#[derive(Clone, Copy)]
+pub struct RayColumns<'a> {
+    /// origin x, y, z.
+    pub origin: [&'a [f32]; 3],
+    /// direction x, y, z.
+    pub direction: [&'a [f32]; 3],
+    /// End of the interval (T_MIN, tmax).
+    pub tmax: &'a [f32],
+}
+
+impl RayColumns<'_> {
+    /// Number of rays.
+    pub fn len(&self) -> usize {
+        self.tmax.len()
+    }
+    /// True without rays.
+    pub fn is_empty(&self) -> bool {
+        self.tmax.is_empty()
+    }
+}
+
+/// Eight rays in registers.
+#[derive(Clone, Copy)]
+pub struct Rays8 {
+    ox: f32x8,
+    oy: f32x8,
+    oz: f32x8,
+    dx: f32x8,
+    dy: f32x8,
+    dz: f32x8,
+}
+
+#[inline(always)]
+fn load(col: &[f32], i: usize, pad: f32) -> f32x8 {
+    match col.get(i..i + LANES) {
+        Some(s) => f32x8::new(s.try_into().expect("8 lanes")),
+        None => {
+            let mut a = [pad; LANES];
+            let rest = &col[i.min(col.len())..];
+            a[..rest.len()].copy_from_slice(rest);
+            f32x8::new(a)
+        }
+    }
+}
+
+impl Rays8 {
+    /// Loads rays `i..i + 8` (padding past the end with NaN directions).
+    #[inline(always)]
+    fn load(r: &RayColumns, i: usize) -> Rays8 {
+        Rays8 {
+            ox: load(r.origin[0], i, 0.0),
+            oy: load(r.origin[1], i, 0.0),
+            oz: load(r.origin[2], i, 0.0),
+            dx: load(r.direction[0], i, f32::NAN),
+            dy: load(r.direction[1], i, f32::NAN),
+            dz: load(r.direction[2], i, f32::NAN),
+        }
+    }
+}
+
+/// The live lanes of the chunk starting at `i` of a batch of `len`.
+#[inline(always)]
+fn live_lanes(i: usize, len: usize) -> u32 {
+    let n = (len - i).min(LANES);
+    (1u32 << n) - 1
+}
+
+/// Möller–Trumbore for 8 rays against one triangle; lane k equals
+/// `intersect_triangle(tri, ray_k, tmax_k, two_sided)`.
+///
+/// ```text
+/// p = d × e2; det = e1·p; facing = det > 0 (det ≠ 0 if two-sided)
+/// s = o − v0; u = s·p / det; q = s × e1; v = d·q / det; t = e2·q / det
+/// hit = facing ∧ u ≥ 0 ∧ v ≥ 0 ∧ u + v ≤ 1 ∧ T_MIN < t < tmax   → t, else ∞
+/// ```
+#[inline(always)]
+pub fn triangle8(tri: &Triangle, r: &Rays8, tmax: f32x8, two_sided: bool) -> f32x8 {
+    let (e1x, e1y, e1z) = (
+        f32x8::splat(tri.e1.x),
+        f32x8::splat(tri.e1.y),
+        f32x8::splat(tri.e1.z),
+    );
+    let (e2x, e2y, e2z) = (
+        f32x8::splat(tri.e2.x),
+        f32x8::splat(tri.e2.y),
+        f32x8::splat(tri.e2.z),
+    );
+    // pvec = d × e2 (glam's cross: self.y * rhs.z - rhs.y * self.z, ...)
+    let px = r.dy * e2z - e2y * r.dz;
+    let py = r.dz * e2x - e2z * r.dx;
+    let pz = r.dx * e2y - e2x * r.dy;
+    let det = e1x * px + e1y * py + e1z * pz;
+    let zero = f32x8::ZERO;
+    let facing = if two_sided {
+        det.simd_ne(zero)
+    } else {
+        det.simd_gt(zero)
+    };
+    let inv_det = f32x8::ONE / det;
+    let tx = r.ox - f32x8::splat(tri.v0.x);
+    let ty = r.oy - f32x8::splat(tri.v0.y);
+    let tz = r.oz - f32x8::splat(tri.v0.z);
+    let u = (tx * px + ty * py + tz * pz) * inv_det;
+    // qvec = tvec × e1
+    let qx = ty * e1z - e1y * tz;
+    let qy = tz * e1x - e1z * tx;
+    let qz = tx * e1y - e1x * ty;
+    let v = (r.dx * qx + r.dy * qy + r.dz * qz) * inv_det;
+    let t = (e2x * qx + e2y * qy + e2z * qz) * inv_det;
+    let hit = facing
+        & u.simd_ge(zero)
+        & v.simd_ge(zero)
+        & (u + v).simd_le(f32x8::ONE)
+        & t.simd_gt(f32x8::splat(T_MIN))
+        & t.simd_lt(tmax);
+    hit.select(t, f32x8::splat(f32::INFINITY))
+}
+
+/// The lanes that `tri` blocks, as a bitmask: `triangle8(..) < tmax`, but returning early when
+/// no lane faces the triangle (for one-sided faces about half the walls of a box, seen from a
+/// coherent packet of shadow rays).
+#[inline(always)]
+fn triangle8_blocks(tri: &Triangle, r: &Rays8, tmax: f32x8, two_sided: bool) -> u32 {
+    if !two_sided {
+        let (e1x, e1y, e1z) = (
+            f32x8::splat(tri.e1.x),
+            f32x8::splat(tri.e1.y),
+            f32x8::splat(tri.e1.z),
+        );
+        let (e2x, e2y, e2z) = (
+            f32x8::splat(tri.e2.x),
+            f32x8::splat(tri.e2.y),
+            f32x8::splat(tri.e2.z),
+        );
+        let px = r.dy * e2z - e2y * r.dz;
+        let py = r.dz * e2x - e2z * r.dx;
+        let pz = r.dx * e2y - e2x * r.dy;
+        let det = e1x * px + e1y * py + e1z * pz;
+        if det.simd_gt(f32x8::ZERO).none() {
+            return 0;
+        }
+    }
+    triangle8(tri, r, tmax, two_sided)
+        .simd_lt(tmax)
+        .to_bitmask()
+}
+
+/// Ray–sphere for 8 rays; lane k equals `intersect_sphere(sphere, ray_k, tmax_k)`.
+///
+/// ```text
+/// oc = o − c; a = d·d; b = oc·d; c = oc·oc − r²; disc = b² − a·c
+/// near = (−b − √disc)/a; far = (−b + √disc)/a; t = near > T_MIN ? near : far
+/// hit = disc ≥ 0 ∧ T_MIN < t < tmax   → t, else ∞
+/// ```
+#[inline(always)]
+pub fn sphere8(s: &Sphere, r: &Rays8, tmax: f32x8) -> f32x8 {
+    let ocx = r.ox - f32x8::splat(s.center.x);
+    let ocy = r.oy - f32x8::splat(s.center.y);
+    let ocz = r.oz - f32x8::splat(s.center.z);
+    let a = r.dx * r.dx + r.dy * r.dy + r.dz * r.dz;
+    let b = ocx * r.dx + ocy * r.dy + ocz * r.dz;
+    let c = (ocx * ocx + ocy * ocy + ocz * ocz) - f32x8::splat(s.radius * s.radius);
+    let disc = b * b - a * c;
+    let ok = disc.simd_ge(f32x8::ZERO);
+    let root = disc.sqrt();
+    let nb = -b;
+    let near = (nb - root) / a;
+    let far = (nb + root) / a;
+    let t_min = f32x8::splat(T_MIN);
+    let t = near.simd_gt(t_min).select(near, far);
+    let hit = ok & t.simd_gt(t_min) & t.simd_lt(tmax);
+    hit.select(t, f32x8::splat(f32::INFINITY))
+}
+
+/// Closest hit of every ray against every primitive, in the reference's order (triangles by
+/// index, then spheres; a later primitive wins only when strictly closer). Writes `t`
+/// (`f32::INFINITY` on a miss) and the global primitive id (`NO_HIT` on a miss).
+pub fn closest_hits(
+    triangles: &[Triangle],
+    spheres: &[Sphere],
+    rays: &RayColumns,
+    two_sided: bool,
+    t_out: &mut [f32],
+    prim_out: &mut [u32],
+) {
+    let n = rays.len();
+    debug_assert!(t_out.len() == n && prim_out.len() == n);
+    let no_hit = f32x8::splat(f32::from_bits(NO_HIT));
+    let base = triangles.len() as u32;
+    for i in (0..n).step_by(LANES) {
+        let r = Rays8::load(rays, i);
+        let mut best_t = load(rays.tmax, i, 0.0);
+        // Primitive ids ride in float lanes as raw bits: `select` only moves bits.
+        let mut best_prim = no_hit;
+        for (k, tri) in triangles.iter().enumerate() {
+            let t = triangle8(tri, &r, best_t, two_sided);
+            let closer = t.simd_lt(best_t);
+            best_t = closer.select(t, best_t);
+            best_prim = closer.select(f32x8::splat(f32::from_bits(k as u32)), best_prim);
+        }
+        for (k, s) in spheres.iter().enumerate() {
+            let t = sphere8(s, &r, best_t);
+            let closer = t.simd_lt(best_t);
+            best_t = closer.select(t, best_t);
+            best_prim = closer.select(f32x8::splat(f32::from_bits(base + k as u32)), best_prim);
+        }
+        let ts = best_t.to_array();
+        let ps = best_prim.to_array();
+        for lane in 0..(n - i).min(LANES) {
+            let prim = ps[lane].to_bits();
+            prim_out[i + lane] = prim;
+            t_out[i + lane] = if prim == NO_HIT {
+                f32::INFINITY
+            } else {
+                ts[lane]
+            };
+        }
+    }
+}
+
+/// For every ray, whether anything blocks it in (T_MIN, tmax). Spheres first, then triangles;
+/// a chunk of 8 stops as soon as all its live lanes are blocked.
+pub fn occluded(
+    triangles: &[Triangle],
+    spheres: &[Sphere],
+    rays: &RayColumns,
+    two_sided: bool,
+    out: &mut [bool],
+) {
+    let n = rays.len();
+    debug_assert!(out.len() == n);
+    for i in (0..n).step_by(LANES) {
+        let r = Rays8::load(rays, i);
+        let tmax = load(rays.tmax, i, 0.0);
+        // A lane with tmax ≤ 0 (dead, or a light point within T_MIN) can never be blocked, so
+        // it does not hold up the early exit.
+        let live = live_lanes(i, n) & tmax.simd_gt(f32x8::ZERO).to_bitmask();
+        let mut blocked = 0u32;
+        'prims: {
+            if live == 0 {
+                break 'prims;
+            }
+            for s in spheres {
+                blocked |= sphere8(s, &r, tmax).simd_lt(tmax).to_bitmask();
+                if blocked & live == live {
+                    break 'prims;
+                }
+            }
+            for tri in triangles {
+                blocked |= triangle8_blocks(tri, &r, tmax, two_sided);
+                if blocked & live == live {
+                    break 'prims;
+                }
+            }
+        }
+        for lane in 0..(n - i).min(LANES) {
+            out[i + lane] = blocked & (1 << lane) != 0;
+        }
+    }
+}
+
+/// Chris Wellons' `lowbias32`, 8 lanes; twin of `sampling::mix32`.
+#[inline(always)]
+fn mix32x8(mut x: u32x8) -> u32x8 {
+    x ^= x >> 16;
+    x *= u32x8::splat(0x7feb_352d);
+    x ^= x >> 15;
+    x *= u32x8::splat(0x846c_a68b);
+    x ^= x >> 16;
+    x
+}
+
+/// Uniform numbers in [0, 1) for dimensions `dims` of the stream whose hash prefix is `prefix`
+/// (see `shadow::key_prefix`): twin of `sampling::uniform`.
+#[inline(always)]
+fn uniform8(prefix: u32, dims: u32x8) -> f32x8 {
+    let h = mix32x8(u32x8::splat(prefix) ^ dims) >> 8;
+    // h < 2^24, so the signed conversion is exact.
+    f32x8::from_i32x8(wide::bytemuck::cast::<u32x8, i32x8>(h)) * f32x8::splat(1.0 / 16_777_216.0)
+}
+
+/// Where 8 consecutive light samples `j0..j0 + 8` of one (pixel, sample, bounce, light) stream
+/// land on a parallelogram light.
+#[derive(Clone, Copy, Debug)]
+pub struct LightBlock<'a> {
+    /// `shadow::key_prefix` of the stream's SampleKey.
+    pub prefix: u32,
+    /// First sample index of the block.
+    pub j0: u32,
+    /// For stratified sampling: the stratum column and row of every sample index, as floats
+    /// (from `sampling::strata_grid`), and the grid size; `None` for random sampling.
+    pub strata: Option<(&'a [f32], &'a [f32], f32, f32)>,
+    /// Corner a of the light.
+    pub origin: Vec3,
+    /// b − a.
+    pub edge_u: Vec3,
+    /// d − a.
+    pub edge_v: Vec3,
+}
+
+/// Light points x, y, z of samples `j0..j0 + 8`: lane k equals
+/// `light.point(square_sample(sampler, key, j0 + k, count))`.
+#[inline]
+pub fn light_points8(b: &LightBlock) -> [[f32; LANES]; 3] {
+    let j = u32x8::splat(b.j0) + u32x8::new([0, 1, 2, 3, 4, 5, 6, 7]);
+    let xi0 = uniform8(b.prefix, j + j);
+    let xi1 = uniform8(b.prefix, j + j + u32x8::ONE);
+    let (u, v) = match b.strata {
+        None => (xi0, xi1),
+        Some((cell_x, cell_y, nx, ny)) => {
+            let at = b.j0 as usize;
+            let cx = load(cell_x, at, 0.0);
+            let cy = load(cell_y, at, 0.0);
+            let one_minus_eps = f32x8::splat(crate::sampling::ONE_MINUS_EPS);
+            (
+                ((cx + xi0) / f32x8::splat(nx)).fast_min(one_minus_eps),
+                ((cy + xi1) / f32x8::splat(ny)).fast_min(one_minus_eps),
+            )
+        }
+    };
+    // origin + u·edge_u + v·edge_v, evaluated left to right like glam.
+    let axis = |o: f32, eu: f32, ev: f32| {
+        (f32x8::splat(o) + u * f32x8::splat(eu) + v * f32x8::splat(ev)).to_array()
+    };
+    [
+        axis(b.origin.x, b.edge_u.x, b.edge_v.x),
+        axis(b.origin.y, b.edge_u.y, b.edge_v.y),
+        axis(b.origin.z, b.edge_u.z, b.edge_v.z),
+    ]
+}
+
+/// Shadow rays from `point` (normal `n`) to 8 targets, the first `lanes` of them real: unit
+/// directions l, tmax = dist − T_MIN and n·l, each lane equal to the reference's
+/// `to_light = target − point; dist = |to_light|; l = to_light / dist; n·l`. Lanes with
+/// n·l ≤ 0 (the reference casts no ray) or past `lanes` come back dead: tmax = 0, n·l = 0.
+/// Also returns the bitmask of live lanes.
+#[inline]
+#[allow(clippy::type_complexity)]
+pub fn shadow_rays8(
+    point: Vec3,
+    n: Vec3,
+    target: &[[f32; LANES]; 3],
+    lanes: usize,
+) -> ([[f32; LANES]; 3], [f32; LANES], [f32; LANES], u32) {
+    let x = f32x8::new(target[0]) - f32x8::splat(point.x);
+    let y = f32x8::new(target[1]) - f32x8::splat(point.y);
+    let z = f32x8::new(target[2]) - f32x8::splat(point.z);
+    let dist = (x * x + y * y + z * z).sqrt();
+    let (lx, ly, lz) = (x / dist, y / dist, z / dist);
+    let n_dot_l = f32x8::splat(n.x) * lx + f32x8::splat(n.y) * ly + f32x8::splat(n.z) * lz;
+    let first = f32x8::new(std::array::from_fn(|k| if k < lanes { 1.0 } else { 0.0 }));
+    let live = n_dot_l.simd_gt(f32x8::ZERO) & first.simd_gt(f32x8::ZERO);
+    let zero = f32x8::ZERO;
+    (
+        [lx.to_array(), ly.to_array(), lz.to_array()],
+        live.select(dist - f32x8::splat(T_MIN), zero).to_array(),
+        live.select(n_dot_l, zero).to_array(),
+        live.to_bitmask(),
+    )
+}
+
+/// Lane-level entry points for tests: 8 rays given as arrays, the kernels' answers as arrays.
+pub mod lanes {
+    use super::*;
+    use crate::geometry::Ray;
+
+    fn rays8(rays: &[Ray; LANES]) -> Rays8 {
+        let col = |f: fn(&Ray) -> f32| f32x8::new(std::array::from_fn(|k| f(&rays[k])));
+        Rays8 {
+            ox: col(|r| r.origin.x),
+            oy: col(|r| r.origin.y),
+            oz: col(|r| r.origin.z),
+            dx: col(|r| r.direction.x),
+            dy: col(|r| r.direction.y),
+            dz: col(|r| r.direction.z),
+        }
+    }
+
+    /// [`triangle8`] on arrays.
+    pub fn triangle(
+        tri: &Triangle,
+        rays: &[Ray; LANES],
+        tmax: [f32; LANES],
+        two_sided: bool,
+    ) -> [f32; LANES] {
+        triangle8(tri, &rays8(rays), f32x8::new(tmax), two_sided).to_array()
+    }
+
+    /// [`sphere8`] on arrays.
+    pub fn sphere(s: &Sphere, rays: &[Ray; LANES], tmax: [f32; LANES]) -> [f32; LANES] {
+        sphere8(s, &rays8(rays), f32x8::new(tmax)).to_array()
+    }
+}
