@@ -1,0 +1,446 @@
+//! SIMD == scalar twin, lane by lane and bit for bit: the 8-wide kernels of the wavefront engine
+//! against the scalar kernels of `geometry`, `sampling` and `shading`, on an edge-case table
+//! (NaN, infinities, −0.0, grazing and axis-aligned rays, rays starting on a surface, empty
+//! scene, one primitive), on random input, and for batch lengths around the lane width.
+
+use glam::Vec3;
+use proptest::prelude::*;
+use raywave::geometry::{Accel, Ray, intersect_sphere, intersect_triangle};
+use raywave::sampling::{LightSampler, SampleKey, square_sample, strata_grid, uniform};
+use raywave::scene::{Light, LightShape, Material, NO_HIT, Scene, Sphere, Triangle};
+use raywave::shading::shade;
+use raywave::wavefront::context::MaterialTerms;
+use raywave::wavefront::shadow::{key_prefix, shade_terms};
+use raywave::wavefront::simd::{self, LightBlock, RayColumns, lanes};
+
+fn triangle(v0: Vec3, v1: Vec3, v2: Vec3) -> Triangle {
+    let (e1, e2) = (v1 - v0, v2 - v0);
+    Triangle {
+        v0,
+        e1,
+        e2,
+        normal: e1.cross(e2).normalize(),
+        material: 0,
+        face: 0,
+    }
+}
+
+fn ray(origin: [f32; 3], direction: [f32; 3]) -> Ray {
+    Ray {
+        origin: Vec3::from_array(origin),
+        direction: Vec3::from_array(direction),
+    }
+}
+
+const NAN: f32 = f32::NAN;
+const INF: f32 = f32::INFINITY;
+
+/// Rays chosen to sit on the kernels' edges for the unit triangle (0,0,0) (1,0,0) (0,1,0),
+/// whose front faces +z, and the unit sphere at the origin.
+fn edge_rays() -> Vec<Ray> {
+    let s = std::f32::consts::FRAC_1_SQRT_2;
+    vec![
+        ray([0.25, 0.25, 1.0], [0.0, 0.0, -1.0]), // axis-aligned, straight through
+        ray([0.25, 0.25, -1.0], [0.0, 0.0, 1.0]), // from behind
+        ray([0.25, 0.25, 0.0], [0.0, 0.0, -1.0]), // starting on the surface
+        ray([0.25, 0.25, 5e-5], [0.0, 0.0, -1.0]), // just inside T_MIN
+        ray([0.25, 0.25, 2e-4], [0.0, 0.0, -1.0]), // just past T_MIN
+        ray([-1.0, 0.25, 0.0], [1.0, 0.0, 0.0]),  // grazing, in the plane
+        ray([-1.0, 0.25, 1e-7], [1.0, 0.0, -1e-7]), // nearly grazing
+        ray([0.0, 0.0, 1.0], [0.0, 0.0, -1.0]),   // through a corner
+        ray([0.5, 0.5, 1.0], [0.0, 0.0, -1.0]),   // through the hypotenuse
+        ray([1.0, 0.0, 1.0], [0.0, 0.0, -1.0]),   // another corner
+        ray([0.5, -0.0, 1.0], [-0.0, 0.0, -1.0]), // −0.0 on an edge
+        ray([0.25, 0.25, 1.0], [-0.0, -0.0, -1.0]), // −0.0 direction components
+        ray([NAN, 0.25, 1.0], [0.0, 0.0, -1.0]),  // NaN origin
+        ray([0.25, 0.25, 1.0], [0.0, NAN, -1.0]), // NaN direction
+        ray([INF, 0.25, 1.0], [0.0, 0.0, -1.0]),  // infinite origin
+        ray([0.25, 0.25, 1.0], [0.0, 0.0, -INF]), // infinite direction
+        ray([0.25, 0.25, 1.0], [0.0, 0.0, 0.0]),  // zero direction
+        ray([0.0, 0.0, 3.0], [0.0, 0.0, -1.0]),   // sphere: through the centre
+        ray([0.0, 0.0, 0.0], [s, s, 0.0]),        // sphere: from the centre
+        ray([1.0, 0.0, 0.0], [0.0, 1.0, 0.0]),    // sphere: tangent, on the surface
+        ray([1.0, 0.0, 0.0], [1.0, 0.0, 0.0]),    // sphere: leaving from the surface
+        ray([1.0, 0.0, 0.0], [-1.0, 0.0, 0.0]),   // sphere: entering from the surface
+        ray([1.0, -2.0, 0.0], [0.0, 1.0, 0.0]),   // sphere: grazing
+        ray([0.25, 0.25, 1e30], [0.0, 0.0, -1.0]), // far away
+        ray([0.25, 0.25, 1.0], [0.0, 0.0, -1e-30]), // tiny direction
+    ]
+}
+
+fn tmaxes() -> [f32; 6] {
+    [INF, 1.0, 0.5, 0.0, -1.0, NAN]
+}
+
+/// Runs the 8-wide kernel on every run of 8 of `rays` (wrapping around) and each `tmax`.
+fn check_lanes(
+    rays: &[Ray],
+    simd: impl Fn(&[Ray; 8], [f32; 8]) -> [f32; 8],
+    scalar: impl Fn(&Ray, f32) -> f32,
+) {
+    for &tmax in &tmaxes() {
+        for start in 0..rays.len() {
+            let batch: [Ray; 8] = std::array::from_fn(|k| rays[(start + k) % rays.len()]);
+            // Vary tmax across lanes too.
+            let tm: [f32; 8] = std::array::from_fn(|k| if k % 3 == 0 { tmax } else { INF });
+            let got = simd(&batch, tm);
+            for k in 0..8 {
+                let want = scalar(&batch[k], tm[k]);
+                assert_eq!(
+                    got[k].to_bits(),
+                    want.to_bits(),
+                    "lane {k}: {:?} tmax {}: simd {} scalar {want}",
+                    batch[k],
+                    tm[k],
+                    got[k]
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn triangle_kernel_equals_scalar_on_edge_cases() {
+    let tris = [
+        triangle(Vec3::ZERO, Vec3::X, Vec3::Y),
+        triangle(Vec3::ZERO, Vec3::Y, Vec3::X), // facing −z
+        triangle(Vec3::ZERO, Vec3::X, Vec3::new(2.0, 0.0, 0.0)), // degenerate
+    ];
+    for tri in &tris {
+        for two_sided in [false, true] {
+            check_lanes(
+                &edge_rays(),
+                |r, tm| lanes::triangle(tri, r, tm, two_sided),
+                |r, tm| intersect_triangle(tri, r, tm, two_sided),
+            );
+        }
+    }
+}
+
+#[test]
+fn sphere_kernel_equals_scalar_on_edge_cases() {
+    for radius in [1.0, 1e-3, 1e20] {
+        let sphere = Sphere {
+            center: Vec3::ZERO,
+            radius,
+            material: 0,
+        };
+        check_lanes(
+            &edge_rays(),
+            |r, tm| lanes::sphere(&sphere, r, tm),
+            |r, tm| intersect_sphere(&sphere, r, tm),
+        );
+    }
+}
+
+fn scene_of(triangles: Vec<Triangle>, spheres: Vec<Sphere>) -> Scene {
+    Scene {
+        triangles,
+        spheres,
+        materials: vec![Material::default()],
+        ..Scene::default()
+    }
+}
+
+struct Columns {
+    ox: Vec<f32>,
+    oy: Vec<f32>,
+    oz: Vec<f32>,
+    dx: Vec<f32>,
+    dy: Vec<f32>,
+    dz: Vec<f32>,
+    tmax: Vec<f32>,
+}
+
+impl Columns {
+    fn new(rays: &[(Ray, f32)]) -> Columns {
+        let col = |f: &dyn Fn(&(Ray, f32)) -> f32| rays.iter().map(f).collect::<Vec<f32>>();
+        Columns {
+            ox: col(&|r| r.0.origin.x),
+            oy: col(&|r| r.0.origin.y),
+            oz: col(&|r| r.0.origin.z),
+            dx: col(&|r| r.0.direction.x),
+            dy: col(&|r| r.0.direction.y),
+            dz: col(&|r| r.0.direction.z),
+            tmax: col(&|r| r.1),
+        }
+    }
+    fn view(&self) -> RayColumns<'_> {
+        RayColumns {
+            origin: [&self.ox, &self.oy, &self.oz],
+            direction: [&self.dx, &self.dy, &self.dz],
+            tmax: &self.tmax,
+        }
+    }
+}
+
+/// `closest_hits` and `occluded` over a whole batch against `Accel` without a BVH.
+fn check_batch(scene: &Scene, rays: &[(Ray, f32)], two_sided: bool) {
+    assert!(scene.triangles.len() < raywave::geometry::BVH_MIN_TRIANGLES);
+    let accel = Accel::new(scene);
+    let cols = Columns::new(rays);
+    let n = rays.len();
+    let (mut t, mut prim, mut blocked) = (vec![0.0; n], vec![0; n], vec![false; n]);
+    simd::closest_hits(
+        &scene.triangles,
+        &scene.spheres,
+        &cols.view(),
+        two_sided,
+        &mut t,
+        &mut prim,
+    );
+    simd::occluded(
+        &scene.triangles,
+        &scene.spheres,
+        &cols.view(),
+        two_sided,
+        &mut blocked,
+    );
+    for (i, (r, tmax)) in rays.iter().enumerate() {
+        let want = accel.closest(scene, r, *tmax, two_sided);
+        assert_eq!(
+            (t[i].to_bits(), prim[i]),
+            (want.t.to_bits(), want.prim),
+            "ray {i}: {r:?}"
+        );
+        assert_eq!(
+            blocked[i],
+            accel.occluded(scene, r, *tmax, two_sided),
+            "ray {i}: {r:?} tmax {tmax}"
+        );
+    }
+}
+
+fn lab_box() -> Scene {
+    raywave::scene::Scene::builtin_default()
+}
+
+/// Deterministic rays through the lab box, some with finite tmax.
+fn box_rays(n: usize) -> Vec<(Ray, f32)> {
+    (0..n)
+        .map(|i| {
+            let key = SampleKey {
+                pixel: i as u32,
+                sample: 0,
+                bounce: 0,
+                light: 0,
+                seed: 11,
+            };
+            let u = |d| uniform(&key, d) * 2.0 - 1.0;
+            let o = Vec3::new(u(0) * 0.9, u(1) * 0.9, u(2) * 0.9);
+            let d = Vec3::new(u(3), u(4), u(5)).normalize();
+            let tmax = if i % 2 == 0 { INF } else { 0.5 + u(6).abs() };
+            (
+                Ray {
+                    origin: o,
+                    direction: d,
+                },
+                tmax,
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn batch_kernels_handle_lengths_around_the_lane_width() {
+    let scene = lab_box();
+    for n in [0, 1, 7, 8, 9, 8 * 5 + 1, 8 * 64 + 1] {
+        for two_sided in [false, true] {
+            check_batch(&scene, &box_rays(n), two_sided);
+        }
+    }
+}
+
+#[test]
+fn batch_kernels_on_empty_and_one_primitive_scenes() {
+    let rays: Vec<(Ray, f32)> = edge_rays()
+        .into_iter()
+        .flat_map(|r| tmaxes().map(|t| (r, t)))
+        .collect();
+    let tri = triangle(Vec3::ZERO, Vec3::X, Vec3::Y);
+    let sphere = Sphere {
+        center: Vec3::ZERO,
+        radius: 1.0,
+        material: 0,
+    };
+    for scene in [
+        scene_of(vec![], vec![]),
+        scene_of(vec![tri], vec![]),
+        scene_of(vec![], vec![sphere]),
+        scene_of(vec![tri], vec![sphere]),
+    ] {
+        check_batch(&scene, &rays, false);
+        check_batch(&scene, &rays, true);
+    }
+    // Ties: two identical triangles; the first one wins, as in the reference.
+    let twin = scene_of(vec![tri, tri], vec![]);
+    check_batch(&twin, &rays, false);
+}
+
+fn finite() -> impl Strategy<Value = f32> {
+    -2.0f32..2.0
+}
+
+fn vec3() -> impl Strategy<Value = Vec3> {
+    (finite(), finite(), finite()).prop_map(|(x, y, z)| Vec3::new(x, y, z))
+}
+
+fn any_f32() -> impl Strategy<Value = f32> {
+    prop_oneof![
+        8 => finite(),
+        1 => Just(0.0f32),
+        1 => Just(-0.0f32),
+        1 => Just(f32::NAN),
+        1 => Just(f32::INFINITY),
+        1 => any::<f32>(),
+    ]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(256))]
+
+    #[test]
+    fn kernels_equal_scalar_on_random_input(
+        v in [vec3(), vec3(), vec3()],
+        center in vec3(),
+        radius in 0.01f32..2.0,
+        origins in proptest::collection::vec([any_f32(), any_f32(), any_f32()], 8),
+        dirs in proptest::collection::vec(vec3(), 8),
+        tmax in proptest::collection::vec(prop_oneof![Just(INF), 0.0f32..4.0], 8),
+        two_sided in any::<bool>(),
+    ) {
+        let tri = triangle(v[0], v[1], v[2]);
+        let sphere = Sphere { center, radius, material: 0 };
+        let rays: [Ray; 8] = std::array::from_fn(|k| Ray {
+            origin: Vec3::from_array(origins[k]),
+            direction: dirs[k].normalize_or_zero(),
+        });
+        let tm: [f32; 8] = std::array::from_fn(|k| tmax[k]);
+        let got_t = lanes::triangle(&tri, &rays, tm, two_sided);
+        let got_s = lanes::sphere(&sphere, &rays, tm);
+        for k in 0..8 {
+            prop_assert_eq!(got_t[k].to_bits(), intersect_triangle(&tri, &rays[k], tm[k], two_sided).to_bits());
+            prop_assert_eq!(got_s[k].to_bits(), intersect_sphere(&sphere, &rays[k], tm[k]).to_bits());
+        }
+    }
+
+    #[test]
+    fn batches_equal_scalar_on_random_scenes(
+        tris in proptest::collection::vec([vec3(), vec3(), vec3()], 0..6),
+        spheres in proptest::collection::vec((vec3(), 0.05f32..0.8), 0..4),
+        n in 0usize..40,
+        seed in any::<u32>(),
+    ) {
+        let scene = scene_of(
+            tris.iter().map(|v| triangle(v[0], v[1], v[2])).collect(),
+            spheres.iter().map(|&(center, radius)| Sphere { center, radius, material: 0 }).collect(),
+        );
+        let rays: Vec<(Ray, f32)> = box_rays(n + 8).into_iter().skip(8).map(|(r, t)| {
+            (Ray { origin: r.origin * 2.0 + Vec3::splat(seed as f32 * 1e-10), ..r }, t)
+        }).collect();
+        check_batch(&scene, &rays, seed % 2 == 0);
+    }
+
+    #[test]
+    fn shade_terms_equals_shade(
+        kd in vec3(), kr in prop_oneof![Just(Vec3::ZERO), vec3()], ke in vec3(),
+        g in prop_oneof![Just(0.0f32), Just(1.0f32), 0.0f32..1.0, -0.5f32..0.0],
+        n in vec3(), e in vec3(), l in vec3(), lc in vec3(),
+    ) {
+        let m = Material { diffuse: kd.abs(), reflective: kr.abs(), emitted: ke.abs(), glossiness: g };
+        let terms = MaterialTerms {
+            diffuse: m.diffuse,
+            reflective: m.reflective,
+            ambient: raywave::shading::AMBIENT * m.diffuse,
+            ambient_emitted: raywave::shading::AMBIENT * m.emitted,
+            specular: 0.8 * m.reflective,
+            shininess: m.shininess(),
+            is_reflective: m.is_reflective(),
+        };
+        let (n, e, l) = (n.normalize_or(Vec3::Z), e.normalize_or(Vec3::Z), l.normalize_or(Vec3::Z));
+        let ndl = n.dot(l);
+        prop_assume!(ndl > 0.0);
+        let want = shade(&m, n, e, l, ndl, lc.abs());
+        let got = shade_terms(&terms, n, e, l, ndl, lc.abs());
+        prop_assert_eq!(got.to_array().map(f32::to_bits), want.to_array().map(f32::to_bits),
+            "{:?} vs {:?}", got, want);
+    }
+
+    #[test]
+    fn simd_light_points_equal_scalar_sampling(
+        pixel in any::<u32>(), sample in 0u32..4, bounce in 0u32..6, light in 0u32..3, seed in any::<u32>(),
+        count in 1u32..80, stratified in any::<bool>(),
+        origin in vec3(), edge_u in vec3(), edge_v in vec3(), point in vec3(), n in vec3(),
+    ) {
+        let key = SampleKey { pixel, sample, bounce, light, seed };
+        // The prefix trick: hash(key, dim) = mix32(prefix ^ dim).
+        for dim in [0, 1, 2 * count - 1, 2 * count] {
+            let h = raywave::sampling::mix32(key_prefix(&key) ^ dim);
+            prop_assert_eq!((h >> 8) as f32 * (1.0 / 16_777_216.0), uniform(&key, dim));
+        }
+        let sampler = if stratified { LightSampler::Stratified } else { LightSampler::Random };
+        let (nx, ny) = strata_grid(count);
+        let padded = count.div_ceil(8) * 8;
+        let cell_x: Vec<f32> = (0..padded).map(|j| (j % nx) as f32).collect();
+        let cell_y: Vec<f32> = (0..padded).map(|j| (j / nx) as f32).collect();
+        let lamp = Light {
+            face: 0,
+            shape: LightShape::Parallelogram { origin, edge_u, edge_v },
+            centroid: origin,
+            area: 1.0,
+            normal: Vec3::Z,
+            color: Vec3::ONE,
+        };
+        let n = n.normalize_or(Vec3::Z);
+        for j0 in (0..count).step_by(8) {
+            let block = LightBlock {
+                prefix: key_prefix(&key),
+                j0,
+                strata: stratified.then_some((&cell_x[..], &cell_y[..], nx as f32, ny as f32)),
+                origin, edge_u, edge_v,
+            };
+            let pts = simd::light_points8(&block);
+            let lanes = ((count - j0) as usize).min(8);
+            let (l, tmax, ndl, live) = simd::shadow_rays8(point, n, &pts, lanes);
+            for k in 0..lanes {
+                let (u, v) = square_sample(sampler, &key, j0 + k as u32, count);
+                let target = lamp.point(u, v);
+                prop_assert_eq!([pts[0][k], pts[1][k], pts[2][k]].map(f32::to_bits),
+                    target.to_array().map(f32::to_bits));
+                let to_light = target - point;
+                let dist = to_light.length();
+                let want_l = to_light / dist;
+                let want_ndl = n.dot(want_l);
+                let alive = want_ndl > 0.0;
+                prop_assert_eq!(live & (1 << k) != 0, alive);
+                if alive {
+                    prop_assert_eq!([l[0][k], l[1][k], l[2][k]].map(f32::to_bits),
+                        want_l.to_array().map(f32::to_bits));
+                    prop_assert_eq!(tmax[k].to_bits(), (dist - raywave::geometry::T_MIN).to_bits());
+                    prop_assert_eq!(ndl[k].to_bits(), want_ndl.to_bits());
+                } else {
+                    prop_assert_eq!((tmax[k], ndl[k]), (0.0, 0.0));
+                }
+            }
+            for k in lanes..8 {
+                prop_assert_eq!(live & (1 << k), 0, "lane past the last point is live");
+            }
+        }
+    }
+}
+
+#[test]
+fn miss_sentinels_are_the_scalar_ones() {
+    let scene = scene_of(vec![], vec![]);
+    let cols = Columns::new(&[(ray([0.0; 3], [0.0, 0.0, 1.0]), INF)]);
+    let (mut t, mut prim) = (vec![0.0], vec![0]);
+    simd::closest_hits(
+        &scene.triangles,
+        &scene.spheres,
+        &cols.view(),
+        false,
+        &mut t,
+        &mut prim,
+    );
+    assert_eq!((t[0], prim[0]), (INF, NO_HIT));
+}
