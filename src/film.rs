@@ -63,6 +63,62 @@ impl Film {
         })
     }
 
+    /// Reads a colour PFM as written by `write_hdr` (little-endian, rows bottom to top).
+    pub fn read_pfm(path: &Path) -> Result<Film> {
+        let bytes =
+            std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?;
+        let bad = || anyhow::anyhow!("{}: not a little-endian colour PFM", path.display());
+        // Header: "PF", width height, scale; each ends at a newline.
+        let mut fields = Vec::new();
+        let mut at = 0;
+        for _ in 0..3 {
+            let end = bytes[at..]
+                .iter()
+                .position(|&b| b == b'\n')
+                .ok_or_else(bad)?
+                + at;
+            fields.push(
+                std::str::from_utf8(&bytes[at..end])
+                    .map_err(|_| bad())?
+                    .trim()
+                    .to_string(),
+            );
+            at = end + 1;
+        }
+        let dims: Vec<u32> = fields[1]
+            .split_whitespace()
+            .filter_map(|t| t.parse().ok())
+            .collect();
+        let scale: f32 = fields[2].parse().map_err(|_| bad())?;
+        if fields[0] != "PF" || dims.len() != 2 || scale >= 0.0 {
+            return Err(bad());
+        }
+        let (width, height) = (dims[0], dims[1]);
+        let floats = &bytes[at..];
+        if floats.len() != width as usize * height as usize * 12 {
+            return Err(bad());
+        }
+        let mut pixels: Vec<Vec3> = floats
+            .chunks_exact(12)
+            .map(|c| {
+                let f = |i: usize| f32::from_le_bytes([c[i], c[i + 1], c[i + 2], c[i + 3]]);
+                Vec3::new(f(0), f(4), f(8))
+            })
+            .collect();
+        // Rows were stored bottom to top.
+        let rows: Vec<Vec<Vec3>> = pixels
+            .chunks(width as usize)
+            .rev()
+            .map(|r| r.to_vec())
+            .collect();
+        pixels = rows.concat();
+        Ok(Film {
+            width,
+            height,
+            pixels,
+        })
+    }
+
     /// Writes linear floats: `.pfm` (portable float map) or `.exr`.
     pub fn write_hdr(&self, path: &Path) -> Result<()> {
         match hdr_extension(path)? {

@@ -18,6 +18,7 @@ pub mod scene;
 pub mod settings;
 pub mod shading;
 pub mod stats;
+pub mod variance;
 pub mod wavefront;
 
 /// Which SIMD instructions this build uses for `wide::f32x8`, decided at compile time.

@@ -21,6 +21,12 @@ pub enum LightSampler {
     /// Jittered: the light's (u, v) square split into N strata (nx × ny, see `strata_grid`),
     /// one uniform point in each.
     Stratified,
+    /// Owen-scrambled Sobol points (Burley 2020), scrambled independently for every
+    /// (pixel, sample, bounce, light): low discrepancy for any N, best at powers of two.
+    Sobol,
+    /// The lab's own strategy: the centre of the light's (u, v) square (its centroid, for a
+    /// parallelogram) when N = 1, independent random points otherwise.
+    Lab,
 }
 
 impl LightSampler {
@@ -29,8 +35,18 @@ impl LightSampler {
         match self {
             LightSampler::Random => "random",
             LightSampler::Stratified => "stratified",
+            LightSampler::Sobol => "sobol",
+            LightSampler::Lab => "lab",
         }
     }
+
+    /// Every sampler, in the order reports list them.
+    pub const ALL: [LightSampler; 4] = [
+        LightSampler::Random,
+        LightSampler::Stratified,
+        LightSampler::Sobol,
+        LightSampler::Lab,
+    ];
 }
 
 /// Identifies one stream of random numbers.
@@ -95,6 +111,17 @@ pub fn square_sample(sampler: LightSampler, key: &SampleKey, index: u32, count: 
     let xi1 = uniform(key, 2 * index + 1);
     match sampler {
         LightSampler::Random => (xi0, xi1),
+        LightSampler::Lab if count == 1 => (0.5, 0.5),
+        LightSampler::Lab => (xi0, xi1),
+        LightSampler::Sobol => {
+            // One scramble seed per stream; the Sobol index is the sample number (< 2^16,
+            // which the command line's limit on N guarantees).
+            let scramble = hash(key, SOBOL_SEED_DIM);
+            (
+                sobol_burley::sample(index, 0, scramble),
+                sobol_burley::sample(index, 1, scramble),
+            )
+        }
         LightSampler::Stratified => {
             let (nx, ny) = strata_grid(count);
             let (cx, cy) = (index % nx, index / nx);
@@ -105,6 +132,9 @@ pub fn square_sample(sampler: LightSampler, key: &SampleKey, index: u32, count: 
         }
     }
 }
+
+/// The hash dimension that seeds a stream's Sobol scramble (far above the 2j, 2j + 1 range).
+const SOBOL_SEED_DIM: u32 = u32::MAX;
 
 /// The largest f32 below 1.
 pub const ONE_MINUS_EPS: f32 = 1.0 - f32::EPSILON / 2.0;

@@ -1,0 +1,122 @@
+//! The penumbra mask: where light sampling's noise comes from shadow edges.
+//!
+//! For every pixel, follow its camera ray and mirror bounces exactly as `trace` does, and at
+//! each hit estimate every light's visibility with a dense stratified grid: the fraction of the
+//! light's points that face the hit (n·l > 0) and are unoccluded. A pixel is
+//! - **penumbra** if any hit on its path sees some light partly (0 < fraction < 1);
+//! - **lit** if every hit on its path sees every light fully (fraction = 1);
+//! - neither (umbra, lights seen edge-on, the background) otherwise.
+
+use crate::camera::CameraRays;
+use crate::geometry::{Accel, Ray, T_MIN, geometric_normal};
+use crate::sampling::{LightSampler, SampleKey, square_sample};
+use crate::scene::Scene;
+use crate::settings::RenderSettings;
+use crate::shading::reflect;
+use rayon::prelude::*;
+
+/// Per-pixel region membership.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Regions {
+    /// Some light partly visible somewhere on the pixel's path.
+    pub penumbra: Vec<bool>,
+    /// Every light fully visible everywhere on the pixel's path.
+    pub lit: Vec<bool>,
+}
+
+impl Regions {
+    /// Every pixel.
+    pub fn whole(&self) -> Vec<bool> {
+        vec![true; self.penumbra.len()]
+    }
+}
+
+/// Computes the regions with `points` stratified points per light per hit (a square number
+/// such as 1024 keeps every stratum a square).
+pub fn penumbra_mask(scene: &Scene, settings: &RenderSettings, points: u32) -> Regions {
+    let accel = Accel::new(scene);
+    let camera = CameraRays::new(&scene.camera, settings.width, settings.height);
+    let pixels = settings.width * settings.height;
+    let classes: Vec<(bool, bool)> = (0..pixels)
+        .into_par_iter()
+        .map(|pixel| classify(scene, settings, &accel, &camera, pixel, points))
+        .collect();
+    Regions {
+        penumbra: classes.iter().map(|c| c.0).collect(),
+        lit: classes.iter().map(|c| c.1).collect(),
+    }
+}
+
+fn classify(
+    scene: &Scene,
+    settings: &RenderSettings,
+    accel: &Accel,
+    camera: &CameraRays,
+    pixel: u32,
+    points: u32,
+) -> (bool, bool) {
+    let (x, y) = camera.screen(pixel, 0.5, 0.5);
+    let mut ray = camera.ray(x, y);
+    let mut penumbra = false;
+    let mut lit = true;
+    let mut any_hit = false;
+    for bounce in 0..=settings.bounces {
+        let hit = accel.closest(scene, &ray, f32::INFINITY, settings.two_sided);
+        if !hit.is_hit() {
+            break;
+        }
+        any_hit = true;
+        let point = ray.origin + hit.t * ray.direction;
+        let mut n = geometric_normal(scene, hit.prim, point);
+        if settings.two_sided
+            && (hit.prim as usize) < scene.triangles.len()
+            && n.dot(ray.direction) > 0.0
+        {
+            n = -n;
+        }
+        for (li, light) in scene.lights.iter().enumerate() {
+            let key = SampleKey {
+                pixel,
+                sample: 0,
+                bounce,
+                light: li as u32,
+                seed: 0x6d61_736b,
+            };
+            let mut visible = 0;
+            for j in 0..points {
+                let (u, v) = square_sample(LightSampler::Stratified, &key, j, points);
+                let to = light.point(u, v) - point;
+                let dist = to.length();
+                let l = to / dist;
+                if n.dot(l) > 0.0
+                    && !accel.occluded(
+                        scene,
+                        &Ray {
+                            origin: point,
+                            direction: l,
+                        },
+                        dist - T_MIN,
+                        settings.two_sided,
+                    )
+                {
+                    visible += 1;
+                }
+            }
+            if visible > 0 && visible < points {
+                penumbra = true;
+            }
+            if visible < points {
+                lit = false;
+            }
+        }
+        let material = scene.material_of(hit.prim);
+        if !material.is_reflective() {
+            break;
+        }
+        ray = Ray {
+            origin: point,
+            direction: reflect(ray.direction, n),
+        };
+    }
+    (penumbra, lit && any_hit)
+}

@@ -1,0 +1,356 @@
+//! Issue 4: every sampler is unbiased and keeps its points on the light; the penumbra mask
+//! matches a scene whose penumbra is known in closed form; the study's budget matching.
+//!
+//! The analytic scene: a floor at y = 0 (facing up), a 1 × 1 light at y = 2 over
+//! x, z ∈ [−0.5, 0.5] (facing down) and a blocker at y = 1 covering the half-plane x + z < 0
+//! (facing down, so shadow rays meet its front). A shadow ray from floor point (x, z) to light
+//! point (lx, lz) crosses y = 1 at ((x + lx)/2, (z + lz)/2), so it is blocked exactly when
+//! lx + lz < −(x + z). With s = x + z the floor is fully lit for s > 1, in umbra for s < −1 and
+//! in penumbra between. The edge runs diagonally so that both light coordinates matter: a
+//! sampler biased in either one moves the mean. A camera 10 above the origin looks straight down
+//! (screen up = −z) with a 1.5 half-width at the floor.
+
+use glam::Vec3;
+use raywave::reference::Reference;
+use raywave::sampling::{LightSampler, SampleKey, square_sample, strata_grid};
+use raywave::scene::{Scene, parse_scene_str};
+use raywave::settings::{RenderSettings, ShadowMode};
+use raywave::stats::RayCounts;
+use raywave::variance::{Region, penumbra_mask};
+
+const SIZE: u32 = 64;
+
+fn analytic_scene() -> Scene {
+    let half_angle = 0.15f32.atan(); // tan = 1.5 / 10
+    let text = format!(
+        "PerspectiveCamera {{
+           camera_position 0 10 0
+           point_of_interest 0 0 0
+           up 0 0 -1
+           angle {}
+         }}
+         material
+         emitted 10 10 10
+         material
+         diffuse 0.5 0.5 0.5
+         material
+         diffuse 0.5 0.5 0.5
+         v -0.5 2 -0.5
+         v 0.5 2 -0.5
+         v 0.5 2 0.5
+         v -0.5 2 0.5
+         m 0
+         f 1 2 3 4
+         v -3 0 -3
+         v -3 0 3
+         v 3 0 3
+         v 3 0 -3
+         m 1
+         f 5 6 7 8
+         v -10 1 -10
+         v 10 1 -10
+         v -10 1 10
+         m 2
+         f 9 10 11
+        ",
+        2.0 * half_angle
+    );
+    parse_scene_str(&text, "analytic.obj").expect("analytic scene parses")
+}
+
+/// The floor point (x, z) seen through the centre of pixel (column, row from the top).
+fn floor_xz(column: u32, row: u32) -> (f32, f32) {
+    let x = (2.0 * (column as f32 + 0.5) / SIZE as f32 - 1.0) * 1.5;
+    let j = SIZE - 1 - row; // counted from the bottom
+    let z = -(2.0 * (j as f32 + 0.5) / SIZE as f32 - 1.0) * 1.5;
+    (x, z)
+}
+
+fn settings(sampler: LightSampler, n: u32, seed: u32) -> RenderSettings {
+    RenderSettings {
+        width: SIZE,
+        height: SIZE,
+        bounces: 0,
+        shadows: ShadowMode::Soft,
+        shadow_samples: n,
+        sampler,
+        seed,
+        ..RenderSettings::default()
+    }
+}
+
+#[test]
+fn penumbra_mask_matches_the_closed_form() {
+    let scene = analytic_scene();
+    let regions = penumbra_mask(&scene, &settings(LightSampler::Stratified, 1, 0), 1024);
+    let mut checked = [0; 3];
+    for row in 0..SIZE {
+        for column in 0..SIZE {
+            let p = (row * SIZE + column) as usize;
+            let (x, z) = floor_xz(column, row);
+            let s = x + z;
+            // Stay a pixel and a stratum away from the two edges, where the answer is a tie.
+            if (s.abs() - 1.0).abs() < 0.1 {
+                continue;
+            }
+            let (penumbra, lit) = (regions.penumbra[p], regions.lit[p]);
+            let expected = if s.abs() < 1.0 {
+                (true, false)
+            } else if s > 1.0 {
+                (false, true)
+            } else {
+                (false, false)
+            };
+            assert_eq!(
+                (penumbra, lit),
+                expected,
+                "floor point ({x}, {z}): (penumbra, lit)"
+            );
+            checked[if s.abs() < 1.0 {
+                0
+            } else if s > 1.0 {
+                1
+            } else {
+                2
+            }] += 1;
+        }
+    }
+    assert!(
+        checked.iter().all(|&c| c > 100),
+        "too few pixels checked: {checked:?}"
+    );
+}
+
+/// Mean and standard error of one pixel over `seeds` renders.
+fn pixel_mean(scene: &Scene, sampler: LightSampler, n: u32, seeds: u32, pixel: u32) -> (f64, f64) {
+    let values: Vec<f64> = (0..seeds)
+        .map(|seed| {
+            let s = settings(sampler, n, seed);
+            let r = Reference::new(scene, &s);
+            r.pixel(pixel, &mut RayCounts::default(), &mut ()).x as f64
+        })
+        .collect();
+    let mean = values.iter().sum::<f64>() / seeds as f64;
+    let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (seeds - 1) as f64;
+    (mean, (var / seeds as f64).sqrt())
+}
+
+#[test]
+fn every_sampler_is_unbiased_on_a_penumbra_pixel() {
+    let scene = analytic_scene();
+    // Pixel (35, 36) sees (0.164, 0.211), s = x + z ≈ 0.375: well inside the penumbra.
+    let pixel = 36 * SIZE + 35;
+    let (x, z) = floor_xz(35, 36);
+    assert!((x + z - 0.375).abs() < 0.01, "{x} {z}");
+    let (truth, truth_se) = pixel_mean(&scene, LightSampler::Stratified, 4096, 8, pixel);
+    for sampler in LightSampler::ALL {
+        let (mean, se) = pixel_mean(&scene, sampler, 4, 600, pixel);
+        let bound = 5.0 * (se * se + truth_se * truth_se).sqrt();
+        assert!(
+            (mean - truth).abs() < bound,
+            "{}: mean {mean} vs converged {truth} (bound {bound})",
+            sampler.name()
+        );
+        assert!(
+            se > 0.0,
+            "{}: no noise at all in a penumbra?",
+            sampler.name()
+        );
+    }
+}
+
+#[test]
+fn the_lab_strategy_is_biased_at_one_sample_and_says_so() {
+    // N = 1 puts the single point at the light's centre: a hard shadow, not the soft one.
+    let scene = analytic_scene();
+    let pixel = 36 * SIZE + 35;
+    let (truth, truth_se) = pixel_mean(&scene, LightSampler::Stratified, 4096, 8, pixel);
+    let (lab, _) = pixel_mean(&scene, LightSampler::Lab, 1, 2, pixel);
+    assert!(
+        (lab - truth).abs() > 20.0 * truth_se + 0.05,
+        "lab N=1 {lab} vs {truth}"
+    );
+}
+
+#[test]
+fn points_stay_on_the_unit_square_and_cover_it() {
+    for sampler in LightSampler::ALL {
+        for n in [1u32, 2, 3, 7, 16, 64, 256] {
+            for pixel in 0..20 {
+                let key = SampleKey {
+                    pixel,
+                    sample: 0,
+                    bounce: 1,
+                    light: 2,
+                    seed: 9,
+                };
+                for j in 0..n {
+                    let (u, v) = square_sample(sampler, &key, j, n);
+                    assert!(
+                        (0.0..1.0).contains(&u) && (0.0..1.0).contains(&v),
+                        "{} n={n}: ({u}, {v})",
+                        sampler.name()
+                    );
+                }
+            }
+        }
+    }
+    // Stratified and Sobol put exactly one point in every cell of an nx × ny grid (Sobol for
+    // powers of two, where its net property holds for every 2^a × 2^b grid).
+    for sampler in [LightSampler::Stratified, LightSampler::Sobol] {
+        for n in [4u32, 16, 64, 256] {
+            let (nx, ny) = strata_grid(n);
+            for pixel in 0..10 {
+                let key = SampleKey {
+                    pixel,
+                    sample: 3,
+                    bounce: 0,
+                    light: 0,
+                    seed: 1,
+                };
+                let mut cells = vec![0; n as usize];
+                for j in 0..n {
+                    let (u, v) = square_sample(sampler, &key, j, n);
+                    cells[((v * ny as f32) as u32 * nx + (u * nx as f32) as u32) as usize] += 1;
+                }
+                assert!(
+                    cells.iter().all(|&c| c == 1),
+                    "{} n={n}: {cells:?}",
+                    sampler.name()
+                );
+            }
+        }
+    }
+    // Random points (and the lab's, for N > 1) fill a 4 × 4 grid evenly: 4096 points, 256
+    // expected per cell, standard deviation 15.5; 6 deviations either way.
+    for sampler in [LightSampler::Random, LightSampler::Lab] {
+        let key = SampleKey {
+            pixel: 5,
+            sample: 0,
+            bounce: 0,
+            light: 0,
+            seed: 4,
+        };
+        let mut cells = [0i32; 16];
+        for j in 0..4096 {
+            let (u, v) = square_sample(sampler, &key, j, 4096);
+            cells[((v * 4.0) as usize) * 4 + (u * 4.0) as usize] += 1;
+        }
+        assert!(
+            cells.iter().all(|&c| (c - 256).abs() < 93),
+            "{}: {cells:?}",
+            sampler.name()
+        );
+    }
+}
+
+#[test]
+fn light_points_stay_on_the_light() {
+    // A parallelogram, a triangle and a trapezoid (not a parallelogram: the fan path).
+    let scene = parse_scene_str(
+        "material
+         emitted 1 1 1
+         v 0 0 0
+         v 2 0 0
+         v 3 1 0
+         v 1 1 0
+         v 5 0 0
+         v 6 0 0
+         v 5 1 0
+         v 8 0 0
+         v 12 0 0
+         v 11 1 0
+         v 9 1 0
+         m 0
+         f 1 2 3 4
+         f 5 6 7
+         f 8 9 10 11",
+        "lights.obj",
+    )
+    .unwrap();
+    assert_eq!(scene.lights.len(), 3);
+    let inside = |light: usize, p: Vec3| -> bool {
+        let tol = 1e-5;
+        if p.z.abs() > tol || p.y < -tol || p.y > 1.0 + tol {
+            return false;
+        }
+        match light {
+            0 => p.x >= p.y - tol && p.x <= 2.0 + p.y + tol,
+            1 => p.x >= 5.0 - tol && p.x + p.y <= 6.0 + tol,
+            _ => p.x >= 8.0 + p.y - tol && p.x <= 12.0 - p.y + tol,
+        }
+    };
+    for (li, light) in scene.lights.iter().enumerate() {
+        let mut sum = Vec3::ZERO;
+        let count = 20_000;
+        for j in 0..count {
+            let key = SampleKey {
+                pixel: 1,
+                sample: 0,
+                bounce: 0,
+                light: li as u32,
+                seed: 2,
+            };
+            let (u, v) = square_sample(LightSampler::Random, &key, j, count);
+            let p = light.point(u, v);
+            assert!(inside(li, p), "light {li}: {p} is off the light");
+            sum += p;
+        }
+        // Uniform by area: the mean point is the area centroid.
+        let mean = sum / count as f32;
+        assert!(
+            (mean - light.centroid).length() < 0.02,
+            "light {li}: mean {mean} vs centroid {}",
+            light.centroid
+        );
+    }
+    // Centroids computed independently: trapezoid (8,0) (12,0) (11,1) (9,1): area 3,
+    // centroid y = (1/3)(b + 2a)/(a + b) with bottom b = 4, top a = 2: (4 + 4)/(3·6) = 4/9.
+    assert!((scene.lights[2].centroid - Vec3::new(10.0, 4.0 / 9.0, 0.0)).length() < 1e-5);
+    assert!((scene.lights[1].centroid - Vec3::new(16.0 / 3.0, 1.0 / 3.0, 0.0)).length() < 1e-5);
+}
+
+#[test]
+fn matching_budget_inverts_the_fits() {
+    use raywave::variance::{LogLogFit, Slope, StudyConfig, StudyResult};
+    // random: MSE = 1/N; stratified: MSE = N^-1.5. Random at 150 gives 1/150; stratified
+    // matches it at N = 150^(1/1.5) = 28.2.
+    let slopes = vec![
+        Slope {
+            sampler: "random",
+            region: Region::Penumbra,
+            fit: Some(LogLogFit {
+                slope: -1.0,
+                intercept: 0.0,
+            }),
+        },
+        Slope {
+            sampler: "stratified",
+            region: Region::Penumbra,
+            fit: Some(LogLogFit {
+                slope: -1.5,
+                intercept: 0.0,
+            }),
+        },
+    ];
+    let result = StudyResult {
+        config: StudyConfig::standard(RenderSettings::preview()),
+        scene: "synthetic".into(),
+        engine: "none".into(),
+        region_pixels: [0; 3],
+        reference_mse: [0.0; 3],
+        reference_cached: false,
+        rows: Vec::new(),
+        slopes,
+        heatmaps: Vec::new(),
+    };
+    let n = result
+        .matching_budget(LightSampler::Stratified, Region::Penumbra, 150.0)
+        .unwrap();
+    assert!((n - 150f64.powf(1.0 / 1.5)).abs() < 1e-6, "{n}");
+    assert!(
+        result
+            .matching_budget(LightSampler::Sobol, Region::Penumbra, 150.0)
+            .is_none()
+    );
+}
