@@ -87,6 +87,9 @@ struct Parser<'a> {
 
 /// Parses scene text; `file` is used in messages only.
 pub fn parse_scene_str(text: &str, file: &str) -> Result<Scene, ParseError> {
+    // Editors on Windows start UTF-8 files with a byte-order mark; it is not part of the first
+    // keyword (left in, it turned the first `material` into an unknown keyword).
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut p = Parser {
         file,
         vertices: Vec::new(),
