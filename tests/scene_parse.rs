@@ -546,3 +546,74 @@ fn lab_camera_frames_the_bounding_box() {
     );
     assert_eq!(s.camera.up, Vec3::Y);
 }
+
+#[test]
+fn the_projects_own_scenes_have_the_expected_contents() {
+    // (file, materials, faces, quads, triangles, spheres, lights, camera from file), counted
+    // by hand from the files; a scene not (yet) in scenes/ is skipped.
+    let expected: &[(&str, usize, usize, usize, usize, usize, usize, bool)] = &[
+        ("two_lights.obj", 8, 7, 7, 14, 2, 2, false),
+        ("camera_block.obj", 5, 6, 6, 12, 2, 1, true),
+        (
+            "mesh_spheres_small.obj",
+            8,
+            390,
+            294,
+            2 * 294 + 96,
+            0,
+            1,
+            false,
+        ),
+    ];
+    for &(name, materials, faces, quads, triangles, spheres, lights, camera) in expected {
+        let path = manifest_dir().join("scenes").join(name);
+        if !path.exists() {
+            println!("skipped: scenes/{name} is absent");
+            continue;
+        }
+        let s = Scene::load(&path).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(s.materials.len(), materials, "{name}");
+        assert_eq!(s.face_count, faces, "{name}");
+        assert_eq!(s.quad_count, quads, "{name}");
+        assert_eq!(s.triangles.len(), triangles, "{name}");
+        assert_eq!(s.spheres.len(), spheres, "{name}");
+        assert_eq!(s.lights.len(), lights, "{name}");
+        assert_eq!(s.camera_from_file, camera, "{name}");
+        assert!(s.warnings.is_empty(), "{name}: {:?}", s.warnings);
+        if name == "camera_block.obj" {
+            assert_eq!(s.camera.position, Vec3::new(0.7, 0.35, 4.2));
+            assert_eq!(s.camera.point_of_interest, Vec3::new(0.0, -0.25, 0.0));
+            assert_eq!(s.camera.fov, 0.6, "0.6 < π: radians");
+            assert_eq!(s.background, Some(Vec3::new(0.05, 0.05, 0.1)));
+            assert_eq!(s.materials[2].glossiness, 0.05, "roughness");
+        }
+    }
+}
+
+#[test]
+fn a_utf8_byte_order_mark_is_not_part_of_the_first_keyword() {
+    // Editors on Windows save UTF-8 with a BOM; the first line is still `material`.
+    let text = format!("\u{feff}{MAT}m 0\ns 0 0 0 1\n");
+    let scene = parse_scene_str(&text, "f.obj").unwrap_or_else(|e| panic!("{e}"));
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    assert_eq!(scene.materials[0].diffuse, Vec3::ONE);
+}
+
+#[test]
+fn crlf_line_endings_and_tabs() {
+    let text = format!("{MAT}m 0\r\nv\t0 0 0\r\nv 1 0 \\\r\n0\r\nv 0 1 0\r\nf 1\t2 3\r\n")
+        .replace('\n', "\r\n");
+    let scene = parse_scene_str(&text, "f.obj").unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(scene.triangles.len(), 1);
+    assert_eq!(scene.triangles[0].v0 + scene.triangles[0].e1, Vec3::X);
+}
+
+#[test]
+fn negative_colours_and_glossiness_name_the_line() {
+    error_at("material\ndiffuse 1 -0.5 1\n", 2, &["-0.5"]);
+    error_at("material\nemitted -1 0 0\n", 2, &["-1"]);
+    error_at("material\nglossiness -0.1\n", 2, &["-0.1"]);
+    error_at("material\nroughness -2\n", 2, &["-2"]);
+    let text = format!("{MAT}m 0\ns 0 0 0 1\nbackground_color 0 -1 0\n");
+    error_at(&text, 8, &["-1"]);
+}
