@@ -340,3 +340,166 @@ fn bvh_and_brute_force_agree_on_a_mesh() {
     }
     assert!(hits > 1000, "{hits}");
 }
+
+/// A small deterministic generator for the randomized tables below.
+struct Rng(u32);
+
+impl Rng {
+    fn next(&mut self) -> f64 {
+        self.0 = raywave::sampling::mix32(self.0.wrapping_add(0x9e37_79b9));
+        (self.0 >> 8) as f64 / 16_777_216.0
+    }
+    fn vec(&mut self, scale: f64) -> glam::DVec3 {
+        glam::DVec3::new(
+            (self.next() * 2.0 - 1.0) * scale,
+            (self.next() * 2.0 - 1.0) * scale,
+            (self.next() * 2.0 - 1.0) * scale,
+        )
+    }
+}
+
+#[test]
+fn triangle_kernel_matches_an_independent_f64_plane_test() {
+    // Intersect the plane in f64, then barycentric coordinates by areas; only cases that are
+    // clearly inside or clearly outside (margin 1e-3) are checked.
+    let mut rng = Rng(99);
+    let (mut hits, mut misses, mut backs) = (0, 0, 0);
+    for _ in 0..20000 {
+        // Every input is rounded to f32 first, so the f64 answer is for the kernel's inputs.
+        let f = |v: glam::DVec3| v.as_vec3().as_dvec3();
+        let a = f(rng.vec(2.0));
+        let e1 = f(rng.vec(2.0) - a);
+        let e2 = f(rng.vec(2.0) - a);
+        let (b, c) = (a + e1, a + e2);
+        let n = e1.cross(e2);
+        if n.length() < 0.1 {
+            continue;
+        }
+        let origin = f(rng.vec(4.0));
+        let target = a + rng.next() * 1.4 * e1 + rng.next() * 1.4 * e2 - 0.2 * e1;
+        let d = f((target - origin).normalize());
+        let denom = n.dot(d);
+        // Near-grazing rays amplify the rounding inside the kernel: skip them.
+        if denom.abs() < 0.05 * n.length() {
+            continue;
+        }
+        let t = n.dot(a - origin) / denom;
+        let p = origin + t * d;
+        let area = n.length();
+        let w = [
+            (c - b).cross(p - b).dot(n) / (area * area),
+            (a - c).cross(p - c).dot(n) / (area * area),
+            (b - a).cross(p - a).dot(n) / (area * area),
+        ];
+        let min_w = w.iter().cloned().fold(f64::INFINITY, f64::min);
+        let clearly_in = min_w > 1e-3 && t > 1e-2;
+        let clearly_out = min_w < -1e-3 || t < -1e-2;
+        if !(clearly_in || clearly_out) {
+            continue;
+        }
+        let tri = raywave::scene::Triangle {
+            v0: a.as_vec3(),
+            e1: e1.as_vec3(),
+            e2: e2.as_vec3(),
+            normal: n.normalize().as_vec3(),
+            material: 0,
+            face: 0,
+        };
+        let r = Ray {
+            origin: origin.as_vec3(),
+            direction: d.as_vec3(),
+        };
+        let front = denom < 0.0;
+        let one = intersect_triangle(&tri, &r, f32::INFINITY, false);
+        let two = intersect_triangle(&tri, &r, f32::INFINITY, true);
+        if clearly_in {
+            assert!(
+                (two as f64 - t).abs() < 1e-4 * t.max(1.0),
+                "{r:?} {tri:?}: {two} vs {t}"
+            );
+            if front {
+                assert_eq!(one, two);
+                hits += 1;
+            } else {
+                assert_eq!(one, f32::INFINITY, "back face hit: {r:?} {tri:?}");
+                backs += 1;
+            }
+            // tmax just below t: no hit.
+            assert_eq!(
+                intersect_triangle(&tri, &r, (t * 0.999) as f32, true),
+                f32::INFINITY
+            );
+        } else {
+            assert_eq!(
+                two,
+                f32::INFINITY,
+                "{r:?} {tri:?}: hit at {two}, expected a miss"
+            );
+            misses += 1;
+        }
+    }
+    assert!(
+        hits > 1000 && misses > 1000 && backs > 1000,
+        "{hits} {misses} {backs}"
+    );
+}
+
+#[test]
+fn sphere_kernel_matches_an_independent_f64_root() {
+    let mut rng = Rng(7);
+    let (mut hits, mut misses, mut inside) = (0, 0, 0);
+    for _ in 0..20000 {
+        let f = |v: glam::DVec3| v.as_vec3().as_dvec3();
+        let center = f(rng.vec(2.0));
+        let radius = (0.1 + rng.next() * 1.5) as f32 as f64;
+        let origin = f(rng.vec(4.0));
+        let d = f((center + rng.vec(2.0) - origin).normalize());
+        // |o + t d − c|² = r²  ->  t² + 2 b t + c0 = 0 with b = (o − c)·d.
+        let oc = origin - center;
+        let b = oc.dot(d);
+        let c0 = oc.length_squared() - radius * radius;
+        let disc = b * b - c0;
+        let roots = if disc > 0.0 {
+            let s = disc.sqrt();
+            vec![-b - s, -b + s]
+        } else {
+            vec![]
+        };
+        let expected = roots.iter().cloned().find(|&t| t > 1e-2);
+        let ambiguous = disc.abs() < 1e-3 || roots.iter().any(|&t| t.abs() <= 1e-2);
+        if ambiguous {
+            continue;
+        }
+        let s = Sphere {
+            center: center.as_vec3(),
+            radius: radius as f32,
+            material: 0,
+        };
+        let r = Ray {
+            origin: origin.as_vec3(),
+            direction: d.as_vec3(),
+        };
+        let got = intersect_sphere(&s, &r, f32::INFINITY);
+        match expected {
+            Some(t) => {
+                assert!(
+                    (got as f64 - t).abs() < 1e-4 * t.max(1.0),
+                    "{r:?} {s:?}: {got} vs {t}"
+                );
+                if c0 < 0.0 {
+                    inside += 1;
+                } else {
+                    hits += 1;
+                }
+            }
+            None => {
+                assert_eq!(got, f32::INFINITY, "{r:?} {s:?}");
+                misses += 1;
+            }
+        }
+    }
+    assert!(
+        hits > 1000 && misses > 1000 && inside > 100,
+        "{hits} {misses} {inside}"
+    );
+}
