@@ -19,6 +19,8 @@ pub struct Cli {
 
 /// The subcommands.
 #[derive(Subcommand, Debug)]
+// Parsed once per run: the size of the `Render` variant does not matter.
+#[allow(clippy::large_enum_variant)]
 pub enum Command {
     /// Render a scene to an image (the default command; the lab's flags work too).
     Render(RenderArgs),

@@ -68,16 +68,16 @@ fn render(args: &RenderArgs) -> Result<()> {
         eprintln!("{w}");
     }
     let settings = args.settings(scene.background.map(|c| c.to_array()));
-    if let Some(px) = &args.debug_pixel {
-        if px[0] >= settings.width || px[1] >= settings.height {
-            bail!(
-                "--debug-pixel {} {} is outside the {}×{} image",
-                px[0],
-                px[1],
-                settings.width,
-                settings.height
-            );
-        }
+    if let Some(px) = &args.debug_pixel
+        && (px[0] >= settings.width || px[1] >= settings.height)
+    {
+        bail!(
+            "--debug-pixel {} {} is outside the {}×{} image",
+            px[0],
+            px[1],
+            settings.width,
+            settings.height
+        );
     }
     if let Some(path) = &args.stats_json {
         check_output_dir(path)?;

@@ -2,6 +2,8 @@
 //! against the scalar kernels of `geometry`, `sampling` and `shading`, on an edge-case table
 //! (NaN, infinities, −0.0, grazing and axis-aligned rays, rays starting on a surface, empty
 //! scene, one primitive), on random input, and for batch lengths around the lane width.
+// `!(x > 0.0)` is on purpose: it is true for NaN, like the kernels' tests.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 use glam::Vec3;
 use proptest::prelude::*;
@@ -241,12 +243,27 @@ fn box_rays(n: usize) -> Vec<(Ray, f32)> {
         .collect()
 }
 
+/// Like `box_rays`, but rays come in runs of 8 from one origin, as soft-shadow rays do (the
+/// occlusion kernel then computes the origin terms once); `offset` misaligns the runs with the
+/// 8-lane chunks.
+fn shared_origin_rays(n: usize, offset: usize) -> Vec<(Ray, f32)> {
+    let mut rays = box_rays(n + offset);
+    for i in 0..rays.len() {
+        let leader = i / 8 * 8;
+        rays[i].0.origin = rays[leader].0.origin;
+    }
+    rays.drain(..offset);
+    rays
+}
+
 #[test]
 fn batch_kernels_handle_lengths_around_the_lane_width() {
     let scene = lab_box();
     for n in [0, 1, 7, 8, 9, 8 * 5 + 1, 8 * 64 + 1] {
         for two_sided in [false, true] {
             check_batch(&scene, &box_rays(n), two_sided);
+            check_batch(&scene, &shared_origin_rays(n, 0), two_sided);
+            check_batch(&scene, &shared_origin_rays(n, 3), two_sided);
         }
     }
 }
@@ -339,6 +356,7 @@ proptest! {
             (Ray { origin: r.origin * 2.0 + Vec3::splat(seed as f32 * 1e-10), ..r }, t)
         }).collect();
         check_batch(&scene, &rays, seed % 2 == 0);
+        check_batch(&scene, &shared_origin_rays(n, seed as usize % 8), seed % 3 == 0);
     }
 
     #[test]
@@ -364,6 +382,39 @@ proptest! {
         let got = shade_terms(&terms, n, e, l, ndl, lc.abs());
         prop_assert_eq!(got.to_array().map(f32::to_bits), want.to_array().map(f32::to_bits),
             "{:?} vs {:?}", got, want);
+    }
+
+    #[test]
+    fn shade8_equals_shade_terms_lane_by_lane(
+        kd in vec3(), kr in prop_oneof![Just(Vec3::ZERO), vec3()], ke in vec3(),
+        g in prop_oneof![Just(0.0f32), Just(1.0f32), 0.0f32..1.0, -0.5f32..0.0],
+        n in vec3(), e in vec3(), ls in proptest::collection::vec(vec3(), 8), lc in vec3(),
+        weight in prop_oneof![Just(1.0f32), Just(1.0 / 64.0), 0.001f32..1.0],
+    ) {
+        let m = Material { diffuse: kd.abs(), reflective: kr.abs(), emitted: ke.abs(), glossiness: g };
+        let terms = MaterialTerms {
+            diffuse: m.diffuse,
+            reflective: m.reflective,
+            ambient: raywave::shading::AMBIENT * m.diffuse,
+            ambient_emitted: raywave::shading::AMBIENT * m.emitted,
+            specular: 0.8 * m.reflective,
+            shininess: m.shininess(),
+            is_reflective: m.is_reflective(),
+        };
+        let (n, e) = (n.normalize_or(Vec3::Z), e.normalize_or(Vec3::Z));
+        let ls: Vec<Vec3> = ls.iter().map(|l| l.normalize_or(Vec3::Z)).collect();
+        let col = |f: fn(Vec3) -> f32| ls.iter().map(|&l| f(l)).collect::<Vec<f32>>();
+        let (lx, ly, lz) = (col(|l| l.x), col(|l| l.y), col(|l| l.z));
+        let ndl: Vec<f32> = ls.iter().map(|&l| n.dot(l)).collect();
+        let got = simd::shade8(&terms, n, e, [&lx, &ly, &lz], &ndl, lc.abs(), weight);
+        for k in 0..8 {
+            if !(ndl[k] > 0.0) {
+                continue; // dead lane: never added
+            }
+            let want = shade_terms(&terms, n, e, ls[k], ndl[k], lc.abs()) * weight;
+            prop_assert_eq!([got[0][k], got[1][k], got[2][k]].map(f32::to_bits),
+                want.to_array().map(f32::to_bits), "lane {}", k);
+        }
     }
 
     #[test]

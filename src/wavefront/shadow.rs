@@ -13,6 +13,9 @@
 //! points at a time with the SIMD hash; hard shadows and other light shapes call the scalar
 //! sampling code one point at a time.
 
+// `!(x > 0.0)` is on purpose: it is true for NaN, like the reference's tests.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 use super::batch::{HitBatch, RayBatch, ShadowQueue};
 use super::context::{Context, MaterialTerms};
 use super::simd::{self, LANES, LightBlock, RayColumns};
@@ -182,27 +185,64 @@ fn occlude(ctx: &Context, queue: &mut ShadowQueue) {
     }
 }
 
-/// Adds Shade / N of every unblocked queued ray to its hit, in queue order.
+/// Adds Shade / N of every unblocked queued ray to its hit, in queue order. Aligned blocks of
+/// 8 rays from one hit to one light (soft shadows) are shaded 8 lanes at a time, then added
+/// lane by lane in order.
 fn shade(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch, queue: &ShadowQueue) {
     let weight = 1.0 / ctx.points_per_light as f32;
-    for q in 0..queue.len {
-        if queue.blocked[q] || !(queue.n_dot_l[q] > 0.0) {
+    let mut q = 0;
+    while q < queue.len {
+        let end = q + LANES;
+        // The queue is sorted by (hit, light): equal ends mean one hit and one light.
+        if end <= queue.len
+            && queue.path[q] == queue.path[end - 1]
+            && queue.light[q] == queue.light[end - 1]
+        {
+            let i = queue.path[q] as usize;
+            let m = &ctx.materials[hits.material[i] as usize];
+            let c = simd::shade8(
+                m,
+                hits.normal(i),
+                -rays.direction(i),
+                [
+                    &queue.direction_x[q..end],
+                    &queue.direction_y[q..end],
+                    &queue.direction_z[q..end],
+                ],
+                &queue.n_dot_l[q..end],
+                ctx.lights[queue.light[q] as usize].color,
+                weight,
+            );
+            let (mut r, mut g, mut b) = (hits.direct_r[i], hits.direct_g[i], hits.direct_b[i]);
+            let lanes = queue.blocked[q..end].iter().zip(&queue.n_dot_l[q..end]);
+            for (k, (&blocked, &n_dot_l)) in lanes.enumerate() {
+                if !blocked && n_dot_l > 0.0 {
+                    r += c[0][k];
+                    g += c[1][k];
+                    b += c[2][k];
+                }
+            }
+            (hits.direct_r[i], hits.direct_g[i], hits.direct_b[i]) = (r, g, b);
+            q = end;
             continue;
         }
-        let i = queue.path[q] as usize;
-        let m = &ctx.materials[hits.material[i] as usize];
-        let light_color = ctx.lights[queue.light[q] as usize].color;
-        let c = shade_terms(
-            m,
-            hits.normal(i),
-            -rays.direction(i),
-            queue.direction(q),
-            queue.n_dot_l[q],
-            light_color,
-        ) * weight;
-        hits.direct_r[i] += c.x;
-        hits.direct_g[i] += c.y;
-        hits.direct_b[i] += c.z;
+        if !queue.blocked[q] && queue.n_dot_l[q] > 0.0 {
+            let i = queue.path[q] as usize;
+            let m = &ctx.materials[hits.material[i] as usize];
+            let light_color = ctx.lights[queue.light[q] as usize].color;
+            let c = shade_terms(
+                m,
+                hits.normal(i),
+                -rays.direction(i),
+                queue.direction(q),
+                queue.n_dot_l[q],
+                light_color,
+            ) * weight;
+            hits.direct_r[i] += c.x;
+            hits.direct_g[i] += c.y;
+            hits.direct_b[i] += c.z;
+        }
+        q += 1;
     }
 }
 

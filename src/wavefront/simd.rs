@@ -17,6 +17,7 @@
 //! sentinel. Batches whose length is not a multiple of 8 are padded with lanes that cannot hit
 //! (tmax = 0, NaN directions), and the padding is never stored back.
 
+use super::context::MaterialTerms;
 use crate::geometry::T_MIN;
 use crate::scene::{NO_HIT, Sphere, Triangle};
 use glam::Vec3;
@@ -263,28 +264,125 @@ pub fn occluded(
         // A lane with tmax ≤ 0 (dead, or a light point within T_MIN) can never be blocked, so
         // it does not hold up the early exit.
         let live = live_lanes(i, n) & tmax.simd_gt(f32x8::ZERO).to_bitmask();
-        let mut blocked = 0u32;
-        'prims: {
-            if live == 0 {
-                break 'prims;
-            }
-            for s in spheres {
-                blocked |= sphere8(s, &r, tmax).simd_lt(tmax).to_bitmask();
-                if blocked & live == live {
-                    break 'prims;
-                }
-            }
-            for tri in triangles {
-                blocked |= triangle8_blocks(tri, &r, tmax, two_sided);
-                if blocked & live == live {
-                    break 'prims;
-                }
-            }
-        }
+        let origin = Vec3::new(r.ox.as_array()[0], r.oy.as_array()[0], r.oz.as_array()[0]);
+        // Soft shadows queue each hit's rays in blocks of 8 from one point: then the
+        // origin-only terms are computed once per primitive (same operations, same bits).
+        let shared = (r.ox.simd_eq(f32x8::splat(origin.x))
+            & r.oy.simd_eq(f32x8::splat(origin.y))
+            & r.oz.simd_eq(f32x8::splat(origin.z)))
+        .all();
+        let blocked = if live == 0 {
+            0
+        } else if shared {
+            occluded8(
+                triangles,
+                spheres,
+                live,
+                |s| sphere8_from(s, origin, &r, tmax),
+                |tri| triangle8_blocks_from(tri, origin, &r, tmax, two_sided),
+            )
+        } else {
+            occluded8(
+                triangles,
+                spheres,
+                live,
+                |s| sphere8(s, &r, tmax).simd_lt(tmax).to_bitmask(),
+                |tri| triangle8_blocks(tri, &r, tmax, two_sided),
+            )
+        };
         for lane in 0..(n - i).min(LANES) {
             out[i + lane] = blocked & (1 << lane) != 0;
         }
     }
+}
+
+/// Spheres, then triangles, until every live lane is blocked; returns the blocked lanes.
+#[inline(always)]
+fn occluded8(
+    triangles: &[Triangle],
+    spheres: &[Sphere],
+    live: u32,
+    sphere_blocks: impl Fn(&Sphere) -> u32,
+    triangle_blocks: impl Fn(&Triangle) -> u32,
+) -> u32 {
+    let mut blocked = 0;
+    for s in spheres {
+        blocked |= sphere_blocks(s);
+        if blocked & live == live {
+            return blocked;
+        }
+    }
+    for tri in triangles {
+        blocked |= triangle_blocks(tri);
+        if blocked & live == live {
+            return blocked;
+        }
+    }
+    blocked
+}
+
+/// `triangle8_blocks` for 8 rays that all start at `o`: s = o − v0, q = s × e1 and e2·q are
+/// computed once, in scalar, with the operations the lanes would use.
+#[inline(always)]
+fn triangle8_blocks_from(tri: &Triangle, o: Vec3, r: &Rays8, tmax: f32x8, two_sided: bool) -> u32 {
+    let (e2x, e2y, e2z) = (
+        f32x8::splat(tri.e2.x),
+        f32x8::splat(tri.e2.y),
+        f32x8::splat(tri.e2.z),
+    );
+    let px = r.dy * e2z - e2y * r.dz;
+    let py = r.dz * e2x - e2z * r.dx;
+    let pz = r.dx * e2y - e2x * r.dy;
+    let det =
+        f32x8::splat(tri.e1.x) * px + f32x8::splat(tri.e1.y) * py + f32x8::splat(tri.e1.z) * pz;
+    let zero = f32x8::ZERO;
+    let facing = if two_sided {
+        det.simd_ne(zero)
+    } else {
+        det.simd_gt(zero)
+    };
+    if facing.none() {
+        return 0;
+    }
+    let s = o - tri.v0;
+    let q = s.cross(tri.e1);
+    let t_num = tri.e2.dot(q);
+    let inv_det = f32x8::ONE / det;
+    let u = (f32x8::splat(s.x) * px + f32x8::splat(s.y) * py + f32x8::splat(s.z) * pz) * inv_det;
+    let v =
+        (r.dx * f32x8::splat(q.x) + r.dy * f32x8::splat(q.y) + r.dz * f32x8::splat(q.z)) * inv_det;
+    let t = f32x8::splat(t_num) * inv_det;
+    let hit = facing
+        & u.simd_ge(zero)
+        & v.simd_ge(zero)
+        & (u + v).simd_le(f32x8::ONE)
+        & t.simd_gt(f32x8::splat(T_MIN))
+        & t.simd_lt(tmax);
+    // `triangle8` returns t on a hit, and a hit has t < tmax.
+    hit.to_bitmask()
+}
+
+/// The lanes `s` blocks, for 8 rays that all start at `o` (oc and c computed once), with an
+/// early return when no lane's discriminant is ≥ 0 (most shadow rays miss most spheres, and
+/// that skips the square root and both divisions).
+#[inline(always)]
+fn sphere8_from(s: &Sphere, o: Vec3, r: &Rays8, tmax: f32x8) -> u32 {
+    let oc = o - s.center;
+    let c = oc.length_squared() - s.radius * s.radius;
+    let a = r.dx * r.dx + r.dy * r.dy + r.dz * r.dz;
+    let b = f32x8::splat(oc.x) * r.dx + f32x8::splat(oc.y) * r.dy + f32x8::splat(oc.z) * r.dz;
+    let disc = b * b - a * f32x8::splat(c);
+    let ok = disc.simd_ge(f32x8::ZERO);
+    if ok.none() {
+        return 0;
+    }
+    let root = disc.sqrt();
+    let nb = -b;
+    let near = (nb - root) / a;
+    let far = (nb + root) / a;
+    let t_min = f32x8::splat(T_MIN);
+    let t = near.simd_gt(t_min).select(near, far);
+    (ok & t.simd_gt(t_min) & t.simd_lt(tmax)).to_bitmask()
 }
 
 /// Chris Wellons' `lowbias32`, 8 lanes; twin of `sampling::mix32`.
@@ -385,6 +483,64 @@ pub fn shadow_rays8(
         live.select(n_dot_l, zero).to_array(),
         live.to_bitmask(),
     )
+}
+
+/// Shade · weight of 8 shadow rays cast from one hit towards one light: lane k equals
+/// `shadow::shade_terms(m, n, e, l_k, n_dot_l_k, light_color) * weight` bit for bit (`powf`
+/// runs per lane, in scalar, only where the scalar twin calls it).
+#[inline]
+#[allow(clippy::too_many_arguments)]
+pub fn shade8(
+    m: &MaterialTerms,
+    n: Vec3,
+    e: Vec3,
+    l: [&[f32]; 3],
+    n_dot_l: &[f32],
+    light_color: Vec3,
+    weight: f32,
+) -> [[f32; LANES]; 3] {
+    let ndl = load(n_dot_l, 0, 0.0);
+    let lit = light_color * m.diffuse;
+    let cr = f32x8::splat(m.ambient_emitted.x) + f32x8::splat(lit.x) * ndl;
+    let cg = f32x8::splat(m.ambient_emitted.y) + f32x8::splat(lit.y) * ndl;
+    let cb = f32x8::splat(m.ambient_emitted.z) + f32x8::splat(lit.z) * ndl;
+    let positive = m.shininess > 0.0;
+    let w = f32x8::splat(weight);
+    if positive && !m.is_reflective {
+        return [
+            (cr * w).to_array(),
+            (cg * w).to_array(),
+            (cb * w).to_array(),
+        ];
+    }
+    let (lx, ly, lz) = (load(l[0], 0, 0.0), load(l[1], 0, 0.0), load(l[2], 0, 0.0));
+    // r = normalize(2(n·l) n − l), glam's normalize: v · (1 / |v|).
+    let k = f32x8::splat(2.0) * ndl;
+    let rx = k * f32x8::splat(n.x) - lx;
+    let ry = k * f32x8::splat(n.y) - ly;
+    let rz = k * f32x8::splat(n.z) - lz;
+    let recip = f32x8::ONE / (rx * rx + ry * ry + rz * rz).sqrt();
+    let (rx, ry, rz) = (rx * recip, ry * recip, rz * recip);
+    let e_dot_r =
+        (f32x8::splat(e.x) * rx + f32x8::splat(e.y) * ry + f32x8::splat(e.z) * rz).to_array();
+    let mut spec = [0.0f32; LANES];
+    let mut with_highlight = [0.0f32; LANES];
+    for k in 0..LANES {
+        let base = e_dot_r[k].max(0.0);
+        if !positive || base > 0.0 {
+            spec[k] = base.powf(m.shininess);
+            with_highlight[k] = 1.0;
+        }
+    }
+    let on = f32x8::new(with_highlight).simd_gt(f32x8::ZERO);
+    let s = f32x8::new(spec) * ndl;
+    let sc = light_color * m.specular;
+    let add = |c: f32x8, sc: f32| on.select(c + f32x8::splat(sc) * s, c) * w;
+    [
+        add(cr, sc.x).to_array(),
+        add(cg, sc.y).to_array(),
+        add(cb, sc.z).to_array(),
+    ]
 }
 
 /// Lane-level entry points for tests: 8 rays given as arrays, the kernels' answers as arrays.
