@@ -11,6 +11,7 @@
 //! slope of log MSE against log N                                        per sampler and region
 //! ```
 
+pub mod command;
 pub mod mask;
 pub mod plot;
 pub mod stats;
