@@ -332,6 +332,7 @@ fn bvh_and_brute_force_agree_on_a_mesh() {
                 "{r:?}: bvh {hit:?}, brute {best:?}"
             );
             if best.0.is_finite() {
+                assert_eq!(hit.prim, best.1, "{r:?}: bvh {hit:?}, brute {best:?}");
                 hits += 1;
                 assert!(accel.occluded(&s, &r, best.0 + 1e-3, two_sided));
             }
