@@ -264,29 +264,14 @@ pub fn occluded(
         // A lane with tmax ≤ 0 (dead, or a light point within T_MIN) can never be blocked, so
         // it does not hold up the early exit.
         let live = live_lanes(i, n) & tmax.simd_gt(f32x8::ZERO).to_bitmask();
-        let origin = Vec3::new(r.ox.as_array()[0], r.oy.as_array()[0], r.oz.as_array()[0]);
-        // Soft shadows queue each hit's rays in blocks of 8 from one point: then the
-        // origin-only terms are computed once per primitive (same operations, same bits).
-        let shared = (r.ox.simd_eq(f32x8::splat(origin.x))
-            & r.oy.simd_eq(f32x8::splat(origin.y))
-            & r.oz.simd_eq(f32x8::splat(origin.z)))
-        .all();
         let blocked = if live == 0 {
             0
-        } else if shared {
-            occluded8(
-                triangles,
-                spheres,
-                live,
-                |s| sphere8_from(s, origin, &r, tmax),
-                |tri| triangle8_blocks_from(tri, origin, &r, tmax, two_sided),
-            )
         } else {
             occluded8(
                 triangles,
                 spheres,
                 live,
-                |s| sphere8(s, &r, tmax).simd_lt(tmax).to_bitmask(),
+                |s| sphere8_blocks(s, &r, tmax),
                 |tri| triangle8_blocks(tri, &r, tmax, two_sided),
             )
         };
@@ -321,68 +306,22 @@ fn occluded8(
     blocked
 }
 
-/// `triangle8_blocks` for 8 rays that all start at `o`: s = o − v0, q = s × e1 and e2·q are
-/// computed once, in scalar, with the operations the lanes would use.
+/// The lanes `s` blocks: `sphere8(..) < tmax`, but returning early when no lane's
+/// discriminant is ≥ 0 (most shadow rays miss most spheres; that skips the square root and
+/// both divisions).
 #[inline(always)]
-fn triangle8_blocks_from(tri: &Triangle, o: Vec3, r: &Rays8, tmax: f32x8, two_sided: bool) -> u32 {
-    let (e2x, e2y, e2z) = (
-        f32x8::splat(tri.e2.x),
-        f32x8::splat(tri.e2.y),
-        f32x8::splat(tri.e2.z),
-    );
-    let px = r.dy * e2z - e2y * r.dz;
-    let py = r.dz * e2x - e2z * r.dx;
-    let pz = r.dx * e2y - e2x * r.dy;
-    let det =
-        f32x8::splat(tri.e1.x) * px + f32x8::splat(tri.e1.y) * py + f32x8::splat(tri.e1.z) * pz;
-    let zero = f32x8::ZERO;
-    let facing = if two_sided {
-        det.simd_ne(zero)
-    } else {
-        det.simd_gt(zero)
-    };
-    if facing.none() {
-        return 0;
-    }
-    let s = o - tri.v0;
-    let q = s.cross(tri.e1);
-    let t_num = tri.e2.dot(q);
-    let inv_det = f32x8::ONE / det;
-    let u = (f32x8::splat(s.x) * px + f32x8::splat(s.y) * py + f32x8::splat(s.z) * pz) * inv_det;
-    let v =
-        (r.dx * f32x8::splat(q.x) + r.dy * f32x8::splat(q.y) + r.dz * f32x8::splat(q.z)) * inv_det;
-    let t = f32x8::splat(t_num) * inv_det;
-    let hit = facing
-        & u.simd_ge(zero)
-        & v.simd_ge(zero)
-        & (u + v).simd_le(f32x8::ONE)
-        & t.simd_gt(f32x8::splat(T_MIN))
-        & t.simd_lt(tmax);
-    // `triangle8` returns t on a hit, and a hit has t < tmax.
-    hit.to_bitmask()
-}
-
-/// The lanes `s` blocks, for 8 rays that all start at `o` (oc and c computed once), with an
-/// early return when no lane's discriminant is ≥ 0 (most shadow rays miss most spheres, and
-/// that skips the square root and both divisions).
-#[inline(always)]
-fn sphere8_from(s: &Sphere, o: Vec3, r: &Rays8, tmax: f32x8) -> u32 {
-    let oc = o - s.center;
-    let c = oc.length_squared() - s.radius * s.radius;
+fn sphere8_blocks(s: &Sphere, r: &Rays8, tmax: f32x8) -> u32 {
+    let ocx = r.ox - f32x8::splat(s.center.x);
+    let ocy = r.oy - f32x8::splat(s.center.y);
+    let ocz = r.oz - f32x8::splat(s.center.z);
     let a = r.dx * r.dx + r.dy * r.dy + r.dz * r.dz;
-    let b = f32x8::splat(oc.x) * r.dx + f32x8::splat(oc.y) * r.dy + f32x8::splat(oc.z) * r.dz;
-    let disc = b * b - a * f32x8::splat(c);
-    let ok = disc.simd_ge(f32x8::ZERO);
-    if ok.none() {
+    let b = ocx * r.dx + ocy * r.dy + ocz * r.dz;
+    let c = (ocx * ocx + ocy * ocy + ocz * ocz) - f32x8::splat(s.radius * s.radius);
+    let disc = b * b - a * c;
+    if disc.simd_ge(f32x8::ZERO).none() {
         return 0;
     }
-    let root = disc.sqrt();
-    let nb = -b;
-    let near = (nb - root) / a;
-    let far = (nb + root) / a;
-    let t_min = f32x8::splat(T_MIN);
-    let t = near.simd_gt(t_min).select(near, far);
-    (ok & t.simd_gt(t_min) & t.simd_lt(tmax)).to_bitmask()
+    sphere8(s, r, tmax).simd_lt(tmax).to_bitmask()
 }
 
 /// Chris Wellons' `lowbias32`, 8 lanes; twin of `sampling::mix32`.
