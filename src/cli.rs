@@ -26,6 +26,21 @@ pub enum Command {
     Render(RenderArgs),
     /// Print the build's SIMD path, thread count and version.
     Info,
+    /// Write a generated mesh scene: the lab's Cornell box with its three mirror spheres
+    /// tessellated (for the BVH benchmarks: about 12k or 1M triangles).
+    Meshgen(MeshgenArgs),
+}
+
+/// `raywave meshgen` flags.
+#[derive(Args, Debug, Clone)]
+pub struct MeshgenArgs {
+    /// Approximate number of triangles.
+    #[arg(long, default_value_t = 12_000,
+          value_parser = clap::value_parser!(u64).range(36..=50_000_000))]
+    pub triangles: u64,
+    /// Output scene file (.obj).
+    #[arg(short, long)]
+    pub output: PathBuf,
 }
 
 /// `raywave render` flags.
@@ -176,7 +191,16 @@ const LAB_FLAGS: &[(&str, &[&str])] = &[
     ("-soft_shadow", &["--shadows", "soft"]),
 ];
 
-const SUBCOMMANDS: &[&str] = &["render", "info", "help", "-h", "--help", "-V", "--version"];
+const SUBCOMMANDS: &[&str] = &[
+    "render",
+    "info",
+    "meshgen",
+    "help",
+    "-h",
+    "--help",
+    "-V",
+    "--version",
+];
 
 /// Rewrites argv so clap can read it: the lab's single-dash flags become modern ones, and a
 /// command line without a subcommand (`raywave`, `raywave scene.obj`, `raywave -size ...`)

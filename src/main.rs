@@ -4,7 +4,7 @@
 use anyhow::{Context, Result, bail};
 use clap::Parser;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use raywave::cli::{Cli, Command, Engine, RenderArgs};
+use raywave::cli::{Cli, Command, Engine, MeshgenArgs, RenderArgs};
 use raywave::debug_view::RayRecorder;
 use raywave::film::{check_hdr_path, check_output_dir, ldr_format};
 use raywave::reference::Reference;
@@ -25,6 +25,7 @@ fn main() -> ExitCode {
             info();
             Ok(())
         }
+        Command::Meshgen(args) => meshgen(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -42,6 +43,19 @@ fn info() {
         "threads {} (rayon default; --threads N to change)",
         rayon::current_num_threads()
     );
+}
+
+fn meshgen(args: &MeshgenArgs) -> Result<()> {
+    check_output_dir(&args.output)?;
+    let bands = raywave::meshgen::bands_for(args.triangles as usize);
+    let text = raywave::meshgen::cornell_box_mesh_spheres(bands);
+    raywave::film::write_atomically(&args.output, |w| Ok(w.write_all(text.as_bytes())?))?;
+    println!(
+        "wrote   {}: {} triangles ({bands} latitude bands per sphere)",
+        args.output.display(),
+        raywave::meshgen::triangle_count(bands)
+    );
+    Ok(())
 }
 
 fn thread_pool(threads: Option<u32>) -> Result<rayon::ThreadPool> {
@@ -102,7 +116,11 @@ fn render(args: &RenderArgs) -> Result<()> {
             let (film, stats) = pool.install(|| engine.render(&|| progress.inc(1)));
             let seconds = start.elapsed().as_secs_f64();
             progress.finish_and_clear();
-            let bvh = engine.context().accel.is_some();
+            let bvh = engine
+                .context()
+                .accel
+                .is_some()
+                .then_some(engine.context().bvh_build_time.as_secs_f64());
             (film, Report::new(stats.counts, seconds, Some((stats, bvh))))
         }
     };
@@ -234,12 +252,12 @@ struct RunInfo {
 struct Report {
     counts: RayCounts,
     seconds: f64,
-    /// Wavefront only: per-stage figures, and whether a BVH was used.
-    stages: Option<(RenderStats, bool)>,
+    /// Wavefront only: per-stage figures, and the BVH build time if a BVH was used.
+    stages: Option<(RenderStats, Option<f64>)>,
 }
 
 impl Report {
-    fn new(counts: RayCounts, seconds: f64, stages: Option<(RenderStats, bool)>) -> Report {
+    fn new(counts: RayCounts, seconds: f64, stages: Option<(RenderStats, Option<f64>)>) -> Report {
         Report {
             counts,
             seconds,
@@ -268,6 +286,9 @@ fn print_stats(report: &Report) {
     println!("{:<12} {:>14} {:>14}", "kind", "rays", "Mrays/s");
     for (kind, rays, per_s) in report.kinds() {
         println!("{kind:<12} {rays:>14} {:>14.2}", per_s / 1e6);
+    }
+    if let Some((_, Some(build))) = &report.stages {
+        println!("bvh build {build:.3} s");
     }
     if let Some((stats, _)) = &report.stages {
         println!(
@@ -319,6 +340,11 @@ fn stats_json(
         Some((stats, bvh)) => (serde_json::to_value(stats.stage_rows()).ok(), Some(*bvh)),
         None => (None, None),
     };
+    let (bvh, bvh_build_seconds) = match bvh {
+        Some(Some(t)) => (Some(true), Some(t)),
+        Some(None) => (Some(false), None),
+        None => (None, None),
+    };
     serde_json::json!({
         "raywave": env!("CARGO_PKG_VERSION"),
         "machine": {
@@ -337,6 +363,7 @@ fn stats_json(
             "spheres": scene.spheres.len(),
             "lights": scene.lights.len(),
             "bvh": bvh,
+            "bvh_build_seconds": bvh_build_seconds,
         },
         "settings": settings,
         "seconds": report.seconds,
