@@ -186,7 +186,8 @@ fn extension(path: &Path) -> Option<String> {
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
 }
 
-/// Checks, before a long render, that the directory of `path` exists.
+/// Checks, before a long render, that the directory of `path` exists and `path` is not a
+/// directory itself.
 pub fn check_output_dir(path: &Path) -> Result<()> {
     let dir = parent_dir(path);
     if !dir.is_dir() {
@@ -195,6 +196,11 @@ pub fn check_output_dir(path: &Path) -> Result<()> {
             path.display(),
             dir.display()
         );
+    }
+    // Without this, a directory named like an image was found out only by the final rename,
+    // after the whole render.
+    if path.is_dir() {
+        bail!("cannot write {}: it is a directory", path.display());
     }
     Ok(())
 }
