@@ -265,6 +265,33 @@ fn nonexistent_output_directory_fails_before_rendering() {
 }
 
 #[test]
+fn output_path_that_is_a_directory_fails_before_rendering() {
+    let dir = dir_with(&["cornell_box.obj"]);
+    std::fs::create_dir(dir.path().join("d.png")).unwrap();
+    let start = Instant::now();
+    let out = raywave(
+        dir.path(),
+        &[
+            "cornell_box.obj",
+            "--size",
+            "16384",
+            "16384",
+            "--shadows",
+            "soft",
+            "-o",
+            "d.png",
+        ],
+    );
+    assert!(
+        start.elapsed() < Duration::from_secs(10),
+        "it rendered first"
+    );
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    assert!(stderr(&out).contains("d.png"), "{}", stderr(&out));
+    assert_eq!(files_in(dir.path()), ["cornell_box.obj", "d.png"]);
+}
+
+#[test]
 fn bad_output_extension_fails_before_rendering() {
     let dir = dir_with(&["cornell_box.obj"]);
     let out = raywave(

@@ -148,4 +148,11 @@ fn output_checks() {
     let missing = dir.path().join("x").join("y.png");
     std::fs::write(dir.path().join("x"), b"a file, not a directory").unwrap();
     assert!(check_output_dir(&missing).is_err());
+    // An existing directory is not a file to write to.
+    std::fs::create_dir(dir.path().join("d.png")).unwrap();
+    let e = check_output_dir(&dir.path().join("d.png"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("d.png") && e.contains("directory"), "{e}");
+    assert!(check_output_dir(&dir.path().join("new.png")).is_ok());
 }
