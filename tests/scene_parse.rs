@@ -617,3 +617,23 @@ fn negative_colours_and_glossiness_name_the_line() {
     let text = format!("{MAT}m 0\ns 0 0 0 1\nbackground_color 0 -1 0\n");
     error_at(&text, 8, &["-1"]);
 }
+
+#[test]
+fn camera_block_with_center_and_direction() {
+    // The other RPI spelling: `center` for the position and `direction` instead of a point.
+    let text = format!(
+        "{MAT}m 0\ns 0 0 0 1\nPerspectiveCamera {{ center 0 1 10 direction 0 0 -2 up 0 1 0 angle 30 }}\n"
+    );
+    let s = parse_scene_str(&text, "f.obj").unwrap();
+    assert_eq!(s.camera.position, Vec3::new(0.0, 1.0, 10.0));
+    assert_eq!(s.camera.point_of_interest, Vec3::new(0.0, 1.0, 8.0));
+    assert!((s.camera.fov - 30f32.to_radians()).abs() < 1e-6);
+    // A second camera block is an error naming its line.
+    let twice = format!("{text}PerspectiveCamera {{ center 0 1 10 direction 0 0 -2 angle 30 }}\n");
+    error_at(&twice, 9, &["camera"]);
+    // Up parallel to the view direction.
+    let bad = format!(
+        "{MAT}m 0\ns 0 0 0 1\nPerspectiveCamera {{ center 0 5 0 direction 0 -1 0 up 0 1 0 angle 30 }}\n"
+    );
+    error_at(&bad, 8, &["up"]);
+}
