@@ -145,33 +145,50 @@ pub fn triangle8(tri: &Triangle, r: &Rays8, tmax: f32x8, two_sided: bool) -> f32
     hit.select(t, f32x8::splat(f32::INFINITY))
 }
 
-/// The lanes that `tri` blocks, as a bitmask: `triangle8(..) < tmax`, but returning early when
-/// no lane faces the triangle (for one-sided faces about half the walls of a box, seen from a
-/// coherent packet of shadow rays).
+/// The lanes that `tri` blocks, as a bitmask: `triangle8(..) < tmax`, with the same values
+/// computed in an order that lets whole packets leave early: after det when no lane faces the
+/// triangle (for one-sided faces about half the walls of a box, seen from a coherent packet of
+/// shadow rays), and after t when no lane's t is in (T_MIN, tmax) (the walls behind the light).
 #[inline(always)]
 fn triangle8_blocks(tri: &Triangle, r: &Rays8, tmax: f32x8, two_sided: bool) -> u32 {
-    if !two_sided {
-        let (e1x, e1y, e1z) = (
-            f32x8::splat(tri.e1.x),
-            f32x8::splat(tri.e1.y),
-            f32x8::splat(tri.e1.z),
-        );
-        let (e2x, e2y, e2z) = (
-            f32x8::splat(tri.e2.x),
-            f32x8::splat(tri.e2.y),
-            f32x8::splat(tri.e2.z),
-        );
-        let px = r.dy * e2z - e2y * r.dz;
-        let py = r.dz * e2x - e2z * r.dx;
-        let pz = r.dx * e2y - e2x * r.dy;
-        let det = e1x * px + e1y * py + e1z * pz;
-        if det.simd_gt(f32x8::ZERO).none() {
-            return 0;
-        }
+    let (e1x, e1y, e1z) = (
+        f32x8::splat(tri.e1.x),
+        f32x8::splat(tri.e1.y),
+        f32x8::splat(tri.e1.z),
+    );
+    let (e2x, e2y, e2z) = (
+        f32x8::splat(tri.e2.x),
+        f32x8::splat(tri.e2.y),
+        f32x8::splat(tri.e2.z),
+    );
+    let px = r.dy * e2z - e2y * r.dz;
+    let py = r.dz * e2x - e2z * r.dx;
+    let pz = r.dx * e2y - e2x * r.dy;
+    let det = e1x * px + e1y * py + e1z * pz;
+    let zero = f32x8::ZERO;
+    let facing = if two_sided {
+        det.simd_ne(zero)
+    } else {
+        det.simd_gt(zero)
+    };
+    if facing.none() {
+        return 0;
     }
-    triangle8(tri, r, tmax, two_sided)
-        .simd_lt(tmax)
-        .to_bitmask()
+    let inv_det = f32x8::ONE / det;
+    let tx = r.ox - f32x8::splat(tri.v0.x);
+    let ty = r.oy - f32x8::splat(tri.v0.y);
+    let tz = r.oz - f32x8::splat(tri.v0.z);
+    let qx = ty * e1z - e1y * tz;
+    let qy = tz * e1x - e1z * tx;
+    let qz = tx * e1y - e1x * ty;
+    let t = (e2x * qx + e2y * qy + e2z * qz) * inv_det;
+    let in_range = facing & t.simd_gt(f32x8::splat(T_MIN)) & t.simd_lt(tmax);
+    if in_range.none() {
+        return 0;
+    }
+    let u = (tx * px + ty * py + tz * pz) * inv_det;
+    let v = (r.dx * qx + r.dy * qy + r.dz * qz) * inv_det;
+    (in_range & u.simd_ge(zero) & v.simd_ge(zero) & (u + v).simd_le(f32x8::ONE)).to_bitmask()
 }
 
 /// Ray–sphere for 8 rays; lane k equals `intersect_sphere(sphere, ray_k, tmax_k)`.
@@ -363,6 +380,18 @@ pub struct LightBlock<'a> {
     pub edge_v: Vec3,
 }
 
+/// x / n, as a multiplication when n is a power of two (16 and 64 points make 4×4 and 8×8
+/// strata): x · 2⁻ᵏ and x / 2ᵏ are both the correctly rounded value of the same real number,
+/// so the bits are the same, and a multiply is several times cheaper than a divide.
+#[inline(always)]
+fn divide(x: f32x8, n: f32) -> f32x8 {
+    if n > 0.0 && n.is_normal() && n.to_bits() & 0x007f_ffff == 0 {
+        x * f32x8::splat(1.0 / n)
+    } else {
+        x / f32x8::splat(n)
+    }
+}
+
 /// Light points x, y, z of samples `j0..j0 + 8`: lane k equals
 /// `light.point(square_sample(sampler, key, j0 + k, count))`.
 #[inline]
@@ -378,8 +407,8 @@ pub fn light_points8(b: &LightBlock) -> [[f32; LANES]; 3] {
             let cy = load(cell_y, at, 0.0);
             let one_minus_eps = f32x8::splat(crate::sampling::ONE_MINUS_EPS);
             (
-                ((cx + xi0) / f32x8::splat(nx)).fast_min(one_minus_eps),
-                ((cy + xi1) / f32x8::splat(ny)).fast_min(one_minus_eps),
+                divide(cx + xi0, nx).fast_min(one_minus_eps),
+                divide(cy + xi1, ny).fast_min(one_minus_eps),
             )
         }
     };
