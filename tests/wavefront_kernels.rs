@@ -390,6 +390,7 @@ proptest! {
         g in prop_oneof![Just(0.0f32), Just(1.0f32), 0.0f32..1.0, -0.5f32..0.0],
         n in vec3(), e in vec3(), ls in proptest::collection::vec(vec3(), 8), lc in vec3(),
         weight in prop_oneof![Just(1.0f32), Just(1.0 / 64.0), 0.001f32..1.0],
+        blocked_bits in prop_oneof![Just(0u32), any::<u32>()],
     ) {
         let m = Material { diffuse: kd.abs(), reflective: kr.abs(), emitted: ke.abs(), glossiness: g };
         let terms = MaterialTerms {
@@ -406,10 +407,14 @@ proptest! {
         let col = |f: fn(Vec3) -> f32| ls.iter().map(|&l| f(l)).collect::<Vec<f32>>();
         let (lx, ly, lz) = (col(|l| l.x), col(|l| l.y), col(|l| l.z));
         let ndl: Vec<f32> = ls.iter().map(|&l| n.dot(l)).collect();
-        let got = simd::shade8(&terms, n, e, [&lx, &ly, &lz], &ndl, lc.abs(), weight);
+        let blocked: Vec<bool> = (0..8).map(|k| blocked_bits & (1 << k) != 0).collect();
+        let got = simd::shade8(&terms, n, e, [&lx, &ly, &lz], &ndl, &blocked, lc.abs(), weight);
         for k in 0..8 {
-            if !(ndl[k] > 0.0) {
-                continue; // dead lane: never added
+            if !(ndl[k] > 0.0) || blocked[k] {
+                // Adds nothing: exactly −0.0, the identity of addition.
+                prop_assert_eq!([got[0][k], got[1][k], got[2][k]].map(f32::to_bits),
+                    [(-0.0f32).to_bits(); 3]);
+                continue;
             }
             let want = shade_terms(&terms, n, e, ls[k], ndl[k], lc.abs()) * weight;
             prop_assert_eq!([got[0][k], got[1][k], got[2][k]].map(f32::to_bits),

@@ -210,17 +210,16 @@ fn shade(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch, queue: &ShadowQueu
                     &queue.direction_z[q..end],
                 ],
                 &queue.n_dot_l[q..end],
+                &queue.blocked[q..end],
                 ctx.lights[queue.light[q] as usize].color,
                 weight,
             );
+            // In lane order, like the reference's loop; lanes that add nothing hold −0.0.
             let (mut r, mut g, mut b) = (hits.direct_r[i], hits.direct_g[i], hits.direct_b[i]);
-            let lanes = queue.blocked[q..end].iter().zip(&queue.n_dot_l[q..end]);
-            for (k, (&blocked, &n_dot_l)) in lanes.enumerate() {
-                if !blocked && n_dot_l > 0.0 {
-                    r += c[0][k];
-                    g += c[1][k];
-                    b += c[2][k];
-                }
+            for k in 0..LANES {
+                r += c[0][k];
+                g += c[1][k];
+                b += c[2][k];
             }
             (hits.direct_r[i], hits.direct_g[i], hits.direct_b[i]) = (r, g, b);
             q = end;

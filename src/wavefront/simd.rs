@@ -455,7 +455,9 @@ pub fn shadow_rays8(
 
 /// Shade · weight of 8 shadow rays cast from one hit towards one light: lane k equals
 /// `shadow::shade_terms(m, n, e, l_k, n_dot_l_k, light_color) * weight` bit for bit (`powf`
-/// runs per lane, in scalar, only where the scalar twin calls it).
+/// runs per lane, in scalar, only where the scalar twin calls it). Lanes that add nothing (dead,
+/// n·l ≤ 0, or `blocked`) come back as −0.0, the exact identity of IEEE addition (x + −0 = x for
+/// every x, −0 included), so the caller adds all 8 lanes in order without a branch.
 #[inline]
 #[allow(clippy::too_many_arguments)]
 pub fn shade8(
@@ -464,10 +466,14 @@ pub fn shade8(
     e: Vec3,
     l: [&[f32]; 3],
     n_dot_l: &[f32],
+    blocked: &[bool],
     light_color: Vec3,
     weight: f32,
 ) -> [[f32; LANES]; 3] {
     let ndl = load(n_dot_l, 0, 0.0);
+    let open = f32x8::new(std::array::from_fn(|k| if blocked[k] { 0.0 } else { 1.0 }));
+    let adds = ndl.simd_gt(f32x8::ZERO) & open.simd_gt(f32x8::ZERO);
+    let nothing = f32x8::splat(-0.0);
     let lit = light_color * m.diffuse;
     let cr = f32x8::splat(m.ambient_emitted.x) + f32x8::splat(lit.x) * ndl;
     let cg = f32x8::splat(m.ambient_emitted.y) + f32x8::splat(lit.y) * ndl;
@@ -475,11 +481,8 @@ pub fn shade8(
     let positive = m.shininess > 0.0;
     let w = f32x8::splat(weight);
     if positive && !m.is_reflective {
-        return [
-            (cr * w).to_array(),
-            (cg * w).to_array(),
-            (cb * w).to_array(),
-        ];
+        let out = |c: f32x8| adds.select(c * w, nothing).to_array();
+        return [out(cr), out(cg), out(cb)];
     }
     let (lx, ly, lz) = (load(l[0], 0, 0.0), load(l[1], 0, 0.0), load(l[2], 0, 0.0));
     // r = normalize(2(n·l) n − l), glam's normalize: v · (1 / |v|).
@@ -503,7 +506,7 @@ pub fn shade8(
     let on = f32x8::new(with_highlight).simd_gt(f32x8::ZERO);
     let s = f32x8::new(spec) * ndl;
     let sc = light_color * m.specular;
-    let add = |c: f32x8, sc: f32| on.select(c + f32x8::splat(sc) * s, c) * w;
+    let add = |c: f32x8, sc: f32| adds.select(on.select(c + f32x8::splat(sc) * s, c) * w, nothing);
     [
         add(cr, sc.x).to_array(),
         add(cg, sc.y).to_array(),
