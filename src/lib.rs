@@ -12,6 +12,7 @@ pub mod debug_view;
 pub mod film;
 pub mod geometry;
 pub mod meshgen;
+pub mod peer;
 pub mod reference;
 pub mod sampling;
 pub mod scene;

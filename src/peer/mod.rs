@@ -1,0 +1,438 @@
+//! Peer comparison on mesh scenes: the same rays traced by obvhs's CWBVH one ray at a time, by
+//! raywave's wavefront intersect stage, and (feature `embree`) by Embree, with the hits compared.
+//!
+//! ```text
+//! RaySets::new(scene, seed):                      built once, from a fixed seed
+//!     primary     camera ray through the centre of every pixel of W×H
+//!     shadow      from every primary hit to a uniform point on a light,
+//!                 a segment with tmax = distance − 1e-4
+//!     incoherent  from every primary hit in a uniformly random direction
+//! each engine fills Hits { t, prim } (closest) or a Vec<bool> (occluded) per ray;
+//! agreement: same prim, or both hit with |Δt| ≤ 1e-4·max(1, t) (shared edges), or both miss.
+//! ```
+//!
+//! Every comparison is **two-sided**: Embree (as Debian builds it, without
+//! `EMBREE_BACKFACE_CULLING`) reports hits on both sides of a triangle, so raywave's kernels are
+//! called with `two_sided = true` here, whatever the lab's one-sided convention says; and the
+//! scene is `without_emitters`, since a two-sided light wall would hide the lab's box.
+//!
+//! Rays are stored as wavefront `RayBatch`es of `BATCH` rays, so every engine reads the same
+//! structure-of-arrays columns and the wavefront stage gets its own input type without a copy
+//! inside the timed loop.
+
+#[cfg(feature = "embree")]
+pub mod embree;
+
+use crate::camera::CameraRays;
+use crate::geometry::{Ray, T_MIN, intersect_triangle};
+use crate::scene::{NO_HIT, Scene};
+use crate::wavefront::batch::{HitBatch, PathId, RayBatch};
+use crate::wavefront::context::Context;
+use crate::wavefront::{DEFAULT_BATCH_SIZE, intersect};
+use glam::{Vec3, Vec3A};
+use obvhs::{BvhBuildParams, cwbvh::CwBvh, ray::RayHit};
+use std::time::{Duration, Instant};
+
+/// The scene as the peers see it: every triangle except the emissive ones (the lights).
+///
+/// The lab's light is the box's whole front wall, facing inwards; one-sided, the camera looks
+/// through its back, but two-sided (as Embree traces) it would hide the whole box. The lights
+/// stay in `Scene::lights`, so shadow rays still aim at them; the segments end 1e-4 short of
+/// the light, so they never needed its triangles.
+pub fn without_emitters(scene: &Scene) -> Scene {
+    let mut peer = scene.clone();
+    peer.triangles
+        .retain(|t| scene.materials[t.material as usize].emitted == Vec3::ZERO);
+    peer
+}
+
+/// Rays per `RayBatch` of a ray set: the wavefront engine's default batch size.
+pub const BATCH: usize = DEFAULT_BATCH_SIZE;
+
+/// Which of the three ray sets.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RayKind {
+    /// Camera rays through pixel centres: coherent, closest hit.
+    Primary,
+    /// Segments from primary hits to light points: coherent, any hit (occlusion).
+    Shadow,
+    /// From primary hits in uniformly random directions: incoherent, closest hit.
+    Incoherent,
+}
+
+impl RayKind {
+    /// Lower-case name, for benchmark ids and tables.
+    pub fn name(self) -> &'static str {
+        match self {
+            RayKind::Primary => "primary",
+            RayKind::Shadow => "shadow",
+            RayKind::Incoherent => "incoherent",
+        }
+    }
+}
+
+/// One ray set, in wavefront batches of `BATCH` rays (the last one shorter).
+#[derive(Clone, Debug)]
+pub struct RaySet {
+    /// What the rays are.
+    pub kind: RayKind,
+    /// The rays; `tmax` is infinity except for shadow segments.
+    pub batches: Vec<RayBatch>,
+}
+
+impl RaySet {
+    fn new(kind: RayKind) -> Self {
+        RaySet {
+            kind,
+            batches: Vec::new(),
+        }
+    }
+
+    /// Number of rays.
+    pub fn len(&self) -> usize {
+        self.batches.iter().map(RayBatch::len).sum()
+    }
+
+    /// True without rays.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    fn push(&mut self, origin: Vec3, direction: Vec3, tmax: f32) {
+        if self.batches.last().is_none_or(|b| b.len() == BATCH) {
+            self.batches.push(RayBatch::default());
+        }
+        let batch = self.batches.last_mut().expect("a batch was just pushed");
+        let n = batch.len() as u32;
+        let path = PathId {
+            pixel: n,
+            sample: 0,
+            slot: n,
+        };
+        batch.push(origin, direction, Vec3::ONE, path);
+        *batch.tmax.last_mut().expect("a ray was just pushed") = tmax;
+    }
+
+    /// Ray `i` of batch `b` as the scalar kernels want it, with its tmax.
+    #[inline]
+    pub fn ray(batch: &RayBatch, i: usize) -> (Ray, f32) {
+        (
+            Ray {
+                origin: batch.origin(i),
+                direction: batch.direction(i),
+            },
+            batch.tmax[i],
+        )
+    }
+}
+
+/// The three ray sets of one scene.
+#[derive(Clone, Debug)]
+pub struct RaySets {
+    /// Camera rays, one per pixel.
+    pub primary: RaySet,
+    /// One shadow segment per primary hit.
+    pub shadow: RaySet,
+    /// One random-direction ray per primary hit.
+    pub incoherent: RaySet,
+}
+
+impl RaySets {
+    /// Builds the sets for a `width` × `height` image of the scene's camera; the primary hits
+    /// come from `bvh`, the random numbers from `seed` alone.
+    pub fn new(scene: &Scene, bvh: &ObvhsMesh, width: u32, height: u32, seed: u64) -> Self {
+        let camera = CameraRays::new(&scene.camera, width, height);
+        let mut primary = RaySet::new(RayKind::Primary);
+        for pixel in 0..width * height {
+            let (x, y) = camera.screen(pixel, 0.5, 0.5);
+            let ray = camera.ray(x, y);
+            primary.push(ray.origin, ray.direction, f32::INFINITY);
+        }
+        let mut hits = Hits::default();
+        bvh.closest(scene, &primary, &mut hits);
+
+        let mut rng = SplitMix64(seed);
+        let mut shadow = RaySet::new(RayKind::Shadow);
+        let mut incoherent = RaySet::new(RayKind::Incoherent);
+        let rays = primary
+            .batches
+            .iter()
+            .flat_map(|b| (0..b.len()).map(move |i| (b, i)));
+        for ((batch, i), (&t, &prim)) in rays.zip(hits.t.iter().zip(&hits.prim)) {
+            if prim == NO_HIT {
+                continue;
+            }
+            let point = batch.origin(i) + t * batch.direction(i);
+            if !scene.lights.is_empty() {
+                let light = &scene.lights[rng.below(scene.lights.len())];
+                let target = light.point(rng.unit(), rng.unit());
+                let to_light = target - point;
+                let dist = to_light.length();
+                if dist > 2.0 * T_MIN {
+                    shadow.push(point, to_light / dist, dist - T_MIN);
+                }
+            }
+            // Uniform on the sphere: z uniform in [-1, 1], azimuth uniform.
+            let z = 1.0 - 2.0 * rng.unit();
+            let phi = std::f32::consts::TAU * rng.unit();
+            let r = (1.0 - z * z).max(0.0).sqrt();
+            let direction = Vec3::new(r * phi.cos(), r * phi.sin(), z);
+            incoherent.push(point, direction, f32::INFINITY);
+        }
+        RaySets {
+            primary,
+            shadow,
+            incoherent,
+        }
+    }
+
+    /// The three sets in the order primary, shadow, incoherent.
+    pub fn all(&self) -> [&RaySet; 3] {
+        [&self.primary, &self.shadow, &self.incoherent]
+    }
+}
+
+/// A small, fixed-seed generator (SplitMix64): the ray sets must not depend on `rand`'s
+/// version or platform.
+struct SplitMix64(u64);
+
+impl SplitMix64 {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+
+    /// Uniform in [0, 1) with 24 bits.
+    fn unit(&mut self) -> f32 {
+        (self.next() >> 40) as f32 * (1.0 / (1u64 << 24) as f32)
+    }
+
+    fn below(&mut self, n: usize) -> usize {
+        (self.next() % n as u64) as usize
+    }
+}
+
+/// Closest hits of a ray set, in ray order: `t = INFINITY`, `prim = NO_HIT` for a miss.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Hits {
+    /// Hit distance.
+    pub t: Vec<f32>,
+    /// Triangle index in `Scene::triangles`.
+    pub prim: Vec<u32>,
+}
+
+impl Hits {
+    /// Empties both columns, keeping their capacity.
+    pub fn clear(&mut self) {
+        self.t.clear();
+        self.prim.clear();
+    }
+
+    /// Appends one result.
+    #[inline]
+    pub fn push(&mut self, t: f32, prim: u32) {
+        self.t.push(t);
+        self.prim.push(prim);
+    }
+}
+
+/// obvhs's CWBVH over a scene's triangles, traced one ray at a time: the baseline of issue 3.
+pub struct ObvhsMesh {
+    /// The BVH (primitive indices map back to `Scene::triangles`).
+    pub bvh: CwBvh,
+    /// Wall time of the build, triangle conversion included.
+    pub build_time: Duration,
+}
+
+impl ObvhsMesh {
+    /// Builds the CWBVH with the same preset as raywave's `Accel` (`medium_build`).
+    pub fn new(scene: &Scene) -> Self {
+        let start = Instant::now();
+        let tris: Vec<obvhs::triangle::Triangle> = scene
+            .triangles
+            .iter()
+            .map(|t| obvhs::triangle::Triangle {
+                v0: t.v0.into(),
+                v1: (t.v0 + t.e1).into(),
+                v2: (t.v0 + t.e2).into(),
+            })
+            .collect();
+        let mut core = Duration::ZERO;
+        let bvh = obvhs::cwbvh::builder::build_cwbvh_from_tris(
+            &tris,
+            BvhBuildParams::medium_build(),
+            &mut core,
+        );
+        ObvhsMesh {
+            bvh,
+            build_time: start.elapsed(),
+        }
+    }
+
+    /// Closest two-sided hit of every ray (`ray_traverse`), into `out`.
+    pub fn closest(&self, scene: &Scene, set: &RaySet, out: &mut Hits) {
+        out.clear();
+        let bvh = &self.bvh;
+        for batch in &set.batches {
+            for i in 0..batch.len() {
+                let (ray, tmax) = RaySet::ray(batch, i);
+                let mut hit = RayHit::none();
+                let found = bvh.ray_traverse(obvhs_ray(&ray, tmax), &mut hit, |r, id| {
+                    let tri = &scene.triangles[bvh.primitive_indices[id] as usize];
+                    intersect_triangle(tri, &ray, r.tmax, true)
+                });
+                if found {
+                    out.push(hit.t, bvh.primitive_indices[hit.primitive_id as usize]);
+                } else {
+                    out.push(f32::INFINITY, NO_HIT);
+                }
+            }
+        }
+    }
+
+    /// Whether anything blocks each segment (`ray_traverse_miss`, first blocker), into `out`.
+    pub fn occluded(&self, scene: &Scene, set: &RaySet, out: &mut Vec<bool>) {
+        out.clear();
+        let bvh = &self.bvh;
+        for batch in &set.batches {
+            for i in 0..batch.len() {
+                let (ray, tmax) = RaySet::ray(batch, i);
+                let miss = bvh.ray_traverse_miss(obvhs_ray(&ray, tmax), |_, id| {
+                    let tri = &scene.triangles[bvh.primitive_indices[id] as usize];
+                    intersect_triangle(tri, &ray, tmax, true)
+                });
+                out.push(!miss);
+            }
+        }
+    }
+}
+
+fn obvhs_ray(ray: &Ray, tmax: f32) -> obvhs::ray::Ray {
+    obvhs::ray::Ray::new(
+        Vec3A::from(ray.origin),
+        Vec3A::from(ray.direction),
+        T_MIN,
+        tmax,
+    )
+}
+
+/// raywave's wavefront intersect stage over the set's batches (`intersect::closest`, which also
+/// fills the shading columns of `scratch`), with t and prim copied into `out`. The context must
+/// be built with `two_sided = true` for peer comparisons.
+pub fn wavefront_closest(ctx: &Context, set: &RaySet, scratch: &mut HitBatch, out: &mut Hits) {
+    out.clear();
+    for batch in &set.batches {
+        intersect::closest(ctx, batch, scratch);
+        out.t.extend_from_slice(&scratch.t[..batch.len()]);
+        out.prim.extend_from_slice(&scratch.prim[..batch.len()]);
+    }
+}
+
+/// The wavefront engine's occlusion path for meshes, over the set's batches.
+///
+/// `wavefront::shadow` keeps its occlusion pass (`occlude`) private and only exposes
+/// `direct_light`, which spawns its own shadow rays from light samples; so this repeats that
+/// pass's mesh branch verbatim (`Accel::occluded` per queued ray, `ray_traverse_miss` inside)
+/// through the public `Context::accel`. Scenes below `BVH_MIN_TRIANGLES` have no BVH and are
+/// not mesh scenes: they panic here.
+pub fn wavefront_occluded(ctx: &Context, set: &RaySet, out: &mut Vec<bool>) {
+    out.clear();
+    let accel = ctx
+        .accel
+        .as_ref()
+        .expect("peer comparisons run on mesh scenes, which have a BVH");
+    let two_sided = ctx.settings.two_sided;
+    for batch in &set.batches {
+        for i in 0..batch.len() {
+            let (ray, tmax) = RaySet::ray(batch, i);
+            out.push(accel.occluded(ctx.scene, &ray, tmax, two_sided));
+        }
+    }
+}
+
+/// Every triangle against every ray, two-sided: the independent answer for small tests.
+pub fn brute_force_closest(scene: &Scene, set: &RaySet, out: &mut Hits) {
+    out.clear();
+    for batch in &set.batches {
+        for i in 0..batch.len() {
+            let (ray, mut best) = RaySet::ray(batch, i);
+            let mut prim = NO_HIT;
+            for (k, tri) in scene.triangles.iter().enumerate() {
+                let t = intersect_triangle(tri, &ray, best, true);
+                if t < best {
+                    best = t;
+                    prim = k as u32;
+                }
+            }
+            out.push(if prim == NO_HIT { f32::INFINITY } else { best }, prim);
+        }
+    }
+}
+
+/// How many rays two engines agree on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Agreement {
+    /// Rays compared.
+    pub rays: usize,
+    /// Rays with the same answer.
+    pub agree: usize,
+    /// Of those, rays that hit different triangles at the same distance (a shared edge).
+    pub same_t_other_prim: usize,
+}
+
+impl Agreement {
+    /// agree / rays (1 for no rays).
+    pub fn fraction(&self) -> f64 {
+        if self.rays == 0 {
+            1.0
+        } else {
+            self.agree as f64 / self.rays as f64
+        }
+    }
+
+    /// Rays with different answers.
+    pub fn disagree(&self) -> usize {
+        self.rays - self.agree
+    }
+}
+
+/// Relative distance tolerance under which two hits on different triangles count as one hit
+/// on their shared edge.
+pub const EDGE_T_TOLERANCE: f32 = 1e-4;
+
+/// Closest hits agree when both miss, both name the same triangle, or both hit at distances
+/// within `EDGE_T_TOLERANCE · max(1, t)` (two triangles sharing the edge the ray crosses).
+pub fn hit_agreement(a: &Hits, b: &Hits) -> Agreement {
+    assert_eq!(a.t.len(), b.t.len(), "hit lists of different lengths");
+    let mut agreement = Agreement {
+        rays: a.t.len(),
+        agree: 0,
+        same_t_other_prim: 0,
+    };
+    for i in 0..a.t.len() {
+        let (pa, pb) = (a.prim[i], b.prim[i]);
+        if pa == pb {
+            agreement.agree += 1;
+        } else if pa != NO_HIT
+            && pb != NO_HIT
+            && (a.t[i] - b.t[i]).abs() <= EDGE_T_TOLERANCE * a.t[i].max(1.0)
+        {
+            agreement.agree += 1;
+            agreement.same_t_other_prim += 1;
+        }
+    }
+    agreement
+}
+
+/// Occlusion answers agree when they are equal.
+pub fn occlusion_agreement(a: &[bool], b: &[bool]) -> Agreement {
+    assert_eq!(a.len(), b.len(), "occlusion lists of different lengths");
+    Agreement {
+        rays: a.len(),
+        agree: a.iter().zip(b).filter(|(x, y)| x == y).count(),
+        same_t_other_prim: 0,
+    }
+}
