@@ -216,10 +216,10 @@ fn shade(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch, queue: &ShadowQueu
             );
             // In lane order, like the reference's loop; lanes that add nothing hold −0.0.
             let (mut r, mut g, mut b) = (hits.direct_r[i], hits.direct_g[i], hits.direct_b[i]);
-            for k in 0..LANES {
-                r += c[0][k];
-                g += c[1][k];
-                b += c[2][k];
+            for ((cr, cg), cb) in c[0].iter().zip(&c[1]).zip(&c[2]) {
+                r += cr;
+                g += cg;
+                b += cb;
             }
             (hits.direct_r[i], hits.direct_g[i], hits.direct_b[i]) = (r, g, b);
             q = end;
