@@ -5,7 +5,7 @@
 //! ```text
 //! for scene in [12k, 1M]:                        generated in memory by meshgen, built once
 //!     print triangles, BVH build times, ray counts, hit agreement against obvhs
-//!     for set in [primary, shadow, incoherent]:  group "<set>_<scene>", throughput in rays
+//!     for set in [primary, shadow, incoherent, shadow_fan]:  group "<set>_<scene>", throughput in rays
 //!         obvhs_one_ray, wavefront, embree_single, embree_packet8
 //! ```
 //!
@@ -95,7 +95,7 @@ fn report(s: &Setup, ctx: &Context) {
     let mut scratch = HitBatch::default();
     for set in s.sets.all() {
         let mut lines = Vec::new();
-        if set.kind == RayKind::Shadow {
+        if set.kind.is_occlusion() {
             let (mut reference, mut other) = (Vec::new(), Vec::new());
             s.obvhs.occluded(&s.scene, set, &mut reference);
             let blocked = reference.iter().filter(|&&b| b).count();
@@ -152,7 +152,7 @@ fn bench_set(c: &mut Criterion, s: &Setup, ctx: &Context, set: &RaySet) {
     let mut group = c.benchmark_group(format!("{}_{}", set.kind.name(), s.label));
     group.throughput(Throughput::Elements(set.len() as u64));
     let (mut hits, mut blocked, mut scratch) = (Hits::default(), Vec::new(), HitBatch::default());
-    let shadow = set.kind == RayKind::Shadow;
+    let shadow = set.kind.is_occlusion();
     group.bench_function(BenchmarkId::from_parameter("obvhs_one_ray"), |b| {
         b.iter(|| {
             if shadow {

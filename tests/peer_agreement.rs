@@ -65,6 +65,15 @@ fn ray_sets_are_what_they_claim() {
     for batch in &sets.shadow.batches {
         assert!(batch.tmax.iter().all(|t| t.is_finite() && *t > 0.0));
     }
+    // The fan: 8 segments from every 8th hit, one origin per aligned block of 8.
+    assert_eq!(sets.shadow_fan.len(), 8 * primary_hits.div_ceil(8));
+    for batch in &sets.shadow_fan.batches {
+        assert!(batch.len().is_multiple_of(8));
+        for block in (0..batch.len()).step_by(8) {
+            assert!((block..block + 8).all(|i| batch.origin(i) == batch.origin(block)));
+            assert!((block + 1..block + 8).any(|i| batch.direction(i) != batch.direction(block)));
+        }
+    }
     // Same seed, same rays; another seed, other random rays.
     let again = RaySets::new(&scene, &bvh, SIZE, SIZE, SEED);
     assert_eq!(
@@ -90,12 +99,14 @@ fn obvhs_one_ray_equals_brute_force() {
         check(set.kind.name(), hit_agreement(&a, &b));
     }
     // Occlusion: blocked exactly when the brute-force closest hit lies inside the segment.
-    let mut blocked = Vec::new();
-    bvh.occluded(&scene, &sets.shadow, &mut blocked);
-    let mut closest = Hits::default();
-    brute_force_closest(&scene, &sets.shadow, &mut closest);
-    let brute: Vec<bool> = closest.prim.iter().map(|&p| p != NO_HIT).collect();
-    check("shadow", occlusion_agreement(&blocked, &brute));
+    for set in [&sets.shadow, &sets.shadow_fan] {
+        let mut blocked = Vec::new();
+        bvh.occluded(&scene, set, &mut blocked);
+        let mut closest = Hits::default();
+        brute_force_closest(&scene, set, &mut closest);
+        let brute: Vec<bool> = closest.prim.iter().map(|&p| p != NO_HIT).collect();
+        check(set.kind.name(), occlusion_agreement(&blocked, &brute));
+    }
 }
 
 #[test]
@@ -113,10 +124,12 @@ fn wavefront_equals_obvhs_one_ray() {
         wavefront_closest(&ctx, set, &mut scratch, &mut b);
         check(set.kind.name(), hit_agreement(&a, &b));
     }
-    let (mut a, mut b) = (Vec::new(), Vec::new());
-    bvh.occluded(&scene, &sets.shadow, &mut a);
-    wavefront_occluded(&ctx, &sets.shadow, &mut b);
-    check("shadow", occlusion_agreement(&a, &b));
+    for set in [&sets.shadow, &sets.shadow_fan] {
+        let (mut a, mut b) = (Vec::new(), Vec::new());
+        bvh.occluded(&scene, set, &mut a);
+        wavefront_occluded(&ctx, set, &mut b);
+        check(set.kind.name(), occlusion_agreement(&a, &b));
+    }
 }
 
 #[test]
@@ -158,12 +171,14 @@ fn embree_single_and_packet_equal_obvhs() {
         check(set.kind.name(), hit_agreement(&reference, &single));
         check(set.kind.name(), hit_agreement(&reference, &packet));
     }
-    let (mut reference, mut single, mut packet) = (Vec::new(), Vec::new(), Vec::new());
-    bvh.occluded(&scene, &sets.shadow, &mut reference);
-    embree.occluded1(&sets.shadow, &mut single);
-    embree.occluded8(&sets.shadow, &mut packet);
-    check("shadow single", occlusion_agreement(&reference, &single));
-    check("shadow packet", occlusion_agreement(&reference, &packet));
+    for set in [&sets.shadow, &sets.shadow_fan] {
+        let (mut reference, mut single, mut packet) = (Vec::new(), Vec::new(), Vec::new());
+        bvh.occluded(&scene, set, &mut reference);
+        embree.occluded1(set, &mut single);
+        embree.occluded8(set, &mut packet);
+        check(set.kind.name(), occlusion_agreement(&reference, &single));
+        check(set.kind.name(), occlusion_agreement(&reference, &packet));
+    }
 }
 
 /// Camera rays that enter the box through its open front (the light wall is removed) must hit

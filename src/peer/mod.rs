@@ -7,6 +7,8 @@
 //!     shadow      from every primary hit to a uniform point on a light,
 //!                 a segment with tmax = distance − 1e-4
 //!     incoherent  from every primary hit in a uniformly random direction
+//!     shadow_fan  from every 8th primary hit, 8 segments to 8 random light points: the
+//!                 renderer's soft-shadow pattern (one origin per 8-ray packet)
 //! each engine fills Hits { t, prim } (closest) or a Vec<bool> (occluded) per ray;
 //! agreement: same prim, or both hit with |Δt| ≤ 1e-4·max(1, t) (shared edges), or both miss.
 //! ```
@@ -58,6 +60,9 @@ pub enum RayKind {
     Shadow,
     /// From primary hits in uniformly random directions: incoherent, closest hit.
     Incoherent,
+    /// 8 segments from one primary hit to 8 light points, for every 8th hit: occlusion, one
+    /// origin per aligned block of 8 (how the renderer casts soft shadows).
+    ShadowFan,
 }
 
 impl RayKind {
@@ -67,7 +72,13 @@ impl RayKind {
             RayKind::Primary => "primary",
             RayKind::Shadow => "shadow",
             RayKind::Incoherent => "incoherent",
+            RayKind::ShadowFan => "shadow_fan",
         }
+    }
+
+    /// True for occlusion (any-hit) sets, false for closest-hit sets.
+    pub fn is_occlusion(self) -> bool {
+        matches!(self, RayKind::Shadow | RayKind::ShadowFan)
     }
 }
 
@@ -135,6 +146,8 @@ pub struct RaySets {
     pub shadow: RaySet,
     /// One random-direction ray per primary hit.
     pub incoherent: RaySet,
+    /// 8 shadow segments from every 8th primary hit, in aligned blocks of 8.
+    pub shadow_fan: RaySet,
 }
 
 impl RaySets {
@@ -154,6 +167,10 @@ impl RaySets {
         let mut rng = SplitMix64(seed);
         let mut shadow = RaySet::new(RayKind::Shadow);
         let mut incoherent = RaySet::new(RayKind::Incoherent);
+        let mut shadow_fan = RaySet::new(RayKind::ShadowFan);
+        // Its own stream, so adding the fan set left the other sets unchanged.
+        let mut fan_rng = SplitMix64(seed ^ 0xfa4_fa4_fa4);
+        let mut hit_index = 0usize;
         let rays = primary
             .batches
             .iter()
@@ -178,17 +195,40 @@ impl RaySets {
             let r = (1.0 - z * z).max(0.0).sqrt();
             let direction = Vec3::new(r * phi.cos(), r * phi.sin(), z);
             incoherent.push(point, direction, f32::INFINITY);
+            if hit_index.is_multiple_of(8) && !scene.lights.is_empty() {
+                let light = &scene.lights[fan_rng.below(scene.lights.len())];
+                for _ in 0..8 {
+                    let target = light.point(fan_rng.unit(), fan_rng.unit());
+                    let to_light = target - point;
+                    let dist = to_light.length();
+                    // A dead lane (tmax 0) keeps the block aligned; no engine reports a hit
+                    // in (1e-4, 0).
+                    let (l, tmax) = if dist > 2.0 * T_MIN {
+                        (to_light / dist, dist - T_MIN)
+                    } else {
+                        (Vec3::Z, 0.0)
+                    };
+                    shadow_fan.push(point, l, tmax);
+                }
+            }
+            hit_index += 1;
         }
         RaySets {
             primary,
             shadow,
             incoherent,
+            shadow_fan,
         }
     }
 
-    /// The three sets in the order primary, shadow, incoherent.
-    pub fn all(&self) -> [&RaySet; 3] {
-        [&self.primary, &self.shadow, &self.incoherent]
+    /// The sets in the order primary, shadow, incoherent, shadow_fan.
+    pub fn all(&self) -> [&RaySet; 4] {
+        [
+            &self.primary,
+            &self.shadow,
+            &self.incoherent,
+            &self.shadow_fan,
+        ]
     }
 }
 
