@@ -109,8 +109,9 @@ fn report(s: &Setup, ctx: &Context) {
                 lines.push(("embree_packet8", occlusion_agreement(&reference, &other)));
             }
             eprintln!(
-                "[{}] shadow: {} rays, {blocked} blocked",
+                "[{}] {}: {} rays, {blocked} blocked",
                 s.label,
+                set.kind.name(),
                 set.len()
             );
         } else {
