@@ -177,12 +177,15 @@ impl<'a> Reference<'a> {
                     _ => light.centroid,
                 };
                 let to_light = target - point;
+                // The point must lie more than T_MIN above the tangent plane: for a light's own
+                // points (and coplanar lights) n·l is 0 up to rounding, and a rounding-positive
+                // n·l would add the 0.2·ke term as a speckle.
+                if !(n.dot(to_light) > T_MIN) {
+                    continue;
+                }
                 let dist = to_light.length();
                 let l = to_light / dist;
                 let n_dot_l = n.dot(l);
-                if !(n_dot_l > 0.0) {
-                    continue;
-                }
                 let visible = match settings.shadows {
                     ShadowMode::Off => {
                         log.shadow_ray(key.bounce, li as u32, point, target, None);

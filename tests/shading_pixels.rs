@@ -419,9 +419,6 @@ fn floor_seen_from_below_is_invisible_unless_two_sided() {
 }
 
 #[test]
-#[ignore = "bug in both engines (reference.rs and src/wavefront/shadow.rs, simd.rs): a light seen \
-            directly samples its own plane with n·l = ±rounding, and 0.2·ke then adds random \
-            speckles; needs the same fix in both engines, see the test's comment"]
 fn a_light_seen_directly_is_uniform_not_speckled() {
     // Two coplanar lights at y = 1 facing down (like scenes/two_lights.obj), seen from below.
     // For every point on a light, its own sample points and the other light's lie in its plane:
@@ -430,10 +427,9 @@ fn a_light_seen_directly_is_uniform_not_speckled() {
     //
     // In float arithmetic the hit point is off the plane by a rounding error, n·l comes out as
     // ±1e-8, and whenever it is positive the sample adds Shade = 0.2·ke + (≈ 0) / N: bright
-    // random dots on the lights (visible in scenes/two_lights.obj). Suggested fix, in both
-    // engines with the same expression so they stay twins: count a light point only when it is
-    // more than T_MIN above the surface's tangent plane, `n.dot(to_light) > T_MIN`, instead of
-    // `n.dot(l) > 0` (the same 1e-4 the shadow rays already use).
+    // random dots on the lights (as scenes/two_lights.obj showed). Both engines now count a
+    // light point only when it is more than T_MIN above the surface's tangent plane,
+    // `n.dot(to_light) > T_MIN`, instead of `n.dot(l) > 0` (the same 1e-4 the shadow rays use).
     let text = "\
 material
 diffuse 0.5 0.5 0.5

@@ -467,7 +467,7 @@ proptest! {
                 let dist = to_light.length();
                 let want_l = to_light / dist;
                 let want_ndl = n.dot(want_l);
-                let alive = want_ndl > 0.0;
+                let alive = n.dot(to_light) > raywave::geometry::T_MIN;
                 prop_assert_eq!(live & (1 << k) != 0, alive);
                 if alive {
                     prop_assert_eq!([l[0][k], l[1][k], l[2][k]].map(f32::to_bits),

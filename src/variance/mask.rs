@@ -88,7 +88,8 @@ fn classify(
                 let to = light.point(u, v) - point;
                 let dist = to.length();
                 let l = to / dist;
-                if n.dot(l) > 0.0
+                // Above the tangent plane by more than T_MIN, as in the renderers.
+                if n.dot(to) > T_MIN
                     && !accel.occluded(
                         scene,
                         &Ray {

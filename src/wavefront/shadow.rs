@@ -131,7 +131,8 @@ fn spawn(
                     let dist = to_light.length();
                     let l = to_light / dist;
                     let n_dot_l = n.dot(l);
-                    if n_dot_l > 0.0 {
+                    // Above the tangent plane by more than T_MIN, as in the reference.
+                    if n.dot(to_light) > T_MIN {
                         queue.push(point, l, dist - T_MIN, n_dot_l, i as u32, li as u32);
                         cast += 1;
                     }

@@ -425,8 +425,9 @@ pub fn light_points8(b: &LightBlock) -> [[f32; LANES]; 3] {
 
 /// Shadow rays from `point` (normal `n`) to 8 targets, the first `lanes` of them real: unit
 /// directions l, tmax = dist − T_MIN and n·l, each lane equal to the reference's
-/// `to_light = target − point; dist = |to_light|; l = to_light / dist; n·l`. Lanes with
-/// n·l ≤ 0 (the reference casts no ray) or past `lanes` come back dead: tmax = 0, n·l = 0.
+/// `to_light = target − point; dist = |to_light|; l = to_light / dist; n·l`. Lanes whose
+/// target is not more than T_MIN above the tangent plane (n·to_light ≤ T_MIN: the reference
+/// casts no ray) or past `lanes` come back dead: tmax = 0, n·l = 0.
 /// Also returns the bitmask of live lanes.
 #[inline]
 #[allow(clippy::type_complexity)]
@@ -443,7 +444,8 @@ pub fn shadow_rays8(
     let (lx, ly, lz) = (x / dist, y / dist, z / dist);
     let n_dot_l = f32x8::splat(n.x) * lx + f32x8::splat(n.y) * ly + f32x8::splat(n.z) * lz;
     let first = f32x8::new(std::array::from_fn(|k| if k < lanes { 1.0 } else { 0.0 }));
-    let live = n_dot_l.simd_gt(f32x8::ZERO) & first.simd_gt(f32x8::ZERO);
+    let above = f32x8::splat(n.x) * x + f32x8::splat(n.y) * y + f32x8::splat(n.z) * z;
+    let live = above.simd_gt(f32x8::splat(T_MIN)) & first.simd_gt(f32x8::ZERO);
     let zero = f32x8::ZERO;
     (
         [lx.to_array(), ly.to_array(), lz.to_array()],
