@@ -77,6 +77,11 @@ fn modes() -> Vec<RenderSettings> {
             two_sided: true,
             ..soft(9, LightSampler::Stratified)
         },
+        // Samplers the 8-wide light sampler does not implement (the scalar path); lab at
+        // N = 1 is the centroid, at N > 1 random points.
+        soft(7, LightSampler::Sobol),
+        soft(1, LightSampler::Lab),
+        soft(6, LightSampler::Lab),
     ]
 }
 

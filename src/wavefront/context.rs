@@ -135,6 +135,16 @@ impl<'a> Context<'a> {
         self.settings.shadows == ShadowMode::Soft
     }
 
+    /// True when the 8-wide light sampler (`simd::light_points8`) implements the chosen
+    /// sampler: random and stratified. Sobol and the lab's strategy take the scalar path
+    /// through `sampling::square_sample`, which serves every sampler.
+    pub fn simd_light_sampling(&self) -> bool {
+        matches!(
+            self.settings.sampler,
+            LightSampler::Random | LightSampler::Stratified
+        )
+    }
+
     /// True for stratified light sampling.
     pub fn stratified(&self) -> bool {
         self.settings.sampler == LightSampler::Stratified

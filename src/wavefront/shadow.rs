@@ -93,7 +93,10 @@ fn spawn(
             light: li as u32,
             seed: ctx.settings.seed,
         };
-        match (ctx.samples_lights(), light.parallelogram) {
+        match (
+            ctx.samples_lights() && ctx.simd_light_sampling(),
+            light.parallelogram,
+        ) {
             (true, Some((origin, edge_u, edge_v))) => {
                 let prefix = key_prefix(&key);
                 for j0 in (0..count).step_by(LANES) {
