@@ -5,6 +5,7 @@
 //! of view and non-square images crop it.
 
 use crate::geometry::Ray;
+use crate::sampling::{CAMERA_LIGHT, SampleKey, pixel_offset};
 use crate::scene::Camera;
 use glam::Vec3;
 
@@ -54,6 +55,23 @@ impl CameraRays {
             (i + ox - 0.5 * w) * scale + 0.5,
             (j + oy - 0.5 * h) * scale + 0.5,
         )
+    }
+
+    /// The ray of antialiasing sample `sample` of `samples` in `pixel`: through the pixel centre
+    /// for one sample, through a jittered stratum for more (`sampling::pixel_offset`). Both
+    /// engines generate their camera rays here, so they start from identical rays.
+    #[inline]
+    pub fn sample_ray(&self, pixel: u32, sample: u32, samples: u32, seed: u32) -> Ray {
+        let key = SampleKey {
+            pixel,
+            sample,
+            bounce: 0,
+            light: CAMERA_LIGHT,
+            seed,
+        };
+        let (ox, oy) = pixel_offset(&key, sample, samples);
+        let (x, y) = self.screen(pixel, ox, oy);
+        self.ray(x, y)
     }
 
     /// The camera ray through screen point (x, y).

@@ -15,7 +15,7 @@
 use crate::camera::CameraRays;
 use crate::film::Film;
 use crate::geometry::{Accel, Hit, Ray, T_MIN, geometric_normal};
-use crate::sampling::{SampleKey, pixel_offset, square_sample};
+use crate::sampling::{SampleKey, square_sample};
 use crate::scene::Scene;
 use crate::settings::{RenderSettings, ShadowMode};
 use crate::shading::{AMBIENT, reflect, shade};
@@ -100,10 +100,9 @@ impl<'a> Reference<'a> {
                 light: 0,
                 seed: self.settings.seed,
             };
-            let (ox, oy) = pixel_offset(&key, sample, n);
-            let (x, y) = self.camera.screen(pixel, ox, oy);
+            let ray = self.camera.sample_ray(pixel, sample, n, self.settings.seed);
             counts.camera += 1;
-            sum += self.trace(&self.camera.ray(x, y), key, counts, log);
+            sum += self.trace(&ray, key, counts, log);
         }
         sum / n as f32
     }

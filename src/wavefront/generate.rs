@@ -5,7 +5,6 @@
 
 use super::batch::{PathId, RayBatch};
 use super::context::Context;
-use crate::sampling::{SampleKey, pixel_offset};
 use glam::Vec3;
 
 /// Fills `rays` (depth 0) with the camera rays of pixels `first..first + count`; ray
@@ -15,16 +14,7 @@ pub fn camera_rays(ctx: &Context, first: u32, count: u32, rays: &mut RayBatch) {
     let n = ctx.settings.aa_samples.max(1);
     for pixel in first..first + count {
         for sample in 0..n {
-            let key = SampleKey {
-                pixel,
-                sample,
-                bounce: 0,
-                light: 0,
-                seed: ctx.settings.seed,
-            };
-            let (ox, oy) = pixel_offset(&key, sample, n);
-            let (x, y) = ctx.camera.screen(pixel, ox, oy);
-            let ray = ctx.camera.ray(x, y);
+            let ray = ctx.camera.sample_ray(pixel, sample, n, ctx.settings.seed);
             let slot = (pixel - first) * n + sample;
             rays.push(
                 ray.origin,
