@@ -29,6 +29,8 @@ pub enum Command {
     /// Write a generated mesh scene: the lab's Cornell box with its three mirror spheres
     /// tessellated (for the BVH benchmarks: about 12k or 1M triangles).
     Meshgen(MeshgenArgs),
+    /// Compare light samplers: MSE, bias, variance and slopes against a converged reference.
+    Variance(crate::variance::command::VarianceArgs),
 }
 
 /// `raywave meshgen` flags.
@@ -195,6 +197,7 @@ const SUBCOMMANDS: &[&str] = &[
     "render",
     "info",
     "meshgen",
+    "variance",
     "help",
     "-h",
     "--help",

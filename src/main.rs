@@ -11,8 +11,9 @@ use raywave::reference::Reference;
 use raywave::scene::Scene;
 use raywave::settings::{RenderSettings, ShadowMode};
 use raywave::stats::RayCounts;
-use raywave::wavefront::Wavefront;
+use raywave::variance::command::VarianceArgs;
 use raywave::wavefront::stats::RenderStats;
+use raywave::wavefront::{DEFAULT_BATCH_SIZE, Wavefront};
 use std::io::Write;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -26,6 +27,7 @@ fn main() -> ExitCode {
             Ok(())
         }
         Command::Meshgen(args) => meshgen(&args),
+        Command::Variance(args) => variance(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -56,6 +58,18 @@ fn meshgen(args: &MeshgenArgs) -> Result<()> {
         raywave::meshgen::triangle_count(bands)
     );
     Ok(())
+}
+
+fn variance(args: &VarianceArgs) -> Result<()> {
+    let pool = thread_pool(args.threads)?;
+    let render = |scene: &Scene, settings: &RenderSettings| match args.engine {
+        Engine::Reference => Reference::new(scene, settings).render(&|| {}),
+        Engine::Wavefront => {
+            let (film, stats) = Wavefront::new(scene, settings, DEFAULT_BATCH_SIZE).render(&|| {});
+            (film, stats.counts)
+        }
+    };
+    pool.install(|| raywave::variance::command::run(args, args.engine.name(), &render))
 }
 
 fn thread_pool(threads: Option<u32>) -> Result<rayon::ThreadPool> {
@@ -99,11 +113,11 @@ fn render(args: &RenderArgs) -> Result<()> {
     let pool = thread_pool(args.threads)?;
     let threads = pool.current_num_threads();
 
-    let reference = Reference::new(&scene, &settings);
     let (film, report) = match args.engine {
         Engine::Reference => {
             let progress = progress_bar(settings.height as u64, "rows", args.quiet);
             let start = Instant::now();
+            let reference = Reference::new(&scene, &settings);
             let (film, counts) = pool.install(|| reference.render(&|| progress.inc(1)));
             let seconds = start.elapsed().as_secs_f64();
             progress.finish_and_clear();
@@ -132,6 +146,8 @@ fn render(args: &RenderArgs) -> Result<()> {
             ..Default::default()
         };
         let pixel = px[1] * settings.width + px[0];
+        // The debug view follows the reference's recursion (both engines trace the same rays).
+        let reference = Reference::new(&scene, &settings);
         let colour = reference.pixel(pixel, &mut RayCounts::default(), &mut recorder);
         println!(
             "rays traced for pixel ({}, {}), colour {:.5}:",

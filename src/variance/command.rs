@@ -47,6 +47,12 @@ pub struct VarianceArgs {
     /// Always render the converged reference, ignoring and not writing the cache.
     #[arg(long)]
     pub no_cache: bool,
+    /// The engine that renders the images (both draw the same samples).
+    #[arg(long, value_enum, default_value = "wavefront")]
+    pub engine: crate::cli::Engine,
+    /// Worker threads [default: all cores].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub threads: Option<u32>,
     /// No progress bar.
     #[arg(short, long)]
     pub quiet: bool,
