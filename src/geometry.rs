@@ -14,6 +14,12 @@ use std::time::Duration;
 /// The lab's self-intersection epsilon: a hit needs t > 1e-4.
 pub const T_MIN: f32 = 1e-4;
 
+/// Slack on the barycentric edge tests (u ≥ −ε, v ≥ −ε, u + v ≤ 1 + ε), so that a ray crossing
+/// the edge two triangles share (a quad's a–c diagonal) hits at least one of them: without it,
+/// rounding put both u of one triangle and v of the other just below 0 and rays leaked through
+/// (2 of 9216 camera rays into the lab's box). Both engines use the same constant.
+pub const EDGE_EPSILON: f32 = 1e-6;
+
 /// Below this many triangles the reference tests every primitive; above it, it uses a BVH.
 pub const BVH_MIN_TRIANGLES: usize = 64;
 
@@ -64,7 +70,12 @@ pub fn intersect_triangle(tri: &Triangle, ray: &Ray, tmax: f32, two_sided: bool)
     let qvec = tvec.cross(tri.e1);
     let v = ray.direction.dot(qvec) * inv_det;
     let t = tri.e2.dot(qvec) * inv_det;
-    if u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t > T_MIN && t < tmax {
+    if u >= -EDGE_EPSILON
+        && v >= -EDGE_EPSILON
+        && u + v <= 1.0 + EDGE_EPSILON
+        && t > T_MIN
+        && t < tmax
+    {
         t
     } else {
         f32::INFINITY

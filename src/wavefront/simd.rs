@@ -18,7 +18,7 @@
 //! (tmax = 0, NaN directions), and the padding is never stored back.
 
 use super::context::MaterialTerms;
-use crate::geometry::T_MIN;
+use crate::geometry::{EDGE_EPSILON, T_MIN};
 use crate::scene::{NO_HIT, Sphere, Triangle};
 use glam::Vec3;
 use wide::{f32x8, i32x8, u32x8};
@@ -100,7 +100,7 @@ fn live_lanes(i: usize, len: usize) -> u32 {
 /// ```text
 /// p = d × e2; det = e1·p; facing = det > 0 (det ≠ 0 if two-sided)
 /// s = o − v0; u = s·p / det; q = s × e1; v = d·q / det; t = e2·q / det
-/// hit = facing ∧ u ≥ 0 ∧ v ≥ 0 ∧ u + v ≤ 1 ∧ T_MIN < t < tmax   → t, else ∞
+/// hit = facing ∧ u ≥ −ε ∧ v ≥ −ε ∧ u + v ≤ 1 + ε ∧ T_MIN < t < tmax   → t, else ∞
 /// ```
 #[inline(always)]
 pub fn triangle8(tri: &Triangle, r: &Rays8, tmax: f32x8, two_sided: bool) -> f32x8 {
@@ -137,9 +137,9 @@ pub fn triangle8(tri: &Triangle, r: &Rays8, tmax: f32x8, two_sided: bool) -> f32
     let v = (r.dx * qx + r.dy * qy + r.dz * qz) * inv_det;
     let t = (e2x * qx + e2y * qy + e2z * qz) * inv_det;
     let hit = facing
-        & u.simd_ge(zero)
-        & v.simd_ge(zero)
-        & (u + v).simd_le(f32x8::ONE)
+        & u.simd_ge(f32x8::splat(-EDGE_EPSILON))
+        & v.simd_ge(f32x8::splat(-EDGE_EPSILON))
+        & (u + v).simd_le(f32x8::splat(1.0 + EDGE_EPSILON))
         & t.simd_gt(f32x8::splat(T_MIN))
         & t.simd_lt(tmax);
     hit.select(t, f32x8::splat(f32::INFINITY))
@@ -188,7 +188,11 @@ fn triangle8_blocks(tri: &Triangle, r: &Rays8, tmax: f32x8, two_sided: bool) -> 
     }
     let u = (tx * px + ty * py + tz * pz) * inv_det;
     let v = (r.dx * qx + r.dy * qy + r.dz * qz) * inv_det;
-    (in_range & u.simd_ge(zero) & v.simd_ge(zero) & (u + v).simd_le(f32x8::ONE)).to_bitmask()
+    (in_range
+        & u.simd_ge(f32x8::splat(-EDGE_EPSILON))
+        & v.simd_ge(f32x8::splat(-EDGE_EPSILON))
+        & (u + v).simd_le(f32x8::splat(1.0 + EDGE_EPSILON)))
+    .to_bitmask()
 }
 
 /// Ray–sphere for 8 rays; lane k equals `intersect_sphere(sphere, ray_k, tmax_k)`.
