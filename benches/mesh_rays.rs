@@ -16,8 +16,8 @@
 use criterion::{BenchmarkId, Criterion, Throughput};
 use raywave::meshgen::{bands_for, cornell_box_mesh_spheres, triangle_count};
 use raywave::peer::{
-    Hits, ObvhsMesh, RayKind, RaySet, RaySets, hit_agreement, occlusion_agreement,
-    wavefront_closest, wavefront_occluded, without_emitters,
+    Hits, ObvhsMesh, RaySet, RaySets, hit_agreement, occlusion_agreement, wavefront_closest,
+    wavefront_occluded, without_emitters,
 };
 use raywave::scene::{Scene, parse_scene_str};
 use raywave::settings::RenderSettings;

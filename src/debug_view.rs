@@ -148,19 +148,13 @@ impl RayRecorder {
             };
             draw_segment(img, camera, r.from, r.to, colour);
             // A camera ray runs along the line of sight and projects to a dot: mark its hit.
-            if r.bounce == 0 && matches!(r.kind, LoggedKind::Path { .. }) {
-                if let Some((x, y)) = project(camera, r.to) {
-                    for d in -4i64..=4 {
-                        for (px, py) in [(x as i64 + d, y as i64), (x as i64, y as i64 + d)] {
-                            if px >= 0
-                                && py >= 0
-                                && (px as u32) < img.width()
-                                && (py as u32) < img.height()
-                            {
-                                img.put_pixel(px as u32, py as u32, image::Rgb(colour));
-                            }
-                        }
-                    }
+            if r.bounce == 0
+                && matches!(r.kind, LoggedKind::Path { .. })
+                && let Some((x, y)) = project(camera, r.to)
+            {
+                for d in -4..=4 {
+                    put(img, x as i64 + d, y as i64, colour);
+                    put(img, x as i64, y as i64 + d, colour);
                 }
             }
         }
@@ -191,9 +185,14 @@ fn draw_segment(img: &mut image::RgbImage, camera: &CameraRays, a: Vec3, b: Vec3
     for k in 0..=steps {
         let p = a.lerp(b, k as f32 / steps as f32);
         if let Some((x, y)) = project(camera, p) {
-            if x >= 0.0 && y >= 0.0 && (x as u32) < img.width() && (y as u32) < img.height() {
-                img.put_pixel(x as u32, y as u32, image::Rgb(colour));
-            }
+            put(img, x.floor() as i64, y.floor() as i64, colour);
         }
+    }
+}
+
+/// Sets a pixel if (x, y) lies inside the image.
+fn put(img: &mut image::RgbImage, x: i64, y: i64, colour: [u8; 3]) {
+    if x >= 0 && y >= 0 && (x as u64) < img.width() as u64 && (y as u64) < img.height() as u64 {
+        img.put_pixel(x as u32, y as u32, image::Rgb(colour));
     }
 }

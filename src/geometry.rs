@@ -84,6 +84,7 @@ pub fn intersect_triangle(tri: &Triangle, ray: &Ray, tmax: f32, two_sided: bool)
 
 /// Nearest root of |o + t·d − c|² = r² with t in (T_MIN, tmax), or infinity.
 #[inline]
+#[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(x >= 0)` is on purpose: NaN must miss
 pub fn intersect_sphere(sphere: &Sphere, ray: &Ray, tmax: f32) -> f32 {
     let oc = ray.origin - sphere.center;
     let a = ray.direction.length_squared();

@@ -148,6 +148,7 @@ impl<'a> Reference<'a> {
 
     /// Σ over lights and their N points of Shade / N for the visible points.
     #[allow(clippy::too_many_arguments)]
+    #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(x > T_MIN)` is on purpose: NaN skips
     fn direct(
         &self,
         point: Vec3,

@@ -98,7 +98,7 @@ pub fn uniform(key: &SampleKey, dim: u32) -> f32 {
 pub fn strata_grid(n: u32) -> (u32, u32) {
     let n = n.max(1);
     let mut ny = (n as f64).sqrt() as u32;
-    while ny > 1 && n % ny != 0 {
+    while ny > 1 && !n.is_multiple_of(ny) {
         ny -= 1;
     }
     (n / ny.max(1), ny.max(1))

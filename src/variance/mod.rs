@@ -112,13 +112,13 @@ pub fn converged_reference(
         cache_dir.map(|dir| [0, 1].map(|h| dir.join(format!("reference-{key:016x}-{h}.pfm"))));
     let mut films = None;
     let mut cached = false;
-    if let Some(paths) = &paths {
-        if let (Ok(a), Ok(b)) = (Film::read_pfm(&paths[0]), Film::read_pfm(&paths[1])) {
-            if a.width == config.base.width && a.height == config.base.height {
-                films = Some([a, b]);
-                cached = true;
-            }
-        }
+    if let Some(paths) = &paths
+        && let (Ok(a), Ok(b)) = (Film::read_pfm(&paths[0]), Film::read_pfm(&paths[1]))
+        && a.width == config.base.width
+        && a.height == config.base.height
+    {
+        films = Some([a, b]);
+        cached = true;
     }
     let [a, b] = match films {
         Some(f) => f,
