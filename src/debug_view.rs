@@ -147,14 +147,16 @@ impl RayRecorder {
                 LoggedKind::Shadow { .. } => [40, 255, 40],
             };
             draw_segment(img, camera, r.from, r.to, colour);
-            // A camera ray runs along the line of sight and projects to a dot: mark its hit.
-            if r.bounce == 0
-                && matches!(r.kind, LoggedKind::Path { .. })
+        }
+        // A camera ray runs along the line of sight and projects to a dot: mark its hit with a
+        // cross, drawn last so the rays leaving that hit do not cover it.
+        for r in self.rays.iter().filter(|r| r.bounce == 0) {
+            if let LoggedKind::Path { .. } = r.kind
                 && let Some((x, y)) = project(camera, r.to)
             {
                 for d in -4..=4 {
-                    put(img, x as i64 + d, y as i64, colour);
-                    put(img, x as i64, y as i64 + d, colour);
+                    put(img, x as i64 + d, y as i64, [255, 230, 0]);
+                    put(img, x as i64, y as i64 + d, [255, 230, 0]);
                 }
             }
         }
