@@ -4,9 +4,10 @@ use super::{Region, RenderFn, StudyConfig, run_study};
 use crate::sampling::LightSampler;
 use crate::scene::{BUILTIN_CORNELL_BOX, Scene};
 use crate::settings::RenderSettings;
-use anyhow::{Result, bail};
+use anyhow::{Context, Result, bail};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::io::Write;
 use std::path::PathBuf;
 
 /// Flags of `raywave variance`.
@@ -61,6 +62,24 @@ pub struct VarianceArgs {
 impl VarianceArgs {
     /// Checks the flags against each other; errors name the flag.
     pub fn validate(&self) -> Result<()> {
+        // Every seed's image is kept until its statistics are taken.
+        let bytes = self.seeds as u64 * self.size[0] as u64 * self.size[1] as u64 * 12;
+        if bytes > MAX_STUDY_BYTES {
+            bail!(
+                "--seeds {} at --size {} {} would hold {:.1} GiB of images at once: expected at most {} GiB; use fewer seeds or a smaller size",
+                self.seeds,
+                self.size[0],
+                self.size[1],
+                bytes as f64 / (1u64 << 30) as f64,
+                MAX_STUDY_BYTES >> 30
+            );
+        }
+        if self.out.exists() && !self.out.is_dir() {
+            bail!(
+                "--out {}: expected a directory, found a file",
+                self.out.display()
+            );
+        }
         if !self.budgets.contains(&self.heatmap_n) {
             bail!(
                 "--heatmap-n {} is not one of --budgets {:?}: expected one of the budgets",
@@ -75,7 +94,10 @@ impl VarianceArgs {
     }
 }
 
-/// Runs the study with `render` (the engine) and writes the outputs; prints the table.
+/// The largest total size of the K images a study holds at once.
+pub const MAX_STUDY_BYTES: u64 = 4 << 30;
+
+/// Runs the study with `render` (the engine), writes the outputs, then prints the table.
 pub fn run(args: &VarianceArgs, engine: &str, render: &RenderFn) -> Result<()> {
     args.validate()?;
     let (scene, scene_bytes) = match &args.scene {
@@ -88,6 +110,37 @@ pub fn run(args: &VarianceArgs, engine: &str, render: &RenderFn) -> Result<()> {
     for w in &scene.warnings {
         eprintln!("{w}");
     }
+    if scene.lights.is_empty() {
+        bail!(
+            "{}: expected a scene with at least one area light (a face whose material has a non-zero `emitted`), found none: there is no light sampling to study",
+            scene.source
+        );
+    }
+    // Fail on an unusable output directory now, not after minutes of rendering.
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("cannot create the output directory {}", args.out.display()))?;
+    let mut cache = (!args.no_cache).then_some(args.cache.as_path());
+    if let Some(dir) = cache
+        && let Err(e) = std::fs::create_dir_all(dir)
+    {
+        eprintln!(
+            "warning: cannot use the cache directory {} ({e}): the converged reference will not be cached",
+            dir.display()
+        );
+        cache = None;
+    }
+    let mut samplers = Vec::new();
+    for s in &args.samplers {
+        if !samplers.contains(s) {
+            samplers.push(*s);
+        }
+    }
+    let mut budgets = Vec::new();
+    for n in &args.budgets {
+        if !budgets.contains(n) {
+            budgets.push(*n);
+        }
+    }
     let base = RenderSettings {
         width: args.size[0],
         height: args.size[1],
@@ -99,8 +152,8 @@ pub fn run(args: &VarianceArgs, engine: &str, render: &RenderFn) -> Result<()> {
         ..RenderSettings::default()
     };
     let config = StudyConfig {
-        budgets: args.budgets.clone(),
-        samplers: args.samplers.clone(),
+        budgets,
+        samplers,
         seeds: args.seeds,
         reference_samples: args.reference_samples,
         mask_samples: args.mask_samples,
@@ -122,7 +175,6 @@ pub fn run(args: &VarianceArgs, engine: &str, render: &RenderFn) -> Result<()> {
         bar.set_message("converged reference");
         bar
     };
-    let cache = (!args.no_cache).then_some(args.cache.as_path());
     let result = run_study(
         &scene,
         &scene_bytes,
@@ -136,7 +188,8 @@ pub fn run(args: &VarianceArgs, engine: &str, render: &RenderFn) -> Result<()> {
         },
     )?;
     bar.finish_and_clear();
-    print!("{}", result.table());
+    // Files first: a closed or full standard output must not cost the results.
+    let written = result.write(&args.out)?;
     for region in [Region::Penumbra, Region::Lit] {
         let margin = result.reference_margin(region);
         if result.region_pixels[Region::ALL.iter().position(|&r| r == region).unwrap_or(0)] > 0
@@ -148,22 +201,22 @@ pub fn run(args: &VarianceArgs, engine: &str, render: &RenderFn) -> Result<()> {
             );
         }
     }
-    let written = result.write(&args.out)?;
-    println!(
-        "\nconverged reference: {}",
+    let mut out = std::io::stdout().lock();
+    writeln!(
+        out,
+        "{}\nconverged reference: {}\nwrote   {}",
+        result.table(),
         if result.reference_cached {
             "from the cache"
         } else {
             "rendered"
-        }
-    );
-    println!(
-        "wrote   {}",
+        },
         written
             .iter()
             .map(|p| p.display().to_string())
             .collect::<Vec<_>>()
             .join(", ")
-    );
+    )
+    .context("cannot write to standard output")?;
     Ok(())
 }

@@ -119,5 +119,6 @@ fn classify(
             direction: reflect(ray.direction, n),
         };
     }
-    (penumbra, lit && any_hit)
+    // Without lights nothing is lit (every light fully visible would be vacuously true).
+    (penumbra, lit && any_hit && !scene.lights.is_empty())
 }

@@ -158,15 +158,16 @@ pub fn converged_reference(
     })
 }
 
-/// FNV-1a over the scene bytes and the settings, so any change makes a new cache entry.
+/// FNV-1a over the scene bytes, the settings and the running executable's own bytes, so a
+/// change of scene, settings or renderer code makes a new cache entry (hashing the executable
+/// takes a few milliseconds; where it cannot be read, the version stands in for it).
 fn cache_key(scene_id: &[u8], settings: &[RenderSettings]) -> u64 {
     let mut h = 0xcbf2_9ce4_8422_2325u64;
     let json = serde_json::to_vec(settings).unwrap_or_default();
-    for &byte in scene_id
-        .iter()
-        .chain(&json)
-        .chain(env!("CARGO_PKG_VERSION").as_bytes())
-    {
+    let code = std::env::current_exe()
+        .and_then(std::fs::read)
+        .unwrap_or_else(|_| env!("CARGO_PKG_VERSION").as_bytes().to_vec());
+    for &byte in scene_id.iter().chain(&json).chain(&code) {
         h ^= byte as u64;
         h = h.wrapping_mul(0x0000_0100_0000_01b3);
     }
@@ -429,6 +430,14 @@ impl StudyResult {
             self.engine
         );
         for (i, region) in Region::ALL.iter().enumerate() {
+            if self.region_pixels[i] == 0 {
+                let _ = writeln!(
+                    s,
+                    "\n{}: no pixels in this region, nothing measured",
+                    region.name()
+                );
+                continue;
+            }
             let _ = writeln!(
                 s,
                 "\n{} ({} pixels; reference MSE {:.2e}, {:.0}× below the smallest measured)",
@@ -498,7 +507,8 @@ impl StudyResult {
         if self.config.samplers.contains(&LightSampler::Random) {
             let _ = writeln!(
                 s,
-                "\nbudget matching the MSE of 150 random points (the lab's choice), from the fits:"
+                "\nbudget matching the MSE of 150 random points (the lab's choice), from the fits \
+                 (lab's fit includes its biased N = 1 point):"
             );
             for sampler in self
                 .config
