@@ -31,6 +31,9 @@ pub enum Command {
     Meshgen(MeshgenArgs),
     /// Compare light samplers: MSE, bias, variance and slopes against a converged reference.
     Variance(crate::variance::command::VarianceArgs),
+    /// Time both engines on a scene (rays/s per kind and stage); save and compare records
+    /// (exit 3 when a figure regresses past --threshold).
+    Bench(crate::bench::BenchArgs),
 }
 
 /// `raywave meshgen` flags.
@@ -198,6 +201,7 @@ const SUBCOMMANDS: &[&str] = &[
     "info",
     "meshgen",
     "variance",
+    "bench",
     "help",
     "-h",
     "--help",

@@ -6,11 +6,13 @@
 //! [`shading`] (the lab's Shade), and the engines: [`reference`] (scalar, recursive).
 #![warn(missing_docs)]
 
+pub mod bench;
 pub mod camera;
 pub mod cli;
 pub mod debug_view;
 pub mod film;
 pub mod geometry;
+pub mod machine;
 pub mod meshgen;
 pub mod peer;
 pub mod reference;

@@ -28,6 +28,11 @@ fn main() -> ExitCode {
         }
         Command::Meshgen(args) => meshgen(&args),
         Command::Variance(args) => variance(&args),
+        // Exit 3 when --compare finds a regression (raywave::bench::EXIT_REGRESSION).
+        Command::Bench(args) => match raywave::bench::run(&args) {
+            Ok(outcome) => return ExitCode::from(outcome.exit_code()),
+            Err(e) => Err(e),
+        },
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -323,19 +328,6 @@ fn print_stats(report: &Report) {
     }
 }
 
-/// The CPU's model name from /proc/cpuinfo, where there is one.
-fn cpu_model() -> String {
-    std::fs::read_to_string("/proc/cpuinfo")
-        .ok()
-        .and_then(|text| {
-            text.lines()
-                .find(|l| l.starts_with("model name"))
-                .and_then(|l| l.split_once(':'))
-                .map(|(_, v)| v.trim().to_string())
-        })
-        .unwrap_or_else(|| "unknown".to_string())
-}
-
 fn stats_json(
     scene: &Scene,
     settings: &RenderSettings,
@@ -364,7 +356,7 @@ fn stats_json(
     serde_json::json!({
         "raywave": env!("CARGO_PKG_VERSION"),
         "machine": {
-            "cpu": cpu_model(),
+            "cpu": raywave::machine::cpu_model(),
             "logical_cpus": std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1),
             "os": std::env::consts::OS,
             "arch": std::env::consts::ARCH,

@@ -1,0 +1,400 @@
+//! `raywave bench`: times both engines on one scene over several runs, prints rays/s per kind
+//! and per stage (medians), and keeps and compares records for regression checks.
+//!
+//! ```text
+//! load --compare's record; refuse if its setup (scene, settings, threads) differs
+//! warm-up: one untimed render per engine
+//! for run in 1..=runs: reference, then wavefront (interleaved, so both see the same load)
+//! medians per figure; print; write --save / --json; compare -> table, verdict (exit 3)
+//! ```
+
+pub mod compare;
+pub mod record;
+
+use crate::film::Film;
+use crate::reference::Reference;
+use crate::sampling::LightSampler;
+use crate::scene::{BUILTIN_CORNELL_BOX, Scene};
+use crate::settings::{RenderSettings, ShadowMode};
+use crate::wavefront::{DEFAULT_BATCH_SIZE, Wavefront};
+use anyhow::{Context, Result, bail};
+use clap::Args;
+use record::{
+    BenchRecord, EngineRecord, KindRates, Machine, Measurement, SceneId, Setup, StageFigure,
+};
+use std::io::Write;
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Exit code of `raywave bench --compare` when a headline figure regressed past the threshold.
+pub const EXIT_REGRESSION: u8 = 3;
+
+/// Default `--threshold`, in percent: see docs/BENCHMARKING.md for the noise it is chosen from.
+pub const DEFAULT_THRESHOLD_PCT: f64 = 40.0;
+
+/// Flags of `raywave bench`.
+#[derive(Args, Debug, Clone)]
+pub struct BenchArgs {
+    /// Scene file (.obj); without one, the built-in lab Cornell box with mirror spheres.
+    pub scene: Option<PathBuf>,
+    /// Image size in pixels.
+    #[arg(long, num_args = 2, value_names = ["W", "H"], default_values_t = [512u32, 512],
+          value_parser = clap::value_parser!(u32).range(1..=16384))]
+    pub size: Vec<u32>,
+    /// Maximum mirror bounces.
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(0..=64))]
+    pub bounces: u32,
+    /// Shadows: off, hard or soft. Default: hard, or soft when --shadow-samples > 1 or no
+    /// scene is given (as for render).
+    #[arg(long, value_enum)]
+    pub shadows: Option<ShadowMode>,
+    /// Points per light with soft shadows [default: 16].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    pub shadow_samples: Option<u32>,
+    /// How the points on a light are chosen.
+    #[arg(long, value_enum, default_value = "stratified")]
+    pub sampler: LightSampler,
+    /// Camera rays per pixel.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pub aa: u32,
+    /// Worker threads [default: all cores].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub threads: Option<u32>,
+    /// Timed runs per engine (medians are reported).
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    pub runs: u32,
+    /// Save the record as DIR/NAME.json.
+    #[arg(long, value_name = "NAME")]
+    pub save: Option<String>,
+    /// Compare with the record DIR/NAME.json; exit 3 if a headline figure regressed.
+    #[arg(long, value_name = "NAME")]
+    pub compare: Option<String>,
+    /// Directory of saved records.
+    #[arg(long, default_value = ".raywave-bench")]
+    pub dir: PathBuf,
+    /// Regression threshold in percent: a headline figure that falls by more fails --compare.
+    #[arg(long, value_name = "PCT", default_value_t = DEFAULT_THRESHOLD_PCT,
+          value_parser = parse_threshold)]
+    pub threshold: f64,
+    /// Also write the record as JSON to FILE (`-` for stdout).
+    #[arg(long, value_name = "FILE")]
+    pub json: Option<PathBuf>,
+    /// Print only the comparison (or nothing but errors without --compare).
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+fn parse_threshold(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(x) if x.is_finite() && (0.0..1000.0).contains(&x) => Ok(x),
+        _ => Err(format!(
+            "expected a percentage between 0 and 1000, found `{s}`"
+        )),
+    }
+}
+
+impl BenchArgs {
+    /// The render settings, defaulted like `raywave render`'s.
+    pub fn settings(&self, scene_background: Option<[f32; 3]>) -> RenderSettings {
+        let defaults = RenderSettings::default();
+        let shadows = self.shadows.unwrap_or(match self.shadow_samples {
+            Some(n) if n > 1 => ShadowMode::Soft,
+            _ if self.scene.is_none() => ShadowMode::Soft,
+            _ => ShadowMode::Hard,
+        });
+        RenderSettings {
+            width: self.size[0],
+            height: self.size[1],
+            bounces: self.bounces,
+            shadows,
+            shadow_samples: self.shadow_samples.unwrap_or(defaults.shadow_samples),
+            sampler: self.sampler,
+            aa_samples: self.aa,
+            background: scene_background.unwrap_or(defaults.background),
+            ..defaults
+        }
+    }
+}
+
+/// What `run` found: `Some(comparison)` with `--compare`.
+pub struct Outcome {
+    /// The record of this run.
+    pub record: BenchRecord,
+    /// The comparison, if asked for.
+    pub comparison: Option<compare::Comparison>,
+}
+
+impl Outcome {
+    /// The process exit code: [`EXIT_REGRESSION`] when the comparison regressed, else 0.
+    pub fn exit_code(&self) -> u8 {
+        match &self.comparison {
+            Some(c) if c.regressed() => EXIT_REGRESSION,
+            _ => 0,
+        }
+    }
+}
+
+/// Runs the bench as the flags say, printing the tables; errors name the file or flag.
+pub fn run(args: &BenchArgs) -> Result<Outcome> {
+    // Everything that can fail cheaply happens before the timed part.
+    let save_path = args
+        .save
+        .as_deref()
+        .map(|n| record::record_path(&args.dir, n))
+        .transpose()?;
+    if let Some(p) = args.json.as_ref().filter(|p| p.as_os_str() != "-") {
+        crate::film::check_output_dir(p)?;
+    }
+    let (scene, text) = match &args.scene {
+        Some(path) => {
+            let scene = Scene::load(path)?;
+            let text =
+                std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?;
+            (scene, text)
+        }
+        None => (
+            Scene::builtin_default(),
+            BUILTIN_CORNELL_BOX.as_bytes().to_vec(),
+        ),
+    };
+    for w in &scene.warnings {
+        eprintln!("{w}");
+    }
+    let settings = args.settings(scene.background.map(|c| c.to_array()));
+    let mut builder = rayon::ThreadPoolBuilder::new();
+    if let Some(n) = args.threads {
+        builder = builder.num_threads(n as usize);
+    }
+    let pool = builder.build().context("cannot start the worker threads")?;
+    let setup = Setup {
+        scene: SceneId {
+            source: scene.source.clone(),
+            text_hash: record::text_hash(&text),
+            triangles: scene.triangles.len(),
+            spheres: scene.spheres.len(),
+            lights: scene.lights.len(),
+        },
+        settings: settings.clone(),
+        threads: pool.current_num_threads(),
+        batch_size: DEFAULT_BATCH_SIZE,
+    };
+    let baseline = match &args.compare {
+        Some(name) => {
+            let path = record::record_path(&args.dir, name)?;
+            let before = record::load(&path, name)?;
+            let differences = compare::setup_differences(&before.setup, &setup);
+            if !differences.is_empty() {
+                bail!(
+                    "cannot compare with {}: it was measured with a different setup, so the \
+                     figures would not describe the same work:\n  {}\nrun with the record's \
+                     flags, or save a new record with --save",
+                    path.display(),
+                    differences.join("\n  ")
+                );
+            }
+            Some(before)
+        }
+        None => None,
+    };
+
+    let engines = pool.install(|| measure(&scene, &settings, args.runs));
+    let (git_commit, git_dirty) = record::git_commit();
+    let record = BenchRecord {
+        format: record::FORMAT,
+        raywave: env!("CARGO_PKG_VERSION").to_string(),
+        git_commit,
+        git_dirty,
+        timestamp: record::now_utc(),
+        machine: Machine {
+            hostname: crate::machine::hostname(),
+            cpu: crate::machine::cpu_model(),
+            logical_cpus: crate::machine::logical_cpus(),
+            os: std::env::consts::OS.to_string(),
+            arch: std::env::consts::ARCH.to_string(),
+        },
+        simd: crate::simd_path().to_string(),
+        setup,
+        runs: args.runs,
+        engines,
+    };
+    if !args.quiet {
+        print!("{}", report(&record));
+    }
+    if let Some(path) = &save_path {
+        record::save(path, &record)?;
+        if !args.quiet {
+            println!("saved   {}", path.display());
+        }
+    }
+    match &args.json {
+        Some(p) if p.as_os_str() == "-" => {
+            println!("{}", serde_json::to_string_pretty(&record)?);
+        }
+        Some(p) => crate::film::write_atomically(p, |w| {
+            serde_json::to_writer_pretty(&mut *w, &record)?;
+            Ok(writeln!(w)?)
+        })?,
+        None => {}
+    }
+    let comparison = match &baseline {
+        Some(before) => {
+            let c = compare::compare(before, &record, args.threshold)
+                .map_err(|d| anyhow::anyhow!("setups differ: {}", d.join("; ")))?;
+            if !args.quiet {
+                println!();
+            }
+            println!(
+                "compared with {} ({}, commit {}):",
+                args.compare.as_deref().unwrap_or_default(),
+                before.timestamp,
+                short(&before.git_commit)
+            );
+            print!("{}", c.table());
+            Some(c)
+        }
+        None => None,
+    };
+    Ok(Outcome { record, comparison })
+}
+
+fn short(commit: &str) -> &str {
+    commit.get(..12).unwrap_or(commit)
+}
+
+/// One untimed render per engine, then `runs` interleaved timed renders of each.
+fn measure(scene: &Scene, settings: &RenderSettings, runs: u32) -> Vec<EngineRecord> {
+    let reference = Reference::new(scene, settings);
+    let wavefront = Wavefront::new(scene, settings, DEFAULT_BATCH_SIZE);
+    let time_reference = || {
+        let start = Instant::now();
+        let (film, counts) = reference.render(&|| {});
+        let seconds = start.elapsed().as_secs_f64();
+        drop::<Film>(film);
+        Measurement {
+            seconds,
+            rays: counts,
+            rays_per_second: KindRates::new(&counts, seconds),
+            stages: Vec::new(),
+        }
+    };
+    let time_wavefront = || {
+        let start = Instant::now();
+        let (film, stats) = wavefront.render(&|| {});
+        let seconds = start.elapsed().as_secs_f64();
+        drop::<Film>(film);
+        Measurement {
+            seconds,
+            rays: stats.counts,
+            rays_per_second: KindRates::new(&stats.counts, seconds),
+            stages: stats
+                .stage_rows()
+                .into_iter()
+                .map(|r| StageFigure {
+                    stage: r.stage.to_string(),
+                    rays: r.rays,
+                    thread_seconds: r.thread_seconds,
+                    rays_per_thread_second: r.rays_per_thread_second,
+                })
+                .collect(),
+        }
+    };
+    time_reference();
+    time_wavefront();
+    let (mut r, mut w) = (Vec::new(), Vec::new());
+    for _ in 0..runs {
+        r.push(time_reference());
+        w.push(time_wavefront());
+    }
+    [("reference", r), ("wavefront", w)]
+        .into_iter()
+        .map(|(engine, runs)| EngineRecord {
+            engine: engine.to_string(),
+            median: Measurement::median_of(&runs),
+            runs,
+        })
+        .collect()
+}
+
+/// The printed report of one record: header, then per engine its kinds and stages.
+pub fn report(r: &BenchRecord) -> String {
+    use std::fmt::Write as _;
+    let s = &r.setup.settings;
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "raywave {} · commit {}{} · simd {} · {} thread(s) · {}",
+        r.raywave,
+        short(&r.git_commit),
+        if r.git_dirty == Some(true) {
+            " (dirty)"
+        } else {
+            ""
+        },
+        r.simd,
+        r.setup.threads,
+        r.machine.cpu
+    );
+    let shadows = match s.shadows {
+        ShadowMode::Soft => format!("soft, {} {} points", s.shadow_samples, s.sampler.name()),
+        ShadowMode::Hard => "hard".to_string(),
+        ShadowMode::Off => "off".to_string(),
+    };
+    let _ = writeln!(
+        out,
+        "scene   {} · {}×{}, {} bounces, shadows {shadows}, {} aa · medians of {} run(s)",
+        r.setup.scene.source, s.width, s.height, s.bounces, s.aa_samples, r.runs
+    );
+    let _ = writeln!(
+        out,
+        "{:<10} {:<12} {:>12} {:>10} {:>16}",
+        "engine", "kind", "rays", "seconds", "Mrays/s"
+    );
+    for e in &r.engines {
+        let m = &e.median;
+        let counts = [
+            m.rays.camera,
+            m.rays.shadow,
+            m.rays.reflection,
+            m.rays.total(),
+        ];
+        for ((kind, rate), rays) in m.rays_per_second.rows().iter().zip(counts) {
+            let secs = if *kind == "total" {
+                format!("{:.3}", m.seconds)
+            } else {
+                String::new()
+            };
+            let _ = writeln!(
+                out,
+                "{:<10} {kind:<12} {rays:>12} {secs:>10} {:>16.2}",
+                e.engine,
+                rate / 1e6
+            );
+        }
+    }
+    let _ = writeln!(
+        out,
+        "{:<10} {:<12} {:>12} {:>10} {:>16}",
+        "engine", "stage", "rays", "thread-s", "Mrays/thread-s"
+    );
+    for e in &r.engines {
+        if e.median.stages.is_empty() {
+            let _ = writeln!(
+                out,
+                "{:<10} (no stages: one recursive trace per pixel)",
+                e.engine
+            );
+        }
+        for st in &e.median.stages {
+            let _ = writeln!(
+                out,
+                "{:<10} {:<12} {:>12} {:>10.4} {:>16.2}",
+                e.engine,
+                st.stage,
+                st.rays,
+                st.thread_seconds,
+                st.rays_per_thread_second / 1e6
+            );
+        }
+    }
+    out
+}

@@ -1,0 +1,390 @@
+//! A bench record: what was measured (medians and every run) and under which conditions
+//! (machine, build, scene, settings), as it is saved to `.raywave-bench/NAME.json`.
+
+use crate::settings::RenderSettings;
+use crate::stats::RayCounts;
+use anyhow::{Context, Result, bail};
+use serde::{Deserialize, Serialize};
+use std::io::Write;
+use std::path::Path;
+
+/// Bumped when the layout of a record changes; older records are refused with a message.
+pub const FORMAT: u32 = 1;
+
+/// One `raywave bench` invocation.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BenchRecord {
+    /// Layout version ([`FORMAT`]).
+    pub format: u32,
+    /// raywave's version.
+    pub raywave: String,
+    /// `git rev-parse HEAD` of the source tree, or "unknown".
+    pub git_commit: String,
+    /// Whether the source tree had uncommitted changes (None when unknown).
+    pub git_dirty: Option<bool>,
+    /// When the bench ran, UTC, RFC 3339.
+    pub timestamp: String,
+    /// Where it ran.
+    pub machine: Machine,
+    /// `raywave::simd_path()`.
+    pub simd: String,
+    /// What was measured: two records compare only when these are equal.
+    pub setup: Setup,
+    /// Timed runs per engine.
+    pub runs: u32,
+    /// One entry per engine: reference, then wavefront.
+    pub engines: Vec<EngineRecord>,
+}
+
+/// The machine.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Machine {
+    /// Host name.
+    pub hostname: String,
+    /// CPU model from /proc/cpuinfo.
+    pub cpu: String,
+    /// Logical CPUs available.
+    pub logical_cpus: usize,
+    /// `std::env::consts::OS`.
+    pub os: String,
+    /// `std::env::consts::ARCH`.
+    pub arch: String,
+}
+
+/// Scene, settings and threads: the work and the resources it was given.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Setup {
+    /// The scene.
+    pub scene: SceneId,
+    /// The render settings.
+    pub settings: RenderSettings,
+    /// Worker threads.
+    pub threads: usize,
+    /// Wavefront camera samples per tile.
+    pub batch_size: usize,
+}
+
+/// Which scene: its name and a hash of its text, so a renamed copy still compares and an
+/// edited file does not.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SceneId {
+    /// File path, or `<built-in ...>` (informative only; not compared).
+    pub source: String,
+    /// FNV-1a of the scene text, hex.
+    pub text_hash: String,
+    /// Triangles after parsing.
+    pub triangles: usize,
+    /// Spheres.
+    pub spheres: usize,
+    /// Lights.
+    pub lights: usize,
+}
+
+/// One engine's figures.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct EngineRecord {
+    /// "reference" or "wavefront".
+    pub engine: String,
+    /// Median over the runs of every figure, each taken separately.
+    pub median: Measurement,
+    /// Every timed run, in order.
+    pub runs: Vec<Measurement>,
+}
+
+/// What one render measured (or the medians of several).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Measurement {
+    /// Wall-clock seconds of the render.
+    pub seconds: f64,
+    /// Rays cast, by kind.
+    pub rays: RayCounts,
+    /// Rays per wall-clock second, by kind.
+    pub rays_per_second: KindRates,
+    /// Per stage (wavefront only; empty for the reference, which has no stages).
+    pub stages: Vec<StageFigure>,
+}
+
+/// Rays per second by kind.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct KindRates {
+    /// Camera rays.
+    pub camera: f64,
+    /// Shadow rays.
+    pub shadow: f64,
+    /// Mirror rays.
+    pub reflection: f64,
+    /// All rays: the headline figure.
+    pub total: f64,
+}
+
+impl KindRates {
+    /// Each count divided by `seconds`.
+    pub fn new(rays: &RayCounts, seconds: f64) -> KindRates {
+        let per_s = |n: u64| n as f64 / seconds.max(1e-9);
+        KindRates {
+            camera: per_s(rays.camera),
+            shadow: per_s(rays.shadow),
+            reflection: per_s(rays.reflection),
+            total: per_s(rays.total()),
+        }
+    }
+
+    /// (kind, rays/s) in report order.
+    pub fn rows(&self) -> [(&'static str, f64); 4] {
+        [
+            ("camera", self.camera),
+            ("shadow", self.shadow),
+            ("reflection", self.reflection),
+            ("total", self.total),
+        ]
+    }
+}
+
+/// One wavefront stage's figures.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StageFigure {
+    /// Stage name (generate, intersect, shadow, reflect, film).
+    pub stage: String,
+    /// Rays the stage handled.
+    pub rays: u64,
+    /// Thread-seconds spent in it.
+    pub thread_seconds: f64,
+    /// rays / thread_seconds: the stage's headline figure.
+    pub rays_per_thread_second: f64,
+}
+
+/// The median of `xs` (mean of the middle two for an even count); 0 for none.
+pub fn median(xs: &[f64]) -> f64 {
+    let mut v: Vec<f64> = xs.iter().copied().filter(|x| !x.is_nan()).collect();
+    if v.is_empty() {
+        return 0.0;
+    }
+    v.sort_by(f64::total_cmp);
+    let m = v.len() / 2;
+    if v.len() % 2 == 1 {
+        v[m]
+    } else {
+        (v[m - 1] + v[m]) / 2.0
+    }
+}
+
+impl Measurement {
+    /// Each figure's median over `runs` (ray counts from the first run: they do not vary).
+    pub fn median_of(runs: &[Measurement]) -> Measurement {
+        let Some(first) = runs.first() else {
+            return Measurement {
+                seconds: 0.0,
+                rays: RayCounts::default(),
+                rays_per_second: KindRates::new(&RayCounts::default(), 1.0),
+                stages: Vec::new(),
+            };
+        };
+        let pick =
+            |f: &dyn Fn(&Measurement) -> f64| median(&runs.iter().map(f).collect::<Vec<_>>());
+        let stages = first
+            .stages
+            .iter()
+            .enumerate()
+            .map(|(i, s)| {
+                let col = |f: &dyn Fn(&StageFigure) -> f64| {
+                    median(
+                        &runs
+                            .iter()
+                            .filter_map(|r| r.stages.get(i))
+                            .map(f)
+                            .collect::<Vec<_>>(),
+                    )
+                };
+                StageFigure {
+                    stage: s.stage.clone(),
+                    rays: s.rays,
+                    thread_seconds: col(&|s| s.thread_seconds),
+                    rays_per_thread_second: col(&|s| s.rays_per_thread_second),
+                }
+            })
+            .collect();
+        let seconds = pick(&|r| r.seconds);
+        Measurement {
+            seconds,
+            rays: first.rays,
+            rays_per_second: KindRates {
+                camera: pick(&|r| r.rays_per_second.camera),
+                shadow: pick(&|r| r.rays_per_second.shadow),
+                reflection: pick(&|r| r.rays_per_second.reflection),
+                total: pick(&|r| r.rays_per_second.total),
+            },
+            stages,
+        }
+    }
+}
+
+/// Where `--save NAME` / `--compare NAME` keep a record.
+pub fn record_path(dir: &Path, name: &str) -> Result<std::path::PathBuf> {
+    if name.is_empty()
+        || name.starts_with('.')
+        || name.contains(['/', '\\'])
+        || name.chars().any(char::is_control)
+    {
+        bail!(
+            "bench record name `{name}` is not usable: expected a plain name like `before` \
+             (no path separators, not starting with '.'); use --dir to choose the directory"
+        );
+    }
+    Ok(dir.join(format!("{name}.json")))
+}
+
+/// Reads a saved record; a missing file says how to make one.
+pub fn load(path: &Path, name: &str) -> Result<BenchRecord> {
+    let text = match std::fs::read_to_string(path) {
+        Ok(t) => t,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => bail!(
+            "no bench record {}: create it first with `raywave bench --save {name}` \
+             (same scene and flags; --dir if it lives elsewhere)",
+            path.display()
+        ),
+        Err(e) => return Err(e).with_context(|| format!("cannot read {}", path.display())),
+    };
+    let value: serde_json::Value = serde_json::from_str(&text)
+        .with_context(|| format!("{}: not a JSON bench record", path.display()))?;
+    let format = value.get("format").and_then(|f| f.as_u64());
+    if format != Some(FORMAT as u64) {
+        bail!(
+            "{}: bench record format {}, expected {FORMAT}: save it again with \
+             `raywave bench --save {name}`",
+            path.display(),
+            format.map_or("missing".to_string(), |f| f.to_string())
+        );
+    }
+    serde_json::from_value(value)
+        .with_context(|| format!("{}: not a valid bench record", path.display()))
+}
+
+/// Writes `record` to `path` atomically, creating its directory.
+pub fn save(path: &Path, record: &BenchRecord) -> Result<()> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("cannot create directory {}", dir.display()))?;
+    }
+    crate::film::write_atomically(path, |w| {
+        serde_json::to_writer_pretty(&mut *w, record)?;
+        Ok(writeln!(w)?)
+    })
+}
+
+/// FNV-1a, hex: a stable hash of a scene's text.
+pub fn text_hash(bytes: &[u8]) -> String {
+    let mut h = 0xcbf2_9ce4_8422_2325u64;
+    for &b in bytes {
+        h ^= b as u64;
+        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    format!("{h:016x}")
+}
+
+/// `git rev-parse HEAD` and whether the tree is dirty, for the source tree this binary was
+/// built from (its manifest directory), falling back to the current directory.
+pub fn git_commit() -> (String, Option<bool>) {
+    let git = |dir: &Path, args: &[&str]| {
+        std::process::Command::new("git")
+            .arg("-C")
+            .arg(dir)
+            .args(args)
+            .stderr(std::process::Stdio::null())
+            .output()
+            .ok()
+            .filter(|o| o.status.success())
+            .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+    };
+    for dir in [Path::new(env!("CARGO_MANIFEST_DIR")), Path::new(".")] {
+        if let Some(commit) = git(dir, &["rev-parse", "HEAD"]).filter(|c| !c.is_empty()) {
+            let dirty =
+                git(dir, &["status", "--porcelain", "--untracked-files=no"]).map(|s| !s.is_empty());
+            return (commit, dirty);
+        }
+    }
+    ("unknown".to_string(), None)
+}
+
+/// Seconds since the Unix epoch as RFC 3339 UTC (`2026-11-22T20:13:01Z`).
+pub fn rfc3339_utc(unix_seconds: u64) -> String {
+    let days = (unix_seconds / 86_400) as i64;
+    let secs = unix_seconds % 86_400;
+    // Howard Hinnant's days-to-civil.
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let day = doy - (153 * mp + 2) / 5 + 1;
+    let month = if mp < 10 { mp + 3 } else { mp - 9 };
+    let year = yoe + era * 400 + i64::from(month <= 2);
+    format!(
+        "{year:04}-{month:02}-{day:02}T{:02}:{:02}:{:02}Z",
+        secs / 3600,
+        secs / 60 % 60,
+        secs % 60
+    )
+}
+
+/// Now, as [`rfc3339_utc`].
+pub fn now_utc() -> String {
+    let secs = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map(|d| d.as_secs())
+        .unwrap_or(0);
+    rfc3339_utc(secs)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn timestamps() {
+        assert_eq!(rfc3339_utc(0), "1970-01-01T00:00:00Z");
+        assert_eq!(rfc3339_utc(951_782_400), "2000-02-29T00:00:00Z");
+        assert_eq!(rfc3339_utc(1_795_378_381), "2026-11-22T20:13:01Z");
+    }
+
+    #[test]
+    fn medians() {
+        assert_eq!(median(&[]), 0.0);
+        assert_eq!(median(&[3.0]), 3.0);
+        assert_eq!(median(&[5.0, 1.0, 3.0]), 3.0);
+        assert_eq!(median(&[4.0, 1.0, 3.0, 2.0]), 2.5);
+    }
+
+    #[test]
+    fn record_names() {
+        let dir = Path::new("d");
+        assert_eq!(
+            record_path(dir, "before").unwrap(),
+            Path::new("d/before.json")
+        );
+        for bad in ["", "../x", "a/b", ".hidden"] {
+            let e = record_path(dir, bad).unwrap_err().to_string();
+            assert!(e.contains("not usable"), "{e}");
+        }
+    }
+
+    #[test]
+    fn loading_names_the_file_and_what_was_expected() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("a.json");
+        let e = format!("{:#}", load(&path, "a").unwrap_err());
+        assert!(
+            e.contains("no bench record") && e.contains("--save a"),
+            "{e}"
+        );
+        std::fs::write(&path, "not json").unwrap();
+        let e = format!("{:#}", load(&path, "a").unwrap_err());
+        assert!(e.contains("a.json: not a JSON bench record"), "{e}");
+        std::fs::write(&path, r#"{"format": 99}"#).unwrap();
+        let e = format!("{:#}", load(&path, "a").unwrap_err());
+        assert!(e.contains("format 99, expected 1"), "{e}");
+        std::fs::write(&path, r#"{"format": 1}"#).unwrap();
+        let e = format!("{:#}", load(&path, "a").unwrap_err());
+        assert!(e.contains("a.json: not a valid bench record"), "{e}");
+    }
+}
