@@ -354,3 +354,151 @@ fn matching_budget_inverts_the_fits() {
             .is_none()
     );
 }
+
+/// The whole study, end to end, on the lab's scene at a small size with the wavefront engine:
+/// the issue's floor (random's penumbra slope −1 ± 0.1, stratified's at most −1.35, stratified
+/// MSE at most 1/3 of random's at N = 64, no unbiased sampler flagged) and the output files.
+/// Deterministic for fixed seeds, and it fails if stratification breaks (slope → −1).
+#[test]
+fn the_study_meets_the_issue_floor_and_writes_its_outputs() {
+    use raywave::variance::{StudyConfig, run_study};
+    use raywave::wavefront::{DEFAULT_BATCH_SIZE, Wavefront};
+    let scene = Scene::builtin_default();
+    let base = RenderSettings {
+        width: 48,
+        height: 48,
+        ..RenderSettings::default()
+    };
+    let config = StudyConfig {
+        budgets: vec![4, 16, 64],
+        samplers: vec![LightSampler::Random, LightSampler::Stratified],
+        seeds: 4,
+        reference_samples: 1024,
+        mask_samples: 256,
+        heatmap_n: 16,
+        ..StudyConfig::standard(base)
+    };
+    let render = |scene: &Scene, s: &RenderSettings| {
+        let (film, stats) = Wavefront::new(scene, s, DEFAULT_BATCH_SIZE).render(&|| {});
+        (film, stats.counts)
+    };
+    let result = run_study(
+        &scene,
+        b"test",
+        &config,
+        "wavefront",
+        &render,
+        None,
+        &|_| {},
+    )
+    .unwrap();
+    let slope = |sampler: &str| {
+        result
+            .slopes
+            .iter()
+            .find(|s| s.sampler == sampler && s.region == Region::Penumbra)
+            .and_then(|s| s.fit)
+            .unwrap()
+            .slope
+    };
+    let mse = |sampler: &str, n: u32| {
+        result
+            .rows
+            .iter()
+            .find(|r| r.sampler == sampler && r.n == n && r.region == Region::Penumbra)
+            .unwrap()
+            .stats
+            .mse
+    };
+    println!(
+        "penumbra slopes: random {:.3}, stratified {:.3}; MSE ratio at N = 64: {:.3}",
+        slope("random"),
+        slope("stratified"),
+        mse("stratified", 64) / mse("random", 64)
+    );
+    assert!(
+        (slope("random") + 1.0).abs() <= 0.1,
+        "random slope {}",
+        slope("random")
+    );
+    assert!(
+        slope("stratified") <= -1.35,
+        "stratified slope {}",
+        slope("stratified")
+    );
+    let ratio = mse("stratified", 64) / mse("random", 64);
+    assert!(
+        ratio <= 1.0 / 3.0,
+        "stratified/random MSE at N = 64: {ratio}"
+    );
+    for row in &result.rows {
+        assert!(
+            row.stats.bias.abs() <= row.stats.bias_bound,
+            "{} N={} {:?}: bias {} beyond its bound {}",
+            row.sampler,
+            row.n,
+            row.region,
+            row.stats.bias,
+            row.stats.bias_bound
+        );
+    }
+    assert!(
+        result.region_pixels[1] > 100,
+        "penumbra too small: {:?}",
+        result.region_pixels
+    );
+
+    let dir = tempfile::tempdir().unwrap();
+    let written = result.write(dir.path()).unwrap();
+    let names: Vec<String> = written
+        .iter()
+        .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
+        .collect();
+    for name in [
+        "table.txt",
+        "results.csv",
+        "results.json",
+        "mse.png",
+        "heat_random_N16.png",
+        "heat_stratified_N16.png",
+    ] {
+        assert!(
+            names.contains(&name.to_string()),
+            "{name} missing from {names:?}"
+        );
+    }
+    let csv = std::fs::read_to_string(dir.path().join("results.csv")).unwrap();
+    // Header plus one row per (sampler, N, region).
+    assert_eq!(csv.lines().count(), 1 + 2 * 3 * 3);
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("results.json")).unwrap())
+            .unwrap();
+    assert_eq!(json["rows"].as_array().unwrap().len(), 18);
+    let png = image::open(dir.path().join("mse.png")).unwrap();
+    assert!(png.width() > 100 && png.height() > 100);
+}
+
+#[test]
+fn stratified_covers_every_stratum_for_non_square_n() {
+    for n in [2u32, 3, 6, 7, 8, 10, 12, 15, 18, 100] {
+        let (nx, ny) = strata_grid(n);
+        for pixel in 0..10 {
+            let key = SampleKey {
+                pixel,
+                sample: 1,
+                bounce: 2,
+                light: 0,
+                seed: 5,
+            };
+            let mut cells = vec![0; n as usize];
+            for j in 0..n {
+                let (u, v) = square_sample(LightSampler::Stratified, &key, j, n);
+                cells[((v * ny as f32) as u32 * nx + (u * nx as f32) as u32) as usize] += 1;
+            }
+            assert!(
+                cells.iter().all(|&c| c == 1),
+                "n={n} ({nx}x{ny}): {cells:?}"
+            );
+        }
+    }
+}
