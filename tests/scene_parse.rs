@@ -637,3 +637,33 @@ fn camera_block_with_center_and_direction() {
     );
     error_at(&bad, 8, &["up"]);
 }
+
+#[test]
+fn a_non_utf8_byte_is_an_error_naming_its_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("latin1.obj");
+    std::fs::write(&path, b"material\ndiffuse 1 1 1\n# caf\xe9\nv 0 0 0\n").unwrap();
+    let err = raywave::scene::Scene::load(&path).unwrap_err().to_string();
+    assert!(err.contains("latin1.obj:3:"), "{err}");
+    assert!(err.contains("expected UTF-8"), "{err}");
+}
+
+#[test]
+fn a_non_convex_polygon_is_loaded_with_a_warning() {
+    // A dart (0,0) (2,1) (0,2) (1,1): fanned from (0,0), its second triangle (0,0) (0,2) (1,1)
+    // winds the other way, so the fan overlaps itself. The square after it is convex.
+    let scene = raywave::scene::parse_scene_str(
+        "material\ndiffuse 1 1 1\n\
+         v 0 0 0\nv 2 1 0\nv 0 2 0\nv 1 1 0\n\
+         v 3 0 0\nv 4 0 0\nv 4 1 0\nv 3 1 0\n\
+         m 0\nf 1 2 3 4\nf 5 6 7 8\n",
+        "dart.obj",
+    )
+    .unwrap();
+    let warnings: Vec<String> = scene.warnings.iter().map(|w| w.to_string()).collect();
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    assert!(
+        warnings[0].starts_with("dart.obj:12:") && warnings[0].contains("non-convex"),
+        "{warnings:?}"
+    );
+}

@@ -198,11 +198,20 @@ pub struct Scene {
 impl Scene {
     /// Reads and parses a scene file; errors name the file and line.
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
-        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
-            path: path.display().to_string(),
+        let file = path.display().to_string();
+        let bytes = std::fs::read(path).map_err(|source| SceneError::Io {
+            path: file.clone(),
             source,
         })?;
-        Ok(parse_scene_str(&text, &path.display().to_string())?)
+        let text = String::from_utf8(bytes).map_err(|e| {
+            let valid = &e.as_bytes()[..e.utf8_error().valid_up_to()];
+            ParseError {
+                line: 1 + valid.iter().filter(|&&b| b == b'\n').count(),
+                message: "expected UTF-8 text, found a byte that is not UTF-8".into(),
+                file: file.clone(),
+            }
+        })?;
+        Ok(parse_scene_str(&text, &file)?)
     }
 
     /// The built-in default: the lab's Cornell box with three mirror spheres.
