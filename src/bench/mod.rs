@@ -218,17 +218,17 @@ pub fn run(args: &BenchArgs) -> Result<Outcome> {
         engines,
     };
     if !args.quiet {
-        print!("{}", report(&record));
+        emit(&report(&record))?;
     }
     if let Some(path) = &save_path {
         record::save(path, &record)?;
         if !args.quiet {
-            println!("saved   {}", path.display());
+            emit(&format!("saved   {}\n", path.display()))?;
         }
     }
     match &args.json {
         Some(p) if p.as_os_str() == "-" => {
-            println!("{}", serde_json::to_string_pretty(&record)?);
+            emit(&format!("{}\n", serde_json::to_string_pretty(&record)?))?;
         }
         Some(p) => crate::film::write_atomically(p, |w| {
             serde_json::to_writer_pretty(&mut *w, &record)?;
@@ -241,20 +241,28 @@ pub fn run(args: &BenchArgs) -> Result<Outcome> {
             let c = compare::compare(before, &record, args.threshold)
                 .map_err(|d| anyhow::anyhow!("setups differ: {}", d.join("; ")))?;
             if !args.quiet {
-                println!();
+                emit("\n")?;
             }
-            println!(
-                "compared with {} ({}, commit {}):",
+            emit(&format!(
+                "compared with {} ({}, commit {}):\n{}",
                 args.compare.as_deref().unwrap_or_default(),
                 before.timestamp,
-                short(&before.git_commit)
-            );
-            print!("{}", c.table());
+                short(&before.git_commit),
+                c.table()
+            ))?;
             Some(c)
         }
         None => None,
     };
     Ok(Outcome { record, comparison })
+}
+
+/// Writes to stdout; a closed pipe (`raywave bench | head`) is an error, not a panic.
+fn emit(text: &str) -> Result<()> {
+    let mut out = std::io::stdout().lock();
+    out.write_all(text.as_bytes())
+        .and_then(|()| out.flush())
+        .context("cannot write to stdout")
 }
 
 fn short(commit: &str) -> &str {
