@@ -1,10 +1,10 @@
 //! The `raywave` command. `main` owns the exit code: 0 on success, 2 for a usage error (clap),
 //! 1 for anything else, printed once with its cause chain.
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use clap::Parser;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use raywave::cli::{Cli, Command, Engine, MeshgenArgs, RenderArgs};
+use raywave::cli::{Cli, Command, Engine, MeshgenArgs, RenderArgs, UsageError};
 use raywave::debug_view::RayRecorder;
 use raywave::film::{check_hdr_path, check_output_dir, ldr_format};
 use raywave::reference::Reference;
@@ -18,14 +18,27 @@ use std::io::Write;
 use std::process::ExitCode;
 use std::time::Instant;
 
+// Standard output that fails with an error (exit 1) instead of panicking when it is closed
+// (`raywave ... | head`) or full: these shadow std's macros in this file, so every function that
+// prints returns a Result.
+macro_rules! println {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        writeln!(std::io::stdout().lock(), $($arg)*).context("cannot write to standard output")?
+    }};
+}
+macro_rules! print {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        write!(std::io::stdout().lock(), $($arg)*).context("cannot write to standard output")?
+    }};
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse_from(raywave::cli::normalize_args(std::env::args_os()));
     let result = match cli.command {
         Command::Render(args) => render(&args),
-        Command::Info => {
-            info();
-            Ok(())
-        }
+        Command::Info => info(),
         Command::Meshgen(args) => meshgen(&args),
         Command::Variance(args) => variance(&args),
         // Exit 3 when --compare finds a regression (raywave::bench::EXIT_REGRESSION).
@@ -36,6 +49,10 @@ fn main() -> ExitCode {
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        Err(e) if e.downcast_ref::<UsageError>().is_some() => {
+            eprintln!("error: {e:#}\n\nFor more information, try '--help'.");
+            ExitCode::from(2)
+        }
         Err(e) => {
             eprintln!("error: {e:#}");
             ExitCode::from(1)
@@ -43,13 +60,14 @@ fn main() -> ExitCode {
     }
 }
 
-fn info() {
+fn info() -> Result<()> {
     println!("raywave {}", env!("CARGO_PKG_VERSION"));
     println!("simd    {}", raywave::simd_path());
     println!(
         "threads {} (rayon default; --threads N to change)",
         rayon::current_num_threads()
     );
+    Ok(())
 }
 
 fn meshgen(args: &MeshgenArgs) -> Result<()> {
@@ -87,10 +105,10 @@ fn thread_pool(threads: Option<u32>) -> Result<rayon::ThreadPool> {
 
 fn render(args: &RenderArgs) -> Result<()> {
     // Check everything that can fail cheaply before the long part.
-    ldr_format(&args.output)?;
+    ldr_format(&args.output).map_err(|e| UsageError::from_error(&e))?;
     check_output_dir(&args.output)?;
     if let Some(hdr) = &args.hdr {
-        check_hdr_path(hdr)?;
+        check_hdr_path(hdr).map_err(|e| UsageError::from_error(&e))?;
         check_output_dir(hdr)?;
     }
     let scene = match args.scene_path() {
@@ -104,13 +122,11 @@ fn render(args: &RenderArgs) -> Result<()> {
     if let Some(px) = &args.debug_pixel
         && (px[0] >= settings.width || px[1] >= settings.height)
     {
-        bail!(
+        return Err(UsageError(format!(
             "--debug-pixel {} {} is outside the {}×{} image",
-            px[0],
-            px[1],
-            settings.width,
-            settings.height
-        );
+            px[0], px[1], settings.width, settings.height
+        ))
+        .into());
     }
     if let Some(path) = &args.stats_json {
         check_output_dir(path)?;
@@ -183,7 +199,7 @@ fn render(args: &RenderArgs) -> Result<()> {
         })?;
     }
     if !args.quiet {
-        summary(&scene, &settings, &run, &report);
+        summary(&scene, &settings, &run, &report)?;
         let extra = args
             .hdr
             .as_ref()
@@ -192,7 +208,7 @@ fn render(args: &RenderArgs) -> Result<()> {
         println!("wrote   {}{extra}", args.output.display());
     }
     if args.stats {
-        print_stats(&report);
+        print_stats(&report)?;
     }
     Ok(())
 }
@@ -213,7 +229,7 @@ fn progress_bar(len: u64, unit: &str, quiet: bool) -> ProgressBar {
     bar
 }
 
-fn summary(scene: &Scene, s: &RenderSettings, run: &RunInfo, report: &Report) {
+fn summary(scene: &Scene, s: &RenderSettings, run: &RunInfo, report: &Report) -> Result<()> {
     let shadows = match s.shadows {
         ShadowMode::Off => "off (every light visible)".to_string(),
         ShadowMode::Hard => "hard (light centroids)".to_string(),
@@ -260,6 +276,7 @@ fn summary(scene: &Scene, s: &RenderSettings, run: &RunInfo, report: &Report) {
         report.seconds,
         report.rays_per_second() / 1e6
     );
+    Ok(())
 }
 
 /// How the render ran, for the summary and the JSON.
@@ -303,7 +320,7 @@ impl Report {
     }
 }
 
-fn print_stats(report: &Report) {
+fn print_stats(report: &Report) -> Result<()> {
     println!("{:<12} {:>14} {:>14}", "kind", "rays", "Mrays/s");
     for (kind, rays, per_s) in report.kinds() {
         println!("{kind:<12} {rays:>14} {:>14.2}", per_s / 1e6);
@@ -326,6 +343,7 @@ fn print_stats(report: &Report) {
             );
         }
     }
+    Ok(())
 }
 
 fn stats_json(

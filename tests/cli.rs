@@ -305,7 +305,8 @@ fn bad_output_extension_fails_before_rendering() {
             "out.jpg",
         ],
     );
-    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    // A flag value raywave cannot use is a usage error, like clap's own: exit 2.
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(stderr(&out).contains("out.jpg"));
     assert_eq!(files_in(dir.path()), ["cornell_box.obj"]);
 }

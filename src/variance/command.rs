@@ -81,11 +81,11 @@ impl VarianceArgs {
             );
         }
         if !self.budgets.contains(&self.heatmap_n) {
-            bail!(
+            return Err(crate::cli::UsageError(format!(
                 "--heatmap-n {} is not one of --budgets {:?}: expected one of the budgets",
-                self.heatmap_n,
-                self.budgets
-            );
+                self.heatmap_n, self.budgets
+            ))
+            .into());
         }
         if self.samplers.is_empty() {
             bail!("--samplers is empty: expected at least one of random, stratified, sobol, lab");
