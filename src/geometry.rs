@@ -133,21 +133,7 @@ impl Accel {
             };
         }
         let start = std::time::Instant::now();
-        let tris: Vec<obvhs::triangle::Triangle> = scene
-            .triangles
-            .iter()
-            .map(|t| obvhs::triangle::Triangle {
-                v0: t.v0.into(),
-                v1: (t.v0 + t.e1).into(),
-                v2: (t.v0 + t.e2).into(),
-            })
-            .collect();
-        let mut core = Duration::ZERO;
-        let bvh = obvhs::cwbvh::builder::build_cwbvh_from_tris(
-            &tris,
-            BvhBuildParams::medium_build(),
-            &mut core,
-        );
+        let bvh = build_cwbvh(scene);
         Accel {
             bvh: Some(bvh),
             build_time: start.elapsed(),
@@ -225,6 +211,22 @@ impl Accel {
             }),
         }
     }
+}
+
+/// The CWBVH over a scene's triangles, with the preset every raywave BVH uses
+/// (`medium_build`); `bvh.primitive_indices` maps its leaves back to `scene.triangles`.
+pub fn build_cwbvh(scene: &Scene) -> CwBvh {
+    let tris: Vec<obvhs::triangle::Triangle> = scene
+        .triangles
+        .iter()
+        .map(|t| obvhs::triangle::Triangle {
+            v0: t.v0.into(),
+            v1: (t.v0 + t.e1).into(),
+            v2: (t.v0 + t.e2).into(),
+        })
+        .collect();
+    let mut core = Duration::ZERO;
+    obvhs::cwbvh::builder::build_cwbvh_from_tris(&tris, BvhBuildParams::medium_build(), &mut core)
 }
 
 fn obvhs_ray(ray: &Ray, tmax: f32) -> obvhs::ray::Ray {

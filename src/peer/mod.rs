@@ -32,7 +32,7 @@ use crate::wavefront::batch::{HitBatch, PathId, RayBatch};
 use crate::wavefront::context::Context;
 use crate::wavefront::{DEFAULT_BATCH_SIZE, intersect};
 use glam::{Vec3, Vec3A};
-use obvhs::{BvhBuildParams, cwbvh::CwBvh, ray::RayHit};
+use obvhs::{cwbvh::CwBvh, ray::RayHit};
 use std::time::{Duration, Instant};
 
 /// The scene as the peers see it: every triangle except the emissive ones (the lights).
@@ -291,21 +291,7 @@ impl ObvhsMesh {
     /// Builds the CWBVH with the same preset as raywave's `Accel` (`medium_build`).
     pub fn new(scene: &Scene) -> Self {
         let start = Instant::now();
-        let tris: Vec<obvhs::triangle::Triangle> = scene
-            .triangles
-            .iter()
-            .map(|t| obvhs::triangle::Triangle {
-                v0: t.v0.into(),
-                v1: (t.v0 + t.e1).into(),
-                v2: (t.v0 + t.e2).into(),
-            })
-            .collect();
-        let mut core = Duration::ZERO;
-        let bvh = obvhs::cwbvh::builder::build_cwbvh_from_tris(
-            &tris,
-            BvhBuildParams::medium_build(),
-            &mut core,
-        );
+        let bvh = crate::geometry::build_cwbvh(scene);
         ObvhsMesh {
             bvh,
             build_time: start.elapsed(),
