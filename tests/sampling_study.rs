@@ -199,26 +199,7 @@ fn points_stay_on_the_unit_square_and_cover_it() {
     // powers of two, where its net property holds for every 2^a × 2^b grid).
     for sampler in [LightSampler::Stratified, LightSampler::Sobol] {
         for n in [4u32, 16, 64, 256] {
-            let (nx, ny) = strata_grid(n);
-            for pixel in 0..10 {
-                let key = SampleKey {
-                    pixel,
-                    sample: 3,
-                    bounce: 0,
-                    light: 0,
-                    seed: 1,
-                };
-                let mut cells = vec![0; n as usize];
-                for j in 0..n {
-                    let (u, v) = square_sample(sampler, &key, j, n);
-                    cells[((v * ny as f32) as u32 * nx + (u * nx as f32) as u32) as usize] += 1;
-                }
-                assert!(
-                    cells.iter().all(|&c| c == 1),
-                    "{} n={n}: {cells:?}",
-                    sampler.name()
-                );
-            }
+            assert_one_point_per_stratum(sampler, n, 3, 0);
         }
     }
     // Random points (and the lab's, for N > 1) fill a 4 × 4 grid evenly: 4096 points, 256
@@ -481,24 +462,31 @@ fn the_study_meets_the_issue_floor_and_writes_its_outputs() {
 #[test]
 fn stratified_covers_every_stratum_for_non_square_n() {
     for n in [2u32, 3, 6, 7, 8, 10, 12, 15, 18, 100] {
-        let (nx, ny) = strata_grid(n);
-        for pixel in 0..10 {
-            let key = SampleKey {
-                pixel,
-                sample: 1,
-                bounce: 2,
-                light: 0,
-                seed: 5,
-            };
-            let mut cells = vec![0; n as usize];
-            for j in 0..n {
-                let (u, v) = square_sample(LightSampler::Stratified, &key, j, n);
-                cells[((v * ny as f32) as u32 * nx + (u * nx as f32) as u32) as usize] += 1;
-            }
-            assert!(
-                cells.iter().all(|&c| c == 1),
-                "n={n} ({nx}x{ny}): {cells:?}"
-            );
+        assert_one_point_per_stratum(LightSampler::Stratified, n, 1, 2);
+    }
+}
+
+/// Exactly one of the n points of `sampler` in each cell of the `strata_grid(n)` grid, for ten
+/// pixels' streams.
+fn assert_one_point_per_stratum(sampler: LightSampler, n: u32, sample: u32, bounce: u32) {
+    let (nx, ny) = strata_grid(n);
+    for pixel in 0..10 {
+        let key = SampleKey {
+            pixel,
+            sample,
+            bounce,
+            light: 0,
+            seed: 5,
+        };
+        let mut cells = vec![0; n as usize];
+        for j in 0..n {
+            let (u, v) = square_sample(sampler, &key, j, n);
+            cells[((v * ny as f32) as u32 * nx + (u * nx as f32) as u32) as usize] += 1;
         }
+        assert!(
+            cells.iter().all(|&c| c == 1),
+            "{} n={n} ({nx}x{ny}): {cells:?}",
+            sampler.name()
+        );
     }
 }
