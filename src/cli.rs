@@ -59,25 +59,9 @@ pub struct RenderArgs {
     /// Output image (.png or .ppm), written whole or not at all.
     #[arg(short, long, default_value = "render.png")]
     pub output: PathBuf,
-    /// Image size in pixels.
-    #[arg(long, num_args = 2, value_names = ["W", "H"], value_parser = clap::value_parser!(u32).range(1..=16384))]
-    pub size: Option<Vec<u32>>,
-    /// Maximum mirror bounces.
-    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(0..=64))]
-    pub bounces: u32,
-    /// Shadows: off (every light visible), hard (centroid), soft (N points per light).
-    /// Default: hard, or soft when --shadow-samples > 1 or no scene is given.
-    #[arg(long, value_enum)]
-    pub shadows: Option<ShadowMode>,
-    /// Points per light with soft shadows [default: 16].
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
-    pub shadow_samples: Option<u32>,
-    /// How the points on a light are chosen.
-    #[arg(long, value_enum, default_value = "stratified")]
-    pub sampler: LightSampler,
-    /// Camera rays per pixel (1 = pixel centre, more = jittered strata).
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=4096))]
-    pub aa: u32,
+    /// Size, bounces, shadows and sampling (shared with `raywave bench`).
+    #[command(flatten)]
+    pub image: ImageArgs,
     /// Background colour for rays that hit nothing [default: the scene's, else white].
     #[arg(long, num_args = 3, value_names = ["R", "G", "B"], value_parser = parse_colour_component)]
     pub background: Option<Vec<f32>>,
@@ -155,6 +139,47 @@ impl RenderArgs {
 
     /// Turns the flags into settings; `scene_background` is the file's `background_color`.
     pub fn settings(&self, scene_background: Option<[f32; 3]>) -> RenderSettings {
+        let background = match &self.background {
+            Some(c) => [c[0], c[1], c[2]],
+            None => scene_background.unwrap_or(RenderSettings::default().background),
+        };
+        RenderSettings {
+            seed: self.seed,
+            two_sided: self.two_sided,
+            ..self.image.settings(self.scene_path().is_some(), background)
+        }
+    }
+}
+
+/// The flags that shape the image, shared by `render` and `bench` so that both default alike
+/// (a bench record then measures what the same flags render).
+#[derive(Args, Debug, Clone)]
+pub struct ImageArgs {
+    /// Image size in pixels [default: 512 512].
+    #[arg(long, num_args = 2, value_names = ["W", "H"], value_parser = clap::value_parser!(u32).range(1..=16384))]
+    pub size: Option<Vec<u32>>,
+    /// Maximum mirror bounces.
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(0..=64))]
+    pub bounces: u32,
+    /// Shadows: off (every light visible), hard (centroid), soft (N points per light).
+    /// Default: hard, or soft when --shadow-samples > 1 or no scene is given.
+    #[arg(long, value_enum)]
+    pub shadows: Option<ShadowMode>,
+    /// Points per light with soft shadows [default: 16].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    pub shadow_samples: Option<u32>,
+    /// How the points on a light are chosen.
+    #[arg(long, value_enum, default_value = "stratified")]
+    pub sampler: LightSampler,
+    /// Camera rays per pixel (1 = pixel centre, more = jittered strata).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pub aa: u32,
+}
+
+impl ImageArgs {
+    /// Settings from these flags, seed 0 and one-sided faces. Shadows default to soft when
+    /// --shadow-samples > 1 or no scene is given (the lab's third run line), else hard.
+    pub fn settings(&self, has_scene: bool, background: [f32; 3]) -> RenderSettings {
         let defaults = RenderSettings::default();
         let size = self
             .size
@@ -162,13 +187,9 @@ impl RenderArgs {
             .unwrap_or(vec![defaults.width, defaults.height]);
         let shadows = self.shadows.unwrap_or(match self.shadow_samples {
             Some(n) if n > 1 => ShadowMode::Soft,
-            _ if self.scene_path().is_none() => ShadowMode::Soft,
+            _ if !has_scene => ShadowMode::Soft,
             _ => ShadowMode::Hard,
         });
-        let background = match &self.background {
-            Some(c) => [c[0], c[1], c[2]],
-            None => scene_background.unwrap_or(defaults.background),
-        };
         RenderSettings {
             width: size[0],
             height: size[1],
@@ -178,8 +199,7 @@ impl RenderArgs {
             sampler: self.sampler,
             aa_samples: self.aa,
             background,
-            seed: self.seed,
-            two_sided: self.two_sided,
+            ..defaults
         }
     }
 }

@@ -229,7 +229,8 @@ pub fn build_cwbvh(scene: &Scene) -> CwBvh {
     obvhs::cwbvh::builder::build_cwbvh_from_tris(&tris, BvhBuildParams::medium_build(), &mut core)
 }
 
-fn obvhs_ray(ray: &Ray, tmax: f32) -> obvhs::ray::Ray {
+/// The obvhs ray for (T_MIN, tmax) along `ray`.
+pub fn obvhs_ray(ray: &Ray, tmax: f32) -> obvhs::ray::Ray {
     obvhs::ray::Ray::new(
         Vec3A::from(ray.origin),
         Vec3A::from(ray.direction),

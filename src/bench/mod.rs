@@ -13,7 +13,6 @@ pub mod record;
 
 use crate::film::Film;
 use crate::reference::Reference;
-use crate::sampling::LightSampler;
 use crate::scene::{BUILTIN_CORNELL_BOX, Scene};
 use crate::settings::{RenderSettings, ShadowMode};
 use crate::wavefront::{DEFAULT_BATCH_SIZE, Wavefront};
@@ -37,26 +36,9 @@ pub const DEFAULT_THRESHOLD_PCT: f64 = 40.0;
 pub struct BenchArgs {
     /// Scene file (.obj); without one, the built-in lab Cornell box with mirror spheres.
     pub scene: Option<PathBuf>,
-    /// Image size in pixels.
-    #[arg(long, num_args = 2, value_names = ["W", "H"], default_values_t = [512u32, 512],
-          value_parser = clap::value_parser!(u32).range(1..=16384))]
-    pub size: Vec<u32>,
-    /// Maximum mirror bounces.
-    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(0..=64))]
-    pub bounces: u32,
-    /// Shadows: off, hard or soft. Default: hard, or soft when --shadow-samples > 1 or no
-    /// scene is given (as for render).
-    #[arg(long, value_enum)]
-    pub shadows: Option<ShadowMode>,
-    /// Points per light with soft shadows [default: 16].
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
-    pub shadow_samples: Option<u32>,
-    /// How the points on a light are chosen.
-    #[arg(long, value_enum, default_value = "stratified")]
-    pub sampler: LightSampler,
-    /// Camera rays per pixel.
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=4096))]
-    pub aa: u32,
+    /// Size, bounces, shadows and sampling, as for `raywave render`.
+    #[command(flatten)]
+    pub image: crate::cli::ImageArgs,
     /// Worker threads [default: all cores].
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
     pub threads: Option<u32>,
@@ -94,25 +76,10 @@ fn parse_threshold(s: &str) -> Result<f64, String> {
 }
 
 impl BenchArgs {
-    /// The render settings, defaulted like `raywave render`'s.
+    /// The render settings, defaulted like `raywave render`'s (the same `ImageArgs`).
     pub fn settings(&self, scene_background: Option<[f32; 3]>) -> RenderSettings {
-        let defaults = RenderSettings::default();
-        let shadows = self.shadows.unwrap_or(match self.shadow_samples {
-            Some(n) if n > 1 => ShadowMode::Soft,
-            _ if self.scene.is_none() => ShadowMode::Soft,
-            _ => ShadowMode::Hard,
-        });
-        RenderSettings {
-            width: self.size[0],
-            height: self.size[1],
-            bounces: self.bounces,
-            shadows,
-            shadow_samples: self.shadow_samples.unwrap_or(defaults.shadow_samples),
-            sampler: self.sampler,
-            aa_samples: self.aa,
-            background: scene_background.unwrap_or(defaults.background),
-            ..defaults
-        }
+        let background = scene_background.unwrap_or(RenderSettings::default().background);
+        self.image.settings(self.scene.is_some(), background)
     }
 }
 

@@ -26,12 +26,12 @@
 pub mod embree;
 
 use crate::camera::CameraRays;
-use crate::geometry::{Ray, T_MIN, intersect_triangle};
+use crate::geometry::{Ray, T_MIN, intersect_triangle, obvhs_ray};
 use crate::scene::{NO_HIT, Scene};
 use crate::wavefront::batch::{HitBatch, PathId, RayBatch};
 use crate::wavefront::context::Context;
 use crate::wavefront::{DEFAULT_BATCH_SIZE, intersect};
-use glam::{Vec3, Vec3A};
+use glam::Vec3;
 use obvhs::{cwbvh::CwBvh, ray::RayHit};
 use std::time::{Duration, Instant};
 
@@ -334,15 +334,6 @@ impl ObvhsMesh {
             }
         }
     }
-}
-
-fn obvhs_ray(ray: &Ray, tmax: f32) -> obvhs::ray::Ray {
-    obvhs::ray::Ray::new(
-        Vec3A::from(ray.origin),
-        Vec3A::from(ray.direction),
-        T_MIN,
-        tmax,
-    )
 }
 
 /// raywave's wavefront intersect stage over the set's batches (`intersect::closest`, which also
