@@ -6,7 +6,7 @@
 //! outward normal; a hit needs t > `T_MIN`. A miss returns `f32::INFINITY`, never `None`, and any
 //! NaN in the input makes a miss (every test is written so that NaN compares false).
 
-use crate::scene::{NO_HIT, Scene, Sphere, Triangle};
+use crate::scene::{LightShape, NO_HIT, Scene, Sphere, Triangle};
 use glam::{Vec3, Vec3A};
 use obvhs::{BvhBuildParams, cwbvh::CwBvh, ray::RayHit};
 use std::time::Duration;
@@ -119,6 +119,9 @@ pub fn geometric_normal(scene: &Scene, prim: u32, point: Vec3) -> Vec3 {
 /// How the reference finds hits: every primitive in turn, or a BVH over the triangles.
 pub struct Accel {
     bvh: Option<CwBvh>,
+    /// Without a BVH, the triangles that shadow rays test when faces are one-sided (see
+    /// `shadow_casters`).
+    casters: Vec<Triangle>,
     /// BVH build time, for reporting (zero without a BVH).
     pub build_time: Duration,
 }
@@ -129,6 +132,7 @@ impl Accel {
         if scene.triangles.len() < BVH_MIN_TRIANGLES {
             return Accel {
                 bvh: None,
+                casters: shadow_casters(scene),
                 build_time: Duration::ZERO,
             };
         }
@@ -136,6 +140,7 @@ impl Accel {
         let bvh = build_cwbvh(scene);
         Accel {
             bvh: Some(bvh),
+            casters: Vec::new(),
             build_time: start.elapsed(),
         }
     }
@@ -197,8 +202,7 @@ impl Accel {
             return true;
         }
         match &self.bvh {
-            None => scene
-                .triangles
+            None => casters(scene, &self.casters, two_sided)
                 .iter()
                 .any(|tri| intersect_triangle(tri, ray, tmax, two_sided) < tmax),
             Some(bvh) => !bvh.ray_traverse_miss(obvhs_ray(ray, tmax), |_, id| {
@@ -211,6 +215,75 @@ impl Accel {
             }),
         }
     }
+}
+
+/// The triangles that can block a shadow ray toward one of the scene's lights when faces are
+/// one-sided: every triangle except those with every light wholly on their front side.
+///
+/// A shadow ray runs from a point x to a point p on a light and is blocked in (T_MIN,
+/// |p − x| − T_MIN). A one-sided face is hit only from its front, by a ray going from its front
+/// half-space to its back one, so it meets the face's plane at or beyond p when p is on the
+/// front side or on the plane: such a face can never block it. The lab's box shows why this
+/// matters: its light is a wall of the box, so the light lies on or in front of every wall's
+/// plane and no wall can shadow it; only the spheres can. Signed distances are taken in f64
+/// with a tolerance of 1e-6 of the scene's size, so a light *touching* a face's plane (the
+/// lab's light shares an edge with four walls) counts as in front of it despite rounding in
+/// the face's edges. Both engines test this same list, so they still agree bit for bit; with
+/// `--two-sided` every triangle is tested.
+pub fn shadow_casters(scene: &Scene) -> Vec<Triangle> {
+    let corners: Vec<Vec3> = scene
+        .lights
+        .iter()
+        .flat_map(|light| match &light.shape {
+            LightShape::Parallelogram {
+                origin,
+                edge_u,
+                edge_v,
+            } => vec![
+                *origin,
+                *origin + *edge_u,
+                *origin + *edge_v,
+                *origin + *edge_u + *edge_v,
+            ],
+            LightShape::Fan { triangles, .. } => triangles
+                .iter()
+                .flat_map(|&(a, e1, e2)| [a, a + e1, a + e2])
+                .collect(),
+        })
+        .collect();
+    let size = scene
+        .triangles
+        .iter()
+        .flat_map(|t| [t.v0, t.v0 + t.e1, t.v0 + t.e2])
+        .chain(corners.iter().copied())
+        .fold(1.0f64, |m, p| m.max(p.abs().max_element() as f64));
+    let tolerance = 1e-6 * size;
+    scene
+        .triangles
+        .iter()
+        .filter(|tri| {
+            let (e1, e2) = (tri.e1.as_dvec3(), tri.e2.as_dvec3());
+            let normal = e1.cross(e2);
+            let length = normal.length();
+            // A degenerate triangle is never hit (det = 0); keep it anyway, it costs nothing.
+            if length.is_nan() || length == 0.0 {
+                return true;
+            }
+            let normal = normal / length;
+            let v0 = tri.v0.as_dvec3();
+            corners
+                .iter()
+                .any(|c| normal.dot(c.as_dvec3() - v0) < -tolerance)
+        })
+        .copied()
+        .collect()
+}
+
+/// The triangles a shadow ray tests without a BVH: the casters for one-sided faces, all of
+/// them for two-sided ones.
+#[inline]
+pub fn casters<'a>(scene: &'a Scene, casters: &'a [Triangle], two_sided: bool) -> &'a [Triangle] {
+    if two_sided { &scene.triangles } else { casters }
 }
 
 /// The CWBVH over a scene's triangles, with the preset every raywave BVH uses

@@ -7,7 +7,7 @@
 
 use glam::Vec3;
 use proptest::prelude::*;
-use raywave::geometry::{Accel, Ray, intersect_sphere, intersect_triangle};
+use raywave::geometry::{self, Accel, Ray, intersect_sphere, intersect_triangle, shadow_casters};
 use raywave::sampling::{LightSampler, SampleKey, square_sample, strata_grid, uniform};
 use raywave::scene::{Light, LightShape, Material, NO_HIT, Scene, Sphere, Triangle};
 use raywave::shading::shade;
@@ -182,7 +182,8 @@ fn check_batch(scene: &Scene, rays: &[(Ray, f32)], two_sided: bool) {
     let accel = Accel::new(scene);
     let cols = Columns::new(rays);
     let n = rays.len();
-    let (mut t, mut prim, mut blocked) = (vec![0.0; n], vec![0; n], vec![false; n]);
+    let (mut t, mut prim) = (vec![0.0; n], vec![0; n]);
+    let (mut blocked, mut blocked_by_casters) = (vec![false; n], vec![false; n]);
     simd::closest_hits(
         &scene.triangles,
         &scene.spheres,
@@ -198,6 +199,15 @@ fn check_batch(scene: &Scene, rays: &[(Ray, f32)], two_sided: bool) {
         two_sided,
         &mut blocked,
     );
+    // What the engines run: only the triangles that can shadow a light (all when two-sided).
+    let casters = shadow_casters(scene);
+    simd::occluded(
+        geometry::casters(scene, &casters, two_sided),
+        &scene.spheres,
+        &cols.view(),
+        two_sided,
+        &mut blocked_by_casters,
+    );
     for (i, (r, tmax)) in rays.iter().enumerate() {
         let want = accel.closest(scene, r, *tmax, two_sided);
         assert_eq!(
@@ -205,8 +215,17 @@ fn check_batch(scene: &Scene, rays: &[(Ray, f32)], two_sided: bool) {
             (want.t.to_bits(), want.prim),
             "ray {i}: {r:?}"
         );
+        let every_primitive = scene
+            .spheres
+            .iter()
+            .any(|s| intersect_sphere(s, r, *tmax) < *tmax)
+            || scene
+                .triangles
+                .iter()
+                .any(|tri| intersect_triangle(tri, r, *tmax, two_sided) < *tmax);
+        assert_eq!(blocked[i], every_primitive, "ray {i}: {r:?} tmax {tmax}");
         assert_eq!(
-            blocked[i],
+            blocked_by_casters[i],
             accel.occluded(scene, r, *tmax, two_sided),
             "ray {i}: {r:?} tmax {tmax}"
         );

@@ -2,9 +2,9 @@
 //! once (material and light terms, the strata grid, the acceleration choice).
 
 use crate::camera::CameraRays;
-use crate::geometry::Accel;
+use crate::geometry::{Accel, shadow_casters};
 use crate::sampling::{LightSampler, strata_grid};
-use crate::scene::{LightShape, Scene};
+use crate::scene::{LightShape, Scene, Triangle};
 use crate::settings::{RenderSettings, ShadowMode};
 use crate::shading::AMBIENT;
 use glam::Vec3;
@@ -57,6 +57,9 @@ pub struct Context<'a> {
     pub accel: Option<Accel>,
     /// BVH build time (zero without one).
     pub bvh_build_time: Duration,
+    /// Without a BVH, the triangles that can block a shadow ray when faces are one-sided
+    /// (`geometry::shadow_casters`, the reference's list).
+    pub shadow_casters: Vec<Triangle>,
     /// One entry per material.
     pub materials: Vec<MaterialTerms>,
     /// One entry per light.
@@ -114,6 +117,11 @@ impl<'a> Context<'a> {
             scene,
             settings,
             camera: CameraRays::new(&scene.camera, settings.width, settings.height),
+            shadow_casters: if accel.is_none() {
+                shadow_casters(scene)
+            } else {
+                Vec::new()
+            },
             accel,
             bvh_build_time,
             materials,

@@ -4,7 +4,8 @@
 //! for each group of hits whose shadow rays fit the queue:
 //!     spawn:   for hit, for light, for point j < N:  l, dist, n·l;  queue it if n·l > 0
 //!     occlude: 8 queued rays at a time, stop at the first blocker (obvhs `ray_traverse_miss`
-//!              for meshes)
+//!              for meshes); small scenes test only the triangles that can shadow a light
+//!              (`geometry::shadow_casters`)
 //!     shade:   in queue order, direct[hit] += Shade(l) / N for the rays not blocked
 //! ```
 //!
@@ -19,7 +20,7 @@
 use super::batch::{HitBatch, RayBatch, ShadowQueue};
 use super::context::{Context, MaterialTerms};
 use super::simd::{self, LANES, LightBlock, RayColumns};
-use crate::geometry::{Ray, T_MIN};
+use crate::geometry::{Ray, T_MIN, casters};
 use crate::sampling::{SampleKey, mix32, square_sample};
 use crate::scene::NO_HIT;
 use glam::Vec3;
@@ -167,7 +168,7 @@ fn occlude(ctx: &Context, queue: &mut ShadowQueue) {
                 tmax: &queue.tmax[..n],
             };
             simd::occluded(
-                &scene.triangles,
+                casters(scene, &ctx.shadow_casters, two_sided),
                 &scene.spheres,
                 &cols,
                 two_sided,

@@ -1,0 +1,186 @@
+//! Shadow-caster culling (`geometry::shadow_casters`): a one-sided face with every light on its
+//! front side (or on its plane) can never block a shadow ray, so the engines skip it. These
+//! tests check the rule by hand on the lab's box and on two facing blockers, and check on random
+//! scenes that culling never changes whether a shadow ray is blocked.
+
+use glam::Vec3;
+use raywave::geometry::{Accel, Ray, T_MIN, intersect_sphere, intersect_triangle, shadow_casters};
+use raywave::scene::{Scene, parse_scene_str};
+use std::fmt::Write;
+use std::path::Path;
+
+fn scene(name: &str) -> Scene {
+    Scene::load(
+        &Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("scenes")
+            .join(name),
+    )
+    .unwrap()
+}
+
+/// Blocked with every triangle tested: what the engines did before culling.
+fn blocked_unculled(scene: &Scene, ray: &Ray, tmax: f32) -> bool {
+    scene
+        .spheres
+        .iter()
+        .any(|s| intersect_sphere(s, ray, tmax) < tmax)
+        || scene
+            .triangles
+            .iter()
+            .any(|t| intersect_triangle(t, ray, tmax, false) < tmax)
+}
+
+#[test]
+fn the_lab_box_walls_never_shadow_its_light() {
+    // The light is the box's front wall: every wall, and the light itself, has it on or in front
+    // of its plane, so only the spheres can cast shadows.
+    for name in [
+        "cornell_box.obj",
+        "cornell_box_diffuse_sphere.obj",
+        "cornell_box_reflective_spheres.obj",
+    ] {
+        let s = scene(name);
+        assert_eq!(s.triangles.len(), 12, "{name}");
+        assert_eq!(shadow_casters(&s).len(), 0, "{name}");
+    }
+}
+
+/// A light square at y = 2 facing down, and a blocker square at y = 1 over x, z in [−1, 1],
+/// wound to face `blocker_faces` (−1: down, towards the floor; +1: up, towards the light).
+fn blocker_scene(blocker_faces: f32) -> Scene {
+    let blocker = if blocker_faces > 0.0 {
+        "f 5 6 7 8"
+    } else {
+        "f 8 7 6 5"
+    };
+    let text = format!(
+        "material\ndiffuse 1 1 1\nemitted 1 1 1\nmaterial\ndiffuse 1 1 1\n\
+         v -1 2 -1\nv 1 2 -1\nv 1 2 1\nv -1 2 1\n\
+         v -1 1 -1\nv -1 1 1\nv 1 1 1\nv 1 1 -1\n\
+         m 0\nf 1 2 3 4\nm 1\n{blocker}\n"
+    );
+    parse_scene_str(&text, "blocker.obj").unwrap()
+}
+
+#[test]
+fn a_face_is_kept_exactly_when_it_can_block() {
+    let down = blocker_scene(-1.0);
+    let up = blocker_scene(1.0);
+    assert_eq!(down.triangles[2].normal, Vec3::NEG_Y);
+    assert_eq!(up.triangles[2].normal, Vec3::Y);
+    // Facing the floor, the blocker has the light behind it: kept. The light faces down too,
+    // and lies in its own plane: culled. Facing up, the blocker has the light in front: culled.
+    assert_eq!(shadow_casters(&down).len(), 2);
+    assert_eq!(shadow_casters(&down)[0].normal, Vec3::NEG_Y);
+    assert_eq!(shadow_casters(&up).len(), 0);
+    // A floor point under the blocker, towards the light's centre: blocked by the face that
+    // faces it, not by its back.
+    let from = Vec3::new(0.1, 0.0, 0.2);
+    let to = Vec3::new(0.0, 2.0, 0.0);
+    let ray = Ray {
+        origin: from,
+        direction: (to - from).normalize(),
+    };
+    let tmax = (to - from).length() - T_MIN;
+    assert!(Accel::new(&down).occluded(&down, &ray, tmax, false));
+    assert!(!Accel::new(&up).occluded(&up, &ray, tmax, false));
+    // Two-sided, both block.
+    assert!(Accel::new(&up).occluded(&up, &ray, tmax, true));
+}
+
+/// xorshift64*, enough for test geometry.
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> f32 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        (self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 40) as f32 / (1u64 << 24) as f32
+    }
+    fn range(&mut self, lo: f32, hi: f32) -> f32 {
+        lo + (hi - lo) * self.next()
+    }
+    fn point(&mut self, half: f32) -> Vec3 {
+        Vec3::new(
+            self.range(-half, half),
+            self.range(-half, half),
+            self.range(-half, half),
+        )
+    }
+}
+
+/// Random triangles in a cube of half-size 2, a random parallelogram light and a sphere.
+fn random_scene(rng: &mut Rng, triangles: usize) -> Scene {
+    let mut text =
+        String::from("material\ndiffuse 1 1 1\nemitted 1 1 1\nmaterial\ndiffuse 1 1 1\n");
+    let light = rng.point(2.0);
+    let (eu, ev) = (rng.point(0.7), rng.point(0.7));
+    for p in [light, light + eu, light + eu + ev, light + ev] {
+        writeln!(text, "v {} {} {}", p.x, p.y, p.z).unwrap();
+    }
+    text.push_str("m 0\nf 1 2 3 4\nm 1\n");
+    for k in 0..triangles {
+        let a = rng.point(2.0);
+        let (b, c) = (a + rng.point(1.0), a + rng.point(1.0));
+        for p in [a, b, c] {
+            writeln!(text, "v {} {} {}", p.x, p.y, p.z).unwrap();
+        }
+        let i = 5 + 3 * k;
+        writeln!(text, "f {} {} {}", i, i + 1, i + 2).unwrap();
+    }
+    let c = rng.point(1.5);
+    writeln!(text, "s {} {} {} 0.3", c.x, c.y, c.z).unwrap();
+    parse_scene_str(&text, "random.obj").unwrap()
+}
+
+#[test]
+fn culling_changes_only_rounding_hits_on_the_light_points_plane() {
+    let mut rng = Rng(0x5eed_2026);
+    let (mut rays, mut blocked, mut culled, mut total, mut grazing) = (0, 0, 0, 0, 0);
+    for _ in 0..200 {
+        let scene = random_scene(&mut rng, 24);
+        // Every triangle is tested by the reference's brute force below 64 triangles.
+        let accel = Accel::new(&scene);
+        assert!(!accel.uses_bvh());
+        total += scene.triangles.len();
+        culled += scene.triangles.len() - shadow_casters(&scene).len();
+        let light = &scene.lights[0];
+        for _ in 0..500 {
+            let from = rng.point(2.5);
+            let to = light.point(rng.next(), rng.next());
+            let dist = (to - from).length();
+            let ray = Ray {
+                origin: from,
+                direction: (to - from) / dist,
+            };
+            let tmax = dist - T_MIN;
+            let expected = blocked_unculled(&scene, &ray, tmax);
+            let culled_blocked = accel.occluded(&scene, &ray, tmax, false);
+            if culled_blocked != expected {
+                // Culling only removes faces, so it can only unblock a ray, and only where the
+                // brute force's hit is rounding: within 1e-5 of the light point, measured along
+                // the face's normal (p is rounded on the light's plane; at a grazing angle that
+                // becomes a hit just before p, in (T_MIN, tmax)).
+                assert!(expected && !culled_blocked);
+                let rounding_only = scene.triangles.iter().all(|t| {
+                    let th = intersect_triangle(t, &ray, tmax, false);
+                    !(th < tmax) || (dist - th) * t.normal.dot(ray.direction).abs() < 1e-5
+                });
+                assert!(rounding_only, "from {from} to {to}");
+                grazing += 1;
+            }
+            rays += 1;
+            blocked += expected as u32;
+        }
+    }
+    // Not vacuous: a good share of triangles were culled and of rays blocked.
+    assert!(culled * 5 > total, "culled {culled} of {total} triangles");
+    assert!(blocked * 20 > rays, "blocked {blocked} of {rays} rays");
+    // And the rounding cases are rare: about one ray in ten thousand.
+    assert!(
+        grazing * 1000 < rays,
+        "{grazing} of {rays} rays differ by rounding"
+    );
+    eprintln!("{culled} of {total} triangles culled; {rays} rays, {blocked} blocked, {grazing} unblocked by culling (rounding)");
+}
