@@ -154,3 +154,16 @@ fn antialiased_pixel_over_an_edge_is_the_area_mix() {
         }
     }
 }
+
+/// The Sobol sampler takes dimensions 0 and 1 from `sobol_burley::sample_4d`; the crate tests
+/// that against `sample` for indices below 256 only, so check the whole range N allows (2^16).
+#[test]
+fn sobol_4d_equals_one_dimension_at_a_time() {
+    for seed in [0, 1, 0x9e37_79b9, u32::MAX] {
+        for index in (0..1u32 << 16).step_by(7).chain([(1 << 16) - 1]) {
+            let [u, v, _, _] = sobol_burley::sample_4d(index, 0, seed);
+            assert_eq!(u.to_bits(), sobol_burley::sample(index, 0, seed).to_bits());
+            assert_eq!(v.to_bits(), sobol_burley::sample(index, 1, seed).to_bits());
+        }
+    }
+}

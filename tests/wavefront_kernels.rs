@@ -13,7 +13,7 @@ use raywave::scene::{Light, LightShape, Material, NO_HIT, Scene, Sphere, Triangl
 use raywave::shading::shade;
 use raywave::wavefront::context::MaterialTerms;
 use raywave::wavefront::shadow::{key_prefix, shade_terms};
-use raywave::wavefront::simd::{self, LightBlock, RayColumns, lanes};
+use raywave::wavefront::simd::{self, BlockSampler, LightBlock, RayColumns, lanes};
 
 fn triangle(v0: Vec3, v1: Vec3, v2: Vec3) -> Triangle {
     let (e1, e2) = (v1 - v0, v2 - v0);
@@ -444,7 +444,7 @@ proptest! {
     #[test]
     fn simd_light_points_equal_scalar_sampling(
         pixel in any::<u32>(), sample in 0u32..4, bounce in 0u32..6, light in 0u32..3, seed in any::<u32>(),
-        count in 1u32..80, stratified in any::<bool>(),
+        count in 1u32..80, which in 0usize..4,
         origin in vec3(), edge_u in vec3(), edge_v in vec3(), point in vec3(), n in vec3(),
     ) {
         let key = SampleKey { pixel, sample, bounce, light, seed };
@@ -453,7 +453,9 @@ proptest! {
             let h = raywave::sampling::mix32(key_prefix(&key) ^ dim);
             prop_assert_eq!((h >> 8) as f32 * (1.0 / 16_777_216.0), uniform(&key, dim));
         }
-        let sampler = if stratified { LightSampler::Stratified } else { LightSampler::Random };
+        // Every sampler with an 8-wide twin (the lab's strategy only for N > 1).
+        let sampler = [LightSampler::Random, LightSampler::Stratified, LightSampler::Sobol, LightSampler::Lab][which];
+        let count = if sampler == LightSampler::Lab { count.max(2) } else { count };
         let (nx, ny) = strata_grid(count);
         let padded = count.div_ceil(8) * 8;
         let cell_x: Vec<f32> = (0..padded).map(|j| (j % nx) as f32).collect();
@@ -471,7 +473,15 @@ proptest! {
             let block = LightBlock {
                 prefix: key_prefix(&key),
                 j0,
-                strata: stratified.then_some((&cell_x[..], &cell_y[..], nx as f32, ny as f32)),
+                sampler: match sampler {
+                    LightSampler::Stratified => BlockSampler::Stratified {
+                        cell_x: &cell_x, cell_y: &cell_y, nx: nx as f32, ny: ny as f32,
+                    },
+                    LightSampler::Sobol => BlockSampler::Sobol {
+                        scramble: raywave::sampling::hash(&key, raywave::sampling::SOBOL_SEED_DIM),
+                    },
+                    LightSampler::Random | LightSampler::Lab => BlockSampler::Random,
+                },
                 origin, edge_u, edge_v,
             };
             let pts = simd::light_points8(&block);
@@ -518,4 +528,53 @@ fn miss_sentinels_are_the_scalar_ones() {
         &mut prim,
     );
     assert_eq!((t[0], prim[0]), (INF, NO_HIT));
+}
+
+/// The 8-wide Sobol points over the whole index range N allows (the proptest covers N < 80).
+#[test]
+fn simd_sobol_points_equal_scalar_up_to_the_largest_index() {
+    let (origin, edge_u, edge_v) = (Vec3::new(-1.0, 2.0, 0.5), Vec3::X * 2.0, Vec3::Z * 0.5);
+    let lamp = Light {
+        face: 0,
+        shape: LightShape::Parallelogram {
+            origin,
+            edge_u,
+            edge_v,
+        },
+        centroid: origin,
+        area: 1.0,
+        normal: Vec3::Y,
+        color: Vec3::ONE,
+    };
+    let count = 1 << 16;
+    for seed in [0, 7, u32::MAX] {
+        let key = SampleKey {
+            pixel: 12_345,
+            sample: 1,
+            bounce: 2,
+            light: 0,
+            seed,
+        };
+        let scramble = raywave::sampling::hash(&key, raywave::sampling::SOBOL_SEED_DIM);
+        for j0 in (0..count).step_by(8 * 61).chain([count - 8]) {
+            let pts = simd::light_points8(&LightBlock {
+                prefix: key_prefix(&key),
+                j0,
+                sampler: BlockSampler::Sobol { scramble },
+                origin,
+                edge_u,
+                edge_v,
+            });
+            for k in 0..8 {
+                let (u, v) = square_sample(LightSampler::Sobol, &key, j0 + k as u32, count);
+                let want = lamp.point(u, v);
+                assert_eq!(
+                    [pts[0][k], pts[1][k], pts[2][k]].map(f32::to_bits),
+                    want.to_array().map(f32::to_bits),
+                    "seed {seed}, sample {}",
+                    j0 + k as u32
+                );
+            }
+        }
+    }
 }

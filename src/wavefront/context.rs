@@ -1,9 +1,10 @@
 //! What every stage reads: the scene, the settings, and per-render tables derived from them
 //! once (material and light terms, the strata grid, the acceleration choice).
 
+use super::simd::BlockSampler;
 use crate::camera::CameraRays;
 use crate::geometry::{Accel, shadow_casters};
-use crate::sampling::{LightSampler, strata_grid};
+use crate::sampling::{LightSampler, SOBOL_SEED_DIM, SampleKey, hash, strata_grid};
 use crate::scene::{LightShape, Scene, Triangle};
 use crate::settings::{RenderSettings, ShadowMode};
 use crate::shading::AMBIENT;
@@ -144,13 +145,31 @@ impl<'a> Context<'a> {
     }
 
     /// True when the 8-wide light sampler (`simd::light_points8`) implements the chosen
-    /// sampler: random and stratified. Sobol and the lab's strategy take the scalar path
-    /// through `sampling::square_sample`, which serves every sampler.
+    /// sampler: all of them, except the lab's strategy at N = 1 (the centroid), which goes
+    /// through the scalar `sampling::square_sample`.
     pub fn simd_light_sampling(&self) -> bool {
-        matches!(
-            self.settings.sampler,
-            LightSampler::Random | LightSampler::Stratified
-        )
+        match self.settings.sampler {
+            LightSampler::Random | LightSampler::Stratified | LightSampler::Sobol => true,
+            // The lab's strategy is random points, except the centroid for N = 1.
+            LightSampler::Lab => self.points_per_light > 1,
+        }
+    }
+
+    /// The 8-wide sampler for a stream whose SampleKey is `key` (when
+    /// `simd_light_sampling()`).
+    pub fn block_sampler(&self, key: &SampleKey) -> BlockSampler<'_> {
+        match self.settings.sampler {
+            LightSampler::Stratified => BlockSampler::Stratified {
+                cell_x: &self.cell_x,
+                cell_y: &self.cell_y,
+                nx: self.grid.0,
+                ny: self.grid.1,
+            },
+            LightSampler::Sobol => BlockSampler::Sobol {
+                scramble: hash(key, SOBOL_SEED_DIM),
+            },
+            LightSampler::Random | LightSampler::Lab => BlockSampler::Random,
+        }
     }
 
     /// True for stratified light sampling.

@@ -10,9 +10,9 @@
 //! ```
 //!
 //! Queue order is the reference's loop order, so each hit's sum is added in the same order and
-//! comes out bit-identical. Soft shadows on a parallelogram light (every lab light) generate 8
-//! points at a time with the SIMD hash; hard shadows and other light shapes call the scalar
-//! sampling code one point at a time.
+//! comes out bit-identical. Soft shadows on a parallelogram light (every lab light) go 8 points
+//! at a time, every sampler with an 8-wide twin (`simd::light_points8`); hard shadows and
+//! other light shapes call the scalar sampling code one point at a time.
 
 // `!(x > 0.0)` is on purpose: it is true for NaN, like the reference's tests.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -99,22 +99,16 @@ fn spawn(
             light.parallelogram,
         ) {
             (true, Some((origin, edge_u, edge_v))) => {
-                let prefix = key_prefix(&key);
+                let block = LightBlock {
+                    prefix: key_prefix(&key),
+                    j0: 0,
+                    sampler: ctx.block_sampler(&key),
+                    origin,
+                    edge_u,
+                    edge_v,
+                };
                 for j0 in (0..count).step_by(LANES) {
-                    let block = LightBlock {
-                        prefix,
-                        j0,
-                        strata: ctx.stratified().then_some((
-                            &ctx.cell_x[..],
-                            &ctx.cell_y[..],
-                            ctx.grid.0,
-                            ctx.grid.1,
-                        )),
-                        origin,
-                        edge_u,
-                        edge_v,
-                    };
-                    let target = simd::light_points8(&block);
+                    let target = simd::light_points8(&LightBlock { j0, ..block });
                     let lanes = ((count - j0) as usize).min(LANES);
                     let (l, tmax, n_dot_l, live) = simd::shadow_rays8(point, n, &target, lanes);
                     if live != 0 {

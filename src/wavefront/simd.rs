@@ -384,6 +384,31 @@ fn uniform8(prefix: u32, dims: u32x8) -> f32x8 {
     f32x8::from_i32x8(wide::bytemuck::cast::<u32x8, i32x8>(h)) * f32x8::splat(1.0 / 16_777_216.0)
 }
 
+/// How a block's (u, v) are drawn: the samplers with an 8-wide twin.
+#[derive(Clone, Copy, Debug)]
+pub enum BlockSampler<'a> {
+    /// Two hashed uniforms per point: random sampling, and the lab's strategy for N > 1.
+    Random,
+    /// Jittered strata: the stratum column and row of every sample index, as floats (from
+    /// `sampling::strata_grid`), and the grid size.
+    Stratified {
+        /// Column of sample j.
+        cell_x: &'a [f32],
+        /// Row of sample j.
+        cell_y: &'a [f32],
+        /// Columns.
+        nx: f32,
+        /// Rows.
+        ny: f32,
+    },
+    /// Owen-scrambled Sobol, dimensions 0 and 1, with the stream's scramble seed
+    /// `sampling::hash(key, SOBOL_SEED_DIM)`.
+    Sobol {
+        /// The scramble seed.
+        scramble: u32,
+    },
+}
+
 /// Where 8 consecutive light samples `j0..j0 + 8` of one (pixel, sample, bounce, light) stream
 /// land on a parallelogram light.
 #[derive(Clone, Copy, Debug)]
@@ -392,9 +417,8 @@ pub struct LightBlock<'a> {
     pub prefix: u32,
     /// First sample index of the block.
     pub j0: u32,
-    /// For stratified sampling: the stratum column and row of every sample index, as floats
-    /// (from `sampling::strata_grid`), and the grid size; `None` for random sampling.
-    pub strata: Option<(&'a [f32], &'a [f32], f32, f32)>,
+    /// The sampler.
+    pub sampler: BlockSampler<'a>,
     /// Corner a of the light.
     pub origin: Vec3,
     /// b − a.
@@ -420,11 +444,19 @@ fn divide(x: f32x8, n: f32) -> f32x8 {
 #[inline]
 pub fn light_points8(b: &LightBlock) -> [[f32; LANES]; 3] {
     let j = u32x8::splat(b.j0) + u32x8::new([0, 1, 2, 3, 4, 5, 6, 7]);
-    let xi0 = uniform8(b.prefix, j + j);
-    let xi1 = uniform8(b.prefix, j + j + u32x8::ONE);
-    let (u, v) = match b.strata {
-        None => (xi0, xi1),
-        Some((cell_x, cell_y, nx, ny)) => {
+    let (u, v) = match b.sampler {
+        BlockSampler::Random => (
+            uniform8(b.prefix, j + j),
+            uniform8(b.prefix, j + j + u32x8::ONE),
+        ),
+        BlockSampler::Stratified {
+            cell_x,
+            cell_y,
+            nx,
+            ny,
+        } => {
+            let xi0 = uniform8(b.prefix, j + j);
+            let xi1 = uniform8(b.prefix, j + j + u32x8::ONE);
             let at = b.j0 as usize;
             let cx = load(cell_x, at, 0.0);
             let cy = load(cell_y, at, 0.0);
@@ -434,15 +466,94 @@ pub fn light_points8(b: &LightBlock) -> [[f32; LANES]; 3] {
                 divide(cy + xi1, ny).fast_min(one_minus_eps),
             )
         }
+        BlockSampler::Sobol { scramble } => sobol8(j, scramble),
     };
+    parallelogram_points8(b.origin, b.edge_u, b.edge_v, u, v)
+}
+
+/// The first 16 reversed-bit direction numbers of Sobol dimensions 0 and 1, as
+/// `sobol_burley::parts::sobol_rev` uses them: vector k is what a reversed index with only bit
+/// 31 − k set selects.
+static SOBOL_VECTORS: std::sync::LazyLock<[[u32; 16]; 2]> = std::sync::LazyLock::new(|| {
+    let vectors = |d| std::array::from_fn(|k| sobol_burley::parts::sobol_rev(1 << (31 - k), d));
+    [vectors(0), vectors(1)]
+});
+
+/// `sobol_burley::parts::owen_scramble_rev`, 8 lanes.
+#[inline(always)]
+fn owen_scramble_rev8(mut n: u32x8, scramble: u32) -> u32x8 {
+    n ^= n * u32x8::splat(0x3d20_adea);
+    n += u32x8::splat(scramble);
+    n *= u32x8::splat((scramble >> 16) | 1);
+    n ^= n * u32x8::splat(0x0552_6c56);
+    n ^= n * u32x8::splat(0x53a2_2864);
+    n
+}
+
+/// `u32::reverse_bits`, 8 lanes.
+#[inline(always)]
+fn reverse_bits8(mut x: u32x8) -> u32x8 {
+    for (shift, mask) in [
+        (1, 0x5555_5555u32),
+        (2, 0x3333_3333),
+        (4, 0x0f0f_0f0f),
+        (8, 0x00ff_00ff),
+    ] {
+        let m = u32x8::splat(mask);
+        x = ((x >> shift) & m) | ((x & m) << shift);
+    }
+    (x >> 16) | (x << 16)
+}
+
+/// `sobol_burley::parts::u32_to_f32_norm`, 8 lanes.
+#[inline(always)]
+fn u32_to_f32_norm8(n: u32x8) -> f32x8 {
+    let bits = (n >> 9) | u32x8::splat(0x3f80_0000);
+    wide::bytemuck::cast::<u32x8, f32x8>(bits) - f32x8::ONE
+}
+
+/// Dimensions 0 and 1 of Owen-scrambled Sobol points `j`: lane k equals
+/// `sobol_burley::sample(j[k], 0 | 1, scramble)`, the crate's own steps on 8 lanes (the
+/// index shuffle, the direction-number XOR over the top 16 bits, the per-dimension scramble).
+#[inline(always)]
+fn sobol8(j: u32x8, scramble: u32) -> (f32x8, f32x8) {
+    use sobol_burley::parts::hash;
+    let index = owen_scramble_rev8(reverse_bits8(j), hash(scramble ^ 0x79c6_8e4a));
+    let vectors = &*SOBOL_VECTORS;
+    let (mut s0, mut s1) = (u32x8::ZERO, u32x8::ZERO);
+    for k in 0..16 {
+        // All ones where bit 31 − k of the index is set.
+        let bit = wide::bytemuck::cast::<u32x8, i32x8>(index << k as u32) >> 31;
+        let bit = wide::bytemuck::cast::<i32x8, u32x8>(bit);
+        s0 ^= bit & u32x8::splat(vectors[0][k]);
+        s1 ^= bit & u32x8::splat(vectors[1][k]);
+    }
+    let seed = scramble.wrapping_mul(0x9c8f_2d3b);
+    let s0 = owen_scramble_rev8(s0, hash(seed ^ 0x912f_69ba));
+    let s1 = owen_scramble_rev8(s1, hash(seed ^ 0x174f_18ab));
+    (
+        u32_to_f32_norm8(reverse_bits8(s0)),
+        u32_to_f32_norm8(reverse_bits8(s1)),
+    )
+}
+
+/// origin + u·edge_u + v·edge_v on 8 lanes: lane k equals `light.point(u[k], v[k])`.
+#[inline(always)]
+fn parallelogram_points8(
+    origin: Vec3,
+    edge_u: Vec3,
+    edge_v: Vec3,
+    u: f32x8,
+    v: f32x8,
+) -> [[f32; LANES]; 3] {
     // origin + u·edge_u + v·edge_v, evaluated left to right like glam.
     let axis = |o: f32, eu: f32, ev: f32| {
         (f32x8::splat(o) + u * f32x8::splat(eu) + v * f32x8::splat(ev)).to_array()
     };
     [
-        axis(b.origin.x, b.edge_u.x, b.edge_v.x),
-        axis(b.origin.y, b.edge_u.y, b.edge_v.y),
-        axis(b.origin.z, b.edge_u.z, b.edge_v.z),
+        axis(origin.x, edge_u.x, edge_v.x),
+        axis(origin.y, edge_u.y, edge_v.y),
+        axis(origin.z, edge_u.z, edge_v.z),
     ]
 }
 
