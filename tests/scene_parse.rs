@@ -293,6 +293,27 @@ fn camera_block_errors_name_the_line() {
 }
 
 #[test]
+fn numbers_too_large_to_square_are_errors() {
+    // 1e38 is a finite f32, but its square is not: it used to come out as a "degenerate" face
+    // or an infinite light.
+    let box_ = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nm 0\nf 1 2 3 4\n";
+    error_at(
+        &format!("{MAT}v 1e38 0 0\n{box_}"),
+        6,
+        &["1st number of `v`", "at most 1e9", "`1e38`"],
+    );
+    error_at(
+        "material\ndiffuse 1 1 1\nemitted 2e9 2e9 2e9\n",
+        3,
+        &["`emitted`", "at most 1e9", "`2e9`"],
+    );
+    // The limit itself is accepted.
+    let ok = format!("material\ndiffuse 1 1 1\nemitted 1e9 1e9 1e9\nv -1e9 0 0\n{box_}");
+    let scene = parse_scene_str(&ok, "f.obj").unwrap();
+    assert!(scene.lights[0].color.is_finite());
+}
+
+#[test]
 fn errors_after_a_continuation_name_a_line_of_the_logical_line() {
     // Lines 7-8 form one logical line; the bad number is on line 8 physically. Accept either
     // line of the logical line, but never a later one.

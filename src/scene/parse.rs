@@ -139,6 +139,12 @@ pub fn parse_scene_str(text: &str, file: &str) -> Result<Scene, ParseError> {
     p.finish(last_line.max(1))
 }
 
+/// The largest magnitude of any number in a scene file. Squared lengths, areas and the light
+/// colour 0.2·ke·area multiply up to four of them, which stays finite in f32 (1e36 < 3.4e38)
+/// below 1e9; larger values overflowed to infinity and came out as "degenerate" faces or
+/// infinite lights.
+pub const MAX_NUMBER: f32 = 1e9;
+
 fn number(file: &str, line: usize, what: &str, token: Option<&str>) -> Result<f32, ParseError> {
     let error = |message: String| ParseError {
         file: file.to_string(),
@@ -148,7 +154,10 @@ fn number(file: &str, line: usize, what: &str, token: Option<&str>) -> Result<f3
     let token =
         token.ok_or_else(|| error(format!("expected {what}, found the end of the line")))?;
     match token.parse::<f32>() {
-        Ok(x) if x.is_finite() => Ok(x),
+        Ok(x) if x.is_finite() && x.abs() <= MAX_NUMBER => Ok(x),
+        Ok(x) if x.is_finite() => Err(error(format!(
+            "expected {what} of magnitude at most 1e9, found `{token}`"
+        ))),
         Ok(_) => Err(error(format!(
             "expected {what} (a finite number), found `{token}`"
         ))),
