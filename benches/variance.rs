@@ -123,10 +123,26 @@ fn cache_dir() -> Option<PathBuf> {
     Some(exe.parent()?.parent()?.join("raywave-variance-cache"))
 }
 
-/// A measured (sampler, N): its figure, the median seconds per image and the rays per image.
+/// Criterion's mean time of `variance/<sampler>/<n>` from this run, in seconds: read from its
+/// `estimates.json` under the target directory (`target/criterion/`), if written after `since`
+/// (in test mode criterion times nothing and this is None).
+fn criterion_mean(sampler: &str, n: u32, since: std::time::SystemTime) -> Option<f64> {
+    let exe = std::env::current_exe().ok()?;
+    let target = exe.parent()?.parent()?.parent()?;
+    let path = target.join(format!(
+        "criterion/variance/{sampler}/{n}/new/estimates.json"
+    ));
+    if std::fs::metadata(&path).ok()?.modified().ok()? < since {
+        return None;
+    }
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(path).ok()?).ok()?;
+    Some(json["mean"]["point_estimate"].as_f64()? * 1e-9)
+}
+
+/// A measured (sampler, N): its figure and the rays per image.
 struct Measured {
     figure: Figure,
-    seconds: f64,
     rays: u64,
 }
 
@@ -166,16 +182,12 @@ fn measure(scene: &Scene, config: &StudyConfig) -> (usize, Vec<Measured>) {
     for &sampler in &config.samplers {
         for &n in &config.budgets {
             let mut films = Vec::new();
-            let mut times = Vec::new();
             let mut rays = 0;
             for seed in 1..=config.seeds {
-                let t = Instant::now();
                 let (film, counts) = render(scene, &config.run_settings(sampler, n, seed));
-                times.push(t.elapsed().as_secs_f64());
                 rays = counts.total();
                 films.push(film);
             }
-            times.sort_by(f64::total_cmp);
             let images: Vec<&[glam::Vec3]> = films.iter().map(|f| f.pixels.as_slice()).collect();
             let mse = |mask: &[bool]| {
                 error_stats(&images, &reference.film.pixels, &reference.noise, mask).mse
@@ -187,7 +199,6 @@ fn measure(scene: &Scene, config: &StudyConfig) -> (usize, Vec<Measured>) {
                     penumbra_mse: mse(&regions.penumbra),
                     whole_mse: mse(&whole),
                 },
-                seconds: times[times.len() / 2],
                 rays,
             });
         }
@@ -238,6 +249,7 @@ fn main() {
         reference_samples: config.reference_samples,
         mask_samples: config.mask_samples,
     };
+    let started = std::time::SystemTime::now();
     let (penumbra_pixels, measured) = measure(&scene, &config);
     let simd = raywave::simd_path().to_string();
 
@@ -307,7 +319,7 @@ fn main() {
     );
     println!(
         "{:<11} {:>4} {:>14} {:>14} {:>10} {:>14} {:>9} {:>8}",
-        "sampler", "N", "penumbra MSE", "record", "change", "whole MSE", "ms/image", "Mrays/s"
+        "sampler", "N", "penumbra MSE", "record", "change", "whole MSE", "ms", "Mrays/s"
     );
     for m in &measured {
         let f = &m.figure;
@@ -355,21 +367,20 @@ fn main() {
         } else if record.is_ok() {
             problems.push(format!("{} N={} is not in the record", f.sampler, f.n));
         }
+        let (ms, rate) = match criterion_mean(&f.sampler, f.n, started) {
+            Some(t) => (
+                format!("{:.3}", t * 1e3),
+                format!("{:.2}", m.rays as f64 / t.max(1e-12) / 1e6),
+            ),
+            None => ("-".into(), "-".into()),
+        };
         println!(
-            "{:<11} {:>4} {:>14.6e} {:>14} {:>10} {:>14.6e} {:>9.2} {:>8.2}{}",
-            f.sampler,
-            f.n,
-            f.penumbra_mse,
-            cells.0,
-            cells.1,
-            f.whole_mse,
-            m.seconds * 1e3,
-            m.rays as f64 / m.seconds.max(1e-12) / 1e6,
-            cells.2
+            "{:<11} {:>4} {:>14.6e} {:>14} {:>10} {:>14.6e} {ms:>9} {rate:>8}{}",
+            f.sampler, f.n, f.penumbra_mse, cells.0, cells.1, f.whole_mse, cells.2
         );
     }
     println!(
-        "ms/image and Mrays/s: median of the {SEEDS} seeds' renders above (all cores), not criterion's estimate"
+        "ms and Mrays/s: criterion's mean time of one render (seed 1, all cores); `-` when nothing was timed (test mode)"
     );
 
     if std::env::var_os("RAYWAVE_RECORD").is_some_and(|v| !v.is_empty() && v != "0") {
