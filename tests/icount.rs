@@ -364,6 +364,36 @@ fn measure() -> Option<Vec<(&'static str, u64)>> {
     Some(counts)
 }
 
+/// A region's count against its baseline.
+#[derive(Debug, PartialEq)]
+enum Verdict {
+    Within,
+    Rose,
+    Fell,
+}
+
+/// The relative change of `now` against `before`, and what the gate makes of it.
+fn judge(before: u64, now: u64) -> (f64, Verdict) {
+    let change = (now as f64 - before as f64) / before.max(1) as f64;
+    let verdict = if change > THRESHOLD {
+        Verdict::Rose
+    } else if change < -THRESHOLD {
+        Verdict::Fell
+    } else {
+        Verdict::Within
+    };
+    (change, verdict)
+}
+
+#[test]
+fn the_threshold_is_one_percent_either_way() {
+    assert_eq!(judge(1_000_000, 1_000_000).1, Verdict::Within);
+    assert_eq!(judge(1_000_000, 1_010_000).1, Verdict::Within);
+    assert_eq!(judge(1_000_000, 1_010_001).1, Verdict::Rose);
+    assert_eq!(judge(1_000_000, 989_999).1, Verdict::Fell);
+    assert_eq!(judge(1_000_000, 990_000).1, Verdict::Within);
+}
+
 #[test]
 fn kernel_instruction_counts() {
     if std::env::var_os(CHILD).is_some() {
@@ -401,11 +431,13 @@ fn kernel_instruction_counts() {
         let before = baseline.and_then(|b| b.get(region)).copied();
         let (cell, change) = match before {
             Some(b) => {
-                let change = (now as f64 - b as f64) / b as f64;
-                if change > THRESHOLD {
-                    rose.push(format!("{region} {:+.2}% ({b} -> {now})", change * 100.0));
-                } else if change < -THRESHOLD {
-                    fell.push(format!("{region} {:+.2}%", change * 100.0));
+                let (change, verdict) = judge(b, now);
+                match verdict {
+                    Verdict::Rose => {
+                        rose.push(format!("{region} {:+.2}% ({b} -> {now})", change * 100.0))
+                    }
+                    Verdict::Fell => fell.push(format!("{region} {:+.2}%", change * 100.0)),
+                    Verdict::Within => {}
                 }
                 (b.to_string(), format!("{:+.2}%", change * 100.0))
             }
