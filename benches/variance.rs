@@ -123,6 +123,25 @@ fn cache_dir() -> Option<PathBuf> {
     Some(exe.parent()?.parent()?.join("raywave-variance-cache"))
 }
 
+/// Removes the cached references of earlier builds (every rebuild makes a new key), so the
+/// cache holds one reference, not one per build.
+fn prune_cache(before: std::time::SystemTime) {
+    let Some(dir) = cache_dir() else { return };
+    let Ok(entries) = std::fs::read_dir(&dir) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let path = entry.path();
+        let old = entry
+            .metadata()
+            .and_then(|m| m.modified())
+            .is_ok_and(|t| t < before);
+        if old && path.extension().is_some_and(|e| e == "pfm") {
+            let _ = std::fs::remove_file(path);
+        }
+    }
+}
+
 /// Criterion's mean time of `variance/<sampler>/<n>` from this run, in seconds: read from its
 /// `estimates.json` under the target directory (`target/criterion/`), if written after `since`
 /// (in test mode criterion times nothing and this is None).
@@ -148,6 +167,7 @@ struct Measured {
 
 fn measure(scene: &Scene, config: &StudyConfig) -> (usize, Vec<Measured>) {
     let start = Instant::now();
+    let start_time = std::time::SystemTime::now();
     let reference = converged_reference(
         scene,
         raywave::scene::BUILTIN_CORNELL_BOX.as_bytes(),
@@ -156,6 +176,9 @@ fn measure(scene: &Scene, config: &StudyConfig) -> (usize, Vec<Measured>) {
         cache_dir().as_deref(),
     )
     .expect("the converged reference");
+    if !reference.cached {
+        prune_cache(start_time);
+    }
     let regions = penumbra_mask(scene, &config.base, config.mask_samples);
     let whole = regions.whole();
     let penumbra_pixels = regions.penumbra.iter().filter(|&&p| p).count();
