@@ -216,8 +216,7 @@ fn ci_runs_the_readme_test_command() {
     let last = run
         .lines()
         .map(str::trim)
-        .filter(|l| !l.is_empty() && !l.starts_with('#'))
-        .next_back()
+        .rfind(|l| !l.is_empty() && !l.starts_with('#'))
         .unwrap_or("");
     assert_eq!(
         last, "cargo test --release --all-targets",
