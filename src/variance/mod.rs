@@ -71,7 +71,9 @@ impl StudyConfig {
         }
     }
 
-    fn run_settings(&self, sampler: LightSampler, n: u32, seed: u32) -> RenderSettings {
+    /// The settings of one study render: soft shadows, `n` points of `sampler`, `seed`, 1 aa
+    /// sample (also used by `benches/variance.rs`, so the bench renders what the study does).
+    pub fn run_settings(&self, sampler: LightSampler, n: u32, seed: u32) -> RenderSettings {
         RenderSettings {
             shadows: ShadowMode::Soft,
             shadow_samples: n,

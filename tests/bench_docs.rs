@@ -1,0 +1,315 @@
+//! Every command in docs/BENCHMARKING.md is run or checked here, so the page cannot drift from
+//! the code.
+//!
+//! ```text
+//! for each line of every ```sh block of docs/BENCHMARKING.md (comments stripped):
+//!     raywave ...      run with the built binary in one temporary directory, in page order,
+//!                      shortened (QUICK below: smaller images, one run, fewer seeds); exit 0
+//!                      (a `--compare` may also exit 3: tiny timings are noise)
+//!     cargo ...        must be a command `.ci/run` covers: `cargo bench`/`cargo test` of a
+//!                      target that exists, with only the flags listed below; `.ci/run`
+//!                      (`cargo test --release --all-targets`) builds every target and runs each
+//!                      benchmark once in criterion's test mode
+//!     anything else    must be in MANUAL, with the page saying why
+//! ```
+//!
+//! A command added to the page that is none of these fails the test. Nested `cargo` is never
+//! run from here (it would wait on the target directory's lock this test build holds).
+
+use std::collections::BTreeSet;
+use std::path::Path;
+use std::process::Command;
+
+const DOC: &str = include_str!("../docs/BENCHMARKING.md");
+const ROOT: &str = env!("CARGO_MANIFEST_DIR");
+
+/// Commands not run by CI, each with the reason the page gives.
+const MANUAL: [(&str, &str); 2] = [
+    (
+        "sudo apt-get install libembree-dev",
+        "installs a system package",
+    ),
+    (
+        "cargo bench --features embree --bench mesh_rays",
+        "needs libembree3; .ci/run builds without the embree feature",
+    ),
+];
+
+/// How the test shortens a `raywave` command: (subcommand, flag, values). A flag the command
+/// gives is replaced, one it lacks is added. docs/BENCHMARKING.md repeats this table.
+const QUICK: [(&str, &str, &[&str]); 9] = [
+    ("bench", "--size", &["24", "24"]),
+    ("bench", "--runs", &["1"]),
+    ("bench", "--shadow-samples", &["4"]),
+    ("render", "--size", &["24", "24"]),
+    ("render", "--shadow-samples", &["4"]),
+    ("variance", "--size", &["16", "16"]),
+    ("variance", "--seeds", &["2"]),
+    ("variance", "--reference-samples", &["64"]),
+    ("variance", "--mask-samples", &["16"]),
+];
+
+/// The ```sh lines of the page, comments and blank lines dropped.
+fn commands(doc: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut in_sh = false;
+    for line in doc.lines() {
+        let trimmed = line.trim();
+        if let Some(lang) = trimmed.strip_prefix("```") {
+            in_sh = !in_sh && matches!(lang, "sh" | "bash" | "shell" | "console");
+            continue;
+        }
+        if !in_sh {
+            continue;
+        }
+        let command = trimmed.split(" #").next().unwrap_or("").trim();
+        if !command.is_empty() && !command.starts_with('#') {
+            out.push(command.to_string());
+        }
+    }
+    out
+}
+
+/// Names declared by `[[bench]]` in Cargo.toml.
+fn bench_targets() -> BTreeSet<String> {
+    let toml = std::fs::read_to_string(Path::new(ROOT).join("Cargo.toml")).unwrap();
+    let mut names = BTreeSet::new();
+    let mut in_bench = false;
+    for line in toml.lines().map(str::trim) {
+        if line.starts_with('[') {
+            in_bench = line == "[[bench]]";
+        } else if in_bench && let Some(v) = line.strip_prefix("name") {
+            names.insert(
+                v.trim_start_matches([' ', '='])
+                    .trim_matches('"')
+                    .to_string(),
+            );
+        }
+    }
+    names
+}
+
+/// Integration tests: the files of tests/.
+fn test_targets() -> BTreeSet<String> {
+    std::fs::read_dir(Path::new(ROOT).join("tests"))
+        .unwrap()
+        .filter_map(|e| {
+            let p = e.ok()?.path();
+            if p.extension()? != "rs" {
+                return None;
+            }
+            Some(p.file_stem()?.to_string_lossy().into_owned())
+        })
+        .collect()
+}
+
+/// Why a `cargo` command is not covered by `.ci/run`, or Ok.
+fn check_cargo(words: &[&str]) -> Result<(), String> {
+    let mut words = words;
+    // Environment assignments the page may use: the deliberate re-record switch.
+    while let Some(w) = words.first().filter(|w| w.contains('=')) {
+        if *w != "RAYWAVE_RECORD=1" {
+            return Err(format!("unknown environment assignment {w}"));
+        }
+        words = &words[1..];
+    }
+    let (cargo_args, program_args) = match words.iter().position(|w| *w == "--") {
+        Some(i) => (&words[..i], &words[i + 1..]),
+        None => (words, &[][..]),
+    };
+    let [cargo, sub, rest @ ..] = cargo_args else {
+        return Err("expected `cargo SUBCOMMAND ...`".into());
+    };
+    if *cargo != "cargo" {
+        return Err("not a cargo command".into());
+    }
+    let mut i = 0;
+    while i < rest.len() {
+        match (rest[i], rest.get(i + 1)) {
+            ("--release" | "--all-targets", _) => i += 1,
+            ("--bench", Some(name)) if *sub != "build" => {
+                if !bench_targets().contains(*name) {
+                    return Err(format!("no [[bench]] named {name} in Cargo.toml"));
+                }
+                i += 2;
+            }
+            ("--test", Some(name)) if *sub == "test" => {
+                if !test_targets().contains(*name) {
+                    return Err(format!("no tests/{name}.rs"));
+                }
+                i += 2;
+            }
+            (flag, _) => {
+                return Err(format!(
+                    "`{flag}` is not built by .ci/run (cargo test --release --all-targets)"
+                ));
+            }
+        }
+    }
+    match *sub {
+        "build" | "test" => {
+            if let Some(a) = program_args.iter().find(|a| **a != "--nocapture") {
+                return Err(format!("test argument {a} is not what .ci/run passes"));
+            }
+        }
+        "bench" => {
+            // Criterion's own flags: .ci/run runs the same target once in test mode.
+            let mut j = 0;
+            while j < program_args.len() {
+                match program_args[j] {
+                    "--save-baseline" | "--baseline" | "--warm-up-time" | "--measurement-time"
+                    | "--noise-threshold" | "--sample-size"
+                        if j + 1 < program_args.len() =>
+                    {
+                        j += 2
+                    }
+                    "--test" | "--quick" => j += 1,
+                    filter if !filter.starts_with('-') => j += 1,
+                    flag => return Err(format!("criterion flag {flag} is not in the list")),
+                }
+            }
+        }
+        other => return Err(format!("cargo {other} is not run by .ci/run")),
+    }
+    Ok(())
+}
+
+/// The command with QUICK's values for its subcommand.
+fn shorten(words: &[&str]) -> Vec<String> {
+    let sub = words.get(1).copied().unwrap_or("");
+    let mut out: Vec<String> = words.iter().map(|w| w.to_string()).collect();
+    for (s, flag, values) in QUICK {
+        if s != sub {
+            continue;
+        }
+        if let Some(i) = out.iter().position(|w| w == flag) {
+            out.splice(
+                i + 1..i + 1 + values.len(),
+                values.iter().map(|v| v.to_string()),
+            );
+        } else {
+            out.push(flag.to_string());
+            out.extend(values.iter().map(|v| v.to_string()));
+        }
+    }
+    out
+}
+
+#[test]
+fn the_page_has_commands_and_manual_ones_are_still_on_it() {
+    let cmds = commands(DOC);
+    assert!(
+        cmds.iter().filter(|c| c.starts_with("raywave ")).count() >= 6,
+        "expected the page's raywave commands, found {cmds:?}"
+    );
+    for (command, why) in MANUAL {
+        assert!(
+            cmds.iter().any(|c| c == command),
+            "MANUAL lists `{command}` ({why}), which is no longer on the page: remove it"
+        );
+    }
+}
+
+#[test]
+fn ci_runs_the_readme_test_command() {
+    let run = std::fs::read_to_string(Path::new(ROOT).join(".ci/run")).unwrap();
+    let last = run
+        .lines()
+        .map(str::trim)
+        .rfind(|l| !l.is_empty() && !l.starts_with('#'))
+        .unwrap_or("");
+    assert_eq!(
+        last, "cargo test --release --all-targets",
+        ".ci/run changed"
+    );
+    let readme = std::fs::read_to_string(Path::new(ROOT).join("README.md")).unwrap();
+    assert!(readme.contains("cargo test --release --all-targets"));
+}
+
+#[test]
+fn cargo_commands_are_covered_by_ci_and_others_are_listed() {
+    let mut problems = Vec::new();
+    for command in commands(DOC) {
+        let words: Vec<&str> = command.split_whitespace().collect();
+        if words[0] == "raywave" || MANUAL.iter().any(|(m, _)| *m == command) {
+            continue;
+        }
+        if let Err(why) = check_cargo(&words) {
+            problems.push(format!("`{command}`: {why}"));
+        }
+    }
+    assert!(
+        problems.is_empty(),
+        "commands in docs/BENCHMARKING.md that neither this test nor .ci/run covers (run them \
+         here, make them covered, or list them in MANUAL with the page saying why):\n{}",
+        problems.join("\n")
+    );
+}
+
+#[test]
+fn the_checker_refuses_what_ci_does_not_run() {
+    for bad in [
+        "cargo bench --bench no_such_bench",
+        "cargo bench --features embree --bench mesh_rays",
+        "cargo run --release -- bench",
+        "cargo test --release --test no_such_test",
+        "cargo bench --bench wavefront -- --profile-time 5",
+        "FOO=1 cargo bench --bench variance",
+    ] {
+        let words: Vec<&str> = bad.split_whitespace().collect();
+        assert!(check_cargo(&words).is_err(), "`{bad}` passed the checker");
+    }
+    for good in [
+        "cargo bench --bench wavefront -- --save-baseline main stages/film",
+        "RAYWAVE_RECORD=1 cargo bench --bench variance -- --test",
+        "RAYWAVE_RECORD=1 cargo test --release --test icount",
+    ] {
+        let words: Vec<&str> = good.split_whitespace().collect();
+        assert_eq!(check_cargo(&words), Ok(()), "`{good}`");
+    }
+}
+
+#[test]
+fn raywave_commands_run_in_page_order() {
+    let dir = tempfile::tempdir().unwrap();
+    // The page's `scene.obj`: one of the bundled scenes.
+    std::fs::copy(
+        Path::new(ROOT).join("scenes/cornell_box.obj"),
+        dir.path().join("scene.obj"),
+    )
+    .unwrap();
+    let mut ran = 0;
+    for command in commands(DOC) {
+        let words: Vec<&str> = command.split_whitespace().collect();
+        if words[0] != "raywave" {
+            continue;
+        }
+        assert!(
+            !command.contains(['"', '\'', '|', '>', '<', '$', '`']),
+            "`{command}`: quoting, pipes and redirections are not supported here"
+        );
+        let args = shorten(&words);
+        let out = Command::new(env!("CARGO_BIN_EXE_raywave"))
+            .args(&args[1..])
+            .current_dir(dir.path())
+            .output()
+            .expect("run raywave");
+        let (stdout, stderr) = (
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr),
+        );
+        let code = out.status.code();
+        // A comparison of sub-millisecond renders may call noise a regression (exit 3); it must
+        // still have compared.
+        let compared =
+            words.contains(&"--compare") && code == Some(3) && stdout.contains("verdict:");
+        assert!(
+            code == Some(0) || compared,
+            "`{command}` (run as `{}`) exited {code:?}:\n{stdout}\n{stderr}",
+            args.join(" ")
+        );
+        println!("ran `{}`: exit {code:?}", args.join(" "));
+        ran += 1;
+    }
+    assert!(ran >= 6, "ran only {ran} raywave commands");
+}
