@@ -1,8 +1,8 @@
 //! What every stage reads: the scene, the settings, and per-render tables derived from them
 //! once (material and light terms, the strata grid, the acceleration choice).
 
+use super::bvh::MeshBvh;
 use crate::camera::CameraRays;
-use crate::geometry::Accel;
 use crate::sampling::{LightSampler, strata_grid};
 use crate::scene::{LightShape, Scene};
 use crate::settings::{RenderSettings, ShadowMode};
@@ -10,8 +10,8 @@ use crate::shading::AMBIENT;
 use glam::Vec3;
 use std::time::Duration;
 
-/// At or above this many triangles, rays go through obvhs's CWBVH one at a time; below it, the
-/// 8-wide kernels test every primitive. It equals the reference's `BVH_MIN_TRIANGLES`, so both
+/// At or above this many triangles, rays go through the engine's 8-wide BVH (`bvh::MeshBvh`);
+/// below it, the 8-wide kernels test every primitive. It equals the reference's `BVH_MIN_TRIANGLES`, so both
 /// engines find hits the same way; see docs/PERFORMANCE.md for the measurements behind it.
 pub const BVH_MIN_TRIANGLES: usize = crate::geometry::BVH_MIN_TRIANGLES;
 
@@ -53,8 +53,8 @@ pub struct Context<'a> {
     pub settings: &'a RenderSettings,
     /// Camera set up for the image size.
     pub camera: CameraRays,
-    /// The CWBVH when the scene has at least `BVH_MIN_TRIANGLES` triangles.
-    pub accel: Option<Accel>,
+    /// The 8-wide mesh BVH when the scene has at least `BVH_MIN_TRIANGLES` triangles.
+    pub accel: Option<MeshBvh>,
     /// BVH build time (zero without one).
     pub bvh_build_time: Duration,
     /// One entry per material.
@@ -74,7 +74,7 @@ pub struct Context<'a> {
 impl<'a> Context<'a> {
     /// Derives the tables and builds the BVH if the scene needs one.
     pub fn new(scene: &'a Scene, settings: &'a RenderSettings) -> Self {
-        let accel = (scene.triangles.len() >= BVH_MIN_TRIANGLES).then(|| Accel::new(scene));
+        let accel = (scene.triangles.len() >= BVH_MIN_TRIANGLES).then(|| MeshBvh::new(scene));
         let bvh_build_time = accel.as_ref().map_or(Duration::ZERO, |a| a.build_time);
         let materials = scene
             .materials

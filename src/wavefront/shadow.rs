@@ -3,8 +3,8 @@
 //! ```text
 //! for each group of hits whose shadow rays fit the queue:
 //!     spawn:   for hit, for light, for point j < N:  l, dist, n·l;  queue it if n·l > 0
-//!     occlude: 8 queued rays at a time, stop at the first blocker (obvhs `ray_traverse_miss`
-//!              for meshes)
+//!     occlude: 8 queued rays at a time, stop at the first blocker (for meshes: one ray at a
+//!              time through `bvh::MeshBvh`, 8 boxes or 8 triangles per test)
 //!     shade:   in queue order, direct[hit] += Shade(l) / N for the rays not blocked
 //! ```
 //!
@@ -19,7 +19,7 @@
 use super::batch::{HitBatch, RayBatch, ShadowQueue};
 use super::context::{Context, MaterialTerms};
 use super::simd::{self, LANES, LightBlock, RayColumns};
-use crate::geometry::{Ray, T_MIN};
+use crate::geometry::T_MIN;
 use crate::sampling::{SampleKey, mix32, square_sample};
 use crate::scene::NO_HIT;
 use glam::Vec3;
@@ -174,17 +174,23 @@ fn occlude(ctx: &Context, queue: &mut ShadowQueue) {
                 &mut queue.blocked[..n],
             );
         }
-        Some(accel) => {
-            for i in 0..queue.len {
-                if !(queue.n_dot_l[i] > 0.0) {
-                    continue;
-                }
-                let ray = Ray {
-                    origin: Vec3::new(queue.origin_x[i], queue.origin_y[i], queue.origin_z[i]),
-                    direction: queue.direction(i),
-                };
-                queue.blocked[i] = accel.occluded(scene, &ray, queue.tmax[i], two_sided);
-            }
+        Some(bvh) => {
+            // Dead entries (n·l ≤ 0) carry tmax = 0, which `MeshBvh::occluded` skips.
+            let n = queue.len;
+            let cols = RayColumns {
+                origin: [
+                    &queue.origin_x[..n],
+                    &queue.origin_y[..n],
+                    &queue.origin_z[..n],
+                ],
+                direction: [
+                    &queue.direction_x[..n],
+                    &queue.direction_y[..n],
+                    &queue.direction_z[..n],
+                ],
+                tmax: &queue.tmax[..n],
+            };
+            bvh.occluded(scene, &cols, two_sided, &mut queue.blocked[..n]);
         }
     }
 }
