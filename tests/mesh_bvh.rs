@@ -452,3 +452,43 @@ fn batch_entry_points_equal_brute_force_for_lengths_around_the_lane_width() {
     eprintln!("Accel (obvhs CWBVH) differs from brute force on {accel_differs} rays");
 }
 
+/// Not a test: the instruction-count probe behind docs/PERFORMANCE.md's mesh choices. Traces
+/// the peer ray sets of the 12k-triangle box (128×128) through one engine, chosen by
+/// `PROBE=obvhs|wavefront` and `SET=primary|shadow|incoherent|shadow_fan`, 5 times:
+/// `valgrind --tool=callgrind --toggle-collect='*probe_trace*' <test binary> --ignored probe`.
+#[test]
+#[ignore]
+fn probe() {
+    use raywave::peer::{Hits, ObvhsMesh, RaySets, without_emitters};
+    let scene = without_emitters(&mesh_scene(raywave::meshgen::bands_for(12_000)));
+    let obvhs = ObvhsMesh::new(&scene);
+    let sets = RaySets::new(&scene, &obvhs, 128, 128, 2026);
+    let settings = raywave::settings::RenderSettings {
+        width: 128,
+        height: 128,
+        two_sided: true,
+        ..Default::default()
+    };
+    let ctx = raywave::wavefront::context::Context::new(&scene, &settings);
+    let engine = std::env::var("PROBE").unwrap_or_else(|_| "wavefront".into());
+    let set = std::env::var("SET").unwrap_or_else(|_| "primary".into());
+    let set = sets
+        .all()
+        .into_iter()
+        .find(|s| s.kind.name() == set)
+        .expect("a set");
+    #[inline(never)]
+    fn probe_trace(f: &mut dyn FnMut()) {
+        for _ in 0..5 {
+            f();
+        }
+    }
+    let (mut hits, mut blocked, mut scratch) = (Hits::default(), Vec::new(), Default::default());
+    probe_trace(&mut || match (engine.as_str(), set.kind.is_occlusion()) {
+        ("obvhs", false) => obvhs.closest(&scene, set, &mut hits),
+        ("obvhs", true) => obvhs.occluded(&scene, set, &mut blocked),
+        (_, false) => raywave::peer::wavefront_closest(&ctx, set, &mut scratch, &mut hits),
+        (_, true) => raywave::peer::wavefront_occluded(&ctx, set, &mut blocked),
+    });
+    std::hint::black_box((&hits, &blocked));
+}
