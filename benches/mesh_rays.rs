@@ -7,8 +7,7 @@
 //! for scene in [12k, 1M]:                        generated in memory by meshgen, built once
 //!     print triangles, BVH build times, ray counts, hit agreement against obvhs
 //!     for set in [primary, shadow, incoherent, shadow_fan]:  group "<set>_<scene>", throughput in rays
-//!         obvhs_one_ray, wavefront, wavefront_one_ray (primary only), embree_single,
-//!         embree_packet8
+//!         obvhs_one_ray, wavefront, embree_single, embree_packet8
 //! ```
 //!
 //! Every engine traces on one thread, two-sided, on the scene without its emissive wall
@@ -18,14 +17,13 @@
 use criterion::{BenchmarkId, Criterion, Throughput};
 use raywave::meshgen::{bands_for, cornell_box_mesh_spheres, triangle_count};
 use raywave::peer::{
-    Hits, ObvhsMesh, RayKind, RaySet, RaySets, hit_agreement, occlusion_agreement,
-    wavefront_closest, wavefront_occluded, without_emitters,
+    Hits, ObvhsMesh, RaySet, RaySets, hit_agreement, occlusion_agreement, wavefront_closest,
+    wavefront_occluded, without_emitters,
 };
 use raywave::scene::{Scene, parse_scene_str};
 use raywave::settings::RenderSettings;
 use raywave::wavefront::batch::HitBatch;
 use raywave::wavefront::context::Context;
-use raywave::wavefront::intersect;
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 
@@ -37,7 +35,7 @@ const TEST_SIZE: u32 = 32;
 const SEED: u64 = 2026;
 
 #[cfg(feature = "embree")]
-use raywave::peer::embree::EmbreeMesh;
+use raywave::peer::{RayKind, embree::EmbreeMesh};
 
 /// Everything one scene's groups need, built before any timing.
 struct Setup {
@@ -179,27 +177,6 @@ fn bench_set(c: &mut Criterion, s: &Setup, ctx: &Context, set: &RaySet) {
             }
         })
     });
-    if set.kind == RayKind::Primary {
-        // The engine's other traversal on the same rays, to show why primary rays go in
-        // packets: `MeshBvh::closest_hits`, one ray at a time (spheres included, no shading
-        // columns, so it does slightly less than the stage).
-        let bvh = ctx.accel.as_ref().expect("mesh scenes have a BVH");
-        group.bench_function(BenchmarkId::from_parameter("wavefront_one_ray"), |b| {
-            b.iter(|| {
-                for batch in &black_box(set).batches {
-                    let n = batch.len();
-                    scratch.resize(n);
-                    bvh.closest_hits(
-                        &s.scene,
-                        &intersect::columns(batch),
-                        true,
-                        &mut scratch.t[..n],
-                        &mut scratch.prim[..n],
-                    );
-                }
-            })
-        });
-    }
     #[cfg(feature = "embree")]
     {
         let coherent = set.kind != RayKind::Incoherent;

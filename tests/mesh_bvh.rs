@@ -429,10 +429,6 @@ fn batch_entry_points_equal_brute_force_for_lengths_around_the_lane_width() {
         for two_sided in [false, true] {
             let (mut t, mut prim, mut blocked) = (vec![0.0; n], vec![0; n], vec![false; n]);
             bvh.closest_hits(&scene, &cols, two_sided, &mut t, &mut prim);
-            let (mut pt, mut pprim) = (vec![0.0; n], vec![0; n]);
-            bvh.closest_hits_packets(&scene, &cols, two_sided, &mut pt, &mut pprim);
-            let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<u32>>();
-            assert_eq!((bits(&pt), &pprim), (bits(&t), &prim), "packets, {n} rays");
             bvh.occluded(&scene, &cols, two_sided, &mut blocked);
             for (i, (r, tmax)) in rays.iter().enumerate() {
                 let (mut want_t, mut want_prim) = brute_force(&scene, r, *tmax, two_sided);
@@ -495,44 +491,4 @@ fn probe() {
         (_, true) => raywave::peer::wavefront_occluded(&ctx, set, &mut blocked),
     });
     std::hint::black_box((&hits, &blocked));
-}
-
-/// Packets of camera rays (the case they are for) give the single-ray answers bit for bit.
-#[test]
-fn packets_of_camera_rays_equal_single_rays() {
-    let scene = mesh_scene(10);
-    let bvh = MeshBvh::new(&scene);
-    let cam = raywave::camera::CameraRays::new(&scene.camera, 61, 37);
-    let rays: Vec<Ray> = (0..61 * 37).map(|p| cam.sample_ray(p, 0, 1, 3)).collect();
-    let col = |f: &dyn Fn(&Ray) -> f32| rays.iter().map(f).collect::<Vec<f32>>();
-    let c = [
-        col(&|r| r.origin.x),
-        col(&|r| r.origin.y),
-        col(&|r| r.origin.z),
-        col(&|r| r.direction.x),
-        col(&|r| r.direction.y),
-        col(&|r| r.direction.z),
-        vec![INF; rays.len()],
-    ];
-    let cols = RayColumns {
-        origin: [&c[0], &c[1], &c[2]],
-        direction: [&c[3], &c[4], &c[5]],
-        tmax: &c[6],
-    };
-    let n = rays.len();
-    for two_sided in [false, true] {
-        let (mut t, mut prim) = (vec![0.0; n], vec![0; n]);
-        let (mut pt, mut pprim) = (vec![0.0; n], vec![0; n]);
-        bvh.closest_hits(&scene, &cols, two_sided, &mut t, &mut prim);
-        bvh.closest_hits_packets(&scene, &cols, two_sided, &mut pt, &mut pprim);
-        for i in 0..n {
-            assert_eq!(
-                (pt[i].to_bits(), pprim[i]),
-                (t[i].to_bits(), prim[i]),
-                "ray {i}"
-            );
-            let (bt, bp) = brute_force(&scene, &rays[i], INF, two_sided);
-            assert_eq!((t[i].to_bits(), prim[i]), (bt.to_bits(), bp), "ray {i}");
-        }
-    }
 }

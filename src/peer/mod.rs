@@ -114,9 +114,6 @@ impl RaySet {
             self.batches.push(RayBatch::default());
         }
         let batch = self.batches.last_mut().expect("a batch was just pushed");
-        // Depth 0 for camera rays, 1 for the rest (the incoherent set stands for mirror rays):
-        // the wavefront intersect stage chooses its mesh traversal by depth.
-        batch.bounce = u32::from(self.kind != RayKind::Primary);
         let n = batch.len() as u32;
         let path = PathId {
             pixel: n,

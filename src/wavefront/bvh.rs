@@ -33,8 +33,7 @@ use obvhs::bvh2::Bvh2;
 use obvhs::bvh2::reinsertion::ReinsertionOptimizer;
 use obvhs::{BvhBuildParams, aabb::Aabb};
 use std::time::{Duration, Instant};
-use wide::bytemuck::cast;
-use wide::{f32x8, u32x8};
+use wide::f32x8;
 
 /// Children per node and triangles per block.
 pub const WIDTH: usize = 8;
@@ -438,255 +437,6 @@ impl MeshBvh {
     }
 }
 
-/// The 8 lanes of a vector, in place.
-#[inline(always)]
-fn lanes_of(v: &f32x8) -> &[f32; WIDTH] {
-    wide::bytemuck::cast_ref(v)
-}
-
-/// 1 / c with |c| raised to at least 1e-18 (sign kept), so that an axis-parallel ray never
-/// makes 0 · ∞ = NaN in the slab test; a NaN stays NaN and enters no box.
-#[inline(always)]
-fn inverse(c: f32) -> f32 {
-    let c = if c.abs() < 1e-18 {
-        1e-18f32.copysign(c)
-    } else {
-        c
-    };
-    1.0 / c
-}
-
-/// 8 rays in lanes (a packet), with what the slab test needs.
-struct Packet {
-    o: [f32x8; 3],
-    d: [f32x8; 3],
-    /// 1 / d with |d| raised to at least 1e-18, as in `RayLanes`.
-    inv: [f32x8; 3],
-}
-
-impl Packet {
-    /// Rays `i..i + 8` of the columns; lanes past the end get NaN directions (they enter no
-    /// box and hit nothing).
-    #[inline(always)]
-    fn load(rays: &RayColumns, i: usize) -> Packet {
-        // Plain loops: `array::map` with closures was not inlined (8% of the instructions).
-        let mut o = [[0.0f32; WIDTH]; 3];
-        let mut d = [[f32::NAN; WIDTH]; 3];
-        let mut inv = [[f32::NAN; WIDTH]; 3];
-        for k in 0..(rays.len() - i).min(WIDTH) {
-            for a in 0..3 {
-                o[a][k] = rays.origin[a][i + k];
-                d[a][k] = rays.direction[a][i + k];
-                inv[a][k] = inverse(d[a][k]);
-            }
-        }
-        let (o, d, inv) = (o.map(f32x8::new), d.map(f32x8::new), inv.map(f32x8::new));
-        Packet { o, d, inv }
-    }
-
-    /// Slab test of child box `k` of `node` against the 8 rays over [0, best_t]: the entry
-    /// distance of every lane, +∞ where the lane misses the box.
-    #[inline(always)]
-    fn enter(&self, node: &Node, k: usize, best_t: f32x8) -> f32x8 {
-        let mut near = f32x8::ZERO;
-        let mut far = best_t;
-        for axis in 0..3 {
-            let lo = f32x8::splat(lanes_of(&node.bounds[axis][0])[k]);
-            let hi = f32x8::splat(lanes_of(&node.bounds[axis][1])[k]);
-            let t0 = (lo - self.o[axis]) * self.inv[axis];
-            let t1 = (hi - self.o[axis]) * self.inv[axis];
-            near = near.fast_max(t0.fast_min(t1));
-            far = far.fast_min(t0.fast_max(t1));
-        }
-        near.simd_le(far).select(near, f32x8::splat(f32::INFINITY))
-    }
-}
-
-/// Möller–Trumbore for the 8 rays of a packet against one triangle: lane k equals
-/// `intersect_triangle(tri, ray_k, tmax_k, two_sided)` (`simd::triangle8` line for line, with
-/// the triangle read from lane `j` of a block).
-#[inline(always)]
-fn triangle_packet(b: &Block, j: usize, p: &Packet, tmax: f32x8, two_sided: bool) -> f32x8 {
-    let s = |c: &f32x8| f32x8::splat(lanes_of(c)[j]);
-    let (e1x, e1y, e1z) = (s(&b.e1[0]), s(&b.e1[1]), s(&b.e1[2]));
-    let (e2x, e2y, e2z) = (s(&b.e2[0]), s(&b.e2[1]), s(&b.e2[2]));
-    let [dx, dy, dz] = p.d;
-    let px = dy * e2z - e2y * dz;
-    let py = dz * e2x - e2z * dx;
-    let pz = dx * e2y - e2x * dy;
-    let det = e1x * px + e1y * py + e1z * pz;
-    let facing = if two_sided {
-        det.simd_ne(f32x8::ZERO)
-    } else {
-        det.simd_gt(f32x8::ZERO)
-    };
-    let inv_det = f32x8::ONE / det;
-    let tx = p.o[0] - s(&b.v0[0]);
-    let ty = p.o[1] - s(&b.v0[1]);
-    let tz = p.o[2] - s(&b.v0[2]);
-    let u = (tx * px + ty * py + tz * pz) * inv_det;
-    let qx = ty * e1z - e1y * tz;
-    let qy = tz * e1x - e1z * tx;
-    let qz = tx * e1y - e1x * ty;
-    let v = (dx * qx + dy * qy + dz * qz) * inv_det;
-    let t = (e2x * qx + e2y * qy + e2z * qz) * inv_det;
-    let hit = facing
-        & u.simd_ge(f32x8::splat(-EDGE_EPSILON))
-        & v.simd_ge(f32x8::splat(-EDGE_EPSILON))
-        & (u + v).simd_le(f32x8::splat(1.0 + EDGE_EPSILON))
-        & t.simd_gt(f32x8::splat(T_MIN))
-        & t.simd_lt(tmax);
-    hit.select(t, f32x8::splat(f32::INFINITY))
-}
-
-/// The packet traversal's stack: (child reference, entry distance of every lane).
-struct PacketStack(Vec<(u32, f32x8)>);
-
-impl MeshBvh {
-    /// Closest triangle hits of 8 rays traced together (rays `i..i + 8` of the columns): one
-    /// node fetch and one child order for the packet, each box tested against the 8 rays, each
-    /// leaf triangle against the 8 rays. Same (t, id) per lane as [`Self::closest_triangle`].
-    fn closest_packet(
-        &self,
-        rays: &RayColumns,
-        i: usize,
-        two_sided: bool,
-        stack: &mut PacketStack,
-    ) -> ([f32; WIDTH], [u32; WIDTH]) {
-        let p = Packet::load(rays, i);
-        let tmax = f32x8::new(std::array::from_fn(|k| {
-            rays.tmax.get(i + k).copied().unwrap_or(0.0)
-        }));
-        let mut best_t = tmax;
-        let mut best_prim = [NO_HIT; WIDTH];
-        let mut found = f32x8::ZERO.simd_ne(f32x8::ZERO); // no lane yet
-        let stack = &mut stack.0;
-        stack.clear();
-        let mut cur = self.root;
-        loop {
-            if cur & LEAF == 0 {
-                let node = &self.nodes[cur as usize];
-                let mut order = [(0.0f32, 0u32, f32x8::ZERO); WIDTH];
-                let mut n = 0;
-                for k in 0..WIDTH {
-                    if node.child[k] == EMPTY {
-                        break;
-                    }
-                    let near = p.enter(node, k, best_t);
-                    let first = near.to_array().into_iter().fold(f32::INFINITY, f32::min);
-                    if first < f32::INFINITY {
-                        let mut j = n;
-                        while j > 0 && order[j - 1].0 < first {
-                            order[j] = order[j - 1];
-                            j -= 1;
-                        }
-                        order[j] = (first, node.child[k], near);
-                        n += 1;
-                    }
-                }
-                if n > 0 {
-                    for &(_, c, near) in &order[..n - 1] {
-                        stack.push((c, near));
-                    }
-                    cur = order[n - 1].1;
-                    continue;
-                }
-            } else if cur != EMPTY {
-                let block = &self.blocks[(cur & !LEAF) as usize];
-                for j in 0..WIDTH {
-                    let prim = block.prim[j];
-                    if prim == NO_HIT {
-                        break;
-                    }
-                    // Per lane as in `closest_in`: ties count once something is hit.
-                    // next_up of every lane (best_t > T_MIN > 0 where `found`).
-                    let up = cast::<u32x8, f32x8>(cast::<f32x8, u32x8>(best_t) + u32x8::ONE);
-                    let limit = found.select(up, best_t);
-                    let t = triangle_packet(block, j, &p, limit, two_sided);
-                    let hit = t.simd_lt(limit).to_bitmask();
-                    if hit != 0 {
-                        let ts = t.to_array();
-                        let mut bt = best_t.to_array();
-                        for k in 0..WIDTH {
-                            if hit & (1 << k) != 0
-                                && (ts[k] < bt[k] || (ts[k] == bt[k] && prim < best_prim[k]))
-                            {
-                                bt[k] = ts[k];
-                                best_prim[k] = prim;
-                            }
-                        }
-                        best_t = f32x8::new(bt);
-                        found = f32x8::new(std::array::from_fn(|k| {
-                            if best_prim[k] == NO_HIT { 0.0 } else { 1.0 }
-                        }))
-                        .simd_gt(f32x8::ZERO);
-                    }
-                }
-            }
-            loop {
-                let Some((c, near)) = stack.pop() else {
-                    let t = best_t.to_array();
-                    return (
-                        std::array::from_fn(|k| {
-                            if best_prim[k] == NO_HIT {
-                                f32::INFINITY
-                            } else {
-                                t[k]
-                            }
-                        }),
-                        best_prim,
-                    );
-                };
-                if near.simd_le(best_t).any() {
-                    cur = c;
-                    break;
-                }
-            }
-        }
-    }
-
-    /// [`Self::closest_hits`] with the rays traced in packets of 8 consecutive rays: for
-    /// coherent rays (camera rays of neighbouring pixels). Same answers, bit for bit.
-    pub fn closest_hits_packets(
-        &self,
-        scene: &Scene,
-        rays: &RayColumns,
-        two_sided: bool,
-        t_out: &mut [f32],
-        prim_out: &mut [u32],
-    ) {
-        let base = scene.triangles.len() as u32;
-        let mut stack = PacketStack(Vec::with_capacity(STACK));
-        for i in (0..rays.len()).step_by(WIDTH) {
-            let (ts, prims) = self.closest_packet(rays, i, two_sided, &mut stack);
-            for k in 0..(rays.len() - i).min(WIDTH) {
-                let ray = ray_at(rays, i + k);
-                let mut best = Hit {
-                    t: ts[k],
-                    prim: prims[k],
-                };
-                let mut t = if best.prim == NO_HIT {
-                    rays.tmax[i + k]
-                } else {
-                    best.t
-                };
-                for (s, sphere) in scene.spheres.iter().enumerate() {
-                    let ts = intersect_sphere(sphere, &ray, t);
-                    if ts < t {
-                        t = ts;
-                        best = Hit {
-                            t,
-                            prim: base + s as u32,
-                        };
-                    }
-                }
-                t_out[i + k] = best.t;
-                prim_out[i + k] = best.prim;
-            }
-        }
-    }
-}
-
 #[inline(always)]
 fn ray_at(rays: &RayColumns, i: usize) -> Ray {
     Ray {
@@ -731,7 +481,14 @@ impl RayLanes {
     fn new(ray: &Ray) -> RayLanes {
         let o = ray.origin.to_array();
         let d = ray.direction.to_array();
-        let inv = d.map(inverse);
+        let inv = d.map(|c| {
+            let c = if c.abs() < 1e-18 {
+                1e-18f32.copysign(c)
+            } else {
+                c
+            };
+            1.0 / c
+        });
         RayLanes {
             o: o.map(f32x8::splat),
             d: d.map(f32x8::splat),

@@ -37,15 +37,6 @@ pub fn closest(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch) {
             &mut hits.t,
             &mut hits.prim,
         ),
-        // Camera rays of neighbouring pixels go through the tree 8 at a time; mirror rays,
-        // which fan out, one at a time (docs/PERFORMANCE.md, "Mesh rays").
-        Some(bvh) if rays.bounce == 0 => bvh.closest_hits_packets(
-            scene,
-            &columns(rays),
-            two_sided,
-            &mut hits.t[..n],
-            &mut hits.prim[..n],
-        ),
         Some(bvh) => bvh.closest_hits(
             scene,
             &columns(rays),
