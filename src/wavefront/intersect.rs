@@ -3,9 +3,9 @@
 //!
 //! Small scenes (below `BVH_MIN_TRIANGLES` triangles) go through the 8-wide kernel over every
 //! primitive; meshes go through the engine's 8-wide BVH (`bvh::MeshBvh`), one ray at a time
-//! with 8 child boxes or 8 triangles per test. Its t values are bit-equal to the reference's
-//! (`Accel::closest` over obvhs's CWBVH); only ties on shared edges may pick the other
-//! triangle.
+//! with 8 child boxes or 8 triangles per test. Its hits are brute force's (same t bits, ties to
+//! the lowest triangle id), as are the reference's (`Accel::closest` over obvhs's CWBVH), except
+//! for the few axis-parallel rays obvhs's box test misses (docs/PERFORMANCE.md, "Mesh rays").
 
 use super::batch::{HitBatch, RayBatch};
 use super::context::Context;
