@@ -90,16 +90,15 @@ fn edge_triangles() -> Vec<Triangle> {
 fn check_leaf(tris: &[Triangle], r: &Ray, tmax: f32, two_sided: bool) {
     let got = lanes::triangles(tris, r, tmax, two_sided);
     let mut any = false;
-    for k in 0..8 {
+    for (k, got) in got.iter().enumerate() {
         let want = tris
             .get(k)
             .map_or(INF, |t| intersect_triangle(t, r, tmax, two_sided));
         any |= want < tmax;
         assert_eq!(
-            got[k].to_bits(),
+            got.to_bits(),
             want.to_bits(),
-            "lane {k}: {r:?} tmax {tmax} two-sided {two_sided}: leaf {} scalar {want}",
-            got[k]
+            "lane {k}: {r:?} tmax {tmax} two-sided {two_sided}: leaf {got} scalar {want}"
         );
     }
     assert_eq!(

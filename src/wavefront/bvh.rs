@@ -420,15 +420,15 @@ impl MeshBvh {
     /// not traced (the shadow queue's dead lanes have tmax = 0).
     pub fn occluded(&self, scene: &Scene, rays: &RayColumns, two_sided: bool, out: &mut [bool]) {
         let mut stack = Stack::new();
-        for i in 0..rays.len() {
+        for (i, blocked) in out[..rays.len()].iter_mut().enumerate() {
             let tmax = rays.tmax[i];
             #[allow(clippy::neg_cmp_op_on_partial_ord)] // NaN must not be traced either
             if !(tmax > T_MIN) {
-                out[i] = false;
+                *blocked = false;
                 continue;
             }
             let ray = ray_at(rays, i);
-            out[i] = scene
+            *blocked = scene
                 .spheres
                 .iter()
                 .any(|s| intersect_sphere(s, &ray, tmax) < tmax)
