@@ -1,4 +1,5 @@
-//! Mesh rays: raywave's wavefront intersect stage against obvhs's one-ray CWBVH traversal and
+//! Mesh rays: raywave's wavefront intersect stage and occlusion pass (its own 8-wide BVH,
+//! `wavefront::bvh::MeshBvh`) against obvhs's one-ray CWBVH traversal and
 //! (with `--features embree`) Embree's single rays and 8-ray packets, on the same primary,
 //! shadow and incoherent rays of the generated ~12k and ~1M triangle Cornell boxes.
 //!
@@ -34,7 +35,7 @@ const TEST_SIZE: u32 = 32;
 const SEED: u64 = 2026;
 
 #[cfg(feature = "embree")]
-use raywave::peer::embree::EmbreeMesh;
+use raywave::peer::{RayKind, embree::EmbreeMesh};
 
 /// Everything one scene's groups need, built before any timing.
 struct Setup {
@@ -79,11 +80,15 @@ fn setup(label: &'static str, target_triangles: usize, size: u32) -> Setup {
 
 /// Prints build times, ray counts and agreement: the non-timing half of the comparison.
 fn report(s: &Setup, ctx: &Context) {
+    let bvh = ctx.accel.as_ref().expect("mesh scenes have a BVH");
+    let (nodes, blocks) = bvh.size();
     eprintln!(
-        "[{}] BVH build: obvhs CWBVH {:.3} s, wavefront Context (same CWBVH via Accel) {:.3} s",
+        "[{}] BVH build: obvhs CWBVH {:.3} s, wavefront MeshBvh {:.3} s ({nodes} 8-wide nodes, \
+         {blocks} triangle blocks, depth {})",
         s.label,
         s.obvhs.build_time.as_secs_f64(),
-        ctx.bvh_build_time.as_secs_f64()
+        ctx.bvh_build_time.as_secs_f64(),
+        bvh.depth
     );
     #[cfg(feature = "embree")]
     eprintln!(

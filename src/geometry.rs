@@ -166,17 +166,26 @@ impl Accel {
                 }
             }
             Some(bvh) => {
+                // Ties (the same t on a shared edge, or where two walls meet) go to the lowest
+                // triangle id, as in the loop above, whatever order the CWBVH visits them in:
+                // obvhs keeps only strictly closer hits, so the pair (t, id) is tracked here.
+                // The wavefront engine's own BVH breaks ties the same way.
                 let bray = obvhs_ray(ray, best.t);
                 let mut hit = RayHit::none();
-                if bvh.ray_traverse(bray, &mut hit, |r, id| {
-                    let tri = &scene.triangles[bvh.primitive_indices[id] as usize];
-                    intersect_triangle(tri, ray, r.tmax, two_sided)
-                }) {
-                    best = Hit {
-                        t: hit.t,
-                        prim: bvh.primitive_indices[hit.primitive_id as usize],
+                bvh.ray_traverse(bray, &mut hit, |_, id| {
+                    let prim = bvh.primitive_indices[id];
+                    let limit = if best.prim == NO_HIT {
+                        best.t
+                    } else {
+                        best.t.next_up()
                     };
-                }
+                    let t =
+                        intersect_triangle(&scene.triangles[prim as usize], ray, limit, two_sided);
+                    if t < best.t || (t == best.t && prim < best.prim) {
+                        best = Hit { t, prim };
+                    }
+                    t
+                });
             }
         }
         let base = scene.triangles.len() as u32;

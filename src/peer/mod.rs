@@ -350,23 +350,26 @@ pub fn wavefront_closest(ctx: &Context, set: &RaySet, scratch: &mut HitBatch, ou
 
 /// The wavefront engine's occlusion path for meshes, over the set's batches.
 ///
-/// `wavefront::shadow` keeps its occlusion pass (`occlude`) private and only exposes
-/// `direct_light`, which spawns its own shadow rays from light samples; so this repeats that
-/// pass's mesh branch verbatim (`Accel::occluded` per queued ray, `ray_traverse_miss` inside)
-/// through the public `Context::accel`. Scenes below `BVH_MIN_TRIANGLES` have no BVH and are
-/// not mesh scenes: they panic here.
+/// `wavefront::shadow`'s occlusion pass hands the shadow queue's columns to
+/// `MeshBvh::occluded` for meshes; this hands it each batch's columns, so it times the same
+/// function. Scenes below `BVH_MIN_TRIANGLES` have no BVH and are not mesh scenes: they panic
+/// here.
 pub fn wavefront_occluded(ctx: &Context, set: &RaySet, out: &mut Vec<bool>) {
     out.clear();
-    let accel = ctx
+    let bvh = ctx
         .accel
         .as_ref()
         .expect("peer comparisons run on mesh scenes, which have a BVH");
     let two_sided = ctx.settings.two_sided;
     for batch in &set.batches {
-        for i in 0..batch.len() {
-            let (ray, tmax) = RaySet::ray(batch, i);
-            out.push(accel.occluded(ctx.scene, &ray, tmax, two_sided));
-        }
+        let start = out.len();
+        out.resize(start + batch.len(), false);
+        bvh.occluded(
+            ctx.scene,
+            &intersect::columns(batch),
+            two_sided,
+            &mut out[start..],
+        );
     }
 }
 

@@ -1,9 +1,10 @@
 //! What every stage reads: the scene, the settings, and per-render tables derived from them
 //! once (material and light terms, the strata grid, the acceleration choice).
 
+use super::bvh::MeshBvh;
 use super::simd::BlockSampler;
 use crate::camera::CameraRays;
-use crate::geometry::{Accel, shadow_casters};
+use crate::geometry::shadow_casters;
 use crate::sampling::{LightSampler, SOBOL_SEED_DIM, SampleKey, hash, strata_grid};
 use crate::scene::{LightShape, Scene, Triangle};
 use crate::settings::{RenderSettings, ShadowMode};
@@ -11,8 +12,8 @@ use crate::shading::AMBIENT;
 use glam::Vec3;
 use std::time::Duration;
 
-/// At or above this many triangles, rays go through obvhs's CWBVH one at a time; below it, the
-/// 8-wide kernels test every primitive. It equals the reference's `BVH_MIN_TRIANGLES`, so both
+/// At or above this many triangles, rays go through the engine's 8-wide BVH (`bvh::MeshBvh`);
+/// below it, the 8-wide kernels test every primitive. It equals the reference's `BVH_MIN_TRIANGLES`, so both
 /// engines find hits the same way; see docs/PERFORMANCE.md for the measurements behind it.
 pub const BVH_MIN_TRIANGLES: usize = crate::geometry::BVH_MIN_TRIANGLES;
 
@@ -54,8 +55,8 @@ pub struct Context<'a> {
     pub settings: &'a RenderSettings,
     /// Camera set up for the image size.
     pub camera: CameraRays,
-    /// The CWBVH when the scene has at least `BVH_MIN_TRIANGLES` triangles.
-    pub accel: Option<Accel>,
+    /// The 8-wide mesh BVH when the scene has at least `BVH_MIN_TRIANGLES` triangles.
+    pub accel: Option<MeshBvh>,
     /// BVH build time (zero without one).
     pub bvh_build_time: Duration,
     /// Without a BVH, the triangles that can block a shadow ray when faces are one-sided
@@ -78,7 +79,7 @@ pub struct Context<'a> {
 impl<'a> Context<'a> {
     /// Derives the tables and builds the BVH if the scene needs one.
     pub fn new(scene: &'a Scene, settings: &'a RenderSettings) -> Self {
-        let accel = (scene.triangles.len() >= BVH_MIN_TRIANGLES).then(|| Accel::new(scene));
+        let accel = (scene.triangles.len() >= BVH_MIN_TRIANGLES).then(|| MeshBvh::new(scene));
         let bvh_build_time = accel.as_ref().map_or(Duration::ZERO, |a| a.build_time);
         let materials = scene
             .materials

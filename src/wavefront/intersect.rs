@@ -2,13 +2,15 @@
 //! normal flipped for two-sided faces, material).
 //!
 //! Small scenes (below `BVH_MIN_TRIANGLES` triangles) go through the 8-wide kernel over every
-//! primitive; meshes go through obvhs's CWBVH one ray at a time, via the reference's own
-//! `Accel::closest`, so both engines agree on every hit.
+//! primitive; meshes go through the engine's 8-wide BVH (`bvh::MeshBvh`), one ray at a time
+//! with 8 child boxes or 8 triangles per test. Its hits are brute force's (same t bits, ties to
+//! the lowest triangle id), as are the reference's (`Accel::closest` over obvhs's CWBVH), except
+//! for the few axis-parallel rays obvhs's box test misses (docs/PERFORMANCE.md, "Mesh rays").
 
 use super::batch::{HitBatch, RayBatch};
 use super::context::Context;
 use super::simd::{self, RayColumns};
-use crate::geometry::{Ray, geometric_normal};
+use crate::geometry::geometric_normal;
 use crate::scene::NO_HIT;
 
 /// The ray columns of a batch.
@@ -35,17 +37,13 @@ pub fn closest(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch) {
             &mut hits.t,
             &mut hits.prim,
         ),
-        Some(accel) => {
-            for i in 0..n {
-                let ray = Ray {
-                    origin: rays.origin(i),
-                    direction: rays.direction(i),
-                };
-                let hit = accel.closest(scene, &ray, rays.tmax[i], two_sided);
-                hits.t[i] = hit.t;
-                hits.prim[i] = hit.prim;
-            }
-        }
+        Some(bvh) => bvh.closest_hits(
+            scene,
+            &columns(rays),
+            two_sided,
+            &mut hits.t[..n],
+            &mut hits.prim[..n],
+        ),
     }
     for i in 0..n {
         let prim = hits.prim[i];

@@ -19,6 +19,7 @@
 //! is the film plus one `Workspace` per worker, bounded by the batch size.
 
 pub mod batch;
+pub mod bvh;
 pub mod context;
 pub mod film;
 pub mod generate;

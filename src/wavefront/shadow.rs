@@ -3,9 +3,9 @@
 //! ```text
 //! for each group of hits whose shadow rays fit the queue:
 //!     spawn:   for hit, for light, for point j < N:  l, dist, n·l;  queue it if n·l > 0
-//!     occlude: 8 queued rays at a time, stop at the first blocker (obvhs `ray_traverse_miss`
-//!              for meshes); small scenes test only the triangles that can shadow a light
-//!              (`geometry::shadow_casters`)
+//!     occlude: 8 queued rays at a time, stop at the first blocker; small scenes test only the
+//!              triangles that can shadow a light (`geometry::shadow_casters`), meshes go one
+//!              ray at a time through `bvh::MeshBvh`, 8 boxes or 8 triangles per test
 //!     shade:   in queue order, direct[hit] += Shade(l) / N for the rays not blocked
 //! ```
 //!
@@ -20,7 +20,7 @@
 use super::batch::{HitBatch, RayBatch, ShadowQueue};
 use super::context::{Context, MaterialTerms};
 use super::simd::{self, LANES, LightBlock, RayColumns};
-use crate::geometry::{Ray, T_MIN, casters};
+use crate::geometry::{T_MIN, casters};
 use crate::sampling::{SampleKey, mix32, square_sample};
 use crate::scene::NO_HIT;
 use glam::Vec3;
@@ -61,9 +61,10 @@ pub fn direct_light(
             cast += spawn(ctx, rays, hits, next, queue);
             next += 1;
         }
-        queue.blocked[..queue.len].fill(false);
         if ctx.casts_shadow_rays() {
-            occlude(ctx, queue);
+            occlude(ctx, queue); // writes every entry
+        } else {
+            queue.blocked[..queue.len].fill(false);
         }
         shade(ctx, rays, hits, queue);
     }
@@ -141,46 +142,35 @@ fn spawn(
     cast
 }
 
-/// Sets `queue.blocked` for every queued ray.
+/// Sets `queue.blocked` for every queued ray (both kernels write every entry).
 fn occlude(ctx: &Context, queue: &mut ShadowQueue) {
     let scene = ctx.scene;
     let two_sided = ctx.settings.two_sided;
+    let n = queue.len;
+    let cols = RayColumns {
+        origin: [
+            &queue.origin_x[..n],
+            &queue.origin_y[..n],
+            &queue.origin_z[..n],
+        ],
+        direction: [
+            &queue.direction_x[..n],
+            &queue.direction_y[..n],
+            &queue.direction_z[..n],
+        ],
+        tmax: &queue.tmax[..n],
+    };
+    let blocked = &mut queue.blocked[..n];
     match &ctx.accel {
-        None => {
-            let n = queue.len;
-            let cols = RayColumns {
-                origin: [
-                    &queue.origin_x[..n],
-                    &queue.origin_y[..n],
-                    &queue.origin_z[..n],
-                ],
-                direction: [
-                    &queue.direction_x[..n],
-                    &queue.direction_y[..n],
-                    &queue.direction_z[..n],
-                ],
-                tmax: &queue.tmax[..n],
-            };
-            simd::occluded(
-                casters(scene, &ctx.shadow_casters, two_sided),
-                &scene.spheres,
-                &cols,
-                two_sided,
-                &mut queue.blocked[..n],
-            );
-        }
-        Some(accel) => {
-            for i in 0..queue.len {
-                if !(queue.n_dot_l[i] > 0.0) {
-                    continue;
-                }
-                let ray = Ray {
-                    origin: Vec3::new(queue.origin_x[i], queue.origin_y[i], queue.origin_z[i]),
-                    direction: queue.direction(i),
-                };
-                queue.blocked[i] = accel.occluded(scene, &ray, queue.tmax[i], two_sided);
-            }
-        }
+        None => simd::occluded(
+            casters(scene, &ctx.shadow_casters, two_sided),
+            &scene.spheres,
+            &cols,
+            two_sided,
+            blocked,
+        ),
+        // Dead entries (n·l ≤ 0) carry tmax = 0, which `MeshBvh::occluded` skips.
+        Some(bvh) => bvh.occluded(scene, &cols, two_sided, blocked),
     }
 }
 

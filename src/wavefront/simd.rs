@@ -1,4 +1,5 @@
-//! The 8-wide kernels: the only module that names `wide` types.
+//! The 8-wide kernels: with `bvh.rs` (the mesh BVH's node and leaf tests), the only module that
+//! names `wide` types.
 //!
 //! Every kernel here is a lane-by-lane copy of a scalar twin, with the same operations in the
 //! same order, so that with IEEE arithmetic (no FMA contraction: Rust never fuses `a * b + c`,

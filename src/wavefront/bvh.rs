@@ -1,0 +1,633 @@
+//! The wavefront engine's own BVH for meshes: an 8-wide tree with uncompressed child boxes stored
+//! as columns, and triangles copied into 8-lane blocks in traversal order. With `simd.rs`, the
+//! only module that names `wide` types.
+//!
+//! ```text
+//! build:    obvhs PLOC BVH2 + reinsertion (the CWBVH's own first steps, medium_build preset)
+//!           → collapse: each wide node takes up to 8 BVH2 descendants, opening the largest
+//!             one first; a subtree of ≤ LEAF_MAX triangles becomes a leaf (one block)
+//! closest:  one ray, all 8 child boxes in one f32x8 slab test, hit children near to far on a
+//!           fixed stack (entries carry their entry distance, skipped once a closer hit is
+//!           known); a leaf tests its 8 triangles in one f32x8 Möller–Trumbore
+//! occluded: the same walk, no sorting, stops at the first blocker
+//! ```
+//!
+//! Node (`Node`, 224 bytes, 32-aligned): `bounds[axis][0]` = min, `bounds[axis][1]` = max of
+//! the 8 children, one f32x8 each; `child[k]` = a node index, or `LEAF | block`, or `EMPTY`
+//! (empty slots have min = +∞, max = −∞, which no ray enters). Block (`Block`, 320 bytes):
+//! v0, e1, e2 x/y/z columns of 8 triangles and their `Scene::triangles` ids; unused lanes are
+//! NaN (they never hit: every comparison with NaN is false) with id `NO_HIT`.
+//!
+//! Every lane of the triangle test is `geometry::intersect_triangle` with the same operations
+//! in the same order, so each t is bit-equal to the scalar kernel's: the BVH only decides which
+//! triangles are tested. Boxes are padded outward (`pad`) so that the kernel's edge slack
+//! (u, v ≥ −EDGE_EPSILON) and the slab test's rounding never cull a triangle the kernel would
+//! hit. Ties (two triangles at the same t: a shared edge, a corner of two walls) go to the
+//! lowest triangle id, as in a brute-force loop in index order, so the closest hit is exactly
+//! brute force's.
+
+use super::simd::RayColumns;
+use crate::geometry::{EDGE_EPSILON, Hit, Ray, T_MIN, intersect_sphere};
+use crate::scene::{NO_HIT, Scene, Triangle};
+use obvhs::bvh2::Bvh2;
+use obvhs::bvh2::reinsertion::ReinsertionOptimizer;
+use obvhs::{BvhBuildParams, aabb::Aabb};
+use std::time::{Duration, Instant};
+use wide::f32x8;
+
+/// Children per node and triangles per block.
+pub const WIDTH: usize = 8;
+/// Largest subtree made into a leaf: one block.
+const LEAF_MAX: u32 = 8;
+/// Traversal stack entries: a node pushes at most 7, so this allows depth 146.
+const STACK: usize = 1024;
+/// Child reference bit for a leaf (its block index in the low bits).
+const LEAF: u32 = 1 << 31;
+/// An unused child slot.
+const EMPTY: u32 = u32::MAX;
+
+/// An 8-wide node: the children's boxes as columns, then the children.
+#[derive(Clone, Copy)]
+#[repr(C, align(32))]
+struct Node {
+    bounds: [[f32x8; 2]; 3],
+    child: [u32; WIDTH],
+}
+
+/// 8 triangles as columns (v0, e1, e2; x, y, z) and their scene ids.
+#[derive(Clone, Copy)]
+#[repr(C, align(32))]
+struct Block {
+    v0: [f32x8; 3],
+    e1: [f32x8; 3],
+    e2: [f32x8; 3],
+    prim: [u32; WIDTH],
+}
+
+impl Block {
+    /// Triangles `tris[ids[k]]` in lanes k < ids.len() (at most 8); NaN lanes after them.
+    fn new(tris: &[Triangle], ids: &[u32]) -> Block {
+        debug_assert!(ids.len() <= WIDTH);
+        let col = |f: fn(&Triangle) -> f32| {
+            f32x8::new(std::array::from_fn(|k| {
+                ids.get(k).map_or(f32::NAN, |&id| f(&tris[id as usize]))
+            }))
+        };
+        Block {
+            v0: [col(|t| t.v0.x), col(|t| t.v0.y), col(|t| t.v0.z)],
+            e1: [col(|t| t.e1.x), col(|t| t.e1.y), col(|t| t.e1.z)],
+            e2: [col(|t| t.e2.x), col(|t| t.e2.y), col(|t| t.e2.z)],
+            prim: std::array::from_fn(|k| ids.get(k).copied().unwrap_or(NO_HIT)),
+        }
+    }
+}
+
+/// The wavefront engine's mesh BVH (see the module docs for the layout).
+pub struct MeshBvh {
+    nodes: Vec<Node>,
+    blocks: Vec<Block>,
+    /// `EMPTY` without triangles, a leaf reference for ≤ LEAF_MAX of them, else node 0.
+    root: u32,
+    /// Depth of the wide tree (the root node is depth 1).
+    pub depth: usize,
+    /// Wall time of the build (BVH2, collapse, triangle copy).
+    pub build_time: Duration,
+}
+
+/// Outward padding of a box: covers the kernel's edge slack (a hit may lie EDGE_EPSILON · |e|
+/// outside its triangle) and a few ulps of the slab test, with a wide margin.
+fn pad(b: &Aabb) -> f32 {
+    let extent = (b.max - b.min).max_element();
+    let magnitude = b.min.abs().max(b.max.abs()).max_element();
+    1e-5 * (extent + magnitude)
+}
+
+impl MeshBvh {
+    /// Builds the tree over `scene.triangles` with obvhs's `medium_build` settings.
+    pub fn new(scene: &Scene) -> MeshBvh {
+        let start = Instant::now();
+        let tris = &scene.triangles;
+        let aabbs: Vec<Aabb> = tris
+            .iter()
+            .map(|t| {
+                let mut b = Aabb::from_point(t.v0.into());
+                b.extend((t.v0 + t.e1).into());
+                b.extend((t.v0 + t.e2).into());
+                b
+            })
+            .collect();
+        let mut bvh = MeshBvh {
+            nodes: Vec::new(),
+            blocks: Vec::new(),
+            root: EMPTY,
+            depth: 0,
+            build_time: Duration::ZERO,
+        };
+        if !tris.is_empty() {
+            let p = BvhBuildParams::medium_build();
+            let mut bvh2 = obvhs::ploc::PlocBuilder::with_capacity(aabbs.len()).build(
+                p.ploc_search_distance,
+                &aabbs,
+                (0..aabbs.len() as u32).collect(),
+                p.sort_precision,
+                p.search_depth_threshold,
+            );
+            ReinsertionOptimizer::default().run(&mut bvh2, p.reinsertion_batch_ratio, None);
+            bvh.collapse(&bvh2, tris);
+        }
+        assert!(
+            bvh.depth * (WIDTH - 1) < STACK,
+            "mesh BVH too deep for the traversal stack: depth {}",
+            bvh.depth
+        );
+        bvh.build_time = start.elapsed();
+        bvh
+    }
+
+    /// Turns obvhs's BVH2 into the 8-wide tree; triangles are copied leaf by leaf.
+    fn collapse(&mut self, bvh2: &Bvh2, tris: &[Triangle]) {
+        let n2 = &bvh2.nodes;
+        // Triangles under every BVH2 node (children have higher indices than their parent in
+        // a PLOC build, but reinsertion may move them, so count with an explicit post-order).
+        let mut count = vec![0u32; n2.len()];
+        let mut order = Vec::with_capacity(n2.len());
+        let mut todo = vec![0usize];
+        while let Some(i) = todo.pop() {
+            order.push(i);
+            if !n2[i].is_leaf() {
+                let c = n2[i].first_index as usize;
+                todo.extend([c, c + 1]);
+            }
+        }
+        for &i in order.iter().rev() {
+            count[i] = if n2[i].is_leaf() {
+                n2[i].prim_count
+            } else {
+                let c = n2[i].first_index as usize;
+                count[c] + count[c + 1]
+            };
+        }
+        if count[0] <= LEAF_MAX {
+            self.root = self.leaf(bvh2, 0, tris);
+            self.depth = 0;
+            return;
+        }
+        self.root = 0;
+        self.nodes.push(empty_node());
+        // (BVH2 node, wide node index, depth)
+        let mut work = vec![(0usize, 0usize, 1usize)];
+        while let Some((i, w, depth)) = work.pop() {
+            self.depth = self.depth.max(depth);
+            let c = n2[i].first_index as usize;
+            let mut kids = vec![c, c + 1];
+            // Open the largest child that is too big for a leaf until 8 slots are used.
+            while kids.len() < WIDTH {
+                let open = kids
+                    .iter()
+                    .enumerate()
+                    .filter(|&(_, &k)| !n2[k].is_leaf() && count[k] > LEAF_MAX)
+                    .max_by(|a, b| {
+                        n2[*a.1]
+                            .aabb()
+                            .half_area()
+                            .total_cmp(&n2[*b.1].aabb().half_area())
+                    })
+                    .map(|(slot, _)| slot);
+                let Some(slot) = open else { break };
+                let k = kids.swap_remove(slot);
+                let c = n2[k].first_index as usize;
+                kids.extend([c, c + 1]);
+            }
+            let mut node = empty_node();
+            for (slot, &k) in kids.iter().enumerate() {
+                let b = n2[k].aabb();
+                let p = pad(b);
+                for axis in 0..3 {
+                    let mut lo = node.bounds[axis][0].to_array();
+                    let mut hi = node.bounds[axis][1].to_array();
+                    lo[slot] = b.min[axis] - p;
+                    hi[slot] = b.max[axis] + p;
+                    node.bounds[axis][0] = f32x8::new(lo);
+                    node.bounds[axis][1] = f32x8::new(hi);
+                }
+                node.child[slot] = if count[k] <= LEAF_MAX {
+                    self.leaf(bvh2, k, tris)
+                } else {
+                    let index = self.nodes.len();
+                    self.nodes.push(empty_node());
+                    work.push((k, index, depth + 1));
+                    index as u32
+                };
+            }
+            self.nodes[w] = node;
+        }
+    }
+
+    /// One block with the (≤ 8) triangles under BVH2 node `i`; returns its leaf reference.
+    fn leaf(&mut self, bvh2: &Bvh2, i: usize, tris: &[Triangle]) -> u32 {
+        let mut ids = Vec::with_capacity(WIDTH);
+        let mut todo = vec![i];
+        while let Some(k) = todo.pop() {
+            let n = &bvh2.nodes[k];
+            if n.is_leaf() {
+                let first = n.first_index as usize;
+                ids.extend_from_slice(
+                    &bvh2.primitive_indices[first..first + n.prim_count as usize],
+                );
+            } else {
+                let c = n.first_index as usize;
+                todo.extend([c + 1, c]);
+            }
+        }
+        self.blocks.push(Block::new(tris, &ids));
+        LEAF | (self.blocks.len() - 1) as u32
+    }
+
+    /// Number of 8-wide nodes and of triangle blocks (for reports).
+    pub fn size(&self) -> (usize, usize) {
+        (self.nodes.len(), self.blocks.len())
+    }
+
+    /// Closest triangle hit in (T_MIN, tmax): `Hit::MISS` when none. The same t bits and
+    /// triangle as testing every triangle with `intersect_triangle` in index order.
+    pub fn closest_triangle(&self, ray: &Ray, tmax: f32, two_sided: bool) -> Hit {
+        self.closest_in(ray, tmax, two_sided, &mut Stack::new())
+    }
+
+    /// [`Self::closest_triangle`] with a stack from the caller: zeroing 8 KB per ray cost more
+    /// than a whole traversal.
+    #[inline]
+    fn closest_in(&self, ray: &Ray, tmax: f32, two_sided: bool, stack: &mut Stack) -> Hit {
+        let stack = &mut stack.0;
+        let r = RayLanes::new(ray);
+        let mut best_t = tmax;
+        let mut best_prim = NO_HIT;
+        let mut sp = 0;
+        let mut cur = self.root;
+        loop {
+            if cur & LEAF == 0 {
+                let node = &self.nodes[cur as usize];
+                let (mask, near) = r.boxes(node, best_t);
+                if mask != 0 {
+                    if mask.is_power_of_two() {
+                        cur = node.child[mask.trailing_zeros() as usize];
+                        continue;
+                    }
+                    // Push far to near; go on with the nearest.
+                    let near = near.to_array();
+                    let mut order = [(0.0f32, 0u32); WIDTH];
+                    let mut n = 0;
+                    let mut m = mask;
+                    while m != 0 {
+                        let k = m.trailing_zeros() as usize;
+                        m &= m - 1;
+                        let mut j = n;
+                        while j > 0 && order[j - 1].0 < near[k] {
+                            order[j] = order[j - 1];
+                            j -= 1;
+                        }
+                        order[j] = (near[k], node.child[k]);
+                        n += 1;
+                    }
+                    for &(d, c) in &order[..n - 1] {
+                        stack[sp] = (c, d);
+                        sp += 1;
+                    }
+                    cur = order[n - 1].1;
+                    continue;
+                }
+            } else if cur != EMPTY {
+                let block = &self.blocks[(cur & !LEAF) as usize];
+                // Once something is hit, ties count too: (t, id) is minimised as a pair, so
+                // the answer is brute force's (the lowest id among the closest), whatever the
+                // order the tree visits the triangles in.
+                let limit = if best_prim == NO_HIT {
+                    best_t
+                } else {
+                    best_t.next_up()
+                };
+                let limit8 = f32x8::splat(limit);
+                let t = triangles8(block, &r, limit8, two_sided);
+                let mut m = t.simd_lt(limit8).to_bitmask();
+                if m != 0 {
+                    let ts = t.to_array();
+                    while m != 0 {
+                        let k = m.trailing_zeros() as usize;
+                        m &= m - 1;
+                        let prim = block.prim[k];
+                        if ts[k] < best_t || (ts[k] == best_t && prim < best_prim) {
+                            best_t = ts[k];
+                            best_prim = prim;
+                        }
+                    }
+                }
+            }
+            // Pop the next entry that may still hold a closer hit.
+            loop {
+                if sp == 0 {
+                    return if best_prim == NO_HIT {
+                        Hit::MISS
+                    } else {
+                        Hit {
+                            t: best_t,
+                            prim: best_prim,
+                        }
+                    };
+                }
+                sp -= 1;
+                if stack[sp].1 <= best_t {
+                    cur = stack[sp].0;
+                    break;
+                }
+            }
+        }
+    }
+
+    /// True when a triangle blocks the ray in (T_MIN, tmax); stops at the first blocker.
+    pub fn occluded_triangle(&self, ray: &Ray, tmax: f32, two_sided: bool) -> bool {
+        self.occluded_in(ray, tmax, two_sided, &mut Stack::new())
+    }
+
+    /// [`Self::occluded_triangle`] with a stack from the caller.
+    #[inline]
+    fn occluded_in(&self, ray: &Ray, tmax: f32, two_sided: bool, stack: &mut Stack) -> bool {
+        let stack = &mut stack.0;
+        let r = RayLanes::new(ray);
+        let tmax8 = f32x8::splat(tmax);
+        let mut sp = 0;
+        let mut cur = self.root;
+        loop {
+            if cur & LEAF == 0 {
+                let node = &self.nodes[cur as usize];
+                let (mask, _) = r.boxes(node, tmax);
+                let mut m = mask;
+                while m != 0 {
+                    let k = m.trailing_zeros() as usize;
+                    m &= m - 1;
+                    stack[sp] = (node.child[k], 0.0);
+                    sp += 1;
+                }
+            } else if cur != EMPTY
+                && triangles8_block(&self.blocks[(cur & !LEAF) as usize], &r, tmax8, two_sided)
+            {
+                return true;
+            }
+            if sp == 0 {
+                return false;
+            }
+            sp -= 1;
+            cur = stack[sp].0;
+        }
+    }
+
+    /// Closest hit (triangles through the tree, then spheres, as `Accel::closest`) of every
+    /// ray: writes t (`f32::INFINITY` on a miss) and the global primitive id (`NO_HIT`).
+    pub fn closest_hits(
+        &self,
+        scene: &Scene,
+        rays: &RayColumns,
+        two_sided: bool,
+        t_out: &mut [f32],
+        prim_out: &mut [u32],
+    ) {
+        let base = scene.triangles.len() as u32;
+        let mut stack = Stack::new();
+        for i in 0..rays.len() {
+            let ray = ray_at(rays, i);
+            let mut best = self.closest_in(&ray, rays.tmax[i], two_sided, &mut stack);
+            let mut t = if best.prim == NO_HIT {
+                rays.tmax[i]
+            } else {
+                best.t
+            };
+            for (k, s) in scene.spheres.iter().enumerate() {
+                let ts = intersect_sphere(s, &ray, t);
+                if ts < t {
+                    t = ts;
+                    best = Hit {
+                        t,
+                        prim: base + k as u32,
+                    };
+                }
+            }
+            t_out[i] = best.t;
+            prim_out[i] = best.prim;
+        }
+    }
+
+    /// Whether anything (spheres, then triangles through the tree) blocks every ray in
+    /// (T_MIN, tmax), as `Accel::occluded`. Rays with tmax ≤ T_MIN cannot be blocked and are
+    /// not traced (the shadow queue's dead lanes have tmax = 0).
+    pub fn occluded(&self, scene: &Scene, rays: &RayColumns, two_sided: bool, out: &mut [bool]) {
+        let mut stack = Stack::new();
+        for (i, blocked) in out[..rays.len()].iter_mut().enumerate() {
+            let tmax = rays.tmax[i];
+            #[allow(clippy::neg_cmp_op_on_partial_ord)] // NaN must not be traced either
+            if !(tmax > T_MIN) {
+                *blocked = false;
+                continue;
+            }
+            let ray = ray_at(rays, i);
+            *blocked = scene
+                .spheres
+                .iter()
+                .any(|s| intersect_sphere(s, &ray, tmax) < tmax)
+                || self.occluded_in(&ray, tmax, two_sided, &mut stack);
+        }
+    }
+}
+
+#[inline(always)]
+fn ray_at(rays: &RayColumns, i: usize) -> Ray {
+    Ray {
+        origin: glam::Vec3::new(rays.origin[0][i], rays.origin[1][i], rays.origin[2][i]),
+        direction: glam::Vec3::new(
+            rays.direction[0][i],
+            rays.direction[1][i],
+            rays.direction[2][i],
+        ),
+    }
+}
+
+/// The traversal stack: (child reference, entry distance; 0 for occlusion).
+struct Stack([(u32, f32); STACK]);
+
+impl Stack {
+    fn new() -> Stack {
+        Stack([(0, 0.0); STACK])
+    }
+}
+
+fn empty_node() -> Node {
+    Node {
+        bounds: [[f32x8::splat(f32::INFINITY), f32x8::splat(f32::NEG_INFINITY)]; 3],
+        child: [EMPTY; WIDTH],
+    }
+}
+
+/// One ray splatted over 8 lanes, with what the slab test needs.
+struct RayLanes {
+    o: [f32x8; 3],
+    d: [f32x8; 3],
+    /// 1 / d, with |d| raised to at least 1e-18 (sign kept), so that an axis-parallel ray never
+    /// makes 0 · ∞ = NaN in the slab test; a NaN direction stays NaN and enters no box.
+    inv: [f32x8; 3],
+    /// Per axis, which bound is entered first: 0 (min) for d ≥ 0, 1 (max) for d < 0.
+    near: [usize; 3],
+}
+
+impl RayLanes {
+    #[inline(always)]
+    fn new(ray: &Ray) -> RayLanes {
+        let o = ray.origin.to_array();
+        let d = ray.direction.to_array();
+        let inv = d.map(|c| {
+            let c = if c.abs() < 1e-18 {
+                1e-18f32.copysign(c)
+            } else {
+                c
+            };
+            1.0 / c
+        });
+        RayLanes {
+            o: o.map(f32x8::splat),
+            d: d.map(f32x8::splat),
+            inv: inv.map(f32x8::splat),
+            near: inv.map(|c| usize::from(c.is_sign_negative())),
+        }
+    }
+
+    /// Slab test of the 8 child boxes over [0, tmax]: the mask of boxes entered, and where.
+    #[inline(always)]
+    fn boxes(&self, node: &Node, tmax: f32) -> (u32, f32x8) {
+        let slab = |axis: usize| {
+            let b = &node.bounds[axis];
+            let n = self.near[axis];
+            (
+                (b[n] - self.o[axis]) * self.inv[axis],
+                (b[1 - n] - self.o[axis]) * self.inv[axis],
+            )
+        };
+        let (nx, fx) = slab(0);
+        let (ny, fy) = slab(1);
+        let (nz, fz) = slab(2);
+        let near = nx.fast_max(ny).fast_max(nz).fast_max(f32x8::ZERO);
+        let far = fx.fast_min(fy).fast_min(fz).fast_min(f32x8::splat(tmax));
+        (near.simd_le(far).to_bitmask(), near)
+    }
+}
+
+/// Möller–Trumbore for one ray against the 8 triangles of a block; lane k equals
+/// `intersect_triangle(tri_k, ray, tmax_k, two_sided)` (the ray splatted, the triangle in
+/// columns; otherwise `simd::triangle8` line for line).
+///
+/// ```text
+/// p = d × e2; det = e1·p; facing = det > 0 (det ≠ 0 if two-sided)
+/// s = o − v0; u = s·p / det; q = s × e1; v = d·q / det; t = e2·q / det
+/// hit = facing ∧ u ≥ −ε ∧ v ≥ −ε ∧ u + v ≤ 1 + ε ∧ T_MIN < t < tmax   → t, else ∞
+/// ```
+#[inline(always)]
+fn triangles8(b: &Block, r: &RayLanes, tmax: f32x8, two_sided: bool) -> f32x8 {
+    let [e1x, e1y, e1z] = b.e1;
+    let [e2x, e2y, e2z] = b.e2;
+    let [dx, dy, dz] = r.d;
+    let px = dy * e2z - e2y * dz;
+    let py = dz * e2x - e2z * dx;
+    let pz = dx * e2y - e2x * dy;
+    let det = e1x * px + e1y * py + e1z * pz;
+    let facing = if two_sided {
+        det.simd_ne(f32x8::ZERO)
+    } else {
+        det.simd_gt(f32x8::ZERO)
+    };
+    let inv_det = f32x8::ONE / det;
+    let tx = r.o[0] - b.v0[0];
+    let ty = r.o[1] - b.v0[1];
+    let tz = r.o[2] - b.v0[2];
+    let u = (tx * px + ty * py + tz * pz) * inv_det;
+    let qx = ty * e1z - e1y * tz;
+    let qy = tz * e1x - e1z * tx;
+    let qz = tx * e1y - e1x * ty;
+    let v = (dx * qx + dy * qy + dz * qz) * inv_det;
+    let t = (e2x * qx + e2y * qy + e2z * qz) * inv_det;
+    let hit = facing
+        & u.simd_ge(f32x8::splat(-EDGE_EPSILON))
+        & v.simd_ge(f32x8::splat(-EDGE_EPSILON))
+        & (u + v).simd_le(f32x8::splat(1.0 + EDGE_EPSILON))
+        & t.simd_gt(f32x8::splat(T_MIN))
+        & t.simd_lt(tmax);
+    hit.select(t, f32x8::splat(f32::INFINITY))
+}
+
+/// True when a triangle of the block blocks the ray: `triangles8(..) < tmax` in some lane,
+/// with the same values computed in the order det → t → u, v, leaving as soon as no lane
+/// faces the ray or no lane's t is in (T_MIN, tmax) (as `simd::triangle8_blocks`).
+#[inline(always)]
+fn triangles8_block(b: &Block, r: &RayLanes, tmax: f32x8, two_sided: bool) -> bool {
+    let [e1x, e1y, e1z] = b.e1;
+    let [e2x, e2y, e2z] = b.e2;
+    let [dx, dy, dz] = r.d;
+    let px = dy * e2z - e2y * dz;
+    let py = dz * e2x - e2z * dx;
+    let pz = dx * e2y - e2x * dy;
+    let det = e1x * px + e1y * py + e1z * pz;
+    let facing = if two_sided {
+        det.simd_ne(f32x8::ZERO)
+    } else {
+        det.simd_gt(f32x8::ZERO)
+    };
+    if facing.none() {
+        return false;
+    }
+    let inv_det = f32x8::ONE / det;
+    let tx = r.o[0] - b.v0[0];
+    let ty = r.o[1] - b.v0[1];
+    let tz = r.o[2] - b.v0[2];
+    let qx = ty * e1z - e1y * tz;
+    let qy = tz * e1x - e1z * tx;
+    let qz = tx * e1y - e1x * ty;
+    let t = (e2x * qx + e2y * qy + e2z * qz) * inv_det;
+    let in_range = facing & t.simd_gt(f32x8::splat(T_MIN)) & t.simd_lt(tmax);
+    if in_range.none() {
+        return false;
+    }
+    let u = (tx * px + ty * py + tz * pz) * inv_det;
+    let v = (dx * qx + dy * qy + dz * qz) * inv_det;
+    (in_range
+        & u.simd_ge(f32x8::splat(-EDGE_EPSILON))
+        & v.simd_ge(f32x8::splat(-EDGE_EPSILON))
+        & (u + v).simd_le(f32x8::splat(1.0 + EDGE_EPSILON)))
+    .any()
+}
+
+/// Lane-level entry points for tests: one ray against up to 8 triangles, as in a leaf.
+pub mod lanes {
+    use super::*;
+
+    fn block(tris: &[Triangle]) -> Block {
+        assert!(tris.len() <= WIDTH);
+        let ids: Vec<u32> = (0..tris.len() as u32).collect();
+        Block::new(tris, &ids)
+    }
+
+    /// The leaf's closest-hit kernel: lane k is t for `tris[k]` (∞ for a miss or no triangle).
+    pub fn triangles(tris: &[Triangle], ray: &Ray, tmax: f32, two_sided: bool) -> [f32; WIDTH] {
+        triangles8(
+            &block(tris),
+            &RayLanes::new(ray),
+            f32x8::splat(tmax),
+            two_sided,
+        )
+        .to_array()
+    }
+
+    /// The leaf's occlusion kernel: does one of the triangles block the ray?
+    pub fn blocks(tris: &[Triangle], ray: &Ray, tmax: f32, two_sided: bool) -> bool {
+        triangles8_block(
+            &block(tris),
+            &RayLanes::new(ray),
+            f32x8::splat(tmax),
+            two_sided,
+        )
+    }
+}

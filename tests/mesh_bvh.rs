@@ -1,0 +1,500 @@
+//! The wavefront engine's mesh BVH (`wavefront::bvh`): its leaf kernels against the scalar
+//! `intersect_triangle`, lane by lane and bit for bit (edge-case table and random input), and
+//! its traversal against brute force over every triangle (random rays through a generated mesh,
+//! a triangle soup, and a mesh full of coincident and degenerate triangles), and its batch entry
+//! points for lengths around the lane width against the reference's `Accel`.
+// `!(x > 0.0)` is on purpose: it is true for NaN, like the kernels' tests.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+use glam::Vec3;
+use proptest::prelude::*;
+use raywave::geometry::{Accel, Ray, intersect_triangle};
+use raywave::meshgen::cornell_box_mesh_spheres;
+use raywave::scene::{Material, NO_HIT, Scene, Sphere, Triangle, parse_scene_str};
+use raywave::wavefront::bvh::{MeshBvh, lanes};
+use raywave::wavefront::simd::RayColumns;
+
+const NAN: f32 = f32::NAN;
+const INF: f32 = f32::INFINITY;
+
+fn triangle(v0: Vec3, v1: Vec3, v2: Vec3) -> Triangle {
+    let (e1, e2) = (v1 - v0, v2 - v0);
+    Triangle {
+        v0,
+        e1,
+        e2,
+        normal: e1.cross(e2).normalize_or_zero(),
+        material: 0,
+        face: 0,
+    }
+}
+
+fn ray(origin: [f32; 3], direction: [f32; 3]) -> Ray {
+    Ray {
+        origin: Vec3::from_array(origin),
+        direction: Vec3::from_array(direction),
+    }
+}
+
+/// Rays on the kernel's edges for the unit triangle (0,0,0) (1,0,0) (0,1,0), front +z.
+fn edge_rays() -> Vec<Ray> {
+    vec![
+        ray([0.25, 0.25, 1.0], [0.0, 0.0, -1.0]),
+        ray([0.25, 0.25, -1.0], [0.0, 0.0, 1.0]),
+        ray([0.25, 0.25, 0.0], [0.0, 0.0, -1.0]), // starting on the surface
+        ray([0.25, 0.25, 5e-5], [0.0, 0.0, -1.0]),
+        ray([0.25, 0.25, 2e-4], [0.0, 0.0, -1.0]),
+        ray([-1.0, 0.25, 0.0], [1.0, 0.0, 0.0]), // grazing, in the plane
+        ray([-1.0, 0.25, 1e-7], [1.0, 0.0, -1e-7]),
+        ray([0.0, 0.0, 1.0], [0.0, 0.0, -1.0]), // corner
+        ray([0.5, 0.5, 1.0], [0.0, 0.0, -1.0]), // hypotenuse
+        ray([0.5, -0.0, 1.0], [-0.0, 0.0, -1.0]),
+        ray([0.25, 0.25, 1.0], [-0.0, -0.0, -1.0]),
+        ray([NAN, 0.25, 1.0], [0.0, 0.0, -1.0]),
+        ray([0.25, 0.25, 1.0], [0.0, NAN, -1.0]),
+        ray([INF, 0.25, 1.0], [0.0, 0.0, -1.0]),
+        ray([0.25, 0.25, 1.0], [0.0, 0.0, -INF]),
+        ray([0.25, 0.25, 1.0], [0.0, 0.0, 0.0]),
+        ray([0.25, 0.25, 1e30], [0.0, 0.0, -1.0]),
+        ray([0.25, 0.25, 1.0], [0.0, 0.0, -1e-30]),
+        ray([1.0, 1.0, 1.0], [-0.57735, -0.57735, -0.57735]),
+    ]
+}
+
+fn edge_triangles() -> Vec<Triangle> {
+    vec![
+        triangle(Vec3::ZERO, Vec3::X, Vec3::Y),
+        triangle(Vec3::ZERO, Vec3::Y, Vec3::X), // facing −z
+        triangle(Vec3::ZERO, Vec3::X, Vec3::new(2.0, 0.0, 0.0)), // degenerate
+        triangle(Vec3::X, Vec3::Y, Vec3::Z),
+        triangle(Vec3::ZERO, Vec3::ZERO, Vec3::ZERO), // a point
+        triangle(
+            Vec3::new(0.0, 0.0, 0.5),
+            Vec3::new(1.0, 0.0, 0.5),
+            Vec3::new(0.0, 1.0, 0.5),
+        ),
+        triangle(
+            Vec3::splat(-1e20),
+            Vec3::splat(1e20),
+            Vec3::new(1e20, -1e20, 0.0),
+        ),
+        triangle(
+            Vec3::new(0.5, 0.0, 0.0),
+            Vec3::new(0.0, 0.5, 0.0),
+            Vec3::ZERO,
+        ),
+    ]
+}
+
+/// Lane k of the leaf kernels equals the scalar kernel for `tris[k]`; lanes past the end miss.
+fn check_leaf(tris: &[Triangle], r: &Ray, tmax: f32, two_sided: bool) {
+    let got = lanes::triangles(tris, r, tmax, two_sided);
+    let mut any = false;
+    for (k, got) in got.iter().enumerate() {
+        let want = tris
+            .get(k)
+            .map_or(INF, |t| intersect_triangle(t, r, tmax, two_sided));
+        any |= want < tmax;
+        assert_eq!(
+            got.to_bits(),
+            want.to_bits(),
+            "lane {k}: {r:?} tmax {tmax} two-sided {two_sided}: leaf {got} scalar {want}"
+        );
+    }
+    assert_eq!(
+        lanes::blocks(tris, r, tmax, two_sided),
+        any,
+        "{r:?} tmax {tmax}"
+    );
+}
+
+#[test]
+fn leaf_kernels_equal_scalar_on_edge_cases() {
+    let tris = edge_triangles();
+    for len in [0, 1, 3, 7, 8] {
+        for start in 0..tris.len() {
+            let set: Vec<Triangle> = (0..len).map(|k| tris[(start + k) % tris.len()]).collect();
+            for r in &edge_rays() {
+                for tmax in [INF, 1.0, 0.5, 0.0, -1.0, NAN] {
+                    for two_sided in [false, true] {
+                        check_leaf(&set, r, tmax, two_sided);
+                    }
+                }
+            }
+        }
+    }
+}
+
+fn finite() -> impl Strategy<Value = f32> {
+    -10.0f32..10.0
+}
+
+fn vec3() -> impl Strategy<Value = Vec3> {
+    (finite(), finite(), finite()).prop_map(|(x, y, z)| Vec3::new(x, y, z))
+}
+
+fn any_f32() -> impl Strategy<Value = f32> {
+    prop_oneof![
+        8 => finite(),
+        1 => Just(0.0f32),
+        1 => Just(-0.0f32),
+        1 => Just(INF),
+        1 => Just(-INF),
+        1 => Just(NAN),
+    ]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(512))]
+
+    #[test]
+    fn leaf_kernels_equal_scalar_on_random_input(
+        verts in prop::collection::vec((vec3(), vec3(), vec3()), 0..=8),
+        o in (any_f32(), any_f32(), any_f32()),
+        d in (any_f32(), any_f32(), any_f32()),
+        tmax in prop_oneof![3 => 0.0f32..30.0, 1 => Just(INF), 1 => any_f32()],
+        two_sided: bool,
+    ) {
+        let tris: Vec<Triangle> = verts.iter().map(|&(a, b, c)| triangle(a, b, c)).collect();
+        let r = ray([o.0, o.1, o.2], [d.0, d.1, d.2]);
+        check_leaf(&tris, &r, tmax, two_sided);
+    }
+
+    #[test]
+    fn leaf_kernels_equal_scalar_on_rays_that_hit(
+        verts in prop::collection::vec((vec3(), vec3(), vec3()), 1..=8),
+        o in vec3(),
+        (a, b) in (0.0f32..1.0, 0.0f32..1.0),
+        tmax in prop_oneof![Just(INF), 0.0f32..30.0],
+        two_sided: bool,
+    ) {
+        // Aim at a point of the first triangle, so that lanes hit often.
+        let tris: Vec<Triangle> = verts.iter().map(|&(a, b, c)| triangle(a, b, c)).collect();
+        let target = tris[0].v0 + a * (1.0 - b) * tris[0].e1 + a * b * tris[0].e2;
+        let r = Ray { origin: o, direction: (target - o).normalize_or_zero() };
+        check_leaf(&tris, &r, tmax, two_sided);
+    }
+}
+
+/// A small deterministic generator (xorshift64*), so the traversal tests need no seed plumbing.
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> f32 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        ((self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 40) as f32) / (1u64 << 24) as f32
+    }
+    fn in_box(&mut self, lo: Vec3, hi: Vec3) -> Vec3 {
+        Vec3::new(
+            lo.x + (hi.x - lo.x) * self.next(),
+            lo.y + (hi.y - lo.y) * self.next(),
+            lo.z + (hi.z - lo.z) * self.next(),
+        )
+    }
+    fn direction(&mut self) -> Vec3 {
+        loop {
+            let v = self.in_box(Vec3::splat(-1.0), Vec3::ONE);
+            if v.length_squared() > 1e-3 && v.length_squared() <= 1.0 {
+                return v.normalize();
+            }
+        }
+    }
+}
+
+fn scene_of(triangles: Vec<Triangle>, spheres: Vec<Sphere>) -> Scene {
+    Scene {
+        triangles,
+        spheres,
+        materials: vec![Material::default()],
+        ..Scene::default()
+    }
+}
+
+fn bounds(scene: &Scene) -> (Vec3, Vec3) {
+    let mut lo = Vec3::splat(INF);
+    let mut hi = Vec3::splat(-INF);
+    for t in &scene.triangles {
+        for p in [t.v0, t.v0 + t.e1, t.v0 + t.e2] {
+            lo = lo.min(p);
+            hi = hi.max(p);
+        }
+    }
+    (lo, hi)
+}
+
+/// Rays of every kind the engine casts: from inside and outside the bounds, axis-aligned ones
+/// (±0.0 components), ones starting on a triangle (as shadow and mirror rays do), aimed at a
+/// triangle's vertex or edge, with infinite and finite tmax.
+fn random_rays(scene: &Scene, n: usize, seed: u64) -> Vec<(Ray, f32)> {
+    let mut rng = Rng(seed);
+    let (lo, hi) = bounds(scene);
+    let margin = (hi - lo) * 0.25;
+    let tris = &scene.triangles;
+    (0..n)
+        .map(|i| {
+            let tri = &tris[(rng.next() * tris.len() as f32) as usize % tris.len()];
+            let on = tri.v0 + 0.3 * tri.e1 + 0.3 * tri.e2;
+            let (origin, direction) = match i % 6 {
+                0 => (rng.in_box(lo - margin, hi + margin), rng.direction()),
+                1 => {
+                    let mut d = [0.0f32; 3];
+                    d[i / 6 % 3] = if rng.next() < 0.5 { -1.0 } else { 1.0 };
+                    if i % 12 == 1 {
+                        d[(i / 6 + 1) % 3] = -0.0;
+                    }
+                    (rng.in_box(lo, hi), Vec3::from_array(d))
+                }
+                2 => (on, rng.direction()),
+                3 => {
+                    let o = rng.in_box(lo - margin, hi + margin);
+                    (o, (tri.v0 + tri.e1 - o).normalize())
+                }
+                4 => {
+                    let o = rng.in_box(lo - margin, hi + margin);
+                    (o, (tri.v0 + 0.5 * tri.e2 - o).normalize())
+                }
+                _ => {
+                    let o = rng.in_box(lo, hi);
+                    (o, (on - o).normalize())
+                }
+            };
+            let tmax = match i % 4 {
+                0 | 1 => INF,
+                2 => (hi - lo).length() * rng.next(),
+                _ => 0.5 * rng.next(),
+            };
+            (Ray { origin, direction }, tmax)
+        })
+        .collect()
+}
+
+/// Every triangle in index order, a later one winning only when strictly closer.
+fn brute_force(scene: &Scene, r: &Ray, tmax: f32, two_sided: bool) -> (f32, u32) {
+    let (mut best, mut prim) = (tmax, NO_HIT);
+    for (k, tri) in scene.triangles.iter().enumerate() {
+        let t = intersect_triangle(tri, r, best, two_sided);
+        if t < best {
+            best = t;
+            prim = k as u32;
+        }
+    }
+    if prim == NO_HIT {
+        (INF, NO_HIT)
+    } else {
+        (best, prim)
+    }
+}
+
+/// Same t bits and the same triangle as brute force (ties, from coincident triangles or shared
+/// edges, go to the lowest id in both), for one- and two-sided faces; occlusion equal.
+fn check_against_brute_force(scene: &Scene, rays: &[(Ray, f32)]) {
+    let bvh = MeshBvh::new(scene);
+    for two_sided in [false, true] {
+        for (i, (r, tmax)) in rays.iter().enumerate() {
+            let (t, prim) = brute_force(scene, r, *tmax, two_sided);
+            let hit = bvh.closest_triangle(r, *tmax, two_sided);
+            assert_eq!(
+                hit.t.to_bits(),
+                t.to_bits(),
+                "ray {i} {r:?} tmax {tmax} two-sided {two_sided}: bvh {hit:?}, brute force {t} {prim}"
+            );
+            assert_eq!(
+                hit.prim, prim,
+                "ray {i} {r:?}: a tie must go to the lowest id"
+            );
+            assert_eq!(
+                bvh.occluded_triangle(r, *tmax, two_sided),
+                prim != NO_HIT,
+                "ray {i} {r:?} tmax {tmax} two-sided {two_sided}"
+            );
+        }
+    }
+}
+
+fn mesh_scene(bands: u32) -> Scene {
+    parse_scene_str(&cornell_box_mesh_spheres(bands), "meshgen").expect("meshgen parses")
+}
+
+#[test]
+fn traversal_equals_brute_force_on_a_generated_mesh() {
+    let scene = mesh_scene(8);
+    assert!(scene.triangles.len() > 500);
+    check_against_brute_force(&scene, &random_rays(&scene, 3000, 7));
+}
+
+#[test]
+fn traversal_equals_brute_force_on_a_triangle_soup() {
+    let mut rng = Rng(99);
+    let tris = (0..700)
+        .map(|_| {
+            let c = rng.in_box(Vec3::splat(-5.0), Vec3::splat(5.0));
+            let s = 0.1 + 2.0 * rng.next();
+            triangle(
+                c + s * rng.direction(),
+                c + s * rng.direction(),
+                c + s * rng.direction(),
+            )
+        })
+        .collect();
+    let scene = scene_of(tris, vec![]);
+    check_against_brute_force(&scene, &random_rays(&scene, 3000, 5));
+}
+
+#[test]
+fn traversal_equals_brute_force_with_coincident_and_degenerate_triangles() {
+    let mut rng = Rng(3);
+    let mut tris = Vec::new();
+    let a = triangle(Vec3::ZERO, Vec3::X, Vec3::Y);
+    // 300 copies of one triangle, 100 of its mirror image, 200 zero-area ones, a few real ones.
+    tris.extend(std::iter::repeat_n(a, 300));
+    tris.extend(std::iter::repeat_n(
+        triangle(Vec3::ZERO, Vec3::Y, Vec3::X),
+        100,
+    ));
+    for k in 0..200 {
+        let p = rng.in_box(Vec3::splat(-1.0), Vec3::splat(2.0));
+        tris.push(match k % 3 {
+            0 => triangle(p, p, p),
+            1 => triangle(p, p + Vec3::X, p + 2.0 * Vec3::X),
+            _ => triangle(p, p + Vec3::Y, p),
+        });
+    }
+    for _ in 0..50 {
+        let c = rng.in_box(Vec3::splat(-1.0), Vec3::splat(2.0));
+        tris.push(triangle(
+            c,
+            c + 0.3 * rng.direction(),
+            c + 0.3 * rng.direction(),
+        ));
+    }
+    let scene = scene_of(tris, vec![]);
+    let bvh = MeshBvh::new(&scene);
+    assert!(bvh.depth * 7 < 1024, "depth {}", bvh.depth);
+    check_against_brute_force(&scene, &random_rays(&scene, 3000, 11));
+}
+
+#[test]
+fn tiny_and_empty_meshes() {
+    let one = scene_of(vec![triangle(Vec3::ZERO, Vec3::X, Vec3::Y)], vec![]);
+    let bvh = MeshBvh::new(&one);
+    let r = ray([0.25, 0.25, 1.0], [0.0, 0.0, -1.0]);
+    assert_eq!(bvh.closest_triangle(&r, INF, false).prim, 0);
+    assert!(bvh.occluded_triangle(&r, INF, false));
+    let empty = MeshBvh::new(&scene_of(vec![], vec![]));
+    assert_eq!(empty.closest_triangle(&r, INF, true).prim, NO_HIT);
+    assert!(!empty.occluded_triangle(&r, INF, true));
+    let nine = scene_of(vec![triangle(Vec3::ZERO, Vec3::X, Vec3::Y); 9], vec![]);
+    check_against_brute_force(&nine, &random_rays(&nine, 200, 1));
+}
+
+/// `closest_hits` and `occluded` (spheres included) against brute force over every triangle,
+/// then every sphere (the reference's `Accel` without a BVH): same t bits, same primitive, same
+/// occlusion. `Accel` over obvhs's CWBVH is compared too, and
+/// its disagreements printed: it misses some axis-aligned rays (e.g. direction (−1, −0, 0))
+/// that brute force and this BVH hit.
+#[test]
+fn batch_entry_points_equal_brute_force_for_lengths_around_the_lane_width() {
+    let mut scene = mesh_scene(6);
+    scene.spheres.push(Sphere {
+        center: Vec3::new(0.0, -0.5, 0.0),
+        radius: 0.2,
+        material: 0,
+    });
+    let base = scene.triangles.len() as u32;
+    let bvh = MeshBvh::new(&scene);
+    let accel = Accel::new(&scene);
+    assert!(accel.uses_bvh());
+    let all = random_rays(&scene, 8 * 64 + 1, 21);
+    let (mut accel_differs, mut axis_parallel) = (0, 0);
+    for n in [0, 1, 7, 8, 9, 8 * 64 + 1] {
+        let rays = &all[..n];
+        let col = |f: &dyn Fn(&(Ray, f32)) -> f32| rays.iter().map(f).collect::<Vec<f32>>();
+        let c = [
+            col(&|r| r.0.origin.x),
+            col(&|r| r.0.origin.y),
+            col(&|r| r.0.origin.z),
+            col(&|r| r.0.direction.x),
+            col(&|r| r.0.direction.y),
+            col(&|r| r.0.direction.z),
+            col(&|r| r.1),
+        ];
+        let cols = RayColumns {
+            origin: [&c[0], &c[1], &c[2]],
+            direction: [&c[3], &c[4], &c[5]],
+            tmax: &c[6],
+        };
+        for two_sided in [false, true] {
+            let (mut t, mut prim, mut blocked) = (vec![0.0; n], vec![0; n], vec![false; n]);
+            bvh.closest_hits(&scene, &cols, two_sided, &mut t, &mut prim);
+            bvh.occluded(&scene, &cols, two_sided, &mut blocked);
+            for (i, (r, tmax)) in rays.iter().enumerate() {
+                let (mut want_t, mut want_prim) = brute_force(&scene, r, *tmax, two_sided);
+                let mut best = if want_prim == NO_HIT { *tmax } else { want_t };
+                for (k, s) in scene.spheres.iter().enumerate() {
+                    let ts = raywave::geometry::intersect_sphere(s, r, best);
+                    if ts < best {
+                        best = ts;
+                        (want_t, want_prim) = (ts, base + k as u32);
+                    }
+                }
+                assert_eq!(t[i].to_bits(), want_t.to_bits(), "ray {i} {r:?}");
+                assert_eq!(prim[i], want_prim, "ray {i} {r:?}");
+                assert_eq!(blocked[i], want_prim != NO_HIT, "ray {i}");
+                if accel.closest(&scene, r, *tmax, two_sided).t.to_bits() != want_t.to_bits() {
+                    accel_differs += 1;
+                    if r.direction.to_array().contains(&0.0) {
+                        axis_parallel += 1;
+                    }
+                }
+            }
+        }
+    }
+    eprintln!(
+        "Accel (obvhs CWBVH) differs from brute force on {accel_differs} of {} ray queries \
+         ({axis_parallel} of them with a ±0 direction component)",
+        2 * (1 + 7 + 8 + 9 + 8 * 64 + 1)
+    );
+}
+
+/// Not a test: the instruction-count probe behind docs/PERFORMANCE.md's mesh choices. Traces
+/// the peer ray sets of the 12k-triangle box (128×128) through one engine, chosen by
+/// `PROBE=obvhs|wavefront` and `SET=primary|shadow|incoherent|shadow_fan`, 5 times:
+/// `valgrind --tool=callgrind --toggle-collect='*probe_trace*' <test binary> --ignored probe`.
+#[test]
+#[ignore]
+fn probe() {
+    use raywave::peer::{Hits, ObvhsMesh, RaySets, without_emitters};
+    let scene = without_emitters(&mesh_scene(raywave::meshgen::bands_for(12_000)));
+    let obvhs = ObvhsMesh::new(&scene);
+    let sets = RaySets::new(&scene, &obvhs, 128, 128, 2026);
+    let settings = raywave::settings::RenderSettings {
+        width: 128,
+        height: 128,
+        two_sided: true,
+        ..Default::default()
+    };
+    let ctx = raywave::wavefront::context::Context::new(&scene, &settings);
+    let engine = std::env::var("PROBE").unwrap_or_else(|_| "wavefront".into());
+    let set = std::env::var("SET").unwrap_or_else(|_| "primary".into());
+    let set = sets
+        .all()
+        .into_iter()
+        .find(|s| s.kind.name() == set)
+        .expect("a set");
+    #[inline(never)]
+    fn probe_trace(f: &mut dyn FnMut()) {
+        for _ in 0..5 {
+            f();
+        }
+    }
+    let (mut hits, mut blocked, mut scratch) = (Hits::default(), Vec::new(), Default::default());
+    probe_trace(&mut || match (engine.as_str(), set.kind.is_occlusion()) {
+        ("obvhs", false) => obvhs.closest(&scene, set, &mut hits),
+        ("obvhs", true) => obvhs.occluded(&scene, set, &mut blocked),
+        (_, false) => raywave::peer::wavefront_closest(&ctx, set, &mut scratch, &mut hits),
+        (_, true) => raywave::peer::wavefront_occluded(&ctx, set, &mut blocked),
+    });
+    std::hint::black_box((&hits, &blocked));
+}
