@@ -204,7 +204,10 @@ fn bench_set(c: &mut Criterion, s: &Setup, ctx: &Context, set: &RaySet) {
 }
 
 fn main() {
-    let test_mode = std::env::args().any(|a| a == "--test");
+    // criterion's test mode: `cargo bench -- --test`, or `cargo test --all-targets`, which runs
+    // the bench binary without the `--bench` flag that `cargo bench` passes.
+    let args: Vec<String> = std::env::args().collect();
+    let test_mode = args.iter().any(|a| a == "--test") || !args.iter().any(|a| a == "--bench");
     let size = if test_mode { TEST_SIZE } else { SIZE };
     let mut c = Criterion::default()
         .sample_size(10)
