@@ -165,7 +165,7 @@ fn culling_changes_only_rounding_hits_on_the_light_points_plane() {
                 assert!(expected && !culled_blocked);
                 let rounding_only = scene.triangles.iter().all(|t| {
                     let th = intersect_triangle(t, &ray, tmax, false);
-                    !(th < tmax) || (dist - th) * t.normal.dot(ray.direction).abs() < 1e-5
+                    th >= tmax || (dist - th) * t.normal.dot(ray.direction).abs() < 1e-5
                 });
                 assert!(rounding_only, "from {from} to {to}");
                 grazing += 1;
@@ -182,5 +182,7 @@ fn culling_changes_only_rounding_hits_on_the_light_points_plane() {
         grazing * 1000 < rays,
         "{grazing} of {rays} rays differ by rounding"
     );
-    eprintln!("{culled} of {total} triangles culled; {rays} rays, {blocked} blocked, {grazing} unblocked by culling (rounding)");
+    eprintln!(
+        "{culled} of {total} triangles culled; {rays} rays, {blocked} blocked, {grazing} unblocked by culling (rounding)"
+    );
 }

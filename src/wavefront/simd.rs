@@ -522,12 +522,12 @@ fn sobol8(j: u32x8, scramble: u32) -> (f32x8, f32x8) {
     let index = owen_scramble_rev8(reverse_bits8(j), hash(scramble ^ 0x79c6_8e4a));
     let vectors = &*SOBOL_VECTORS;
     let (mut s0, mut s1) = (u32x8::ZERO, u32x8::ZERO);
-    for k in 0..16 {
+    for (k, (&v0, &v1)) in vectors[0].iter().zip(&vectors[1]).enumerate() {
         // All ones where bit 31 − k of the index is set.
         let bit = wide::bytemuck::cast::<u32x8, i32x8>(index << k as u32) >> 31;
         let bit = wide::bytemuck::cast::<i32x8, u32x8>(bit);
-        s0 ^= bit & u32x8::splat(vectors[0][k]);
-        s1 ^= bit & u32x8::splat(vectors[1][k]);
+        s0 ^= bit & u32x8::splat(v0);
+        s1 ^= bit & u32x8::splat(v1);
     }
     let seed = scramble.wrapping_mul(0x9c8f_2d3b);
     let s0 = owen_scramble_rev8(s0, hash(seed ^ 0x912f_69ba));
