@@ -235,9 +235,9 @@ impl Accel {
 /// front side or on the plane: such a face can never block it. The lab's box shows why this
 /// matters: its light is a wall of the box, so the light lies on or in front of every wall's
 /// plane and no wall can shadow it; only the spheres can. Signed distances are taken in f64
-/// with a tolerance of 1e-6 of the scene's size, so a light *touching* a face's plane (the
-/// lab's light shares an edge with four walls) counts as in front of it despite rounding in
-/// the face's edges. Both engines test this same list, so they still agree bit for bit; with
+/// with a tolerance of 1e-6 of the light corner's coordinates and distance from the face, so a
+/// light *touching* a face's plane (the lab's light shares an edge with four walls) counts as
+/// in front of it despite rounding in the face's edges. Both engines test this same list, so they still agree bit for bit; with
 /// `--two-sided` every triangle is tested.
 pub fn shadow_casters(scene: &Scene) -> Vec<Triangle> {
     let corners: Vec<Vec3> = scene
@@ -260,13 +260,6 @@ pub fn shadow_casters(scene: &Scene) -> Vec<Triangle> {
                 .collect(),
         })
         .collect();
-    let size = scene
-        .triangles
-        .iter()
-        .flat_map(|t| [t.v0, t.v0 + t.e1, t.v0 + t.e2])
-        .chain(corners.iter().copied())
-        .fold(1.0f64, |m, p| m.max(p.abs().max_element() as f64));
-    let tolerance = 1e-6 * size;
     scene
         .triangles
         .iter()
@@ -280,9 +273,14 @@ pub fn shadow_casters(scene: &Scene) -> Vec<Triangle> {
             }
             let normal = normal / length;
             let v0 = tri.v0.as_dvec3();
-            corners
-                .iter()
-                .any(|c| normal.dot(c.as_dvec3() - v0) < -tolerance)
+            corners.iter().any(|c| {
+                // The tolerance is relative to this corner's own coordinates and its distance
+                // from the face (what rounding in the light point and the face's edges scales
+                // with), so one far-away vertex elsewhere cannot widen it for a small face.
+                let c = c.as_dvec3();
+                let tolerance = 1e-6 * (c - v0).abs().max_element().max(c.abs().max_element());
+                normal.dot(c - v0) < -tolerance
+            })
         })
         .copied()
         .collect()

@@ -186,3 +186,64 @@ fn culling_changes_only_rounding_hits_on_the_light_points_plane() {
         "{culled} of {total} triangles culled; {rays} rays, {blocked} blocked, {grazing} unblocked by culling (rounding)"
     );
 }
+
+/// A face near the light keeps its shadow in a scene with far-away geometry: the tolerance is
+/// the face's and light corner's own, not the scene's size. (With a tolerance of 1e-6 of the
+/// largest coordinate, a ±1e6 floor widened it to 1 unit and culled the four sides of this
+/// box, whose light corners lie 0.3–0.9 behind their planes: the box's shadow was cut off at
+/// its footprint.)
+#[test]
+fn far_geometry_does_not_cull_a_box_beside_the_light() {
+    // Light at y = 3 facing down; a one-sided closed box with x, z in [−0.6, 0.6] and y in
+    // [1, 2.5] (faces outwards); a huge floor at y = 0 facing up.
+    let text = "material\ndiffuse 1 1 1\nemitted 1 1 1\nmaterial\ndiffuse 1 1 1\n\
+        v -0.3 3 -0.3\nv 0.3 3 -0.3\nv 0.3 3 0.3\nv -0.3 3 0.3\n\
+        v -1e6 0 -1e6\nv 1e6 0 -1e6\nv 1e6 0 1e6\nv -1e6 0 1e6\n\
+        v -0.6 1 -0.6\nv 0.6 1 -0.6\nv 0.6 1 0.6\nv -0.6 1 0.6\n\
+        v -0.6 2.5 -0.6\nv 0.6 2.5 -0.6\nv 0.6 2.5 0.6\nv -0.6 2.5 0.6\n\
+        m 0\nf 1 2 3 4\nm 1\nf 8 7 6 5\n\
+        f 9 10 11 12\nf 16 15 14 13\n\
+        f 9 13 14 10\nf 10 14 15 11\nf 11 15 16 12\nf 12 16 13 9\n";
+    let scene = parse_scene_str(text, "far.obj").unwrap();
+    assert_eq!(
+        scene.triangles[0].normal,
+        Vec3::NEG_Y,
+        "the light faces down"
+    );
+    assert_eq!(scene.triangles[2].normal, Vec3::Y, "the floor faces up");
+    assert_eq!(
+        scene.triangles[6].normal,
+        Vec3::Y,
+        "the box's top faces out"
+    );
+    assert_eq!(
+        scene.triangles[8].normal,
+        Vec3::NEG_Z,
+        "the box's sides face out"
+    );
+    // Kept: the bottom (light behind it) and the four sides (every light corner behind each
+    // side's plane, 0.3–0.9 away); culled: the light, the floor and the box's top.
+    let casters = shadow_casters(&scene);
+    assert_eq!(casters.len(), 10, "{casters:#?}");
+    // A floor point beside the box, in its shadow: the rays go in through a side face (the
+    // ones that used to be culled) and out through the top.
+    let accel = Accel::new(&scene);
+    let from = Vec3::new(1.0, 0.0, 0.0);
+    let light = &scene.lights[0];
+    let mut blocked = 0;
+    for (u, v) in [(0.1, 0.5), (0.5, 0.5), (0.9, 0.5), (0.5, 0.1), (0.5, 0.9)] {
+        let to = light.point(u, v);
+        let ray = Ray {
+            origin: from,
+            direction: (to - from).normalize(),
+        };
+        let tmax = (to - from).length() - T_MIN;
+        let expected = blocked_unculled(&scene, &ray, tmax);
+        assert_eq!(accel.occluded(&scene, &ray, tmax, false), expected);
+        blocked += expected as u32;
+    }
+    assert!(
+        blocked >= 3,
+        "the box should shadow this floor point ({blocked} of 5 blocked)"
+    );
+}
