@@ -26,8 +26,8 @@
 //! lowest triangle id, as in a brute-force loop in index order, so the closest hit is exactly
 //! brute force's.
 
-use super::simd::RayColumns;
-use crate::geometry::{EDGE_EPSILON, Hit, Ray, T_MIN, intersect_sphere};
+use super::simd::{self, RayColumns, TriangleLanes};
+use crate::geometry::{Hit, Ray, T_MIN, intersect_sphere};
 use crate::scene::{NO_HIT, Scene, Triangle};
 use obvhs::bvh2::Bvh2;
 use obvhs::bvh2::reinsertion::ReinsertionOptimizer;
@@ -65,6 +65,18 @@ struct Block {
 }
 
 impl Block {
+    /// The block's triangles against one ray, as Möller–Trumbore's operands.
+    #[inline(always)]
+    fn lanes(&self, r: &RayLanes) -> TriangleLanes {
+        TriangleLanes {
+            o: r.o,
+            d: r.d,
+            v0: self.v0,
+            e1: self.e1,
+            e2: self.e2,
+        }
+    }
+
     /// Triangles `tris[ids[k]]` in lanes k < ids.len() (at most 8); NaN lanes after them.
     fn new(tris: &[Triangle], ids: &[u32]) -> Block {
         debug_assert!(ids.len() <= WIDTH);
@@ -518,86 +530,18 @@ impl RayLanes {
 }
 
 /// Möller–Trumbore for one ray against the 8 triangles of a block; lane k equals
-/// `intersect_triangle(tri_k, ray, tmax_k, two_sided)` (the ray splatted, the triangle in
-/// columns; otherwise `simd::triangle8` line for line).
-///
-/// ```text
-/// p = d × e2; det = e1·p; facing = det > 0 (det ≠ 0 if two-sided)
-/// s = o − v0; u = s·p / det; q = s × e1; v = d·q / det; t = e2·q / det
-/// hit = facing ∧ u ≥ −ε ∧ v ≥ −ε ∧ u + v ≤ 1 + ε ∧ T_MIN < t < tmax   → t, else ∞
-/// ```
+/// `intersect_triangle(tri_k, ray, tmax_k, two_sided)`: `simd::moller_trumbore8` with the ray
+/// splatted and the triangles in columns.
 #[inline(always)]
 fn triangles8(b: &Block, r: &RayLanes, tmax: f32x8, two_sided: bool) -> f32x8 {
-    let [e1x, e1y, e1z] = b.e1;
-    let [e2x, e2y, e2z] = b.e2;
-    let [dx, dy, dz] = r.d;
-    let px = dy * e2z - e2y * dz;
-    let py = dz * e2x - e2z * dx;
-    let pz = dx * e2y - e2x * dy;
-    let det = e1x * px + e1y * py + e1z * pz;
-    let facing = if two_sided {
-        det.simd_ne(f32x8::ZERO)
-    } else {
-        det.simd_gt(f32x8::ZERO)
-    };
-    let inv_det = f32x8::ONE / det;
-    let tx = r.o[0] - b.v0[0];
-    let ty = r.o[1] - b.v0[1];
-    let tz = r.o[2] - b.v0[2];
-    let u = (tx * px + ty * py + tz * pz) * inv_det;
-    let qx = ty * e1z - e1y * tz;
-    let qy = tz * e1x - e1z * tx;
-    let qz = tx * e1y - e1x * ty;
-    let v = (dx * qx + dy * qy + dz * qz) * inv_det;
-    let t = (e2x * qx + e2y * qy + e2z * qz) * inv_det;
-    let hit = facing
-        & u.simd_ge(f32x8::splat(-EDGE_EPSILON))
-        & v.simd_ge(f32x8::splat(-EDGE_EPSILON))
-        & (u + v).simd_le(f32x8::splat(1.0 + EDGE_EPSILON))
-        & t.simd_gt(f32x8::splat(T_MIN))
-        & t.simd_lt(tmax);
-    hit.select(t, f32x8::splat(f32::INFINITY))
+    simd::moller_trumbore8(&b.lanes(r), tmax, two_sided)
 }
 
-/// True when a triangle of the block blocks the ray: `triangles8(..) < tmax` in some lane,
-/// with the same values computed in the order det → t → u, v, leaving as soon as no lane
-/// faces the ray or no lane's t is in (T_MIN, tmax) (as `simd::triangle8_blocks`).
+/// True when a triangle of the block blocks the ray: `triangles8(..) < tmax` in some lane, with
+/// `simd::moller_trumbore8_blocks`'s early exits.
 #[inline(always)]
 fn triangles8_block(b: &Block, r: &RayLanes, tmax: f32x8, two_sided: bool) -> bool {
-    let [e1x, e1y, e1z] = b.e1;
-    let [e2x, e2y, e2z] = b.e2;
-    let [dx, dy, dz] = r.d;
-    let px = dy * e2z - e2y * dz;
-    let py = dz * e2x - e2z * dx;
-    let pz = dx * e2y - e2x * dy;
-    let det = e1x * px + e1y * py + e1z * pz;
-    let facing = if two_sided {
-        det.simd_ne(f32x8::ZERO)
-    } else {
-        det.simd_gt(f32x8::ZERO)
-    };
-    if facing.none() {
-        return false;
-    }
-    let inv_det = f32x8::ONE / det;
-    let tx = r.o[0] - b.v0[0];
-    let ty = r.o[1] - b.v0[1];
-    let tz = r.o[2] - b.v0[2];
-    let qx = ty * e1z - e1y * tz;
-    let qy = tz * e1x - e1z * tx;
-    let qz = tx * e1y - e1x * ty;
-    let t = (e2x * qx + e2y * qy + e2z * qz) * inv_det;
-    let in_range = facing & t.simd_gt(f32x8::splat(T_MIN)) & t.simd_lt(tmax);
-    if in_range.none() {
-        return false;
-    }
-    let u = (tx * px + ty * py + tz * pz) * inv_det;
-    let v = (dx * qx + dy * qy + dz * qz) * inv_det;
-    (in_range
-        & u.simd_ge(f32x8::splat(-EDGE_EPSILON))
-        & v.simd_ge(f32x8::splat(-EDGE_EPSILON))
-        & (u + v).simd_le(f32x8::splat(1.0 + EDGE_EPSILON)))
-    .any()
+    simd::moller_trumbore8_blocks(&b.lanes(r), tmax, two_sided) != 0
 }
 
 /// Lane-level entry points for tests: one ray against up to 8 triangles, as in a leaf.

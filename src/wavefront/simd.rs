@@ -7,7 +7,7 @@
 //!
 //! | kernel               | scalar twin                                              |
 //! |----------------------|----------------------------------------------------------|
-//! | [`triangle8`]        | `geometry::intersect_triangle`                           |
+//! | [`moller_trumbore8`] | `geometry::intersect_triangle` (8 rays × 1 triangle in [`triangle8`], 1 ray × 8 triangles in `bvh.rs`) |
 //! | [`sphere8`]          | `geometry::intersect_sphere`                             |
 //! | [`closest_hits`]     | `Accel::closest` without a BVH                           |
 //! | [`occluded`]         | `Accel::occluded` without a BVH                          |
@@ -115,8 +115,36 @@ const MASK_BOOLS: [[bool; LANES]; 256] = {
 /// The lane indices 0..8 as floats, to build "lane < count" masks.
 const LANE_INDEX: [f32; LANES] = [0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0];
 
-/// Möller–Trumbore for 8 rays against one triangle; lane k equals
-/// `intersect_triangle(tri, ray_k, tmax_k, two_sided)`.
+/// Möller–Trumbore's operands on 8 lanes, as columns: ray origin o and direction d, triangle
+/// corner v0 and edges e1, e2. [`triangle8`] splats the triangle (8 rays, one triangle), the
+/// mesh BVH's leaf test splats the ray (one ray, 8 triangles); the arithmetic is
+/// [`moller_trumbore8`] and [`moller_trumbore8_blocks`] either way.
+#[derive(Clone, Copy)]
+pub(crate) struct TriangleLanes {
+    pub o: [f32x8; 3],
+    pub d: [f32x8; 3],
+    pub v0: [f32x8; 3],
+    pub e1: [f32x8; 3],
+    pub e2: [f32x8; 3],
+}
+
+impl TriangleLanes {
+    /// One triangle against 8 rays.
+    #[inline(always)]
+    fn splat_triangle(tri: &Triangle, r: &Rays8) -> TriangleLanes {
+        let splat = |v: Vec3| [f32x8::splat(v.x), f32x8::splat(v.y), f32x8::splat(v.z)];
+        TriangleLanes {
+            o: [r.ox, r.oy, r.oz],
+            d: [r.dx, r.dy, r.dz],
+            v0: splat(tri.v0),
+            e1: splat(tri.e1),
+            e2: splat(tri.e2),
+        }
+    }
+}
+
+/// Möller–Trumbore on 8 lanes; lane k equals `intersect_triangle(tri_k, ray_k, tmax_k,
+/// two_sided)`, the same operations in the same order.
 ///
 /// ```text
 /// p = d × e2; det = e1·p; facing = det > 0 (det ≠ 0 if two-sided)
@@ -124,38 +152,31 @@ const LANE_INDEX: [f32; LANES] = [0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0];
 /// hit = facing ∧ u ≥ −ε ∧ v ≥ −ε ∧ u + v ≤ 1 + ε ∧ T_MIN < t < tmax   → t, else ∞
 /// ```
 #[inline(always)]
-pub fn triangle8(tri: &Triangle, r: &Rays8, tmax: f32x8, two_sided: bool) -> f32x8 {
-    let (e1x, e1y, e1z) = (
-        f32x8::splat(tri.e1.x),
-        f32x8::splat(tri.e1.y),
-        f32x8::splat(tri.e1.z),
-    );
-    let (e2x, e2y, e2z) = (
-        f32x8::splat(tri.e2.x),
-        f32x8::splat(tri.e2.y),
-        f32x8::splat(tri.e2.z),
-    );
+pub(crate) fn moller_trumbore8(m: &TriangleLanes, tmax: f32x8, two_sided: bool) -> f32x8 {
+    let [ox, oy, oz] = m.o;
+    let [dx, dy, dz] = m.d;
+    let [e1x, e1y, e1z] = m.e1;
+    let [e2x, e2y, e2z] = m.e2;
     // pvec = d × e2 (glam's cross: self.y * rhs.z - rhs.y * self.z, ...)
-    let px = r.dy * e2z - e2y * r.dz;
-    let py = r.dz * e2x - e2z * r.dx;
-    let pz = r.dx * e2y - e2x * r.dy;
+    let px = dy * e2z - e2y * dz;
+    let py = dz * e2x - e2z * dx;
+    let pz = dx * e2y - e2x * dy;
     let det = e1x * px + e1y * py + e1z * pz;
-    let zero = f32x8::ZERO;
     let facing = if two_sided {
-        det.simd_ne(zero)
+        det.simd_ne(f32x8::ZERO)
     } else {
-        det.simd_gt(zero)
+        det.simd_gt(f32x8::ZERO)
     };
     let inv_det = f32x8::ONE / det;
-    let tx = r.ox - f32x8::splat(tri.v0.x);
-    let ty = r.oy - f32x8::splat(tri.v0.y);
-    let tz = r.oz - f32x8::splat(tri.v0.z);
+    let tx = ox - m.v0[0];
+    let ty = oy - m.v0[1];
+    let tz = oz - m.v0[2];
     let u = (tx * px + ty * py + tz * pz) * inv_det;
     // qvec = tvec × e1
     let qx = ty * e1z - e1y * tz;
     let qy = tz * e1x - e1z * tx;
     let qz = tx * e1y - e1x * ty;
-    let v = (r.dx * qx + r.dy * qy + r.dz * qz) * inv_det;
+    let v = (dx * qx + dy * qy + dz * qz) * inv_det;
     let t = (e2x * qx + e2y * qy + e2z * qz) * inv_det;
     let hit = facing
         & u.simd_ge(f32x8::splat(-EDGE_EPSILON))
@@ -166,39 +187,32 @@ pub fn triangle8(tri: &Triangle, r: &Rays8, tmax: f32x8, two_sided: bool) -> f32
     hit.select(t, f32x8::splat(f32::INFINITY))
 }
 
-/// The lanes that `tri` blocks, as a bitmask: `triangle8(..) < tmax`, with the same values
-/// computed in an order that lets whole packets leave early: after det when no lane faces the
+/// The lanes that block, as a bitmask: `moller_trumbore8(..) < tmax`, with the same values
+/// computed in an order that lets all 8 lanes leave early: after det when no lane faces its
 /// triangle (for one-sided faces about half the walls of a box, seen from a coherent packet of
 /// shadow rays), and after t when no lane's t is in (T_MIN, tmax) (the walls behind the light).
 #[inline(always)]
-fn triangle8_blocks(tri: &Triangle, r: &Rays8, tmax: f32x8, two_sided: bool) -> u32 {
-    let (e1x, e1y, e1z) = (
-        f32x8::splat(tri.e1.x),
-        f32x8::splat(tri.e1.y),
-        f32x8::splat(tri.e1.z),
-    );
-    let (e2x, e2y, e2z) = (
-        f32x8::splat(tri.e2.x),
-        f32x8::splat(tri.e2.y),
-        f32x8::splat(tri.e2.z),
-    );
-    let px = r.dy * e2z - e2y * r.dz;
-    let py = r.dz * e2x - e2z * r.dx;
-    let pz = r.dx * e2y - e2x * r.dy;
+pub(crate) fn moller_trumbore8_blocks(m: &TriangleLanes, tmax: f32x8, two_sided: bool) -> u32 {
+    let [ox, oy, oz] = m.o;
+    let [dx, dy, dz] = m.d;
+    let [e1x, e1y, e1z] = m.e1;
+    let [e2x, e2y, e2z] = m.e2;
+    let px = dy * e2z - e2y * dz;
+    let py = dz * e2x - e2z * dx;
+    let pz = dx * e2y - e2x * dy;
     let det = e1x * px + e1y * py + e1z * pz;
-    let zero = f32x8::ZERO;
     let facing = if two_sided {
-        det.simd_ne(zero)
+        det.simd_ne(f32x8::ZERO)
     } else {
-        det.simd_gt(zero)
+        det.simd_gt(f32x8::ZERO)
     };
     if facing.none() {
         return 0;
     }
     let inv_det = f32x8::ONE / det;
-    let tx = r.ox - f32x8::splat(tri.v0.x);
-    let ty = r.oy - f32x8::splat(tri.v0.y);
-    let tz = r.oz - f32x8::splat(tri.v0.z);
+    let tx = ox - m.v0[0];
+    let ty = oy - m.v0[1];
+    let tz = oz - m.v0[2];
     let qx = ty * e1z - e1y * tz;
     let qy = tz * e1x - e1z * tx;
     let qz = tx * e1y - e1x * ty;
@@ -208,12 +222,25 @@ fn triangle8_blocks(tri: &Triangle, r: &Rays8, tmax: f32x8, two_sided: bool) -> 
         return 0;
     }
     let u = (tx * px + ty * py + tz * pz) * inv_det;
-    let v = (r.dx * qx + r.dy * qy + r.dz * qz) * inv_det;
+    let v = (dx * qx + dy * qy + dz * qz) * inv_det;
     (in_range
         & u.simd_ge(f32x8::splat(-EDGE_EPSILON))
         & v.simd_ge(f32x8::splat(-EDGE_EPSILON))
         & (u + v).simd_le(f32x8::splat(1.0 + EDGE_EPSILON)))
     .to_bitmask()
+}
+
+/// Möller–Trumbore for 8 rays against one triangle; lane k equals
+/// `intersect_triangle(tri, ray_k, tmax_k, two_sided)`.
+#[inline(always)]
+pub fn triangle8(tri: &Triangle, r: &Rays8, tmax: f32x8, two_sided: bool) -> f32x8 {
+    moller_trumbore8(&TriangleLanes::splat_triangle(tri, r), tmax, two_sided)
+}
+
+/// The lanes that `tri` blocks, as a bitmask (`moller_trumbore8_blocks`).
+#[inline(always)]
+fn triangle8_blocks(tri: &Triangle, r: &Rays8, tmax: f32x8, two_sided: bool) -> u32 {
+    moller_trumbore8_blocks(&TriangleLanes::splat_triangle(tri, r), tmax, two_sided)
 }
 
 /// Ray–sphere for 8 rays; lane k equals `intersect_sphere(sphere, ray_k, tmax_k)`.
