@@ -370,9 +370,28 @@ fn traversal_equals_brute_force_with_coincident_and_degenerate_triangles() {
         ));
     }
     let scene = scene_of(tris, vec![]);
-    let bvh = MeshBvh::new(&scene);
-    assert!(bvh.depth * 7 < 1024, "depth {}", bvh.depth);
     check_against_brute_force(&scene, &random_rays(&scene, 3000, 11));
+}
+
+/// Triangles at exponentially growing distances along a line: a lopsided tree (depth 21 for
+/// 2,000 triangles, against 6 for the 12k-triangle box). The traversal stack is sized from the
+/// tree's depth (7 · depth + 1 entries; it used to be a fixed 1,024, and a tree deeper than 146
+/// levels made the build panic), so this checks the traversal on a deep, unbalanced tree.
+#[test]
+fn a_chain_shaped_tree_builds_and_traverses() {
+    let tris: Vec<Triangle> = (0..2000)
+        .map(|k| {
+            let x = 1.02f32.powi(k);
+            triangle(
+                Vec3::new(x, 0.0, 0.0),
+                Vec3::new(x, 1.0, 0.0),
+                Vec3::new(x, 0.0, 1.0),
+            )
+        })
+        .collect();
+    let scene = scene_of(tris, vec![]);
+    assert!(MeshBvh::new(&scene).depth > 12);
+    check_against_brute_force(&scene, &random_rays(&scene, 2000, 13));
 }
 
 #[test]

@@ -39,8 +39,6 @@ use wide::f32x8;
 pub const WIDTH: usize = 8;
 /// Largest subtree made into a leaf: one block.
 const LEAF_MAX: u32 = 8;
-/// Traversal stack entries: a node pushes at most 7, so this allows depth 146.
-const STACK: usize = 1024;
 /// Child reference bit for a leaf (its block index in the low bits).
 const LEAF: u32 = 1 << 31;
 /// An unused child slot.
@@ -147,11 +145,6 @@ impl MeshBvh {
             ReinsertionOptimizer::default().run(&mut bvh2, p.reinsertion_batch_ratio, None);
             bvh.collapse(&bvh2, tris);
         }
-        assert!(
-            bvh.depth * (WIDTH - 1) < STACK,
-            "mesh BVH too deep for the traversal stack: depth {}",
-            bvh.depth
-        );
         bvh.build_time = start.elapsed();
         bvh
     }
@@ -263,14 +256,14 @@ impl MeshBvh {
     /// Closest triangle hit in (T_MIN, tmax): `Hit::MISS` when none. The same t bits and
     /// triangle as testing every triangle with `intersect_triangle` in index order.
     pub fn closest_triangle(&self, ray: &Ray, tmax: f32, two_sided: bool) -> Hit {
-        self.closest_in(ray, tmax, two_sided, &mut Stack::new())
+        self.closest_in(ray, tmax, two_sided, &mut Stack::new(self))
     }
 
     /// [`Self::closest_triangle`] with a stack from the caller: zeroing 8 KB per ray cost more
     /// than a whole traversal.
     #[inline]
     fn closest_in(&self, ray: &Ray, tmax: f32, two_sided: bool, stack: &mut Stack) -> Hit {
-        let stack = &mut stack.0;
+        let stack = &mut stack.0[..];
         let r = RayLanes::new(ray);
         let mut best_t = tmax;
         let mut best_prim = NO_HIT;
@@ -357,13 +350,13 @@ impl MeshBvh {
 
     /// True when a triangle blocks the ray in (T_MIN, tmax); stops at the first blocker.
     pub fn occluded_triangle(&self, ray: &Ray, tmax: f32, two_sided: bool) -> bool {
-        self.occluded_in(ray, tmax, two_sided, &mut Stack::new())
+        self.occluded_in(ray, tmax, two_sided, &mut Stack::new(self))
     }
 
     /// [`Self::occluded_triangle`] with a stack from the caller.
     #[inline]
     fn occluded_in(&self, ray: &Ray, tmax: f32, two_sided: bool, stack: &mut Stack) -> bool {
-        let stack = &mut stack.0;
+        let stack = &mut stack.0[..];
         let r = RayLanes::new(ray);
         let tmax8 = f32x8::splat(tmax);
         let mut sp = 0;
@@ -403,7 +396,7 @@ impl MeshBvh {
         prim_out: &mut [u32],
     ) {
         let base = scene.triangles.len() as u32;
-        let mut stack = Stack::new();
+        let mut stack = Stack::new(self);
         for i in 0..rays.len() {
             let ray = ray_at(rays, i);
             let mut best = self.closest_in(&ray, rays.tmax[i], two_sided, &mut stack);
@@ -431,7 +424,7 @@ impl MeshBvh {
     /// (T_MIN, tmax), as `Accel::occluded`. Rays with tmax ≤ T_MIN cannot be blocked and are
     /// not traced (the shadow queue's dead lanes have tmax = 0).
     pub fn occluded(&self, scene: &Scene, rays: &RayColumns, two_sided: bool, out: &mut [bool]) {
-        let mut stack = Stack::new();
+        let mut stack = Stack::new(self);
         for (i, blocked) in out[..rays.len()].iter_mut().enumerate() {
             let tmax = rays.tmax[i];
             #[allow(clippy::neg_cmp_op_on_partial_ord)] // NaN must not be traced either
@@ -461,12 +454,15 @@ fn ray_at(rays: &RayColumns, i: usize) -> Ray {
     }
 }
 
-/// The traversal stack: (child reference, entry distance; 0 for occlusion).
-struct Stack([(u32, f32); STACK]);
+/// The traversal stack: (child reference, entry distance; 0 for occlusion). Sized by the tree:
+/// a node leaves at most 7 children on it (8 pushed, one popped at once, in `occluded_in`), so
+/// 7 · depth + 1 entries always suffice, however deep a degenerate mesh makes the tree. One is
+/// allocated per batch, not per ray.
+struct Stack(Vec<(u32, f32)>);
 
 impl Stack {
-    fn new() -> Stack {
-        Stack([(0, 0.0); STACK])
+    fn new(bvh: &MeshBvh) -> Stack {
+        Stack(vec![(0, 0.0); bvh.depth * (WIDTH - 1) + 1])
     }
 }
 
