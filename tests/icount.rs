@@ -17,8 +17,8 @@
 //! Workloads, single-threaded and deterministic: the wavefront stages (generate, intersect,
 //! shadow, film, reflect) on a 1024-pixel tile of the lab scene (64×64, 5 bounces, 16
 //! stratified soft-shadow points), their scalar twins (`Accel::closest` on the same rays, the
-//! reference renderer on 128 of the tile's pixels), and intersect and shadow on the generated
-//! mesh scene, which go through the CWBVH.
+//! reference renderer on 128 of the tile's pixels), and intersect and shadow on
+//! `scenes/mesh_spheres_small.obj` (684 triangles), which go through the mesh BVH (`MeshBvh`).
 //!
 //! Re-record deliberately (after a change to a kernel, rustc, a dependency, or on a new
 //! machine): `RAYWAVE_RECORD=1 cargo test --release --test icount`. It rewrites this key's
@@ -221,7 +221,7 @@ fn workloads() {
     let mesh_ctx = Context::new(&mesh, &settings);
     assert!(
         mesh_ctx.accel.is_some(),
-        "the mesh scene goes through the CWBVH"
+        "the mesh scene goes through the mesh BVH"
     );
     let mut mesh_rays = RayBatch::default();
     generate::camera_rays(&mesh_ctx, FIRST, TILE, &mut mesh_rays);
