@@ -478,7 +478,9 @@ struct RayLanes {
     o: [f32x8; 3],
     d: [f32x8; 3],
     /// 1 / d, with |d| raised to at least 1e-18 (sign kept), so that an axis-parallel ray never
-    /// makes 0 · ∞ = NaN in the slab test; a NaN direction stays NaN and enters no box.
+    /// makes 0 · ∞ = NaN in the slab test. A NaN direction stays NaN and, since `fast_max` and
+    /// `fast_min` return their right operand on NaN, enters every box: the answer is still right
+    /// (every triangle test misses on NaN), only slow; no valid scene makes such a ray.
     inv: [f32x8; 3],
     /// Per axis, which bound is entered first: 0 (min) for d ≥ 0, 1 (max) for d < 0.
     near: [usize; 3],
