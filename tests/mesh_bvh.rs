@@ -528,3 +528,71 @@ fn probe() {
     });
     std::hint::black_box((&hits, &blocked));
 }
+
+/// Grazing rays: nearly in a triangle's plane (the normal component 1e-6 to 1e-2 of the
+/// direction), aimed at a point on one of its edges, from up to 3 units away. A grazing hit's t
+/// carries a relative error of about ε / sin θ, so these are the rays most likely to place a hit
+/// before the entry distance of the (padded) box that holds the triangle and have it pruned.
+#[test]
+fn grazing_rays_differ_from_brute_force_only_on_near_parallel_triangles() {
+    let scene = mesh_scene(6);
+    let mut rng = Rng(29);
+    let tris = &scene.triangles;
+    let rays: Vec<(Ray, f32)> = (0..4000)
+        .map(|i| {
+            let tri = &tris[(rng.next() * tris.len() as f32) as usize % tris.len()];
+            let s = rng.next();
+            let on_edge = match i % 3 {
+                0 => tri.v0 + s * tri.e1,
+                1 => tri.v0 + s * tri.e2,
+                _ => tri.v0 + tri.e1 + s * (tri.e2 - tri.e1),
+            };
+            let tangent = (rng.direction() - tri.normal * rng.direction().dot(tri.normal))
+                .normalize_or(tri.e1.normalize());
+            let tangent = (tangent - tri.normal * tangent.dot(tri.normal)).normalize();
+            let slope = 10f32.powf(-6.0 + 4.0 * rng.next());
+            let sign = if i % 2 == 0 { -1.0 } else { 1.0 };
+            let d = (tangent + sign * slope * tri.normal).normalize();
+            let origin = on_edge - d * (0.1 + 2.9 * rng.next());
+            (
+                Ray {
+                    origin,
+                    direction: d,
+                },
+                INF,
+            )
+        })
+        .collect();
+    let bvh = MeshBvh::new(&scene);
+    let mut differ = 0;
+    let mut worst_cos = 0.0f32;
+    for two_sided in [false, true] {
+        for (r, tmax) in &rays {
+            let (t, prim) = brute_force(&scene, r, *tmax, two_sided);
+            let hit = bvh.closest_triangle(r, *tmax, two_sided);
+            assert_eq!(bvh.occluded_triangle(r, *tmax, two_sided), prim != NO_HIT);
+            if (hit.t.to_bits(), hit.prim) == (t.to_bits(), prim) {
+                continue;
+            }
+            differ += 1;
+            // The tree's answer is a real hit of the kernel ...
+            assert_ne!(
+                hit.prim, NO_HIT,
+                "{r:?}: the tree missed, brute force hit {prim}"
+            );
+            let own = intersect_triangle(&scene.triangles[hit.prim as usize], r, *tmax, two_sided);
+            assert_eq!(own.to_bits(), hit.t.to_bits());
+            // ... and brute force's closer one is a grazing hit, whose t is off by ~ε / sin θ.
+            let cos = scene.triangles[prim as usize].normal.dot(r.direction).abs();
+            worst_cos = worst_cos.max(cos);
+            assert!(
+                cos < 1e-3,
+                "{r:?}: brute force {t} {prim} (|n·d| {cos}), tree {hit:?}"
+            );
+        }
+    }
+    eprintln!(
+        "{differ} of {} grazing queries differ from brute force; largest |n·d| {worst_cos}",
+        2 * rays.len()
+    );
+}
