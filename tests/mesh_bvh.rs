@@ -6,6 +6,9 @@
 // `!(x > 0.0)` is on purpose: it is true for NaN, like the kernels' tests.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+mod common;
+
+use common::Rng;
 use glam::Vec3;
 use proptest::prelude::*;
 use raywave::geometry::{Accel, Ray, intersect_triangle};
@@ -173,33 +176,6 @@ proptest! {
         let target = tris[0].v0 + a * (1.0 - b) * tris[0].e1 + a * b * tris[0].e2;
         let r = Ray { origin: o, direction: (target - o).normalize_or_zero() };
         check_leaf(&tris, &r, tmax, two_sided);
-    }
-}
-
-/// A small deterministic generator (xorshift64*), so the traversal tests need no seed plumbing.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> f32 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        ((self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 40) as f32) / (1u64 << 24) as f32
-    }
-    fn in_box(&mut self, lo: Vec3, hi: Vec3) -> Vec3 {
-        Vec3::new(
-            lo.x + (hi.x - lo.x) * self.next(),
-            lo.y + (hi.y - lo.y) * self.next(),
-            lo.z + (hi.z - lo.z) * self.next(),
-        )
-    }
-    fn direction(&mut self) -> Vec3 {
-        loop {
-            let v = self.in_box(Vec3::splat(-1.0), Vec3::ONE);
-            if v.length_squared() > 1e-3 && v.length_squared() <= 1.0 {
-                return v.normalize();
-            }
-        }
     }
 }
 

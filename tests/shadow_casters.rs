@@ -3,6 +3,9 @@
 //! tests check the rule by hand on the lab's box and on two facing blockers, and check on random
 //! scenes that culling never changes whether a shadow ray is blocked.
 
+mod common;
+
+use common::Rng;
 use glam::Vec3;
 use raywave::geometry::{Accel, Ray, T_MIN, intersect_sphere, intersect_triangle, shadow_casters};
 use raywave::scene::{Scene, parse_scene_str};
@@ -86,28 +89,6 @@ fn a_face_is_kept_exactly_when_it_can_block() {
     assert!(!Accel::new(&up).occluded(&up, &ray, tmax, false));
     // Two-sided, both block.
     assert!(Accel::new(&up).occluded(&up, &ray, tmax, true));
-}
-
-/// xorshift64*, enough for test geometry.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> f32 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        (self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 40) as f32 / (1u64 << 24) as f32
-    }
-    fn range(&mut self, lo: f32, hi: f32) -> f32 {
-        lo + (hi - lo) * self.next()
-    }
-    fn point(&mut self, half: f32) -> Vec3 {
-        Vec3::new(
-            self.range(-half, half),
-            self.range(-half, half),
-            self.range(-half, half),
-        )
-    }
 }
 
 /// Random triangles in a cube of half-size 2, a random parallelogram light and a sphere.
