@@ -8,7 +8,7 @@
 
 mod common;
 
-use common::Rng;
+use common::{Rng, ray, triangle};
 use glam::Vec3;
 use proptest::prelude::*;
 use raywave::geometry::{Accel, Ray, intersect_triangle};
@@ -19,25 +19,6 @@ use raywave::wavefront::simd::RayColumns;
 
 const NAN: f32 = f32::NAN;
 const INF: f32 = f32::INFINITY;
-
-fn triangle(v0: Vec3, v1: Vec3, v2: Vec3) -> Triangle {
-    let (e1, e2) = (v1 - v0, v2 - v0);
-    Triangle {
-        v0,
-        e1,
-        e2,
-        normal: e1.cross(e2).normalize_or_zero(),
-        material: 0,
-        face: 0,
-    }
-}
-
-fn ray(origin: [f32; 3], direction: [f32; 3]) -> Ray {
-    Ray {
-        origin: Vec3::from_array(origin),
-        direction: Vec3::from_array(direction),
-    }
-}
 
 /// Rays on the kernel's edges for the unit triangle (0,0,0) (1,0,0) (0,1,0), front +z.
 fn edge_rays() -> Vec<Ray> {

@@ -5,6 +5,9 @@
 // `!(x > 0.0)` is on purpose: it is true for NaN, like the kernels' tests.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+mod common;
+
+use common::{ray, triangle};
 use glam::Vec3;
 use proptest::prelude::*;
 use raywave::geometry::{self, Accel, Ray, intersect_sphere, intersect_triangle, shadow_casters};
@@ -14,25 +17,6 @@ use raywave::shading::shade;
 use raywave::wavefront::context::MaterialTerms;
 use raywave::wavefront::shadow::{key_prefix, shade_terms};
 use raywave::wavefront::simd::{self, BlockSampler, LightBlock, RayColumns, lanes};
-
-fn triangle(v0: Vec3, v1: Vec3, v2: Vec3) -> Triangle {
-    let (e1, e2) = (v1 - v0, v2 - v0);
-    Triangle {
-        v0,
-        e1,
-        e2,
-        normal: e1.cross(e2).normalize(),
-        material: 0,
-        face: 0,
-    }
-}
-
-fn ray(origin: [f32; 3], direction: [f32; 3]) -> Ray {
-    Ray {
-        origin: Vec3::from_array(origin),
-        direction: Vec3::from_array(direction),
-    }
-}
 
 const NAN: f32 = f32::NAN;
 const INF: f32 = f32::INFINITY;
@@ -385,15 +369,7 @@ proptest! {
         n in vec3(), e in vec3(), l in vec3(), lc in vec3(),
     ) {
         let m = Material { diffuse: kd.abs(), reflective: kr.abs(), emitted: ke.abs(), glossiness: g };
-        let terms = MaterialTerms {
-            diffuse: m.diffuse,
-            reflective: m.reflective,
-            ambient: raywave::shading::AMBIENT * m.diffuse,
-            ambient_emitted: raywave::shading::AMBIENT * m.emitted,
-            specular: 0.8 * m.reflective,
-            shininess: m.shininess(),
-            is_reflective: m.is_reflective(),
-        };
+        let terms = MaterialTerms::new(&m);
         let (n, e, l) = (n.normalize_or(Vec3::Z), e.normalize_or(Vec3::Z), l.normalize_or(Vec3::Z));
         let ndl = n.dot(l);
         prop_assume!(ndl > 0.0);
@@ -412,15 +388,7 @@ proptest! {
         blocked_bits in prop_oneof![Just(0u32), any::<u32>()],
     ) {
         let m = Material { diffuse: kd.abs(), reflective: kr.abs(), emitted: ke.abs(), glossiness: g };
-        let terms = MaterialTerms {
-            diffuse: m.diffuse,
-            reflective: m.reflective,
-            ambient: raywave::shading::AMBIENT * m.diffuse,
-            ambient_emitted: raywave::shading::AMBIENT * m.emitted,
-            specular: 0.8 * m.reflective,
-            shininess: m.shininess(),
-            is_reflective: m.is_reflective(),
-        };
+        let terms = MaterialTerms::new(&m);
         let (n, e) = (n.normalize_or(Vec3::Z), e.normalize_or(Vec3::Z));
         let ls: Vec<Vec3> = ls.iter().map(|l| l.normalize_or(Vec3::Z)).collect();
         let col = |f: fn(Vec3) -> f32| ls.iter().map(|&l| f(l)).collect::<Vec<f32>>();
@@ -565,11 +533,11 @@ fn simd_sobol_points_equal_scalar_up_to_the_largest_index() {
                 edge_u,
                 edge_v,
             });
-            for k in 0..8 {
+            for (k, ((x, y), z)) in pts[0].iter().zip(&pts[1]).zip(&pts[2]).enumerate() {
                 let (u, v) = square_sample(LightSampler::Sobol, &key, j0 + k as u32, count);
                 let want = lamp.point(u, v);
                 assert_eq!(
-                    [pts[0][k], pts[1][k], pts[2][k]].map(f32::to_bits),
+                    [*x, *y, *z].map(f32::to_bits),
                     want.to_array().map(f32::to_bits),
                     "seed {seed}, sample {}",
                     j0 + k as u32

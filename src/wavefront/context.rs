@@ -6,7 +6,7 @@ use super::simd::BlockSampler;
 use crate::camera::CameraRays;
 use crate::geometry::shadow_casters;
 use crate::sampling::{LightSampler, SOBOL_SEED_DIM, SampleKey, hash, strata_grid};
-use crate::scene::{LightShape, Scene, Triangle};
+use crate::scene::{LightShape, Material, Scene, Triangle};
 use crate::settings::{RenderSettings, ShadowMode};
 use crate::shading::AMBIENT;
 use glam::Vec3;
@@ -34,6 +34,21 @@ pub struct MaterialTerms {
     pub shininess: f32,
     /// kr ≠ 0: spawns mirror rays and has a highlight.
     pub is_reflective: bool,
+}
+
+impl MaterialTerms {
+    /// The terms of `m`.
+    pub fn new(m: &Material) -> MaterialTerms {
+        MaterialTerms {
+            diffuse: m.diffuse,
+            reflective: m.reflective,
+            ambient: AMBIENT * m.diffuse,
+            ambient_emitted: AMBIENT * m.emitted,
+            specular: 0.8 * m.reflective,
+            shininess: m.shininess(),
+            is_reflective: m.is_reflective(),
+        }
+    }
 }
 
 /// A light's terms, with the parallelogram (all the lab's lights) kept apart for the SIMD path.
@@ -81,19 +96,7 @@ impl<'a> Context<'a> {
     pub fn new(scene: &'a Scene, settings: &'a RenderSettings) -> Self {
         let accel = (scene.triangles.len() >= BVH_MIN_TRIANGLES).then(|| MeshBvh::new(scene));
         let bvh_build_time = accel.as_ref().map_or(Duration::ZERO, |a| a.build_time);
-        let materials = scene
-            .materials
-            .iter()
-            .map(|m| MaterialTerms {
-                diffuse: m.diffuse,
-                reflective: m.reflective,
-                ambient: AMBIENT * m.diffuse,
-                ambient_emitted: AMBIENT * m.emitted,
-                specular: 0.8 * m.reflective,
-                shininess: m.shininess(),
-                is_reflective: m.is_reflective(),
-            })
-            .collect();
+        let materials = scene.materials.iter().map(MaterialTerms::new).collect();
         let lights = scene
             .lights
             .iter()

@@ -3,6 +3,30 @@
 #![allow(dead_code)]
 
 use glam::Vec3;
+use raywave::geometry::Ray;
+use raywave::scene::Triangle;
+
+/// The triangle v0 v1 v2 (front side counter-clockwise), material 0; a degenerate one gets a
+/// zero normal (the kernels never read it).
+pub fn triangle(v0: Vec3, v1: Vec3, v2: Vec3) -> Triangle {
+    let (e1, e2) = (v1 - v0, v2 - v0);
+    Triangle {
+        v0,
+        e1,
+        e2,
+        normal: e1.cross(e2).normalize_or_zero(),
+        material: 0,
+        face: 0,
+    }
+}
+
+/// A ray from arrays.
+pub fn ray(origin: [f32; 3], direction: [f32; 3]) -> Ray {
+    Ray {
+        origin: Vec3::from_array(origin),
+        direction: Vec3::from_array(direction),
+    }
+}
 
 /// A small deterministic generator (xorshift64*), so the traversal tests need no seed plumbing.
 pub struct Rng(pub u64);
