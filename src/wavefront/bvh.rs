@@ -6,15 +6,18 @@
 //! build:    obvhs PLOC BVH2 + reinsertion (the CWBVH's own first steps, medium_build preset)
 //!           → collapse: each wide node takes up to 8 BVH2 descendants, opening the largest
 //!             one first; a subtree of ≤ LEAF_MAX triangles becomes a leaf (one block)
-//! closest:  one ray, all 8 child boxes in one f32x8 slab test, hit children near to far on a
+//! closest:  one ray, all 8 child boxes in one f32x8 slab test (one FMA per plane:
+//!           bound · (1/d) − origin · (1/d)), hit children near to far on a
 //!           fixed stack (entries carry their entry distance, skipped once a closer hit is
 //!           known); a leaf tests its 8 triangles in one f32x8 Möller–Trumbore
 //! occluded: the same walk, no sorting, stops at the first blocker
 //! ```
 //!
-//! Node (`Node`, 224 bytes, 32-aligned): `bounds[axis][0]` = min, `bounds[axis][1]` = max of
+//! Node (`Node`, 224 bytes of fields padded to 256, 64-aligned, so a node is exactly four cache
+//! lines and never straddles a fifth): `bounds[axis][0]` = min, `bounds[axis][1]` = max of
 //! the 8 children, one f32x8 each; `child[k]` = a node index, or `LEAF | block`, or `EMPTY`
-//! (empty slots have min = +∞, max = −∞, which no ray enters). Block (`Block`, 320 bytes):
+//! (empty slots have min = +∞, max = −∞, which no ray enters). Block (`Block`, 320 bytes,
+//! 64-aligned: five cache lines):
 //! v0, e1, e2 x/y/z columns of 8 triangles and their `Scene::triangles` ids; unused lanes are
 //! NaN (they never hit: every comparison with NaN is false) with id `NO_HIT`.
 //!
@@ -49,7 +52,7 @@ const EMPTY: u32 = u32::MAX;
 
 /// An 8-wide node: the children's boxes as columns, then the children.
 #[derive(Clone, Copy)]
-#[repr(C, align(32))]
+#[repr(C, align(64))]
 struct Node {
     bounds: [[f32x8; 2]; 3],
     child: [u32; WIDTH],
@@ -57,7 +60,7 @@ struct Node {
 
 /// 8 triangles as columns (v0, e1, e2; x, y, z) and their scene ids.
 #[derive(Clone, Copy)]
-#[repr(C, align(32))]
+#[repr(C, align(64))]
 struct Block {
     v0: [f32x8; 3],
     e1: [f32x8; 3],
@@ -281,8 +284,18 @@ impl MeshBvh {
                         cur = node.child[mask.trailing_zeros() as usize];
                         continue;
                     }
-                    // Push far to near; go on with the nearest.
                     let near = near.to_array();
+                    if mask.count_ones() == 2 {
+                        // The commonest case: push the far one, go on with the near one.
+                        let a = mask.trailing_zeros() as usize;
+                        let b = 31 - mask.leading_zeros() as usize;
+                        let (first, second) = if near[b] < near[a] { (b, a) } else { (a, b) };
+                        stack[sp] = (node.child[second], near[second]);
+                        sp += 1;
+                        cur = node.child[first];
+                        continue;
+                    }
+                    // Push far to near; go on with the nearest.
                     let mut order = [(0.0f32, 0u32); WIDTH];
                     let mut n = 0;
                     let mut m = mask;
@@ -400,14 +413,12 @@ impl MeshBvh {
     ) {
         let base = scene.triangles.len() as u32;
         let mut stack = Stack::new(self);
-        for i in 0..rays.len() {
-            let ray = ray_at(rays, i);
-            let mut best = self.closest_in(&ray, rays.tmax[i], two_sided, &mut stack);
-            let mut t = if best.prim == NO_HIT {
-                rays.tmax[i]
-            } else {
-                best.t
-            };
+        let (o, d, tmax) = cut(rays);
+        let (t_out, prim_out) = (&mut t_out[..tmax.len()], &mut prim_out[..tmax.len()]);
+        for i in 0..tmax.len() {
+            let ray = ray_at(&o, &d, i);
+            let mut best = self.closest_in(&ray, tmax[i], two_sided, &mut stack);
+            let mut t = if best.prim == NO_HIT { tmax[i] } else { best.t };
             for (k, s) in scene.spheres.iter().enumerate() {
                 let ts = intersect_sphere(s, &ray, t);
                 if ts < t {
@@ -428,14 +439,15 @@ impl MeshBvh {
     /// not traced (the shadow queue's dead lanes have tmax = 0).
     pub fn occluded(&self, scene: &Scene, rays: &RayColumns, two_sided: bool, out: &mut [bool]) {
         let mut stack = Stack::new(self);
-        for (i, blocked) in out[..rays.len()].iter_mut().enumerate() {
-            let tmax = rays.tmax[i];
+        let (o, d, tmax) = cut(rays);
+        for (i, blocked) in out[..tmax.len()].iter_mut().enumerate() {
+            let tmax = tmax[i];
             #[allow(clippy::neg_cmp_op_on_partial_ord)] // NaN must not be traced either
             if !(tmax > T_MIN) {
                 *blocked = false;
                 continue;
             }
-            let ray = ray_at(rays, i);
+            let ray = ray_at(&o, &d, i);
             *blocked = scene
                 .spheres
                 .iter()
@@ -445,15 +457,23 @@ impl MeshBvh {
     }
 }
 
+/// The origin, direction and tmax columns, each cut to the number of rays, so that indexing
+/// them below that number needs no bounds checks.
+#[allow(clippy::type_complexity)]
+fn cut<'a>(rays: &RayColumns<'a>) -> ([&'a [f32]; 3], [&'a [f32]; 3], &'a [f32]) {
+    let n = rays.len();
+    (
+        rays.origin.map(|c| &c[..n]),
+        rays.direction.map(|c| &c[..n]),
+        &rays.tmax[..n],
+    )
+}
+
 #[inline(always)]
-fn ray_at(rays: &RayColumns, i: usize) -> Ray {
+fn ray_at(o: &[&[f32]; 3], d: &[&[f32]; 3], i: usize) -> Ray {
     Ray {
-        origin: glam::Vec3::new(rays.origin[0][i], rays.origin[1][i], rays.origin[2][i]),
-        direction: glam::Vec3::new(
-            rays.direction[0][i],
-            rays.direction[1][i],
-            rays.direction[2][i],
-        ),
+        origin: glam::Vec3::new(o[0][i], o[1][i], o[2][i]),
+        direction: glam::Vec3::new(d[0][i], d[1][i], d[2][i]),
     }
 }
 
@@ -485,6 +505,8 @@ struct RayLanes {
     /// `fast_min` return their right operand on NaN, enters every box: the answer is still right
     /// (every triangle test misses on NaN), only slow; no valid scene makes such a ray.
     inv: [f32x8; 3],
+    /// origin · inv, so that a slab distance is one fused (bound · inv − origin · inv).
+    o_inv: [f32x8; 3],
     /// Per axis, which bound is entered first: 0 (min) for d ≥ 0, 1 (max) for d < 0.
     near: [usize; 3],
 }
@@ -506,6 +528,7 @@ impl RayLanes {
             o: o.map(f32x8::splat),
             d: d.map(f32x8::splat),
             inv: inv.map(f32x8::splat),
+            o_inv: std::array::from_fn(|a| f32x8::splat(o[a] * inv[a])),
             near: inv.map(|c| usize::from(c.is_sign_negative())),
         }
     }
@@ -517,8 +540,8 @@ impl RayLanes {
             let b = &node.bounds[axis];
             let n = self.near[axis];
             (
-                (b[n] - self.o[axis]) * self.inv[axis],
-                (b[1 - n] - self.o[axis]) * self.inv[axis],
+                b[n].mul_sub(self.inv[axis], self.o_inv[axis]),
+                b[1 - n].mul_sub(self.inv[axis], self.o_inv[axis]),
             )
         };
         let (nx, fx) = slab(0);

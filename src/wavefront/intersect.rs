@@ -12,6 +12,7 @@ use super::context::Context;
 use super::simd::{self, RayColumns};
 use crate::geometry::geometric_normal;
 use crate::scene::NO_HIT;
+use glam::Vec3;
 
 /// The ray columns of a batch.
 pub fn columns(rays: &RayBatch) -> RayColumns<'_> {
@@ -45,23 +46,42 @@ pub fn closest(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch) {
             &mut hits.prim[..n],
         ),
     }
+    // Every column cut to n first, so that the loop's indexing needs no bounds checks.
+    let (ox, oy, oz) = (
+        &rays.origin_x[..n],
+        &rays.origin_y[..n],
+        &rays.origin_z[..n],
+    );
+    let (dx, dy, dz) = (
+        &rays.direction_x[..n],
+        &rays.direction_y[..n],
+        &rays.direction_z[..n],
+    );
+    let (t, prims) = (&hits.t[..n], &hits.prim[..n]);
+    let (px, py, pz) = (
+        &mut hits.point_x[..n],
+        &mut hits.point_y[..n],
+        &mut hits.point_z[..n],
+    );
+    let (nx, ny, nz) = (
+        &mut hits.normal_x[..n],
+        &mut hits.normal_y[..n],
+        &mut hits.normal_z[..n],
+    );
+    let material = &mut hits.material[..n];
     for i in 0..n {
-        let prim = hits.prim[i];
+        let prim = prims[i];
         if prim == NO_HIT {
             continue;
         }
-        let d = rays.direction(i);
-        let point = rays.origin(i) + hits.t[i] * d;
+        let d = Vec3::new(dx[i], dy[i], dz[i]);
+        let point = Vec3::new(ox[i], oy[i], oz[i]) + t[i] * d;
         let mut normal = geometric_normal(scene, prim, point);
         if two_sided && (prim as usize) < scene.triangles.len() && normal.dot(d) > 0.0 {
             normal = -normal;
         }
-        hits.point_x[i] = point.x;
-        hits.point_y[i] = point.y;
-        hits.point_z[i] = point.z;
-        hits.normal_x[i] = normal.x;
-        hits.normal_y[i] = normal.y;
-        hits.normal_z[i] = normal.z;
-        hits.material[i] = ctx.material_index(prim);
+        (px[i], py[i], pz[i]) = (point.x, point.y, point.z);
+        (nx[i], ny[i], nz[i]) = (normal.x, normal.y, normal.z);
+        material[i] = ctx.material_index(prim);
     }
 }
