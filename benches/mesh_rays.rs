@@ -7,18 +7,28 @@
 //! for scene in [12k, 1M]:                        generated in memory by meshgen, built once
 //!     print triangles, BVH build times, ray counts, hit agreement against obvhs
 //!     for set in [primary, shadow, incoherent, shadow_fan]:  group "<set>_<scene>", throughput in rays
-//!         obvhs_one_ray, wavefront, embree_single, embree_packet8
+//!         obvhs_one_ray, wavefront, wavefront_bvh (closest-hit sets), embree_single, embree_packet8
 //! ```
+//!
+//! `wavefront` is the engine's intersect stage (traversal, then point, normal and material for
+//! shading) on closest-hit sets and its occlusion pass on shadow sets; `wavefront_bvh` is the
+//! stage's traversal alone, which returns what obvhs and Embree return (t and prim).
 //!
 //! Every engine traces on one thread, two-sided, on the scene without its emissive wall
 //! (`peer::without_emitters`; see `src/peer/mod.rs`). `cargo bench --bench mesh_rays` runs it;
 //! `-- --test` traces each set once on a 32×32 image (CI), `-- --quick` shortens the timing.
+//!
+//! `RAYWAVE_INTERLEAVE=ROUNDS cargo bench --bench mesh_rays` skips criterion and times the
+//! engines in turn, one pass each per round, printing median rays/s and the median of the
+//! per-round ratios: on a machine whose speed drifts from second to second, a ratio taken
+//! within a round is steadier than one between criterion groups timed seconds apart.
+//! `RAYWAVE_MESH=12k` (or `1M`) limits that mode to one scene.
 
 use criterion::{BenchmarkId, Criterion, Throughput};
 use raywave::meshgen::{bands_for, cornell_box_mesh_spheres, triangle_count};
 use raywave::peer::{
-    Hits, ObvhsMesh, RaySet, RaySets, hit_agreement, occlusion_agreement, wavefront_closest,
-    wavefront_occluded, without_emitters,
+    Hits, ObvhsMesh, RaySet, RaySets, hit_agreement, occlusion_agreement, wavefront_bvh_closest,
+    wavefront_closest, wavefront_occluded, without_emitters,
 };
 use raywave::scene::{Scene, parse_scene_str};
 use raywave::settings::RenderSettings;
@@ -125,6 +135,8 @@ fn report(s: &Setup, ctx: &Context) {
             let hit = reference.prim.iter().filter(|&&p| p != u32::MAX).count();
             wavefront_closest(ctx, set, &mut scratch, &mut other);
             lines.push(("wavefront", hit_agreement(&reference, &other)));
+            wavefront_bvh_closest(ctx, set, &mut other);
+            lines.push(("wavefront_bvh", hit_agreement(&reference, &other)));
             #[cfg(feature = "embree")]
             {
                 let coherent = set.kind == RayKind::Primary;
@@ -157,53 +169,146 @@ fn report(s: &Setup, ctx: &Context) {
 fn bench_set(c: &mut Criterion, s: &Setup, ctx: &Context, set: &RaySet) {
     let mut group = c.benchmark_group(format!("{}_{}", set.kind.name(), s.label));
     group.throughput(Throughput::Elements(set.len() as u64));
-    let (mut hits, mut blocked, mut scratch) = (Hits::default(), Vec::new(), HitBatch::default());
-    let shadow = set.kind.is_occlusion();
-    group.bench_function(BenchmarkId::from_parameter("obvhs_one_ray"), |b| {
-        b.iter(|| {
-            if shadow {
-                s.obvhs.occluded(&s.scene, black_box(set), &mut blocked);
-            } else {
-                s.obvhs.closest(&s.scene, black_box(set), &mut hits);
-            }
-        })
-    });
-    group.bench_function(BenchmarkId::from_parameter("wavefront"), |b| {
-        b.iter(|| {
-            if shadow {
-                wavefront_occluded(ctx, black_box(set), &mut blocked);
-            } else {
-                wavefront_closest(ctx, black_box(set), &mut scratch, &mut hits);
-            }
-        })
-    });
-    #[cfg(feature = "embree")]
-    {
-        let coherent = set.kind != RayKind::Incoherent;
-        group.bench_function(BenchmarkId::from_parameter("embree_single"), |b| {
-            b.iter(|| {
-                if shadow {
-                    s.embree.occluded1(black_box(set), &mut blocked);
-                } else {
-                    s.embree.closest1(black_box(set), coherent, &mut hits);
-                }
-            })
-        });
-        group.bench_function(BenchmarkId::from_parameter("embree_packet8"), |b| {
-            b.iter(|| {
-                if shadow {
-                    s.embree.occluded8(black_box(set), &mut blocked);
-                } else {
-                    s.embree.closest8(black_box(set), coherent, &mut hits);
-                }
-            })
+    let mut out = Outputs::default();
+    for engine in engines(set) {
+        group.bench_function(BenchmarkId::from_parameter(engine), |b| {
+            b.iter(|| trace(s, ctx, set, engine, &mut out))
         });
     }
-    black_box((&hits, &blocked));
     group.finish();
 }
 
+/// One pass of `engine` over `set`: the same calls the criterion groups time.
+fn trace(s: &Setup, ctx: &Context, set: &RaySet, engine: &str, out: &mut Outputs) {
+    let shadow = set.kind.is_occlusion();
+    let set = black_box(set);
+    match (engine, shadow) {
+        ("obvhs_one_ray", true) => s.obvhs.occluded(&s.scene, set, &mut out.blocked),
+        ("obvhs_one_ray", false) => s.obvhs.closest(&s.scene, set, &mut out.hits),
+        ("wavefront", true) => wavefront_occluded(ctx, set, &mut out.blocked),
+        ("wavefront", false) => wavefront_closest(ctx, set, &mut out.scratch, &mut out.hits),
+        ("wavefront_bvh", false) => wavefront_bvh_closest(ctx, set, &mut out.hits),
+        #[cfg(feature = "embree")]
+        ("embree_single", true) => s.embree.occluded1(set, &mut out.blocked),
+        #[cfg(feature = "embree")]
+        ("embree_single", false) => {
+            let coherent = set.kind != RayKind::Incoherent;
+            s.embree.closest1(set, coherent, &mut out.hits)
+        }
+        #[cfg(feature = "embree")]
+        ("embree_packet8", true) => s.embree.occluded8(set, &mut out.blocked),
+        #[cfg(feature = "embree")]
+        ("embree_packet8", false) => {
+            let coherent = set.kind != RayKind::Incoherent;
+            s.embree.closest8(set, coherent, &mut out.hits)
+        }
+        _ => unreachable!("engine {engine}"),
+    }
+    black_box(&*out);
+}
+
+#[derive(Default)]
+struct Outputs {
+    hits: Hits,
+    blocked: Vec<bool>,
+    scratch: HitBatch,
+}
+
+/// Every engine, in the order they are timed. `wavefront` is the intersect stage for closest
+/// hits (traversal, then the shading columns) and the occlusion pass for shadow rays;
+/// `wavefront_bvh` is the stage's traversal alone, with the same outputs (t, prim) as obvhs and
+/// Embree, so it is timed on closest-hit sets only (on shadow sets it is `wavefront`).
+const ENGINES: &[&str] = &[
+    "obvhs_one_ray",
+    "wavefront",
+    "wavefront_bvh",
+    #[cfg(feature = "embree")]
+    "embree_single",
+    #[cfg(feature = "embree")]
+    "embree_packet8",
+];
+
+/// The engines timed on `set`.
+fn engines(set: &RaySet) -> Vec<&'static str> {
+    let shadow = set.kind.is_occlusion();
+    ENGINES
+        .iter()
+        .copied()
+        .filter(|&e| !(shadow && e == "wavefront_bvh"))
+        .collect()
+}
+
+/// `RAYWAVE_INTERLEAVE=ROUNDS`: instead of criterion's groups (each engine timed for seconds,
+/// one after another), every round times one pass of each engine in turn, and the ratios are
+/// taken within a round. Load from outside the machine then moves both sides of a ratio alike;
+/// the medians over rounds are printed.
+fn interleaved(s: &Setup, ctx: &Context, rounds: usize) {
+    let median = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    let mut out = Outputs::default();
+    for set in s.sets.all() {
+        let rays = set.len() as f64;
+        let engines = engines(set);
+        let mut rates: Vec<Vec<f64>> = vec![Vec::new(); engines.len()];
+        for round in 0..=rounds {
+            for (e, engine) in engines.iter().enumerate() {
+                let start = Instant::now();
+                trace(s, ctx, set, engine, &mut out);
+                let rate = rays / start.elapsed().as_secs_f64() / 1e6;
+                if round > 0 {
+                    // round 0 warms the caches and is not counted
+                    rates[e].push(rate);
+                }
+            }
+        }
+        let mut line = format!(
+            "{}_{} Mrays/s, median of {rounds}:",
+            set.kind.name(),
+            s.label
+        );
+        for (e, engine) in engines.iter().enumerate() {
+            line += &format!(" {engine} {:.2}", median(rates[e].clone()));
+        }
+        // Ratios within each round, then their median.
+        let ratio = |a: usize, b: usize| {
+            median(rates[a].iter().zip(&rates[b]).map(|(x, y)| x / y).collect())
+        };
+        for (ours, theirs) in [
+            ("wavefront", "obvhs_one_ray"),
+            ("wavefront_bvh", "obvhs_one_ray"),
+            ("wavefront", "embree_single"),
+            ("wavefront_bvh", "embree_single"),
+            ("wavefront", "embree_packet8"),
+        ] {
+            let at = |name| engines.iter().position(|&e| e == name);
+            if let (Some(a), Some(b)) = (at(ours), at(theirs)) {
+                line += &format!(" | {ours}/{theirs} {:.2}x", ratio(a, b));
+            }
+        }
+        println!("{line}");
+    }
+}
+
 fn main() {
+    if let Ok(rounds) = std::env::var("RAYWAVE_INTERLEAVE") {
+        let rounds: usize = rounds
+            .parse()
+            .expect("RAYWAVE_INTERLEAVE is a number of rounds");
+        eprintln!("machine: {}, simd {}", cpu_model(), raywave::simd_path());
+        // RAYWAVE_MESH=12k or 1M: one scene only.
+        let only = std::env::var("RAYWAVE_MESH").unwrap_or_default();
+        for (label, target) in [("12k", 12_000), ("1M", 1_000_000)] {
+            if !only.is_empty() && only != label {
+                continue;
+            }
+            let s = setup(label, target, SIZE);
+            let ctx = Context::new(&s.scene, &s.settings);
+            interleaved(&s, &ctx, rounds.max(1));
+        }
+        return;
+    }
     // criterion's test mode: `cargo bench -- --test`, or `cargo test --all-targets`, which runs
     // the bench binary without the `--bench` flag that `cargo bench` passes.
     let args: Vec<String> = std::env::args().collect();
@@ -223,6 +328,10 @@ fn main() {
         report(&s, &ctx);
         for set in s.sets.all() {
             bench_set(&mut c, &s, &ctx, set);
+        }
+        if test_mode {
+            // The interleaved mode's code, once, so that CI keeps it running.
+            interleaved(&s, &ctx, 1);
         }
     }
     c.final_summary();

@@ -24,13 +24,17 @@ const DOC: &str = include_str!("../docs/BENCHMARKING.md");
 const ROOT: &str = env!("CARGO_MANIFEST_DIR");
 
 /// Commands not run by CI, each with the reason the page gives.
-const MANUAL: [(&str, &str); 2] = [
+const MANUAL: [(&str, &str); 3] = [
     (
         "sudo apt-get install libembree-dev",
         "installs a system package",
     ),
     (
         "cargo bench --features embree --bench mesh_rays",
+        "needs libembree3; .ci/run builds without the embree feature",
+    ),
+    (
+        "RAYWAVE_INTERLEAVE=20 cargo bench --features embree --bench mesh_rays",
         "needs libembree3; .ci/run builds without the embree feature",
     ),
 ];
@@ -106,9 +110,17 @@ fn test_targets() -> BTreeSet<String> {
 /// Why a `cargo` command is not covered by `.ci/run`, or Ok.
 fn check_cargo(words: &[&str]) -> Result<(), String> {
     let mut words = words;
-    // Environment assignments the page may use: the deliberate re-record switch.
+    // Environment assignments the page may use: the deliberate re-record switch, and the
+    // switches of modes whose code the benches' test mode also runs (mesh_rays runs one
+    // interleaved round, scaling one round at 64²).
     while let Some(w) = words.first().filter(|w| w.contains('=')) {
-        if *w != "RAYWAVE_RECORD=1" {
+        let known = match w.split_once('=') {
+            Some(("RAYWAVE_RECORD", v)) => v == "1",
+            Some(("RAYWAVE_INTERLEAVE" | "RAYWAVE_ROUNDS", v)) => v.parse::<u32>().is_ok(),
+            Some(("RAYWAVE_MESH", v)) => v == "12k" || v == "1M",
+            _ => false,
+        };
+        if !known {
             return Err(format!("unknown environment assignment {w}"));
         }
         words = &words[1..];
@@ -255,6 +267,8 @@ fn the_checker_refuses_what_ci_does_not_run() {
         "cargo test --release --test no_such_test",
         "cargo bench --bench wavefront -- --profile-time 5",
         "FOO=1 cargo bench --bench variance",
+        "RAYWAVE_MESH=2M cargo bench --bench mesh_rays",
+        "RAYWAVE_ROUNDS=many cargo bench --bench scaling",
     ] {
         let words: Vec<&str> = bad.split_whitespace().collect();
         assert!(check_cargo(&words).is_err(), "`{bad}` passed the checker");
@@ -263,6 +277,8 @@ fn the_checker_refuses_what_ci_does_not_run() {
         "cargo bench --bench wavefront -- --save-baseline main stages/film",
         "RAYWAVE_RECORD=1 cargo bench --bench variance -- --test",
         "RAYWAVE_RECORD=1 cargo test --release --test icount",
+        "RAYWAVE_INTERLEAVE=20 RAYWAVE_MESH=12k cargo bench --bench mesh_rays",
+        "RAYWAVE_ROUNDS=9 cargo bench --bench scaling",
     ] {
         let words: Vec<&str> = good.split_whitespace().collect();
         assert_eq!(check_cargo(&words), Ok(()), "`{good}`");

@@ -348,6 +348,31 @@ pub fn wavefront_closest(ctx: &Context, set: &RaySet, scratch: &mut HitBatch, ou
     }
 }
 
+/// The wavefront engine's mesh traversal alone (`MeshBvh::closest_hits`, the call inside
+/// `intersect::closest`), over the set's batches: t and prim into `out`, nothing else, as
+/// obvhs's and Embree's calls here produce. `wavefront_closest` adds the intersect stage's
+/// shading columns (point, normal, material) on top.
+pub fn wavefront_bvh_closest(ctx: &Context, set: &RaySet, out: &mut Hits) {
+    out.clear();
+    let bvh = ctx
+        .accel
+        .as_ref()
+        .expect("peer comparisons run on mesh scenes, which have a BVH");
+    let two_sided = ctx.settings.two_sided;
+    for batch in &set.batches {
+        let start = out.t.len();
+        out.t.resize(start + batch.len(), f32::INFINITY);
+        out.prim.resize(start + batch.len(), NO_HIT);
+        bvh.closest_hits(
+            ctx.scene,
+            &intersect::columns(batch),
+            two_sided,
+            &mut out.t[start..],
+            &mut out.prim[start..],
+        );
+    }
+}
+
 /// The wavefront engine's occlusion path for meshes, over the set's batches.
 ///
 /// `wavefront::shadow`'s occlusion pass hands the shadow queue's columns to
