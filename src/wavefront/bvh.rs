@@ -13,11 +13,10 @@
 //! occluded: the same walk, no sorting, stops at the first blocker
 //! ```
 //!
-//! Node (`Node`, 224 bytes of fields padded to 256, 64-aligned, so a node is exactly four cache
-//! lines and never straddles a fifth): `bounds[axis][0]` = min, `bounds[axis][1]` = max of
+//! Node (`Node`, 224 bytes, 32-aligned; 64-aligned 256-byte nodes measured no clear win, see
+//! docs/PERFORMANCE.md): `bounds[axis][0]` = min, `bounds[axis][1]` = max of
 //! the 8 children, one f32x8 each; `child[k]` = a node index, or `LEAF | block`, or `EMPTY`
-//! (empty slots have min = +∞, max = −∞, which no ray enters). Block (`Block`, 320 bytes,
-//! 64-aligned: five cache lines):
+//! (empty slots have min = +∞, max = −∞, which no ray enters). Block (`Block`, 320 bytes):
 //! v0, e1, e2 x/y/z columns of 8 triangles and their `Scene::triangles` ids; unused lanes are
 //! NaN (they never hit: every comparison with NaN is false) with id `NO_HIT`.
 //!
@@ -52,7 +51,7 @@ const EMPTY: u32 = u32::MAX;
 
 /// An 8-wide node: the children's boxes as columns, then the children.
 #[derive(Clone, Copy)]
-#[repr(C, align(64))]
+#[repr(C, align(32))]
 struct Node {
     bounds: [[f32x8; 2]; 3],
     child: [u32; WIDTH],
@@ -60,7 +59,7 @@ struct Node {
 
 /// 8 triangles as columns (v0, e1, e2; x, y, z) and their scene ids.
 #[derive(Clone, Copy)]
-#[repr(C, align(64))]
+#[repr(C, align(32))]
 struct Block {
     v0: [f32x8; 3],
     e1: [f32x8; 3],
