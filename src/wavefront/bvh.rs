@@ -5,7 +5,9 @@
 //! ```text
 //! build:    obvhs PLOC BVH2 + reinsertion (the CWBVH's own first steps, medium_build preset)
 //!           → collapse: each wide node takes up to 8 BVH2 descendants, opening the largest
-//!             one first; a subtree of ≤ LEAF_MAX triangles becomes a leaf (one block)
+//!             one first; a subtree of ≤ LEAF_MAX triangles becomes a leaf (one block), and
+//!             two leaves share a block when they fit and their union box adds no surface
+//!             area (the two triangles of a wall), freeing a slot to open another child
 //! closest:  one ray, all 8 child boxes in one f32x8 slab test (one FMA per plane:
 //!           bound · (1/d) − origin · (1/d)), hit children near to far on a
 //!           fixed stack (entries carry their entry distance, skipped once a closer hit is
@@ -109,6 +111,33 @@ pub struct MeshBvh {
     pub build_time: Duration,
 }
 
+/// A child slot of a wide node during the collapse: one BVH2 node, or, for a leaf, several
+/// whose triangles share one block.
+struct Kid {
+    nodes: Vec<usize>,
+    aabb: Aabb,
+    count: u32,
+}
+
+/// The two leaf children whose merged box has the least surface area beyond their own two,
+/// if one pair fits one block and the merge adds no area (ties: the first pair found).
+fn best_merge(kids: &[Kid]) -> Option<(usize, usize)> {
+    let mut best: Option<(f32, usize, usize)> = None;
+    for i in 0..kids.len() {
+        for j in i + 1..kids.len() {
+            let (a, b) = (&kids[i], &kids[j]);
+            if a.count + b.count > LEAF_MAX {
+                continue;
+            }
+            let added = a.aabb.union(&b.aabb).half_area() - a.aabb.half_area() - b.aabb.half_area();
+            if added <= 0.0 && best.is_none_or(|(least, _, _)| added < least) {
+                best = Some((added, i, j));
+            }
+        }
+    }
+    best.map(|(_, i, j)| (i, j))
+}
+
 /// Outward padding of a box: covers the kernel's edge slack (a hit may lie EDGE_EPSILON · |e|
 /// outside its triangle) and a few ulps of the slab test, with a wide margin.
 fn pad(b: &Aabb) -> f32 {
@@ -178,10 +207,15 @@ impl MeshBvh {
             };
         }
         if count[0] <= LEAF_MAX {
-            self.root = self.leaf(bvh2, 0, tris);
+            self.root = self.leaf(bvh2, &[0], tris);
             self.depth = 0;
             return;
         }
+        let kid = |k: usize| Kid {
+            nodes: vec![k],
+            aabb: *n2[k].aabb(),
+            count: count[k],
+        };
         self.root = 0;
         self.nodes.push(empty_node());
         // (BVH2 node, wide node index, depth)
@@ -189,28 +223,39 @@ impl MeshBvh {
         while let Some((i, w, depth)) = work.pop() {
             self.depth = self.depth.max(depth);
             let c = n2[i].first_index as usize;
-            let mut kids = vec![c, c + 1];
-            // Open the largest child that is too big for a leaf until 8 slots are used.
-            while kids.len() < WIDTH {
-                let open = kids
-                    .iter()
-                    .enumerate()
-                    .filter(|&(_, &k)| !n2[k].is_leaf() && count[k] > LEAF_MAX)
-                    .max_by(|a, b| {
-                        n2[*a.1]
-                            .aabb()
-                            .half_area()
-                            .total_cmp(&n2[*b.1].aabb().half_area())
-                    })
-                    .map(|(slot, _)| slot);
-                let Some(slot) = open else { break };
-                let k = kids.swap_remove(slot);
-                let c = n2[k].first_index as usize;
-                kids.extend([c, c + 1]);
+            let mut kids = vec![kid(c), kid(c + 1)];
+            loop {
+                // Open the largest child that is too big for a leaf while a slot is free.
+                if kids.len() < WIDTH {
+                    let open = kids
+                        .iter()
+                        .enumerate()
+                        .filter(|(_, k)| k.count > LEAF_MAX)
+                        .max_by(|a, b| a.1.aabb.half_area().total_cmp(&b.1.aabb.half_area()))
+                        .map(|(slot, _)| slot);
+                    if let Some(slot) = open {
+                        let k = kids.swap_remove(slot).nodes[0];
+                        let c = n2[k].first_index as usize;
+                        kids.extend([kid(c), kid(c + 1)]);
+                        continue;
+                    }
+                }
+                // Then merge two leaves into one block where that costs no more than both
+                // apart (surface area heuristic: a ray enters a box with probability ∝ its
+                // area, and a block test costs the same for 2 or 8 triangles); a freed slot
+                // goes back to opening.
+                let Some((i, j)) = best_merge(&kids) else {
+                    break;
+                };
+                let b = kids.swap_remove(j);
+                let a = &mut kids[i];
+                a.nodes.extend(b.nodes);
+                a.aabb = a.aabb.union(&b.aabb);
+                a.count += b.count;
             }
             let mut node = empty_node();
-            for (slot, &k) in kids.iter().enumerate() {
-                let b = n2[k].aabb();
+            for (slot, k) in kids.iter().enumerate() {
+                let b = &k.aabb;
                 let p = pad(b);
                 for axis in 0..3 {
                     let mut lo = node.bounds[axis][0].to_array();
@@ -220,12 +265,12 @@ impl MeshBvh {
                     node.bounds[axis][0] = f32x8::new(lo);
                     node.bounds[axis][1] = f32x8::new(hi);
                 }
-                node.child[slot] = if count[k] <= LEAF_MAX {
-                    self.leaf(bvh2, k, tris)
+                node.child[slot] = if k.count <= LEAF_MAX {
+                    self.leaf(bvh2, &k.nodes, tris)
                 } else {
                     let index = self.nodes.len();
                     self.nodes.push(empty_node());
-                    work.push((k, index, depth + 1));
+                    work.push((k.nodes[0], index, depth + 1));
                     index as u32
                 };
             }
@@ -233,10 +278,10 @@ impl MeshBvh {
         }
     }
 
-    /// One block with the (≤ 8) triangles under BVH2 node `i`; returns its leaf reference.
-    fn leaf(&mut self, bvh2: &Bvh2, i: usize, tris: &[Triangle]) -> u32 {
+    /// One block with the (≤ 8) triangles under BVH2 nodes `roots`; returns its leaf reference.
+    fn leaf(&mut self, bvh2: &Bvh2, roots: &[usize], tris: &[Triangle]) -> u32 {
         let mut ids = Vec::with_capacity(WIDTH);
-        let mut todo = vec![i];
+        let mut todo: Vec<usize> = roots.iter().rev().copied().collect();
         while let Some(k) = todo.pop() {
             let n = &bvh2.nodes[k];
             if n.is_leaf() {
@@ -596,5 +641,43 @@ pub mod lanes {
             f32x8::splat(tmax),
             two_sided,
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn kid(min: [f32; 3], max: [f32; 3], count: u32) -> Kid {
+        Kid {
+            nodes: vec![0],
+            aabb: Aabb::new(glam::Vec3A::from(min), glam::Vec3A::from(max)),
+            count,
+        }
+    }
+
+    /// Leaves merge only when they fit one block and their union adds no surface area, and
+    /// the pair that adds least goes first.
+    #[test]
+    fn leaves_merge_only_when_the_union_adds_no_area() {
+        // Two halves of one wall (same box): merge. A box inside another: merge.
+        let wall = [0.0, 0.0, 0.0];
+        let (a, b) = (kid(wall, [1.0, 1.0, 0.0], 1), kid(wall, [1.0, 1.0, 0.0], 1));
+        assert_eq!(best_merge(&[a, b]), Some((0, 1)));
+        let (outer, inner) = (kid([0.0; 3], [2.0; 3], 3), kid([0.5; 3], [1.0; 3], 5));
+        assert_eq!(best_merge(&[outer, inner]), Some((0, 1)));
+        // Too many triangles for one block: no merge, however the boxes lie.
+        let (outer, inner) = (kid([0.0; 3], [2.0; 3], 4), kid([0.5; 3], [1.0; 3], 5));
+        assert_eq!(best_merge(&[outer, inner]), None);
+        // Two boxes apart: the union is larger than both; no merge.
+        let (left, right) = (kid([0.0; 3], [1.0; 3], 1), kid([3.0; 3], [4.0; 3], 1));
+        assert_eq!(best_merge(&[left, right]), None);
+        // Of two candidate pairs, the one that adds least (here: most negative) goes first.
+        let kids = [
+            kid([0.0; 3], [4.0; 3], 2),
+            kid([3.0; 3], [4.0; 3], 2),
+            kid([0.0; 3], [4.0; 3], 2),
+        ];
+        assert_eq!(best_merge(&kids), Some((0, 2)));
     }
 }
