@@ -62,6 +62,16 @@ pub struct LightTerms {
     pub parallelogram: Option<(Vec3, Vec3, Vec3)>,
 }
 
+/// What the intersect stage reads of a hit triangle: its normal and material, 16 bytes where
+/// `Triangle` is 56, so a hit's lookup touches one cache line of a 3.5× denser array.
+#[derive(Clone, Copy, Debug)]
+pub struct TriangleShading {
+    /// `Triangle::normal`.
+    pub normal: Vec3,
+    /// `Triangle::material`.
+    pub material: u32,
+}
+
 /// Scene, settings and derived tables for one render.
 pub struct Context<'a> {
     /// The scene.
@@ -77,6 +87,8 @@ pub struct Context<'a> {
     /// Without a BVH, the triangles that can block a shadow ray when faces are one-sided
     /// (`geometry::shadow_casters`, the reference's list).
     pub shadow_casters: Vec<Triangle>,
+    /// Normal and material of every triangle, in `Scene::triangles` order.
+    pub triangle_shading: Vec<TriangleShading>,
     /// One entry per material.
     pub materials: Vec<MaterialTerms>,
     /// One entry per light.
@@ -129,6 +141,14 @@ impl<'a> Context<'a> {
             },
             accel,
             bvh_build_time,
+            triangle_shading: scene
+                .triangles
+                .iter()
+                .map(|t| TriangleShading {
+                    normal: t.normal,
+                    material: t.material,
+                })
+                .collect(),
             materials,
             lights,
             points_per_light,
@@ -185,11 +205,23 @@ impl<'a> Context<'a> {
     #[inline]
     pub fn material_index(&self, prim: u32) -> u32 {
         let p = prim as usize;
-        let tris = &self.scene.triangles;
-        if p < tris.len() {
-            tris[p].material
-        } else {
-            self.scene.spheres[p - tris.len()].material
+        match self.triangle_shading.get(p) {
+            Some(t) => t.material,
+            None => self.scene.spheres[p - self.triangle_shading.len()].material,
+        }
+    }
+
+    /// Geometric normal (front side, as `geometry::geometric_normal`) and material index of
+    /// primitive `prim` hit at `point`.
+    #[inline]
+    pub fn surface(&self, prim: u32, point: Vec3) -> (Vec3, u32) {
+        let p = prim as usize;
+        match self.triangle_shading.get(p) {
+            Some(t) => (t.normal, t.material),
+            None => {
+                let s = &self.scene.spheres[p - self.triangle_shading.len()];
+                ((point - s.center) / s.radius, s.material)
+            }
         }
     }
 }

@@ -10,7 +10,6 @@
 use super::batch::{HitBatch, RayBatch};
 use super::context::Context;
 use super::simd::{self, RayColumns};
-use crate::geometry::geometric_normal;
 use crate::scene::NO_HIT;
 use glam::Vec3;
 
@@ -76,12 +75,12 @@ pub fn closest(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch) {
         }
         let d = Vec3::new(dx[i], dy[i], dz[i]);
         let point = Vec3::new(ox[i], oy[i], oz[i]) + t[i] * d;
-        let mut normal = geometric_normal(scene, prim, point);
+        let (mut normal, m) = ctx.surface(prim, point);
         if two_sided && (prim as usize) < scene.triangles.len() && normal.dot(d) > 0.0 {
             normal = -normal;
         }
         (px[i], py[i], pz[i]) = (point.x, point.y, point.z);
         (nx[i], ny[i], nz[i]) = (normal.x, normal.y, normal.z);
-        material[i] = ctx.material_index(prim);
+        material[i] = m;
     }
 }
