@@ -253,7 +253,12 @@ fn interleaved(s: &Setup, ctx: &Context, rounds: usize) {
         let engines = engines(set);
         let mut rates: Vec<Vec<f64>> = vec![Vec::new(); engines.len()];
         for round in 0..=rounds {
-            for (e, engine) in engines.iter().enumerate() {
+            // Each round starts one engine later, so that no engine always follows the same
+            // one: `wavefront_bvh` right after `wavefront` would find the same tree and rays
+            // in the caches every time.
+            for step in 0..engines.len() {
+                let e = (round + step) % engines.len();
+                let engine = engines[e];
                 let start = Instant::now();
                 trace(s, ctx, set, engine, &mut out);
                 let rate = rays / start.elapsed().as_secs_f64() / 1e6;
@@ -292,27 +297,33 @@ fn interleaved(s: &Setup, ctx: &Context, rounds: usize) {
 }
 
 fn main() {
-    if let Ok(rounds) = std::env::var("RAYWAVE_INTERLEAVE") {
-        let rounds: usize = rounds
-            .parse()
-            .expect("RAYWAVE_INTERLEAVE is a number of rounds");
-        eprintln!("machine: {}, simd {}", cpu_model(), raywave::simd_path());
-        // RAYWAVE_MESH=12k or 1M: one scene only.
+    // criterion's test mode: `cargo bench -- --test`, or `cargo test --all-targets`, which runs
+    // the bench binary without the `--bench` flag that `cargo bench` passes. It ignores the
+    // RAYWAVE_* switches, so that CI's run stays short whatever the environment.
+    let args: Vec<String> = std::env::args().collect();
+    let test_mode = args.iter().any(|a| a == "--test") || !args.iter().any(|a| a == "--bench");
+    if !test_mode && let Ok(rounds) = std::env::var("RAYWAVE_INTERLEAVE") {
+        let rounds = match rounds.parse::<usize>() {
+            Ok(n) if n > 0 => n,
+            _ => exit_with(&format!(
+                "RAYWAVE_INTERLEAVE={rounds}: expected a number of rounds, 1 or more"
+            )),
+        };
         let only = std::env::var("RAYWAVE_MESH").unwrap_or_default();
+        if !["", "12k", "1M"].contains(&only.as_str()) {
+            exit_with(&format!("RAYWAVE_MESH={only}: expected 12k or 1M"));
+        }
+        eprintln!("machine: {}, simd {}", cpu_model(), raywave::simd_path());
         for (label, target) in [("12k", 12_000), ("1M", 1_000_000)] {
             if !only.is_empty() && only != label {
                 continue;
             }
             let s = setup(label, target, SIZE);
             let ctx = Context::new(&s.scene, &s.settings);
-            interleaved(&s, &ctx, rounds.max(1));
+            interleaved(&s, &ctx, rounds);
         }
         return;
     }
-    // criterion's test mode: `cargo bench -- --test`, or `cargo test --all-targets`, which runs
-    // the bench binary without the `--bench` flag that `cargo bench` passes.
-    let args: Vec<String> = std::env::args().collect();
-    let test_mode = args.iter().any(|a| a == "--test") || !args.iter().any(|a| a == "--bench");
     let size = if test_mode { TEST_SIZE } else { SIZE };
     let mut c = Criterion::default()
         .sample_size(10)
@@ -335,6 +346,12 @@ fn main() {
         }
     }
     c.final_summary();
+}
+
+/// Prints `message` and exits with status 2 (a bad switch, before any measuring).
+fn exit_with(message: &str) -> ! {
+    eprintln!("mesh_rays: {message}");
+    std::process::exit(2)
 }
 
 fn cpu_model() -> String {

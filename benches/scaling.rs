@@ -37,10 +37,18 @@ fn main() {
     let (size, steps, rounds) = if test_mode {
         (64, 100_000, 1)
     } else {
-        let rounds = std::env::var("RAYWAVE_ROUNDS")
-            .ok()
-            .map(|r| r.parse().expect("RAYWAVE_ROUNDS is a number of rounds"))
-            .unwrap_or(9);
+        let rounds = match std::env::var("RAYWAVE_ROUNDS") {
+            Err(_) => 9,
+            Ok(r) => match r.parse::<usize>() {
+                Ok(n) if n > 0 => n,
+                _ => {
+                    eprintln!(
+                        "scaling: RAYWAVE_ROUNDS={r}: expected a number of rounds, 1 or more"
+                    );
+                    std::process::exit(2)
+                }
+            },
+        };
         (1024, CEILING_STEPS, rounds)
     };
     let scene = Scene::builtin_default();

@@ -26,7 +26,9 @@
 //! in the same order, so each t is bit-equal to the scalar kernel's: the BVH only decides which
 //! triangles are tested. Boxes are padded outward (`pad`) so that the kernel's edge slack
 //! (u, v ≥ −EDGE_EPSILON) and the slab test's rounding never cull a triangle the kernel would
-//! hit. Ties (two triangles at the same t: a shared edge, a corner of two walls) go to the
+//! hit, for ray origins within about 100 box sizes of a box; from farther away the origin's
+//! own rounding (about 2⁻²⁴·|origin|) can exceed the padding, in the fused slab test as in
+//! the unfused one before it. Ties (two triangles at the same t: a shared edge, a corner of two walls) go to the
 //! lowest triangle id, as in a brute-force loop in index order, so the closest hit is brute
 //! force's. The exception is a triangle the ray grazes: its computed t is off by about
 //! ε / sin θ and can lie before the entry of the box that holds it, which is then pruned by a
@@ -111,11 +113,8 @@ pub struct MeshBvh {
     pub build_time: Duration,
 }
 
-/// Arrays at least this large go to memory advised for transparent huge pages.
-const HUGE_PAGE_MIN_BYTES: usize = 4 << 20;
-
 /// `v` moved into memory advised for 2 MiB transparent huge pages (Linux, arrays of at least
-/// `HUGE_PAGE_MIN_BYTES`), else `v` itself. A deep ray through a 1M-triangle tree touches
+/// 4 MiB), else `v` itself. A deep ray through a 1M-triangle tree touches
 /// nodes and blocks spread over 65 MB: in 4 KiB pages that is a TLB miss at almost every
 /// level, in 2 MiB pages 33 entries cover it all. Embree's BVH gets huge pages too: before
 /// this, the `mesh_rays` process held 62 MB of `AnonHugePages` with Embree and none without.
@@ -126,11 +125,14 @@ const HUGE_PAGE_MIN_BYTES: usize = 4 << 20;
 fn huge_pages<T: Copy>(v: Vec<T>) -> Vec<T> {
     #[cfg(target_os = "linux")]
     {
+        /// Arrays at least this large go to memory advised for transparent huge pages.
+        const HUGE_PAGE_MIN_BYTES: usize = 4 << 20;
         const HUGE: usize = 2 << 20;
         let bytes = std::mem::size_of_val(v.as_slice());
         if bytes >= HUGE_PAGE_MIN_BYTES {
-            // A fresh allocation this large is mapped by the allocator but not yet touched, so
-            // advising it before the copy lets its first page faults take huge pages.
+            // glibc maps an allocation this large afresh (mmap), untouched, so advising it
+            // before the copy lets its first page faults take huge pages; from an allocator
+            // that reuses touched memory, the advice only lets khugepaged collapse it later.
             let mut out = Vec::with_capacity(v.len());
             let base = out.as_mut_ptr() as usize;
             let (start, end) = (base.next_multiple_of(HUGE), (base + bytes) & !(HUGE - 1));
