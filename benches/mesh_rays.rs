@@ -22,7 +22,8 @@
 //! engines in turn, one pass each per round, printing median rays/s and the median of the
 //! per-round ratios: on a machine whose speed drifts from second to second, a ratio taken
 //! within a round is steadier than one between criterion groups timed seconds apart.
-//! `RAYWAVE_MESH=12k` (or `1M`) limits that mode to one scene.
+//! `RAYWAVE_MESH=12k` (or `1M`) limits either mode to one scene. The test mode ignores both
+//! switches.
 
 use criterion::{BenchmarkId, Criterion, Throughput};
 use raywave::meshgen::{bands_for, cornell_box_mesh_spheres, triangle_count};
@@ -302,6 +303,15 @@ fn main() {
     // RAYWAVE_* switches, so that CI's run stays short whatever the environment.
     let args: Vec<String> = std::env::args().collect();
     let test_mode = args.iter().any(|a| a == "--test") || !args.iter().any(|a| a == "--bench");
+    // RAYWAVE_MESH=12k or 1M: one scene only, in either mode.
+    let only = if test_mode {
+        String::new()
+    } else {
+        std::env::var("RAYWAVE_MESH").unwrap_or_default()
+    };
+    if !["", "12k", "1M"].contains(&only.as_str()) {
+        exit_with(&format!("RAYWAVE_MESH={only}: expected 12k or 1M"));
+    }
     if !test_mode && let Ok(rounds) = std::env::var("RAYWAVE_INTERLEAVE") {
         let rounds = match rounds.parse::<usize>() {
             Ok(n) if n > 0 => n,
@@ -309,10 +319,6 @@ fn main() {
                 "RAYWAVE_INTERLEAVE={rounds}: expected a number of rounds, 1 or more"
             )),
         };
-        let only = std::env::var("RAYWAVE_MESH").unwrap_or_default();
-        if !["", "12k", "1M"].contains(&only.as_str()) {
-            exit_with(&format!("RAYWAVE_MESH={only}: expected 12k or 1M"));
-        }
         eprintln!("machine: {}, simd {}", cpu_model(), raywave::simd_path());
         for (label, target) in [("12k", 12_000), ("1M", 1_000_000)] {
             if !only.is_empty() && only != label {
@@ -334,6 +340,9 @@ fn main() {
         .configure_from_args();
     eprintln!("machine: {}, simd {}", cpu_model(), raywave::simd_path());
     for (label, target) in [("12k", 12_000), ("1M", 1_000_000)] {
+        if !only.is_empty() && only != label {
+            continue;
+        }
         let s = setup(label, target, size);
         let ctx = Context::new(&s.scene, &s.settings);
         report(&s, &ctx);
