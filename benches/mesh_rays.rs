@@ -312,24 +312,16 @@ fn main() {
     if !["", "12k", "1M"].contains(&only.as_str()) {
         exit_with(&format!("RAYWAVE_MESH={only}: expected 12k or 1M"));
     }
-    if !test_mode && let Ok(rounds) = std::env::var("RAYWAVE_INTERLEAVE") {
-        let rounds = match rounds.parse::<usize>() {
-            Ok(n) if n > 0 => n,
+    // RAYWAVE_INTERLEAVE=ROUNDS: the interleaved mode instead of criterion's groups.
+    let interleave = match std::env::var("RAYWAVE_INTERLEAVE") {
+        Ok(rounds) if !test_mode => match rounds.parse::<usize>() {
+            Ok(n) if n > 0 => Some(n),
             _ => exit_with(&format!(
                 "RAYWAVE_INTERLEAVE={rounds}: expected a number of rounds, 1 or more"
             )),
-        };
-        eprintln!("machine: {}, simd {}", cpu_model(), raywave::simd_path());
-        for (label, target) in [("12k", 12_000), ("1M", 1_000_000)] {
-            if !only.is_empty() && only != label {
-                continue;
-            }
-            let s = setup(label, target, SIZE);
-            let ctx = Context::new(&s.scene, &s.settings);
-            interleaved(&s, &ctx, rounds);
-        }
-        return;
-    }
+        },
+        _ => None,
+    };
     let size = if test_mode { TEST_SIZE } else { SIZE };
     let mut c = Criterion::default()
         .sample_size(10)
@@ -345,6 +337,10 @@ fn main() {
         }
         let s = setup(label, target, size);
         let ctx = Context::new(&s.scene, &s.settings);
+        if let Some(rounds) = interleave {
+            interleaved(&s, &ctx, rounds);
+            continue;
+        }
         report(&s, &ctx);
         for set in s.sets.all() {
             bench_set(&mut c, &s, &ctx, set);
@@ -354,7 +350,9 @@ fn main() {
             interleaved(&s, &ctx, 1);
         }
     }
-    c.final_summary();
+    if interleave.is_none() {
+        c.final_summary();
+    }
 }
 
 /// Prints `message` and exits with status 2 (a bad switch, before any measuring).

@@ -17,9 +17,8 @@
 //! `cargo bench --bench scaling` (rounds: `RAYWAVE_ROUNDS`, default 9); under `cargo test` or
 //! `-- --test` it runs one round at 64² with a short loop, to keep the code from rotting.
 
-use raywave::sampling::LightSampler;
 use raywave::scene::Scene;
-use raywave::settings::{RenderSettings, ShadowMode};
+use raywave::settings::RenderSettings;
 use raywave::wavefront::{DEFAULT_BATCH_SIZE, Wavefront};
 use std::hint::black_box;
 use std::time::{Duration, Instant};
@@ -52,15 +51,7 @@ fn main() {
         (1024, CEILING_STEPS, rounds)
     };
     let scene = Scene::builtin_default();
-    let settings = RenderSettings {
-        width: size,
-        height: size,
-        bounces: 5,
-        shadows: ShadowMode::Soft,
-        shadow_samples: 64,
-        sampler: LightSampler::Stratified,
-        ..RenderSettings::default()
-    };
+    let settings = RenderSettings::lab_benchmark(size);
     let engines: Vec<(usize, Wavefront)> = BATCH_SIZES
         .iter()
         .map(|&b| (b, Wavefront::new(&scene, &settings, b)))

@@ -7,32 +7,18 @@
 //! `cargo bench --bench wavefront` (add `-- stages` or `-- frame` to pick a group).
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use raywave::sampling::LightSampler;
 use raywave::scene::Scene;
-use raywave::settings::{RenderSettings, ShadowMode};
+use raywave::settings::RenderSettings;
 use raywave::wavefront::batch::{HitBatch, Radiance, RayBatch, ShadowQueue};
 use raywave::wavefront::context::Context;
 use raywave::wavefront::{Wavefront, film, generate, intersect, reflect, shadow};
 use std::hint::black_box;
 
-/// The lab benchmark settings.
-fn lab_settings(size: u32) -> RenderSettings {
-    RenderSettings {
-        width: size,
-        height: size,
-        bounces: 5,
-        shadows: ShadowMode::Soft,
-        shadow_samples: 64,
-        sampler: LightSampler::Stratified,
-        ..RenderSettings::default()
-    }
-}
-
 const TILE: u32 = 4096;
 
 fn stages(c: &mut Criterion) {
     let scene = Scene::builtin_default();
-    let settings = lab_settings(1024);
+    let settings = RenderSettings::lab_benchmark(1024);
     let ctx = Context::new(&scene, &settings);
     // A tile through the middle of the image: walls, spheres and mirrors.
     let first = 1024 * 600;
@@ -90,7 +76,7 @@ fn frame(c: &mut Criterion) {
     paths.sort();
     let settings = RenderSettings {
         shadow_samples: 16,
-        ..lab_settings(96)
+        ..RenderSettings::lab_benchmark(96)
     };
     let mut g = c.benchmark_group("frame");
     g.sample_size(10);

@@ -72,6 +72,20 @@ impl RenderSettings {
         }
     }
 
+    /// The lab benchmark of docs/PERFORMANCE.md at `size`²: 5 bounces, soft shadows with 64
+    /// stratified points per light (the benches' frame; at 1024² the figure).
+    pub fn lab_benchmark(size: u32) -> Self {
+        RenderSettings {
+            width: size,
+            height: size,
+            bounces: 5,
+            shadows: ShadowMode::Soft,
+            shadow_samples: 64,
+            sampler: LightSampler::Stratified,
+            ..Self::default()
+        }
+    }
+
     /// The background as a vector.
     pub fn background(&self) -> Vec3 {
         Vec3::from_array(self.background)

@@ -29,6 +29,7 @@ use crate::camera::CameraRays;
 use crate::geometry::{Ray, T_MIN, intersect_triangle, obvhs_ray};
 use crate::scene::{NO_HIT, Scene};
 use crate::wavefront::batch::{HitBatch, PathId, RayBatch};
+use crate::wavefront::bvh::MeshBvh;
 use crate::wavefront::context::Context;
 use crate::wavefront::{DEFAULT_BATCH_SIZE, intersect};
 use glam::Vec3;
@@ -348,16 +349,21 @@ pub fn wavefront_closest(ctx: &Context, set: &RaySet, scratch: &mut HitBatch, ou
     }
 }
 
+/// The context's mesh BVH. Scenes below `BVH_MIN_TRIANGLES` have none and are not mesh
+/// scenes: they panic here.
+fn mesh_bvh<'c>(ctx: &'c Context) -> &'c MeshBvh {
+    ctx.accel
+        .as_ref()
+        .expect("peer comparisons run on mesh scenes, which have a BVH")
+}
+
 /// The wavefront engine's mesh traversal alone (`MeshBvh::closest_hits`, the call inside
 /// `intersect::closest`), over the set's batches: t and prim into `out`, nothing else, as
 /// obvhs's and Embree's calls here produce. `wavefront_closest` adds the intersect stage's
 /// shading columns (point, normal, material) on top.
 pub fn wavefront_bvh_closest(ctx: &Context, set: &RaySet, out: &mut Hits) {
     out.clear();
-    let bvh = ctx
-        .accel
-        .as_ref()
-        .expect("peer comparisons run on mesh scenes, which have a BVH");
+    let bvh = mesh_bvh(ctx);
     let two_sided = ctx.settings.two_sided;
     for batch in &set.batches {
         let start = out.t.len();
@@ -377,14 +383,10 @@ pub fn wavefront_bvh_closest(ctx: &Context, set: &RaySet, out: &mut Hits) {
 ///
 /// `wavefront::shadow`'s occlusion pass hands the shadow queue's columns to
 /// `MeshBvh::occluded` for meshes; this hands it each batch's columns, so it times the same
-/// function. Scenes below `BVH_MIN_TRIANGLES` have no BVH and are not mesh scenes: they panic
-/// here.
+/// function (see `mesh_bvh` for scenes without a BVH).
 pub fn wavefront_occluded(ctx: &Context, set: &RaySet, out: &mut Vec<bool>) {
     out.clear();
-    let bvh = ctx
-        .accel
-        .as_ref()
-        .expect("peer comparisons run on mesh scenes, which have a BVH");
+    let bvh = mesh_bvh(ctx);
     let two_sided = ctx.settings.two_sided;
     for batch in &set.batches {
         let start = out.len();
