@@ -201,16 +201,6 @@ impl<'a> Context<'a> {
         self.settings.sampler == LightSampler::Stratified
     }
 
-    /// Material index of a primitive.
-    #[inline]
-    pub fn material_index(&self, prim: u32) -> u32 {
-        let p = prim as usize;
-        match self.triangle_shading.get(p) {
-            Some(t) => t.material,
-            None => self.scene.spheres[p - self.triangle_shading.len()].material,
-        }
-    }
-
     /// Geometric normal (front side, as `geometry::geometric_normal`) and material index of
     /// primitive `prim` hit at `point`.
     #[inline]
