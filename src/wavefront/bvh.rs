@@ -28,9 +28,9 @@
 //! (u, v ≥ −EDGE_EPSILON) and the slab test's rounding never cull a triangle the kernel would
 //! hit, for ray origins within about 100 box sizes of a box; from farther away the origin's
 //! own rounding (about 2⁻²⁴·|origin|) can exceed the padding, in the fused slab test as in
-//! the unfused one before it. Ties (two triangles at the same t: a shared edge, a corner of two walls) go to the
-//! lowest triangle id, as in a brute-force loop in index order, so the closest hit is brute
-//! force's. The exception is a triangle the ray grazes: its computed t is off by about
+//! the unfused one before it. Ties (two triangles at the same t: a shared edge, a corner of
+//! two walls) go to the lowest triangle id, as in a brute-force loop in index order, so the
+//! closest hit is brute force's. The exception is a triangle the ray grazes: its computed t is off by about
 //! ε / sin θ and can lie before the entry of the box that holds it, which is then pruned by a
 //! hit found first. In `tests/mesh_bvh.rs`, 3 of 8,000 grazing queries differ, each time for
 //! a triangle with |n·d| ≤ 1.5e-5; the tree then returns another real hit of the kernel.
@@ -271,7 +271,7 @@ impl MeshBvh {
                     let open = kids
                         .iter()
                         .enumerate()
-                        .filter(|(_, k)| k.count > LEAF_MAX)
+                        .filter(|(_, k)| k.count > LEAF_MAX && !n2[k.nodes[0]].is_leaf())
                         .max_by(|a, b| a.1.aabb.half_area().total_cmp(&b.1.aabb.half_area()))
                         .map(|(slot, _)| slot);
                     if let Some(slot) = open {
