@@ -26,6 +26,7 @@
 //! switches.
 
 use criterion::{BenchmarkId, Criterion, Throughput};
+use raywave::bench::record::median;
 use raywave::meshgen::{bands_for, cornell_box_mesh_spheres, triangle_count};
 use raywave::peer::{
     Hits, ObvhsMesh, RaySet, RaySets, hit_agreement, occlusion_agreement, wavefront_bvh_closest,
@@ -140,10 +141,9 @@ fn report(s: &Setup, ctx: &Context) {
             lines.push(("wavefront_bvh", hit_agreement(&reference, &other)));
             #[cfg(feature = "embree")]
             {
-                let coherent = set.kind == RayKind::Primary;
-                s.embree.closest1(set, coherent, &mut other);
+                s.embree.closest1(set, coherent(set), &mut other);
                 lines.push(("embree_single", hit_agreement(&reference, &other)));
-                s.embree.closest8(set, coherent, &mut other);
+                s.embree.closest8(set, coherent(set), &mut other);
                 lines.push(("embree_packet8", hit_agreement(&reference, &other)));
             }
             eprintln!(
@@ -179,6 +179,12 @@ fn bench_set(c: &mut Criterion, s: &Setup, ctx: &Context, set: &RaySet) {
     group.finish();
 }
 
+/// Embree's ray-coherence hint for `set`: every set but the incoherent one.
+#[cfg(feature = "embree")]
+fn coherent(set: &RaySet) -> bool {
+    set.kind != RayKind::Incoherent
+}
+
 /// One pass of `engine` over `set`: the same calls the criterion groups time.
 fn trace(s: &Setup, ctx: &Context, set: &RaySet, engine: &str, out: &mut Outputs) {
     let shadow = set.kind.is_occlusion();
@@ -192,17 +198,11 @@ fn trace(s: &Setup, ctx: &Context, set: &RaySet, engine: &str, out: &mut Outputs
         #[cfg(feature = "embree")]
         ("embree_single", true) => s.embree.occluded1(set, &mut out.blocked),
         #[cfg(feature = "embree")]
-        ("embree_single", false) => {
-            let coherent = set.kind != RayKind::Incoherent;
-            s.embree.closest1(set, coherent, &mut out.hits)
-        }
+        ("embree_single", false) => s.embree.closest1(set, coherent(set), &mut out.hits),
         #[cfg(feature = "embree")]
         ("embree_packet8", true) => s.embree.occluded8(set, &mut out.blocked),
         #[cfg(feature = "embree")]
-        ("embree_packet8", false) => {
-            let coherent = set.kind != RayKind::Incoherent;
-            s.embree.closest8(set, coherent, &mut out.hits)
-        }
+        ("embree_packet8", false) => s.embree.closest8(set, coherent(set), &mut out.hits),
         _ => unreachable!("engine {engine}"),
     }
     black_box(&*out);
@@ -244,10 +244,6 @@ fn engines(set: &RaySet) -> Vec<&'static str> {
 /// taken within a round. Load from outside the machine then moves both sides of a ratio alike;
 /// the medians over rounds are printed.
 fn interleaved(s: &Setup, ctx: &Context, rounds: usize) {
-    let median = |mut v: Vec<f64>| {
-        v.sort_by(f64::total_cmp);
-        v[v.len() / 2]
-    };
     let mut out = Outputs::default();
     for set in s.sets.all() {
         let rays = set.len() as f64;
@@ -275,11 +271,12 @@ fn interleaved(s: &Setup, ctx: &Context, rounds: usize) {
             s.label
         );
         for (e, engine) in engines.iter().enumerate() {
-            line += &format!(" {engine} {:.2}", median(rates[e].clone()));
+            line += &format!(" {engine} {:.2}", median(&rates[e]));
         }
         // Ratios within each round, then their median.
         let ratio = |a: usize, b: usize| {
-            median(rates[a].iter().zip(&rates[b]).map(|(x, y)| x / y).collect())
+            let ratios: Vec<f64> = rates[a].iter().zip(&rates[b]).map(|(x, y)| x / y).collect();
+            median(&ratios)
         };
         for (ours, theirs) in [
             ("wavefront", "obvhs_one_ray"),

@@ -17,6 +17,7 @@
 //! `cargo bench --bench scaling` (rounds: `RAYWAVE_ROUNDS`, default 9); under `cargo test` or
 //! `-- --test` it runs one round at 64² with a short loop, to keep the code from rotting.
 
+use raywave::bench::record::median;
 use raywave::scene::Scene;
 use raywave::settings::RenderSettings;
 use raywave::wavefront::{DEFAULT_BATCH_SIZE, Wavefront};
@@ -141,10 +142,4 @@ fn fma_loop(steps: u64) -> f32 {
         }
     }
     x.iter().map(|v| v.reduce_add()).sum()
-}
-
-fn median(v: &[f64]) -> f64 {
-    let mut v = v.to_vec();
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
 }
