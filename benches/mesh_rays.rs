@@ -7,12 +7,16 @@
 //! for scene in [12k, 1M]:                        generated in memory by meshgen, built once
 //!     print triangles, BVH build times, ray counts, hit agreement against obvhs
 //!     for set in [primary, shadow, incoherent, shadow_fan]:  group "<set>_<scene>", throughput in rays
-//!         obvhs_one_ray, wavefront, wavefront_bvh (closest-hit sets), embree_single, embree_packet8
+//!         obvhs_one_ray, wavefront, wavefront_bvh (closest-hit sets),
+//!         wavefront_one_ray (primary only), embree_single, embree_packet8
 //! ```
 //!
 //! `wavefront` is the engine's intersect stage (traversal, then point, normal and material for
 //! shading) on closest-hit sets and its occlusion pass on shadow sets; `wavefront_bvh` is the
-//! stage's traversal alone, which returns what obvhs and Embree return (t and prim).
+//! stage's traversal alone, which returns what obvhs and Embree return (t and prim). The stage
+//! traces camera rays in 8-ray packets and all others one ray at a time; `wavefront_one_ray`
+//! is the traversal one ray at a time on the camera rays too, so each run shows what the
+//! packets buy.
 //!
 //! Every engine traces on one thread, two-sided, on the scene without its emissive wall
 //! (`peer::without_emitters`; see `src/peer/mod.rs`). `cargo bench --bench mesh_rays` runs it;
@@ -29,8 +33,9 @@ use criterion::{BenchmarkId, Criterion, Throughput};
 use raywave::bench::record::median;
 use raywave::meshgen::{bands_for, cornell_box_mesh_spheres, triangle_count};
 use raywave::peer::{
-    Hits, ObvhsMesh, RaySet, RaySets, hit_agreement, occlusion_agreement, wavefront_bvh_closest,
-    wavefront_closest, wavefront_occluded, without_emitters,
+    Hits, ObvhsMesh, RayKind, RaySet, RaySets, hit_agreement, occlusion_agreement,
+    wavefront_bvh_closest, wavefront_bvh_closest_one_ray, wavefront_closest, wavefront_occluded,
+    without_emitters,
 };
 use raywave::scene::{Scene, parse_scene_str};
 use raywave::settings::RenderSettings;
@@ -139,6 +144,8 @@ fn report(s: &Setup, ctx: &Context) {
             lines.push(("wavefront", hit_agreement(&reference, &other)));
             wavefront_bvh_closest(ctx, set, &mut other);
             lines.push(("wavefront_bvh", hit_agreement(&reference, &other)));
+            wavefront_bvh_closest_one_ray(ctx, set, &mut other);
+            lines.push(("wavefront_one_ray", hit_agreement(&reference, &other)));
             #[cfg(feature = "embree")]
             {
                 s.embree.closest1(set, coherent(set), &mut other);
@@ -195,6 +202,7 @@ fn trace(s: &Setup, ctx: &Context, set: &RaySet, engine: &str, out: &mut Outputs
         ("wavefront", true) => wavefront_occluded(ctx, set, &mut out.blocked),
         ("wavefront", false) => wavefront_closest(ctx, set, &mut out.scratch, &mut out.hits),
         ("wavefront_bvh", false) => wavefront_bvh_closest(ctx, set, &mut out.hits),
+        ("wavefront_one_ray", false) => wavefront_bvh_closest_one_ray(ctx, set, &mut out.hits),
         #[cfg(feature = "embree")]
         ("embree_single", true) => s.embree.occluded1(set, &mut out.blocked),
         #[cfg(feature = "embree")]
@@ -223,6 +231,7 @@ const ENGINES: &[&str] = &[
     "obvhs_one_ray",
     "wavefront",
     "wavefront_bvh",
+    "wavefront_one_ray",
     #[cfg(feature = "embree")]
     "embree_single",
     #[cfg(feature = "embree")]
@@ -236,6 +245,7 @@ fn engines(set: &RaySet) -> Vec<&'static str> {
         .iter()
         .copied()
         .filter(|&e| !(shadow && e == "wavefront_bvh"))
+        .filter(|&e| set.kind == RayKind::Primary || e != "wavefront_one_ray")
         .collect()
 }
 
@@ -283,6 +293,7 @@ fn interleaved(s: &Setup, ctx: &Context, rounds: usize) {
             ("wavefront_bvh", "obvhs_one_ray"),
             ("wavefront", "embree_single"),
             ("wavefront_bvh", "embree_single"),
+            ("wavefront_bvh", "wavefront_one_ray"),
             ("wavefront", "embree_packet8"),
         ] {
             let at = |name| engines.iter().position(|&e| e == name);

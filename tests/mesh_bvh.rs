@@ -365,7 +365,8 @@ fn tiny_and_empty_meshes() {
     check_against_brute_force(&nine, &random_rays(&nine, 200, 1));
 }
 
-/// `closest_hits` and `occluded` (spheres included) against brute force over every triangle,
+/// `closest_hits`, `closest_hits_coherent` and `occluded` (spheres included) against brute
+/// force over every triangle,
 /// then every sphere (the reference's `Accel` without a BVH): same t bits, same primitive, same
 /// occlusion. `Accel` over obvhs's CWBVH is compared too: it may differ only where the edge
 /// slack decides (the same point, a neighbouring triangle), and never on axis-aligned rays,
@@ -405,6 +406,9 @@ fn batch_entry_points_equal_brute_force_for_lengths_around_the_lane_width() {
             let (mut t, mut prim, mut blocked) = (vec![0.0; n], vec![0; n], vec![false; n]);
             bvh.closest_hits(&scene, &cols, two_sided, &mut t, &mut prim);
             bvh.occluded(&scene, &cols, two_sided, &mut blocked);
+            // Random rays as packets: lanes part at once and finish one ray at a time.
+            let (mut packet_t, mut packet_prim) = (vec![0.0; n], vec![0; n]);
+            bvh.closest_hits_coherent(&scene, &cols, two_sided, &mut packet_t, &mut packet_prim);
             for (i, (r, tmax)) in rays.iter().enumerate() {
                 let (mut want_t, mut want_prim) = brute_force(&scene, r, *tmax, two_sided);
                 let mut best = if want_prim == NO_HIT { *tmax } else { want_t };
@@ -417,6 +421,12 @@ fn batch_entry_points_equal_brute_force_for_lengths_around_the_lane_width() {
                 }
                 assert_eq!(t[i].to_bits(), want_t.to_bits(), "ray {i} {r:?}");
                 assert_eq!(prim[i], want_prim, "ray {i} {r:?}");
+                assert_eq!(
+                    packet_t[i].to_bits(),
+                    want_t.to_bits(),
+                    "packet ray {i} {r:?}"
+                );
+                assert_eq!(packet_prim[i], want_prim, "packet ray {i} {r:?}");
                 assert_eq!(blocked[i], want_prim != NO_HIT, "ray {i}");
                 let got = accel.closest(&scene, r, *tmax, two_sided);
                 if got.t.to_bits() != want_t.to_bits() {
@@ -445,9 +455,117 @@ fn batch_entry_points_equal_brute_force_for_lengths_around_the_lane_width() {
     assert_eq!(axis_parallel, 0);
 }
 
+/// Camera rays through packets (`closest_hits_coherent`, as the intersect stage traces depth-0
+/// batches): brute force's hits, bit for bit, for batch lengths around the lane width, with
+/// rays that break a packet's coherence (NaN and infinite components, a zero direction,
+/// axis-aligned rays with ±0.0, a ray starting on a triangle, tmax 0, NaN and finite) mixed
+/// into otherwise coherent packets. Spheres are tested after the tree, as in `closest_hits`.
+#[test]
+fn packets_of_camera_rays_equal_brute_force() {
+    let mut scene = mesh_scene(12);
+    scene.spheres.push(Sphere {
+        center: Vec3::new(0.3, -0.6, 0.2),
+        radius: 0.25,
+        material: 0,
+    });
+    let base = scene.triangles.len() as u32;
+    let bvh = MeshBvh::new(&scene);
+    let camera = raywave::camera::CameraRays::new(&scene.camera, 48, 40);
+    let mut rng = Rng(31);
+    let mut rays: Vec<(Ray, f32)> = (0..48 * 40)
+        .map(|pixel| {
+            let (x, y) = camera.screen(pixel, rng.next(), rng.next());
+            (camera.ray(x, y), INF)
+        })
+        .collect();
+    let tri = &scene.triangles[scene.triangles.len() / 2];
+    let on = tri.v0 + 0.25 * tri.e1 + 0.25 * tri.e2;
+    let eye = rays[0].0.origin;
+    let odd = [
+        (ray([eye.x, eye.y, eye.z], [NAN, 0.0, -1.0]), INF),
+        (ray([INF, eye.y, eye.z], [0.0, 0.0, -1.0]), INF),
+        (ray([eye.x, eye.y, eye.z], [0.0, 0.0, 0.0]), INF),
+        (ray([eye.x, eye.y, eye.z], [-0.0, 0.0, -1.0]), INF),
+        (ray([eye.x, eye.y, eye.z], [0.0, -0.0, 1.0]), INF),
+        (ray([eye.x, eye.y, eye.z], [0.0, 0.0, -INF]), INF),
+        (
+            Ray {
+                origin: on,
+                direction: -tri.normal,
+            },
+            INF,
+        ),
+        (
+            Ray {
+                origin: on,
+                direction: tri.normal,
+            },
+            INF,
+        ),
+        (rays[5].0, 0.0),
+        (rays[6].0, NAN),
+        (rays[7].0, 0.5),
+    ];
+    for (k, r) in odd.into_iter().enumerate() {
+        // Into packets of coherent rays: lanes 3 of packet 2k + 1.
+        rays[(2 * k + 1) * 8 + 3] = r;
+    }
+    let hit = |r: &Ray, tmax: f32, two_sided: bool| {
+        let (mut t, mut prim) = brute_force(&scene, r, tmax, two_sided);
+        let mut best = if prim == NO_HIT { tmax } else { t };
+        for (k, s) in scene.spheres.iter().enumerate() {
+            let ts = raywave::geometry::intersect_sphere(s, r, best);
+            if ts < best {
+                best = ts;
+                (t, prim) = (ts, base + k as u32);
+            }
+        }
+        (t, prim)
+    };
+    let (mut hits, mut queries) = (0, 0);
+    for n in [0, 1, 7, 8, 9, 8 * 100 + 1, rays.len()] {
+        let rays = &rays[..n];
+        let col = |f: &dyn Fn(&(Ray, f32)) -> f32| rays.iter().map(f).collect::<Vec<f32>>();
+        let c = [
+            col(&|r| r.0.origin.x),
+            col(&|r| r.0.origin.y),
+            col(&|r| r.0.origin.z),
+            col(&|r| r.0.direction.x),
+            col(&|r| r.0.direction.y),
+            col(&|r| r.0.direction.z),
+            col(&|r| r.1),
+        ];
+        let cols = RayColumns {
+            origin: [&c[0], &c[1], &c[2]],
+            direction: [&c[3], &c[4], &c[5]],
+            tmax: &c[6],
+        };
+        for two_sided in [false, true] {
+            let (mut t, mut prim) = (vec![0.0; n], vec![0; n]);
+            bvh.closest_hits_coherent(&scene, &cols, two_sided, &mut t, &mut prim);
+            for (i, (r, tmax)) in rays.iter().enumerate() {
+                let (want_t, want_prim) = hit(r, *tmax, two_sided);
+                assert_eq!(
+                    (t[i].to_bits(), prim[i]),
+                    (want_t.to_bits(), want_prim),
+                    "ray {i} of {n} {r:?} tmax {tmax} two-sided {two_sided}: packet ({}, {}), \
+                     brute force ({want_t}, {want_prim})",
+                    t[i],
+                    prim[i]
+                );
+                hits += usize::from(want_prim != NO_HIT);
+                queries += 1;
+            }
+        }
+    }
+    // The camera looks into the box: most rays hit something.
+    assert!(2 * hits > queries, "{hits} hits of {queries}");
+}
+
 /// Not a test: the instruction-count probe behind docs/PERFORMANCE.md's mesh choices. Traces
 /// the peer ray sets of the 12k-triangle box (128×128) through one engine, chosen by
-/// `PROBE=obvhs|wavefront` and `SET=primary|shadow|incoherent|shadow_fan`, 5 times:
+/// `PROBE=obvhs|wavefront|one_ray` (`one_ray`: the traversal one ray at a time, for closest-hit
+/// sets) and `SET=primary|shadow|incoherent|shadow_fan`, 5 times:
 /// `valgrind --tool=callgrind --toggle-collect='*probe_trace*' <test binary> --ignored probe`.
 #[test]
 #[ignore]
@@ -480,6 +598,7 @@ fn probe() {
     probe_trace(&mut || match (engine.as_str(), set.kind.is_occlusion()) {
         ("obvhs", false) => obvhs.closest(&scene, set, &mut hits),
         ("obvhs", true) => obvhs.occluded(&scene, set, &mut blocked),
+        ("one_ray", false) => raywave::peer::wavefront_bvh_closest_one_ray(&ctx, set, &mut hits),
         (_, false) => raywave::peer::wavefront_closest(&ctx, set, &mut scratch, &mut hits),
         (_, true) => raywave::peer::wavefront_occluded(&ctx, set, &mut blocked),
     });

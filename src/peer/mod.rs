@@ -112,7 +112,12 @@ impl RaySet {
 
     fn push(&mut self, origin: Vec3, direction: Vec3, tmax: f32) {
         if self.batches.last().is_none_or(|b| b.len() == BATCH) {
-            self.batches.push(RayBatch::default());
+            // Camera rays are depth 0, the rest as if from a first bounce: the intersect
+            // stage traces depth-0 batches as coherent packets.
+            self.batches.push(RayBatch {
+                bounce: u32::from(self.kind != RayKind::Primary),
+                ..RayBatch::default()
+            });
         }
         let batch = self.batches.last_mut().expect("a batch was just pushed");
         let n = batch.len() as u32;
@@ -357,11 +362,31 @@ fn mesh_bvh<'c>(ctx: &'c Context) -> &'c MeshBvh {
         .expect("peer comparisons run on mesh scenes, which have a BVH")
 }
 
-/// The wavefront engine's mesh traversal alone (`MeshBvh::closest_hits`, the call inside
+/// The wavefront engine's mesh traversal alone (`intersect::mesh_hits`, the call inside
 /// `intersect::closest`), over the set's batches: t and prim into `out`, nothing else, as
 /// obvhs's and Embree's calls here produce. `wavefront_closest` adds the intersect stage's
 /// shading columns (point, normal, material) on top.
 pub fn wavefront_bvh_closest(ctx: &Context, set: &RaySet, out: &mut Hits) {
+    traverse(ctx, set, out, |bvh, scene, batch, two_sided, t, prim| {
+        intersect::mesh_hits(bvh, scene, batch, two_sided, t, prim)
+    });
+}
+
+/// [`wavefront_bvh_closest`] with every ray traced on its own (`MeshBvh::closest_hits`), as
+/// the stage traces all but camera rays: on camera rays, what the packets buy.
+pub fn wavefront_bvh_closest_one_ray(ctx: &Context, set: &RaySet, out: &mut Hits) {
+    traverse(ctx, set, out, |bvh, scene, batch, two_sided, t, prim| {
+        bvh.closest_hits(scene, &intersect::columns(batch), two_sided, t, prim)
+    });
+}
+
+/// `trace(bvh, scene, batch, two_sided, t, prim)` over the set's batches, into `out`.
+fn traverse(
+    ctx: &Context,
+    set: &RaySet,
+    out: &mut Hits,
+    trace: impl Fn(&MeshBvh, &Scene, &RayBatch, bool, &mut [f32], &mut [u32]),
+) {
     out.clear();
     let bvh = mesh_bvh(ctx);
     let two_sided = ctx.settings.two_sided;
@@ -369,9 +394,10 @@ pub fn wavefront_bvh_closest(ctx: &Context, set: &RaySet, out: &mut Hits) {
         let start = out.t.len();
         out.t.resize(start + batch.len(), f32::INFINITY);
         out.prim.resize(start + batch.len(), NO_HIT);
-        bvh.closest_hits(
+        trace(
+            bvh,
             ctx.scene,
-            &intersect::columns(batch),
+            batch,
             two_sided,
             &mut out.t[start..],
             &mut out.prim[start..],

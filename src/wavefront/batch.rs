@@ -70,7 +70,7 @@ impl RayBatch {
     }
 
     /// Appends one ray.
-    #[inline]
+    #[inline(always)]
     pub fn push(&mut self, origin: Vec3, direction: Vec3, throughput: Vec3, path: PathId) {
         self.origin_x.push(origin.x);
         self.origin_y.push(origin.y);

@@ -2,15 +2,17 @@
 //! normal flipped for two-sided faces, material).
 //!
 //! Small scenes (below `BVH_MIN_TRIANGLES` triangles) go through the 8-wide kernel over every
-//! primitive; meshes go through the engine's 8-wide BVH (`bvh::MeshBvh`), one ray at a time
-//! with 8 child boxes or 8 triangles per test. Its hits are brute force's (same t bits, ties to
+//! primitive; meshes go through the engine's 8-wide BVH (`bvh::MeshBvh`): camera rays in
+//! packets of 8 neighbouring pixels (8 rays against one child box or one triangle per test),
+//! all other rays one at a time (one ray against 8 child boxes or 8 triangles). Its hits are brute force's (same t bits, ties to
 //! the lowest triangle id), as are the reference's (`Accel::closest` over obvhs's CWBVH), except
 //! for the few axis-parallel rays obvhs's box test misses (docs/PERFORMANCE.md, "Mesh rays").
 
 use super::batch::{HitBatch, RayBatch};
+use super::bvh::MeshBvh;
 use super::context::Context;
 use super::simd::{self, RayColumns};
-use crate::scene::NO_HIT;
+use crate::scene::{NO_HIT, Scene};
 use glam::Vec3;
 
 /// The ray columns of a batch.
@@ -19,6 +21,24 @@ pub fn columns(rays: &RayBatch) -> RayColumns<'_> {
         origin: [&rays.origin_x, &rays.origin_y, &rays.origin_z],
         direction: [&rays.direction_x, &rays.direction_y, &rays.direction_z],
         tmax: &rays.tmax,
+    }
+}
+
+/// t and primitive id of every ray's closest hit through the mesh BVH. Camera rays (depth 0:
+/// 8 consecutive rays are neighbouring pixels) go through the tree 8 at a time; mirror rays,
+/// which fan out, one at a time (docs/PERFORMANCE.md, "Mesh rays"). Both give the same hits.
+pub fn mesh_hits(
+    bvh: &MeshBvh,
+    scene: &Scene,
+    rays: &RayBatch,
+    two_sided: bool,
+    t: &mut [f32],
+    prim: &mut [u32],
+) {
+    if rays.bounce == 0 {
+        bvh.closest_hits_coherent(scene, &columns(rays), two_sided, t, prim);
+    } else {
+        bvh.closest_hits(scene, &columns(rays), two_sided, t, prim);
     }
 }
 
@@ -37,9 +57,10 @@ pub fn closest(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch) {
             &mut hits.t,
             &mut hits.prim,
         ),
-        Some(bvh) => bvh.closest_hits(
+        Some(bvh) => mesh_hits(
+            bvh,
             scene,
-            &columns(rays),
+            rays,
             two_sided,
             &mut hits.t[..n],
             &mut hits.prim[..n],
