@@ -52,7 +52,7 @@ const TEST_SIZE: u32 = 32;
 const SEED: u64 = 2026;
 
 #[cfg(feature = "embree")]
-use raywave::peer::{RayKind, embree::EmbreeMesh};
+use raywave::peer::embree::EmbreeMesh;
 
 /// Everything one scene's groups need, built before any timing.
 struct Setup {
