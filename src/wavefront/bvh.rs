@@ -34,10 +34,13 @@
 //! own rounding (about 2⁻²⁴·|origin|) can exceed the padding, in the fused slab test as in
 //! the unfused one before it. Ties (two triangles at the same t: a shared edge, a corner of
 //! two walls) go to the lowest triangle id, as in a brute-force loop in index order, so the
-//! closest hit is brute force's. The exception is a triangle the ray grazes: its computed t is off by about
-//! ε / sin θ and can lie before the entry of the box that holds it, which is then pruned by a
-//! hit found first. In `tests/mesh_bvh.rs`, 3 of 8,000 grazing queries differ, each time for
-//! a triangle with |n·d| ≤ 1.5e-5; the tree then returns another real hit of the kernel.
+//! closest hit is brute force's. The exception is a triangle the ray grazes: its computed t is
+//! off by about ε / sin θ and can lie before the entry of the box that holds it, which is then
+//! pruned by a hit found first. In `tests/mesh_bvh.rs`, 1 of 8,000 grazing queries differs
+//! (one ray at a time and in packets alike; 3 in an earlier tree), for a triangle with
+//! |n·d| ≈ 2e-6; the tree then returns another real hit of the kernel. Which hit is found
+//! first depends on the visiting order, so packets (the first entering lane's order) and one
+//! ray may differ from each other on such a triangle.
 
 use super::simd::{self, RayColumns, TriangleLanes};
 use crate::geometry::{Hit, Ray, T_MIN, intersect_sphere};
@@ -445,7 +448,7 @@ impl MeshBvh {
     }
 
     /// [`Self::occluded_triangle`] with a stack from the caller.
-    #[inline]
+    #[inline(always)]
     fn occluded_in(&self, ray: &Ray, tmax: f32, two_sided: bool, stack: &mut Stack) -> bool {
         let stack = &mut stack.0[..];
         let r = RayLanes::new(ray);
@@ -654,11 +657,15 @@ impl PacketBest {
 }
 
 impl MeshBvh {
-    /// Closest triangle hits of a packet of coherent rays (live lanes `live`, a bitmask):
-    /// per lane the (t, triangle) of [`Self::closest_triangle`]. The packet shares each node
+    /// Closest triangle hits of a packet of coherent rays (live lanes `live`, a bitmask): per
+    /// lane the best (t, triangle), `(tmax, NO_HIT)` for a miss. The packet shares each node
     /// fetch and child order, and tests each child box and leaf triangle against its 8 rays
     /// at once; once fewer than `PACKET_MIN_LANES` lanes enter a subtree, or a leaf holds more
-    /// triangles than lanes enter it, those lanes go on one ray at a time.
+    /// triangles than lanes enter it, those lanes go on one ray at a time. Every test is, lane
+    /// by lane, the one-ray test, and (t, id) is minimised as a pair, so each lane gets brute
+    /// force's answer, as one ray does; the children are visited in the first entering lane's
+    /// order, not each lane's, so where one ray differs from brute force (a grazing hit pruned
+    /// by its box's entry distance, module docs) the packet may differ from one ray too.
     fn closest_packet(
         &self,
         p: &Packet,
@@ -761,6 +768,8 @@ impl MeshBvh {
                         }
                         let take_lanes = MASK_LANES[take as usize];
                         best.t = take_lanes.select(t, best.t);
+                        // next_up(t) as bits + 1: t > T_MIN > 0 here, and finite (t < limit).
+                        const _: () = assert!(T_MIN > 0.0);
                         let up: f32x8 = wide::bytemuck::cast(
                             wide::bytemuck::cast::<f32x8, wide::u32x8>(t) + wide::u32x8::ONE,
                         );
@@ -789,9 +798,9 @@ impl MeshBvh {
         }
     }
 
-    /// [`Self::closest_hits`] for coherent rays (camera rays, 8 consecutive rays being
-    /// neighbouring pixels), traced in packets of 8 (`closest_packet`). The same answers as
-    /// [`Self::closest_hits`], lane for ray.
+    /// [`Self::closest_hits`] for coherent rays (camera rays: 8 consecutive rays are
+    /// neighbouring pixels, or samples of them), traced in packets of 8 (`closest_packet`).
+    /// Brute force's answers, as [`Self::closest_hits`] gives, with the same grazing exception.
     pub fn closest_hits_coherent(
         &self,
         scene: &Scene,
@@ -858,10 +867,13 @@ fn packet_lanes(c: &[f32], i: usize, live: usize) -> f32x8 {
     }
 }
 
-/// Number of triangles in a block (its NaN lanes come last).
+/// Number of triangles in a block: its lanes before the first unused one (id `NO_HIT`). From
+/// the ids, not the vertices: a triangle built in code may have a NaN vertex.
 #[inline(always)]
 fn block_len(block: &Block) -> u32 {
-    (block.v0[0].is_nan().to_bitmask() | 1 << WIDTH).trailing_zeros()
+    let ids: wide::i32x8 = wide::bytemuck::cast(block.prim);
+    let unused = ids.simd_eq(wide::i32x8::splat(NO_HIT as i32)).to_bitmask();
+    (unused | 1 << WIDTH).trailing_zeros()
 }
 
 /// Lane masks by bitmask: `MASK_LANES[m]` is all ones in lane k where bit k of m is set.
@@ -869,16 +881,15 @@ static MASK_LANES: [f32x8; 256] = {
     let mut table = [f32x8::ZERO; 256];
     let mut m = 0;
     while m < 256 {
-        let mut lanes = [0u32; WIDTH];
+        let mut lanes = [0.0f32; WIDTH];
         let mut k = 0;
         while k < WIDTH {
             if m & (1 << k) != 0 {
-                lanes[k] = u32::MAX;
+                lanes[k] = f32::from_bits(u32::MAX);
             }
             k += 1;
         }
-        // SAFETY: f32x8 is 8 f32 lanes (32 bytes, any bit pattern valid).
-        table[m] = unsafe { std::mem::transmute::<[u32; WIDTH], f32x8>(lanes) };
+        table[m] = f32x8::new(lanes);
         m += 1;
     }
     table

@@ -26,7 +26,8 @@ pub fn columns(rays: &RayBatch) -> RayColumns<'_> {
 
 /// t and primitive id of every ray's closest hit through the mesh BVH. Camera rays (depth 0:
 /// 8 consecutive rays are neighbouring pixels) go through the tree 8 at a time; mirror rays,
-/// which fan out, one at a time (docs/PERFORMANCE.md, "Mesh rays"). Both give the same hits.
+/// which fan out, one at a time (docs/PERFORMANCE.md, "Mesh rays"). Both give brute force's
+/// hits, except on the rare grazing triangle (`bvh` module docs).
 pub fn mesh_hits(
     bvh: &MeshBvh,
     scene: &Scene,
