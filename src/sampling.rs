@@ -105,7 +105,7 @@ pub fn strata_grid(n: u32) -> (u32, u32) {
 }
 
 /// The point in [0, 1)² for sample `index` of `count` with the given sampler.
-#[inline]
+#[inline(always)]
 pub fn square_sample(sampler: LightSampler, key: &SampleKey, index: u32, count: u32) -> (f32, f32) {
     let xi0 = uniform(key, 2 * index);
     let xi1 = uniform(key, 2 * index + 1);

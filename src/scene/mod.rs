@@ -122,6 +122,7 @@ pub struct Light {
 
 impl Light {
     /// Maps (u, v) in [0, 1)² to a point on the light, uniformly by area.
+    #[inline]
     pub fn point(&self, u: f32, v: f32) -> Vec3 {
         match &self.shape {
             LightShape::Parallelogram {

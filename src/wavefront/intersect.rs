@@ -4,9 +4,10 @@
 //! Small scenes (below `BVH_MIN_TRIANGLES` triangles) go through the 8-wide kernel over every
 //! primitive; meshes go through the engine's 8-wide BVH (`bvh::MeshBvh`): camera rays in
 //! packets of 8 neighbouring pixels (8 rays against one child box or one triangle per test),
-//! all other rays one at a time (one ray against 8 child boxes or 8 triangles). Its hits are brute force's (same t bits, ties to
-//! the lowest triangle id), as are the reference's (`Accel::closest` over obvhs's CWBVH), except
-//! for the few axis-parallel rays obvhs's box test misses (docs/PERFORMANCE.md, "Mesh rays").
+//! all other rays one at a time (one ray against 8 child boxes or 8 triangles). Its hits are
+//! brute force's (same t bits, ties to the lowest triangle id), as are the reference's
+//! (`Accel::closest` over obvhs's CWBVH), except for the few axis-parallel rays obvhs's box
+//! test misses (docs/PERFORMANCE.md, "Mesh rays").
 
 use super::batch::{HitBatch, RayBatch};
 use super::bvh::MeshBvh;
