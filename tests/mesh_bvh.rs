@@ -244,6 +244,33 @@ fn brute_force(scene: &Scene, r: &Ray, tmax: f32, two_sided: bool) -> (f32, u32)
     }
 }
 
+/// Brute force over every triangle, then every sphere (ids after the triangles'), as the
+/// batch entry points trace a scene with both.
+fn brute_force_with_spheres(scene: &Scene, r: &Ray, tmax: f32, two_sided: bool) -> (f32, u32) {
+    let base = scene.triangles.len() as u32;
+    let (mut t, mut prim) = brute_force(scene, r, tmax, two_sided);
+    let mut best = if prim == NO_HIT { tmax } else { t };
+    for (k, s) in scene.spheres.iter().enumerate() {
+        let ts = raywave::geometry::intersect_sphere(s, r, best);
+        if ts < best {
+            best = ts;
+            (t, prim) = (ts, base + k as u32);
+        }
+    }
+    (t, prim)
+}
+
+/// The generated mesh box with one sphere inside.
+fn mesh_scene_with_sphere(bands: u32, center: Vec3, radius: f32) -> Scene {
+    let mut scene = mesh_scene(bands);
+    scene.spheres.push(Sphere {
+        center,
+        radius,
+        material: 0,
+    });
+    scene
+}
+
 /// The rays and their tmax as the columns a batch holds: origin x/y/z, direction x/y/z, tmax.
 fn columns_of(rays: &[(Ray, f32)]) -> [Vec<f32>; 7] {
     let col = |f: &dyn Fn(&(Ray, f32)) -> f32| rays.iter().map(f).collect::<Vec<f32>>();
@@ -433,13 +460,7 @@ fn tiny_and_empty_meshes() {
 /// which it used to miss when a direction component was −0.0 (see `geometry::obvhs_ray`).
 #[test]
 fn batch_entry_points_equal_brute_force_for_lengths_around_the_lane_width() {
-    let mut scene = mesh_scene(6);
-    scene.spheres.push(Sphere {
-        center: Vec3::new(0.0, -0.5, 0.0),
-        radius: 0.2,
-        material: 0,
-    });
-    let base = scene.triangles.len() as u32;
+    let scene = mesh_scene_with_sphere(6, Vec3::new(0.0, -0.5, 0.0), 0.2);
     let bvh = MeshBvh::new(&scene);
     let accel = Accel::new(&scene);
     assert!(accel.uses_bvh());
@@ -457,15 +478,7 @@ fn batch_entry_points_equal_brute_force_for_lengths_around_the_lane_width() {
             let (mut packet_t, mut packet_prim) = (vec![0.0; n], vec![0; n]);
             bvh.closest_hits_coherent(&scene, &cols, two_sided, &mut packet_t, &mut packet_prim);
             for (i, (r, tmax)) in rays.iter().enumerate() {
-                let (mut want_t, mut want_prim) = brute_force(&scene, r, *tmax, two_sided);
-                let mut best = if want_prim == NO_HIT { *tmax } else { want_t };
-                for (k, s) in scene.spheres.iter().enumerate() {
-                    let ts = raywave::geometry::intersect_sphere(s, r, best);
-                    if ts < best {
-                        best = ts;
-                        (want_t, want_prim) = (ts, base + k as u32);
-                    }
-                }
+                let (want_t, want_prim) = brute_force_with_spheres(&scene, r, *tmax, two_sided);
                 assert_eq!(t[i].to_bits(), want_t.to_bits(), "ray {i} {r:?}");
                 assert_eq!(prim[i], want_prim, "ray {i} {r:?}");
                 assert_eq!(
@@ -509,13 +522,7 @@ fn batch_entry_points_equal_brute_force_for_lengths_around_the_lane_width() {
 /// into otherwise coherent packets. Spheres are tested after the tree, as in `closest_hits`.
 #[test]
 fn packets_of_camera_rays_equal_brute_force() {
-    let mut scene = mesh_scene(12);
-    scene.spheres.push(Sphere {
-        center: Vec3::new(0.3, -0.6, 0.2),
-        radius: 0.25,
-        material: 0,
-    });
-    let base = scene.triangles.len() as u32;
+    let scene = mesh_scene_with_sphere(12, Vec3::new(0.3, -0.6, 0.2), 0.25);
     let bvh = MeshBvh::new(&scene);
     let camera = raywave::camera::CameraRays::new(&scene.camera, 44, 40);
     let mut rng = Rng(31);
@@ -557,25 +564,13 @@ fn packets_of_camera_rays_equal_brute_force() {
         // Into packets of coherent rays: lanes 3 of packet 2k + 1.
         rays[(2 * k + 1) * 8 + 3] = r;
     }
-    let hit = |r: &Ray, tmax: f32, two_sided: bool| {
-        let (mut t, mut prim) = brute_force(&scene, r, tmax, two_sided);
-        let mut best = if prim == NO_HIT { tmax } else { t };
-        for (k, s) in scene.spheres.iter().enumerate() {
-            let ts = raywave::geometry::intersect_sphere(s, r, best);
-            if ts < best {
-                best = ts;
-                (t, prim) = (ts, base + k as u32);
-            }
-        }
-        (t, prim)
-    };
     let (mut hits, mut queries) = (0, 0);
     for n in [0, 1, 7, 8, 9, 8 * 11 + 5, 8 * 100 + 1, rays.len()] {
         let rays = &rays[..n];
         for two_sided in [false, true] {
             let got = packet_hits(&bvh, &scene, rays, two_sided);
             for (i, (r, tmax)) in rays.iter().enumerate() {
-                let (want_t, want_prim) = hit(r, *tmax, two_sided);
+                let (want_t, want_prim) = brute_force_with_spheres(&scene, r, *tmax, two_sided);
                 let (t, prim) = got[i];
                 assert_eq!(
                     (t.to_bits(), prim),
