@@ -489,24 +489,14 @@ impl MeshBvh {
         t_out: &mut [f32],
         prim_out: &mut [u32],
     ) {
-        let base = scene.triangles.len() as u32;
         let mut stack = Stack::new(self);
         let (o, d, tmax) = cut(rays);
         let (t_out, prim_out) = (&mut t_out[..tmax.len()], &mut prim_out[..tmax.len()]);
         for i in 0..tmax.len() {
             let ray = ray_at(&o, &d, i);
-            let mut best = self.closest_in(&ray, tmax[i], two_sided, &mut stack);
-            let mut t = if best.prim == NO_HIT { tmax[i] } else { best.t };
-            for (k, s) in scene.spheres.iter().enumerate() {
-                let ts = intersect_sphere(s, &ray, t);
-                if ts < t {
-                    t = ts;
-                    best = Hit {
-                        t,
-                        prim: base + k as u32,
-                    };
-                }
-            }
+            let r = RayLanes::new(&ray);
+            let found = self.closest_from(self.root, &r, (tmax[i], NO_HIT), two_sided, &mut stack);
+            let best = with_spheres(scene, &ray, found);
             t_out[i] = best.t;
             prim_out[i] = best.prim;
         }
@@ -813,7 +803,6 @@ impl MeshBvh {
             // A tree of one leaf (or none) has nothing to share.
             return self.closest_hits(scene, rays, two_sided, t_out, prim_out);
         }
-        let base = scene.triangles.len() as u32;
         let (mut stack, mut one) = (PacketStack::new(self), Stack::new(self));
         let (o, d, tmax) = cut(rays);
         let (t_out, prim_out) = (&mut t_out[..tmax.len()], &mut prim_out[..tmax.len()]);
@@ -824,28 +813,7 @@ impl MeshBvh {
             let best =
                 self.closest_packet(&p, tmax8, (1 << live) - 1, two_sided, &mut stack, &mut one);
             for k in 0..live {
-                let (t, prim) = best.lane(k);
-                let mut best = if prim == NO_HIT {
-                    Hit::MISS
-                } else {
-                    Hit { t, prim }
-                };
-                let ray = ray_at(&o, &d, i + k);
-                let mut t = if best.prim == NO_HIT {
-                    tmax[i + k]
-                } else {
-                    best.t
-                };
-                for (s, sphere) in scene.spheres.iter().enumerate() {
-                    let ts = intersect_sphere(sphere, &ray, t);
-                    if ts < t {
-                        t = ts;
-                        best = Hit {
-                            t,
-                            prim: base + s as u32,
-                        };
-                    }
-                }
+                let best = with_spheres(scene, &ray_at(&o, &d, i + k), best.lane(k));
                 t_out[i + k] = best.t;
                 prim_out[i + k] = best.prim;
             }
@@ -894,6 +862,26 @@ static MASK_LANES: [f32x8; 256] = {
     }
     table
 };
+
+/// The closer of the tree's best (t, triangle) for a ray (`(tmax, NO_HIT)` when it found none)
+/// and the scene's spheres, tested after the tree as `Accel::closest` does (sphere ids follow
+/// the triangles'); `Hit::MISS` when neither is hit.
+#[inline(always)]
+fn with_spheres(scene: &Scene, ray: &Ray, (mut t, mut prim): (f32, u32)) -> Hit {
+    let base = scene.triangles.len() as u32;
+    for (k, s) in scene.spheres.iter().enumerate() {
+        let ts = intersect_sphere(s, ray, t);
+        if ts < t {
+            t = ts;
+            prim = base + k as u32;
+        }
+    }
+    if prim == NO_HIT {
+        Hit::MISS
+    } else {
+        Hit { t, prim }
+    }
+}
 
 /// The origin, direction and tmax columns, each cut to the number of rays, so that indexing
 /// them below that number needs no bounds checks.
