@@ -77,15 +77,23 @@ impl<'a> Reference<'a> {
             .enumerate()
             .map(|(row, out)| {
                 let mut counts = RayCounts::default();
-                for (i, px) in out.iter_mut().enumerate() {
-                    *px = self.pixel((row * w + i) as u32, &mut counts, &mut ());
-                }
+                self.pixels((row * w) as u32, out, &mut counts);
                 on_row();
                 counts
             })
             .reduce(RayCounts::default, |a, b| a + b);
         debug_assert_eq!(film.pixels.len(), w * h);
         (film, counts)
+    }
+
+    /// Pixels `first..first + out.len()` into `out`, without a trace log: the loop `render`
+    /// runs for each row. Not generic, so it is compiled once, in this crate: the
+    /// instruction-count gate (`tests/icount.rs`) calls it to count the code the renderer
+    /// runs, where a call to the generic `pixel` would count a copy compiled into the test.
+    pub fn pixels(&self, first: u32, out: &mut [Vec3], counts: &mut RayCounts) {
+        for (i, px) in out.iter_mut().enumerate() {
+            *px = self.pixel(first + i as u32, counts, &mut ());
+        }
     }
 
     /// The colour of one pixel: the mean over its antialiasing samples.
