@@ -377,34 +377,20 @@ impl MeshBvh {
     /// Closest triangle hit in (T_MIN, tmax): `Hit::MISS` when none. The same t bits and
     /// triangle as testing every triangle with `intersect_triangle` in index order.
     pub fn closest_triangle(&self, ray: &Ray, tmax: f32, two_sided: bool) -> Hit {
-        self.closest_in(ray, tmax, two_sided, &mut Stack::new(self))
-    }
-
-    /// [`Self::closest_triangle`] with a stack from the caller: zeroing 8 KB per ray cost more
-    /// than a whole traversal.
-    #[inline]
-    fn closest_in(&self, ray: &Ray, tmax: f32, two_sided: bool, stack: &mut Stack) -> Hit {
-        let (best_t, best_prim) = self.closest_from(
+        let r = RayLanes::new(ray);
+        hit(self.closest_from(
             self.root,
-            &RayLanes::new(ray),
+            &r,
             (tmax, NO_HIT),
             two_sided,
-            stack,
-        );
-        if best_prim == NO_HIT {
-            Hit::MISS
-        } else {
-            Hit {
-                t: best_t,
-                prim: best_prim,
-            }
-        }
+            &mut Stack::new(self),
+        ))
     }
 
     /// The closest hit of one ray in the subtree `start`, given the best (t, triangle) found
-    /// so far (`(tmax, NO_HIT)` for none): the better of the two, as a pair. Inlined into
-    /// both callers: called through a reference to a `RayLanes` in memory, one-ray traversal
-    /// took 8% more instructions (callgrind, incoherent rays).
+    /// so far (`(tmax, NO_HIT)` for none): the better of the two, as a pair. Inlined into its
+    /// callers: as a call per ray it ran the primary set at 15 Mrays/s instead of 22, and with
+    /// 12% more instructions (callgrind, incoherent rays; docs/PERFORMANCE.md).
     #[inline(always)]
     fn closest_from(
         &self,
@@ -901,6 +887,12 @@ fn with_spheres(scene: &Scene, ray: &Ray, (mut t, mut prim): (f32, u32)) -> Hit 
             prim = base + k as u32;
         }
     }
+    hit((t, prim))
+}
+
+/// A traversal's best (t, triangle) as a `Hit`: `Hit::MISS` when it found none.
+#[inline(always)]
+fn hit((t, prim): (f32, u32)) -> Hit {
     if prim == NO_HIT {
         Hit::MISS
     } else {
