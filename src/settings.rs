@@ -16,6 +16,17 @@ pub enum ShadowMode {
     Soft,
 }
 
+/// How a light's colour reaches a shaded point.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum LightModel {
+    /// The lab's: Lc = 0.2·ke·area, with no fall-off with distance.
+    #[default]
+    Lab,
+    /// RPI's framework: Lc = 0.2·ke·area divided by π·d², d the distance to the light point.
+    Rpi,
+}
+
 /// Everything that decides the image, apart from the scene.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RenderSettings {
@@ -39,6 +50,9 @@ pub struct RenderSettings {
     pub seed: u32,
     /// Let faces be hit from behind too (normals then face the ray).
     pub two_sided: bool,
+    /// How light falls off with distance (records saved before it existed read as the lab's).
+    #[serde(default)]
+    pub light_model: LightModel,
 }
 
 impl Default for RenderSettings {
@@ -55,6 +69,7 @@ impl Default for RenderSettings {
             background: [1.0, 1.0, 1.0],
             seed: 0,
             two_sided: false,
+            light_model: LightModel::Lab,
         }
     }
 }
