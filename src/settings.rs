@@ -53,6 +53,15 @@ pub struct RenderSettings {
     /// How light falls off with distance (records saved before it existed read as the lab's).
     #[serde(default)]
     pub light_model: LightModel,
+    /// The ambient light: every hit gets ambient ⊙ kd (the lab fixes it at 0.2 grey; RPI's
+    /// `-ambient_light r g b` sets it).
+    #[serde(default = "lab_ambient")]
+    pub ambient: [f32; 3],
+}
+
+/// The lab's fixed ambient light, 0.2 grey.
+fn lab_ambient() -> [f32; 3] {
+    [crate::shading::AMBIENT; 3]
 }
 
 impl Default for RenderSettings {
@@ -70,6 +79,7 @@ impl Default for RenderSettings {
             seed: 0,
             two_sided: false,
             light_model: LightModel::Lab,
+            ambient: lab_ambient(),
         }
     }
 }
