@@ -3,16 +3,22 @@
 //!
 //! Conventions (the lab's): faces are one-sided, hit only from the front (n·d < 0, n from the
 //! counter-clockwise winding) unless `two_sided`; spheres are hit from both sides and report the
-//! outward normal; a hit needs t > `T_MIN`. A miss returns `f32::INFINITY`, never `None`, and any
-//! NaN in the input makes a miss (every test is written so that NaN compares false).
+//! outward normal; a hit needs t > `T_MIN` = 0. A miss returns `f32::INFINITY`, never `None`, and
+//! any NaN in the input makes a miss (every test is written so that NaN compares false).
+//!
+//! There is no self-intersection epsilon on t: an absolute one is wrong at some scale (the lab's
+//! 1e-4 is 5% of a box scaled by 1e-3, and less than the error of a hit point in a box scaled by
+//! 10). Instead hit points are put back on their surface and secondary rays start a bound on that
+//! error away from it (`crate::spawn`), and the sphere test is the numerically stable one.
 
 use crate::scene::{LightShape, NO_HIT, Scene, Sphere, Triangle};
 use glam::{Vec3, Vec3A};
 use obvhs::{BvhBuildParams, cwbvh::CwBvh, ray::RayHit};
 use std::time::Duration;
 
-/// The lab's self-intersection epsilon: a hit needs t > 1e-4.
-pub const T_MIN: f32 = 1e-4;
+/// Where a ray's interval starts: a hit needs t > 0. Secondary rays avoid the surface they leave
+/// by where they start (`crate::spawn`), not by a minimum distance.
+pub const T_MIN: f32 = 0.0;
 
 /// Slack on the barycentric edge tests (u ≥ −ε, v ≥ −ε, u + v ≤ 1 + ε), so that a ray crossing
 /// the edge two triangles share (a quad's a–c diagonal) hits at least one of them: without it,
@@ -83,36 +89,33 @@ pub fn intersect_triangle(tri: &Triangle, ray: &Ray, tmax: f32, two_sided: bool)
 }
 
 /// Nearest root of |o + t·d − c|² = r² with t in (T_MIN, tmax), or infinity.
+///
+/// The numerically stable form (Haines et al., *Ray Tracing Gems* ch. 7): the discriminant is
+/// taken from the ray's perpendicular distance to the centre, f = oc − (b/a)·d, as
+/// a·(r² − f·f), which keeps its precision when the eye is far from a small sphere (b² − a·c
+/// loses it all: the lab's camera ray landed 4e-5 inside a sphere of radius 0.3), and the roots
+/// are c/q and q/a with q = −(b + sign(b)·√disc), which never subtracts nearly equal numbers.
 #[inline]
 #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(x >= 0)` is on purpose: NaN must miss
 pub fn intersect_sphere(sphere: &Sphere, ray: &Ray, tmax: f32) -> f32 {
     let oc = ray.origin - sphere.center;
     let a = ray.direction.length_squared();
     let b = oc.dot(ray.direction);
-    let c = oc.length_squared() - sphere.radius * sphere.radius;
-    let disc = b * b - a * c;
+    let f = oc - (b / a) * ray.direction;
+    let r2 = sphere.radius * sphere.radius;
+    let disc = a * (r2 - f.length_squared());
     if !(disc >= 0.0) {
         return f32::INFINITY;
     }
-    let root = disc.sqrt();
-    let near = (-b - root) / a;
-    let far = (-b + root) / a;
+    let q = -(b + disc.sqrt().copysign(b));
+    let c = oc.length_squared() - r2;
+    let (t0, t1) = (c / q, q / a);
+    let (near, far) = if t0 < t1 { (t0, t1) } else { (t1, t0) };
     let t = if near > T_MIN { near } else { far };
     if t > T_MIN && t < tmax {
         t
     } else {
         f32::INFINITY
-    }
-}
-
-/// Unit normal at a hit, before any flipping for two-sided faces.
-pub fn geometric_normal(scene: &Scene, prim: u32, point: Vec3) -> Vec3 {
-    let p = prim as usize;
-    if p < scene.triangles.len() {
-        scene.triangles[p].normal
-    } else {
-        let s = &scene.spheres[p - scene.triangles.len()];
-        (point - s.center) / s.radius
     }
 }
 

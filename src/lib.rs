@@ -20,6 +20,7 @@ pub mod sampling;
 pub mod scene;
 pub mod settings;
 pub mod shading;
+pub mod spawn;
 pub mod stats;
 pub mod variance;
 pub mod wavefront;

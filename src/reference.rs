@@ -14,11 +14,14 @@
 
 use crate::camera::CameraRays;
 use crate::film::Film;
-use crate::geometry::{Accel, Hit, Ray, T_MIN, geometric_normal};
+use crate::geometry::{Accel, Hit, Ray};
 use crate::sampling::{SampleKey, square_sample};
 use crate::scene::Scene;
 use crate::settings::{RenderSettings, ShadowMode};
-use crate::shading::{AMBIENT, reflect, shade};
+use crate::shading::shade;
+use crate::spawn::{
+    SurfaceHit, falloff, light_end, light_offset, mirror_ray, shadow_ray, surface_hit,
+};
 use crate::stats::RayCounts;
 use glam::Vec3;
 use rayon::prelude::*;
@@ -49,6 +52,8 @@ pub struct Reference<'a> {
     settings: &'a RenderSettings,
     accel: Accel,
     camera: CameraRays,
+    /// `spawn::light_offset` of every light.
+    light_offsets: Vec<f32>,
 }
 
 impl<'a> Reference<'a> {
@@ -59,6 +64,7 @@ impl<'a> Reference<'a> {
             settings,
             accel: Accel::new(scene),
             camera: CameraRays::new(&scene.camera, settings.width, settings.height),
+            light_offsets: scene.lights.iter().map(light_offset).collect(),
         }
     }
 
@@ -129,21 +135,17 @@ impl<'a> Reference<'a> {
         if !hit.is_hit() {
             return self.settings.background();
         }
-        let point = ray.origin + hit.t * ray.direction;
-        let mut n = geometric_normal(self.scene, hit.prim, point);
+        let mut surface = surface_hit(self.scene, hit.prim, ray, hit.t);
         if self.settings.two_sided
             && (hit.prim as usize) < self.scene.triangles.len()
-            && n.dot(ray.direction) > 0.0
+            && surface.normal.dot(ray.direction) > 0.0
         {
-            n = -n;
+            surface.normal = -surface.normal;
         }
         let material = self.scene.material_of(hit.prim);
-        let mut color = AMBIENT * material.diffuse;
+        let mut color = Vec3::from_array(self.settings.ambient) * material.diffuse;
         if material.is_reflective() && key.bounce < self.settings.bounces {
-            let next = Ray {
-                origin: point,
-                direction: reflect(ray.direction, n),
-            };
+            let next = mirror_ray(&surface, ray.direction);
             counts.reflection += 1;
             let bounced = SampleKey {
                 bounce: key.bounce + 1,
@@ -151,16 +153,13 @@ impl<'a> Reference<'a> {
             };
             color += material.reflective * self.trace(&next, bounced, counts, log);
         }
-        color + self.direct(point, n, -ray.direction, material, key, counts, log)
+        color + self.direct(&surface, -ray.direction, material, key, counts, log)
     }
 
     /// Σ over lights and their N points of Shade / N for the visible points.
-    #[allow(clippy::too_many_arguments)]
-    #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(x > T_MIN)` is on purpose: NaN skips
     fn direct(
         &self,
-        point: Vec3,
-        n: Vec3,
+        surface: &SurfaceHit,
         e: Vec3,
         material: &crate::scene::Material,
         key: SampleKey,
@@ -176,6 +175,8 @@ impl<'a> Reference<'a> {
                 light: li as u32,
                 ..key
             };
+            let end_offset = self.light_offsets[li];
+            let end = light_end(light, end_offset, surface.point);
             for j in 0..count {
                 let target = match settings.shadows {
                     ShadowMode::Soft => {
@@ -184,36 +185,32 @@ impl<'a> Reference<'a> {
                     }
                     _ => light.centroid,
                 };
-                let to_light = target - point;
-                // The point must lie more than T_MIN above the tangent plane: for a light's own
-                // points (and coplanar lights) n·l is 0 up to rounding, and a rounding-positive
-                // n·l would add the 0.2·ke term as a speckle.
-                if !(n.dot(to_light) > T_MIN) {
+                let Some(shadow) = shadow_ray(surface, target, end, end_offset) else {
                     continue;
-                }
-                let dist = to_light.length();
-                let l = to_light / dist;
-                let n_dot_l = n.dot(l);
+                };
+                let from = shadow.ray.origin;
                 let visible = match settings.shadows {
                     ShadowMode::Off => {
-                        log.shadow_ray(key.bounce, li as u32, point, target, None);
+                        log.shadow_ray(key.bounce, li as u32, from, target, None);
                         true
                     }
                     _ => {
                         counts.shadow += 1;
-                        let ray = Ray {
-                            origin: point,
-                            direction: l,
-                        };
-                        let blocked =
-                            self.accel
-                                .occluded(self.scene, &ray, dist - T_MIN, settings.two_sided);
-                        log.shadow_ray(key.bounce, li as u32, point, target, Some(blocked));
+                        let blocked = self.accel.occluded(
+                            self.scene,
+                            &shadow.ray,
+                            shadow.tmax,
+                            settings.two_sided,
+                        );
+                        log.shadow_ray(key.bounce, li as u32, from, target, Some(blocked));
                         !blocked
                     }
                 };
                 if visible {
-                    sum += shade(material, n, e, l, n_dot_l, light.color) * weight;
+                    let light_color = light.color * falloff(settings.light_model, shadow.tmax);
+                    let l = shadow.ray.direction;
+                    sum +=
+                        shade(material, surface.normal, e, l, shadow.n_dot_l, light_color) * weight;
                 }
             }
         }

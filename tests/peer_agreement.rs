@@ -135,19 +135,30 @@ fn wavefront_equals_obvhs_one_ray() {
 #[test]
 fn agreement_counts_edges_and_real_differences() {
     let a = Hits {
-        t: vec![1.0, 2.0, f32::INFINITY, 3.0, 4.0, 5.0],
-        prim: vec![0, 1, NO_HIT, 3, 4, 5],
+        t: vec![1.0, 2.0, f32::INFINITY, 3.0, 4.0, 5.0, 1e-6, 1e-4],
+        prim: vec![0, 1, NO_HIT, 3, 4, 5, 6, 7],
     };
     let b = Hits {
         // same; shared edge (other prim, same t); both miss; other prim far away;
-        // a hit against a miss; same prim.
-        t: vec![1.0, 2.0 + 1e-5, f32::INFINITY, 3.5, f32::INFINITY, 5.0],
-        prim: vec![0, 9, NO_HIT, 7, NO_HIT, 5],
+        // a hit against a miss; same prim; a miss against a hit at t ≈ 0 (a ray from an
+        // edge); a miss against a hit that is not near the origin.
+        t: vec![
+            1.0,
+            2.0 + 1e-5,
+            f32::INFINITY,
+            3.5,
+            f32::INFINITY,
+            5.0,
+            f32::INFINITY,
+            f32::INFINITY,
+        ],
+        prim: vec![0, 9, NO_HIT, 7, NO_HIT, 5, NO_HIT, NO_HIT],
     };
     let agreement = hit_agreement(&a, &b);
-    assert_eq!(agreement.rays, 6);
-    assert_eq!(agreement.agree, 4);
+    assert_eq!(agreement.rays, 8);
+    assert_eq!(agreement.agree, 5);
     assert_eq!(agreement.same_t_other_prim, 1);
+    assert_eq!(agreement.near_origin, 1);
     let o = occlusion_agreement(&[true, false, true], &[true, true, true]);
     assert_eq!((o.rays, o.agree), (3, 2));
 }

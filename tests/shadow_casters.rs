@@ -7,8 +7,9 @@ mod common;
 
 use common::Rng;
 use glam::Vec3;
-use raywave::geometry::{Accel, Ray, T_MIN, intersect_sphere, intersect_triangle, shadow_casters};
+use raywave::geometry::{Accel, Ray, intersect_sphere, intersect_triangle, shadow_casters};
 use raywave::scene::{Scene, parse_scene_str};
+use raywave::spawn::{SurfaceHit, light_end, light_offset, shadow_ray};
 use std::fmt::Write;
 use std::path::Path;
 
@@ -80,15 +81,27 @@ fn a_face_is_kept_exactly_when_it_can_block() {
     // faces it, not by its back.
     let from = Vec3::new(0.1, 0.0, 0.2);
     let to = Vec3::new(0.0, 2.0, 0.0);
-    let ray = Ray {
-        origin: from,
-        direction: (to - from).normalize(),
-    };
-    let tmax = (to - from).length() - T_MIN;
+    let (ray, tmax) = segment(&down, from, to);
     assert!(Accel::new(&down).occluded(&down, &ray, tmax, false));
     assert!(!Accel::new(&up).occluded(&up, &ray, tmax, false));
     // Two-sided, both block.
     assert!(Accel::new(&up).occluded(&up, &ray, tmax, true));
+}
+
+/// The renderers' shadow ray from `from` to `to` on the scene's first light (`spawn`): it
+/// ends off the light's plane, on `from`'s side. (`from` is no surface point here: the normal
+/// is taken along the ray, with no offset at the start.)
+fn segment(scene: &Scene, from: Vec3, to: Vec3) -> (Ray, f32) {
+    let light = &scene.lights[0];
+    let start = SurfaceHit {
+        point: from,
+        normal: (to - from).normalize(),
+        offset: 0.0,
+    };
+    let end_offset = light_offset(light);
+    let end = light_end(light, end_offset, from);
+    let s = shadow_ray(&start, to, end, end_offset).expect("a segment to the light");
+    (s.ray, s.tmax)
 }
 
 /// Random triangles in a cube of half-size 2, a random parallelogram light and a sphere.
@@ -130,19 +143,15 @@ fn culling_changes_only_rounding_hits_on_the_light_points_plane() {
         for _ in 0..500 {
             let from = rng.point(2.5);
             let to = light.point(rng.next(), rng.next());
-            let dist = (to - from).length();
-            let ray = Ray {
-                origin: from,
-                direction: (to - from) / dist,
-            };
-            let tmax = dist - T_MIN;
+            let (ray, tmax) = segment(&scene, from, to);
+            let dist = tmax;
             let expected = blocked_unculled(&scene, &ray, tmax);
             let culled_blocked = accel.occluded(&scene, &ray, tmax, false);
             if culled_blocked != expected {
                 // Culling only removes faces, so it can only unblock a ray, and only where the
                 // brute force's hit is rounding: within 1e-5 of the light point, measured along
                 // the face's normal (p is rounded on the light's plane; at a grazing angle that
-                // becomes a hit just before p, in (T_MIN, tmax)).
+                // becomes a hit just before p, in (0, tmax)).
                 assert!(expected && !culled_blocked);
                 let rounding_only = scene.triangles.iter().all(|t| {
                     let th = intersect_triangle(t, &ray, tmax, false);
@@ -214,11 +223,7 @@ fn far_geometry_does_not_cull_a_box_beside_the_light() {
     let mut blocked = 0;
     for (u, v) in [(0.1, 0.5), (0.5, 0.5), (0.9, 0.5), (0.5, 0.1), (0.5, 0.9)] {
         let to = light.point(u, v);
-        let ray = Ray {
-            origin: from,
-            direction: (to - from).normalize(),
-        };
-        let tmax = (to - from).length() - T_MIN;
+        let (ray, tmax) = segment(&scene, from, to);
         let expected = blocked_unculled(&scene, &ray, tmax);
         assert_eq!(accel.occluded(&scene, &ray, tmax, false), expected);
         blocked += expected as u32;

@@ -14,6 +14,7 @@ use raywave::geometry::{self, Accel, Ray, intersect_sphere, intersect_triangle, 
 use raywave::sampling::{LightSampler, SampleKey, square_sample, strata_grid, uniform};
 use raywave::scene::{Light, LightShape, Material, NO_HIT, Scene, Sphere, Triangle};
 use raywave::shading::shade;
+use raywave::spawn::{SurfaceHit, shadow_ray};
 use raywave::wavefront::context::MaterialTerms;
 use raywave::wavefront::shadow::{key_prefix, shade_terms};
 use raywave::wavefront::simd::{self, BlockSampler, LightBlock, RayColumns, lanes};
@@ -29,8 +30,8 @@ fn edge_rays() -> Vec<Ray> {
         ray([0.25, 0.25, 1.0], [0.0, 0.0, -1.0]), // axis-aligned, straight through
         ray([0.25, 0.25, -1.0], [0.0, 0.0, 1.0]), // from behind
         ray([0.25, 0.25, 0.0], [0.0, 0.0, -1.0]), // starting on the surface
-        ray([0.25, 0.25, 5e-5], [0.0, 0.0, -1.0]), // just inside T_MIN
-        ray([0.25, 0.25, 2e-4], [0.0, 0.0, -1.0]), // just past T_MIN
+        ray([0.25, 0.25, 5e-5], [0.0, 0.0, -1.0]), // close above the surface
+        ray([0.25, 0.25, 1e-30], [0.0, 0.0, -1.0]), // a tiny distance above
         ray([-1.0, 0.25, 0.0], [1.0, 0.0, 0.0]),  // grazing, in the plane
         ray([-1.0, 0.25, 1e-7], [1.0, 0.0, -1e-7]), // nearly grazing
         ray([0.0, 0.0, 1.0], [0.0, 0.0, -1.0]),   // through a corner
@@ -369,7 +370,7 @@ proptest! {
         n in vec3(), e in vec3(), l in vec3(), lc in vec3(),
     ) {
         let m = Material { diffuse: kd.abs(), reflective: kr.abs(), emitted: ke.abs(), glossiness: g };
-        let terms = MaterialTerms::new(&m);
+        let terms = MaterialTerms::new(&m, Vec3::splat(raywave::shading::AMBIENT));
         let (n, e, l) = (n.normalize_or(Vec3::Z), e.normalize_or(Vec3::Z), l.normalize_or(Vec3::Z));
         let ndl = n.dot(l);
         prop_assume!(ndl > 0.0);
@@ -386,16 +387,18 @@ proptest! {
         n in vec3(), e in vec3(), ls in proptest::collection::vec(vec3(), 8), lc in vec3(),
         weight in prop_oneof![Just(1.0f32), Just(1.0 / 64.0), 0.001f32..1.0],
         blocked_bits in prop_oneof![Just(0u32), any::<u32>()],
+        falloffs in prop_oneof![Just(vec![1.0f32; 8]), proptest::collection::vec(0.001f32..100.0, 8)],
     ) {
         let m = Material { diffuse: kd.abs(), reflective: kr.abs(), emitted: ke.abs(), glossiness: g };
-        let terms = MaterialTerms::new(&m);
+        let terms = MaterialTerms::new(&m, Vec3::splat(raywave::shading::AMBIENT));
         let (n, e) = (n.normalize_or(Vec3::Z), e.normalize_or(Vec3::Z));
         let ls: Vec<Vec3> = ls.iter().map(|l| l.normalize_or(Vec3::Z)).collect();
         let col = |f: fn(Vec3) -> f32| ls.iter().map(|&l| f(l)).collect::<Vec<f32>>();
         let (lx, ly, lz) = (col(|l| l.x), col(|l| l.y), col(|l| l.z));
         let ndl: Vec<f32> = ls.iter().map(|&l| n.dot(l)).collect();
         let blocked: Vec<bool> = (0..8).map(|k| blocked_bits & (1 << k) != 0).collect();
-        let got = simd::shade8(&terms, n, e, [&lx, &ly, &lz], &ndl, &blocked, lc.abs(), weight);
+        let falloff: [f32; 8] = std::array::from_fn(|k| falloffs[k]);
+        let got = simd::shade8(&terms, n, e, [&lx, &ly, &lz], &ndl, &blocked, lc.abs(), &falloff, weight);
         for k in 0..8 {
             if !(ndl[k] > 0.0) || blocked[k] {
                 // Adds nothing: exactly −0.0, the identity of addition.
@@ -403,7 +406,7 @@ proptest! {
                     [(-0.0f32).to_bits(); 3]);
                 continue;
             }
-            let want = shade_terms(&terms, n, e, ls[k], ndl[k], lc.abs()) * weight;
+            let want = shade_terms(&terms, n, e, ls[k], ndl[k], lc.abs() * falloff[k]) * weight;
             prop_assert_eq!([got[0][k], got[1][k], got[2][k]].map(f32::to_bits),
                 want.to_array().map(f32::to_bits), "lane {}", k);
         }
@@ -414,6 +417,8 @@ proptest! {
         pixel in any::<u32>(), sample in 0u32..4, bounce in 0u32..6, light in 0u32..3, seed in any::<u32>(),
         count in 1u32..80, which in 0usize..4,
         origin in vec3(), edge_u in vec3(), edge_v in vec3(), point in vec3(), n in vec3(),
+        offset in prop_oneof![Just(0.0f32), 0.0f32..0.01], end in vec3(),
+        end_offset in prop_oneof![Just(0.0f32), 0.0f32..0.01],
     ) {
         let key = SampleKey { pixel, sample, bounce, light, seed };
         // The prefix trick: hash(key, dim) = mix32(prefix ^ dim).
@@ -454,23 +459,23 @@ proptest! {
             };
             let pts = simd::light_points8(&block);
             let lanes = ((count - j0) as usize).min(8);
-            let (l, tmax, ndl, live) = simd::shadow_rays8(point, n, &pts, lanes);
+            let hit = SurfaceHit { point, normal: n, offset };
+            let end = end * 0.01;
+            let (from, l, tmax, ndl, live) = simd::shadow_rays8(&hit, &pts, end, end_offset, lanes);
             for k in 0..lanes {
                 let (u, v) = square_sample(sampler, &key, j0 + k as u32, count);
                 let target = lamp.point(u, v);
                 prop_assert_eq!([pts[0][k], pts[1][k], pts[2][k]].map(f32::to_bits),
                     target.to_array().map(f32::to_bits));
-                let to_light = target - point;
-                let dist = to_light.length();
-                let want_l = to_light / dist;
-                let want_ndl = n.dot(want_l);
-                let alive = n.dot(to_light) > raywave::geometry::T_MIN;
-                prop_assert_eq!(live & (1 << k) != 0, alive);
-                if alive {
+                let want = shadow_ray(&hit, target, end, end_offset);
+                prop_assert_eq!(live & (1 << k) != 0, want.is_some());
+                if let Some(want) = want {
+                    prop_assert_eq!(from.to_array().map(f32::to_bits),
+                        want.ray.origin.to_array().map(f32::to_bits));
                     prop_assert_eq!([l[0][k], l[1][k], l[2][k]].map(f32::to_bits),
-                        want_l.to_array().map(f32::to_bits));
-                    prop_assert_eq!(tmax[k].to_bits(), (dist - raywave::geometry::T_MIN).to_bits());
-                    prop_assert_eq!(ndl[k].to_bits(), want_ndl.to_bits());
+                        want.ray.direction.to_array().map(f32::to_bits));
+                    prop_assert_eq!(tmax[k].to_bits(), want.tmax.to_bits());
+                    prop_assert_eq!(ndl[k].to_bits(), want.n_dot_l.to_bits());
                 } else {
                     prop_assert_eq!((tmax[k], ndl[k]), (0.0, 0.0));
                 }

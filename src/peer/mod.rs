@@ -26,8 +26,9 @@
 pub mod embree;
 
 use crate::camera::CameraRays;
-use crate::geometry::{Ray, T_MIN, intersect_triangle, obvhs_ray};
+use crate::geometry::{Ray, intersect_triangle, obvhs_ray};
 use crate::scene::{NO_HIT, Scene};
+use crate::spawn::surface_hit;
 use crate::wavefront::batch::{HitBatch, PathId, RayBatch};
 use crate::wavefront::bvh::MeshBvh;
 use crate::wavefront::context::Context;
@@ -185,14 +186,32 @@ impl RaySets {
             if prim == NO_HIT {
                 continue;
             }
-            let point = batch.origin(i) + t * batch.direction(i);
+            let ray = Ray {
+                origin: batch.origin(i),
+                direction: batch.direction(i),
+            };
+            let hit = surface_hit(scene, prim, &ray, t);
+            // Every ray leaves the surface on the side it goes to, as the renderers' do, but
+            // `LEAVE` off it: these are benchmark inputs, and a random direction grazing a
+            // curved mesh meets the next triangle at t ≈ 1e-6, where the engines' box tests
+            // legitimately differ.
+            let leave = |direction: Vec3| {
+                let side = if direction.dot(hit.normal) >= 0.0 {
+                    LEAVE
+                } else {
+                    -LEAVE
+                };
+                hit.point + side * hit.normal
+            };
             if !scene.lights.is_empty() {
                 let light = &scene.lights[rng.below(scene.lights.len())];
                 let target = light.point(rng.unit(), rng.unit());
-                let to_light = target - point;
+                let to_light = target - hit.point;
                 let dist = to_light.length();
-                if dist > 2.0 * T_MIN {
-                    shadow.push(point, to_light / dist, dist - T_MIN);
+                if dist > 2.0 * LEAVE {
+                    let l = to_light / dist;
+                    let origin = leave(l);
+                    shadow.push(origin, l, (target - origin).length() - LEAVE);
                 }
             }
             // Uniform on the sphere: z uniform in [-1, 1], azimuth uniform.
@@ -200,21 +219,23 @@ impl RaySets {
             let phi = std::f32::consts::TAU * rng.unit();
             let r = (1.0 - z * z).max(0.0).sqrt();
             let direction = Vec3::new(r * phi.cos(), r * phi.sin(), z);
-            incoherent.push(point, direction, f32::INFINITY);
+            incoherent.push(leave(direction), direction, f32::INFINITY);
             if hit_index.is_multiple_of(8) && !scene.lights.is_empty() {
                 let light = &scene.lights[fan_rng.below(scene.lights.len())];
+                // One origin for the block: on the side of the light's centre.
+                let origin = leave(light.centroid - hit.point);
                 for _ in 0..8 {
                     let target = light.point(fan_rng.unit(), fan_rng.unit());
-                    let to_light = target - point;
+                    let to_light = target - hit.point;
                     let dist = to_light.length();
                     // A dead lane (tmax 0) keeps the block aligned; no engine reports a hit
-                    // in (1e-4, 0).
-                    let (l, tmax) = if dist > 2.0 * T_MIN {
-                        (to_light / dist, dist - T_MIN)
+                    // in (0, 0).
+                    let (l, tmax) = if dist > 2.0 * LEAVE {
+                        (to_light / dist, (target - origin).length() - LEAVE)
                     } else {
                         (Vec3::Z, 0.0)
                     };
-                    shadow_fan.push(point, l, tmax);
+                    shadow_fan.push(origin, l, tmax);
                 }
             }
             hit_index += 1;
@@ -237,6 +258,10 @@ impl RaySets {
         ]
     }
 }
+
+/// How far off its surface a ray of the benchmark sets starts, and short of the light a
+/// shadow segment ends: the lab's 1e-4, the scale of the generated mesh scenes.
+const LEAVE: f32 = 1e-4;
 
 /// A small, fixed-seed generator (SplitMix64): the ray sets must not depend on `rand`'s
 /// version or platform.
@@ -454,6 +479,8 @@ pub struct Agreement {
     pub agree: usize,
     /// Of those, rays that hit different triangles at the same distance (a shared edge).
     pub same_t_other_prim: usize,
+    /// Of those, rays that one side saw hit within `NEAR_ORIGIN_T` and the other miss.
+    pub near_origin: usize,
 }
 
 impl Agreement {
@@ -476,14 +503,23 @@ impl Agreement {
 /// on their shared edge.
 pub const EDGE_T_TOLERANCE: f32 = 1e-4;
 
-/// Closest hits agree when both miss, both name the same triangle, or both hit at distances
-/// within `EDGE_T_TOLERANCE · max(1, t)` (two triangles sharing the edge the ray crosses).
+/// Under this distance a hit that one engine reports and the other misses counts as agreeing:
+/// a ray that starts on the edge where two faces meet (a camera ray hit the box's corner) lies
+/// on the other face's plane up to rounding and meets it at t ≈ 1e-7 or not at all; obvhs's slab
+/// test and an exact triangle test legitimately differ there (7 of 6,084 incoherent rays of the
+/// mesh test scene).
+pub const NEAR_ORIGIN_T: f32 = 1e-5;
+
+/// Closest hits agree when both miss, both name the same triangle, both hit at distances
+/// within `EDGE_T_TOLERANCE · max(1, t)` (two triangles sharing the edge the ray crosses), or
+/// one misses and the other hits within `NEAR_ORIGIN_T` of the origin.
 pub fn hit_agreement(a: &Hits, b: &Hits) -> Agreement {
     assert_eq!(a.t.len(), b.t.len(), "hit lists of different lengths");
     let mut agreement = Agreement {
         rays: a.t.len(),
         agree: 0,
         same_t_other_prim: 0,
+        near_origin: 0,
     };
     for i in 0..a.t.len() {
         let (pa, pb) = (a.prim[i], b.prim[i]);
@@ -495,6 +531,9 @@ pub fn hit_agreement(a: &Hits, b: &Hits) -> Agreement {
         {
             agreement.agree += 1;
             agreement.same_t_other_prim += 1;
+        } else if (pa == NO_HIT) != (pb == NO_HIT) && a.t[i].min(b.t[i]) < NEAR_ORIGIN_T {
+            agreement.agree += 1;
+            agreement.near_origin += 1;
         }
     }
     agreement
@@ -507,5 +546,6 @@ pub fn occlusion_agreement(a: &[bool], b: &[bool]) -> Agreement {
         rays: a.len(),
         agree: a.iter().zip(b).filter(|(x, y)| x == y).count(),
         same_t_other_prim: 0,
+        near_origin: 0,
     }
 }

@@ -8,11 +8,11 @@
 //! - neither (umbra, lights seen edge-on, the background) otherwise.
 
 use crate::camera::CameraRays;
-use crate::geometry::{Accel, Ray, T_MIN, geometric_normal};
+use crate::geometry::Accel;
 use crate::sampling::{LightSampler, SampleKey, square_sample};
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
-use crate::shading::reflect;
+use crate::spawn::{light_end, light_offset, mirror_ray, shadow_ray, surface_hit};
 use rayon::prelude::*;
 
 /// Per-pixel region membership.
@@ -66,13 +66,12 @@ fn classify(
             break;
         }
         any_hit = true;
-        let point = ray.origin + hit.t * ray.direction;
-        let mut n = geometric_normal(scene, hit.prim, point);
+        let mut surface = surface_hit(scene, hit.prim, &ray, hit.t);
         if settings.two_sided
             && (hit.prim as usize) < scene.triangles.len()
-            && n.dot(ray.direction) > 0.0
+            && surface.normal.dot(ray.direction) > 0.0
         {
-            n = -n;
+            surface.normal = -surface.normal;
         }
         for (li, light) in scene.lights.iter().enumerate() {
             let key = SampleKey {
@@ -82,23 +81,15 @@ fn classify(
                 light: li as u32,
                 seed: 0x6d61_736b,
             };
+            let end_offset = light_offset(light);
+            let end = light_end(light, end_offset, surface.point);
             let mut visible = 0;
             for j in 0..points {
                 let (u, v) = square_sample(LightSampler::Stratified, &key, j, points);
-                let to = light.point(u, v) - point;
-                let dist = to.length();
-                let l = to / dist;
-                // Above the tangent plane by more than T_MIN, as in the renderers.
-                if n.dot(to) > T_MIN
-                    && !accel.occluded(
-                        scene,
-                        &Ray {
-                            origin: point,
-                            direction: l,
-                        },
-                        dist - T_MIN,
-                        settings.two_sided,
-                    )
+                // Spawned as the renderers spawn it: no ray below the tangent plane.
+                let shadow = shadow_ray(&surface, light.point(u, v), end, end_offset);
+                if shadow
+                    .is_some_and(|s| !accel.occluded(scene, &s.ray, s.tmax, settings.two_sided))
                 {
                     visible += 1;
                 }
@@ -114,10 +105,7 @@ fn classify(
         if !material.is_reflective() {
             break;
         }
-        ray = Ray {
-            origin: point,
-            direction: reflect(ray.direction, n),
-        };
+        ray = mirror_ray(&surface, ray.direction);
     }
     // Without lights nothing is lit (every light fully visible would be vacuously true).
     (penumbra, lit && any_hit && !scene.lights.is_empty())

@@ -5,6 +5,7 @@
 //! Buffers are allocated once per worker and reused (`clear` keeps the capacity), so the memory
 //! of a render is bounded by the batch size, not by the image.
 
+use crate::spawn::SurfaceHit;
 use glam::Vec3;
 
 /// Paths in flight at one depth: their current ray and what they carry.
@@ -142,7 +143,7 @@ pub struct HitBatch {
     pub t: Vec<f32>,
     /// Global primitive id; `NO_HIT` for a miss.
     pub prim: Vec<u32>,
-    /// Hit point x (origin + t·direction).
+    /// Hit point x (origin + t·direction, put back on the surface: `spawn::surface_hit`).
     pub point_x: Vec<f32>,
     /// Hit point y.
     pub point_y: Vec<f32>,
@@ -154,6 +155,8 @@ pub struct HitBatch {
     pub normal_y: Vec<f32>,
     /// Normal z.
     pub normal_z: Vec<f32>,
+    /// How far off the surface secondary rays start (`spawn::SurfaceHit::offset`).
+    pub offset: Vec<f32>,
     /// Material index (0 for a miss, unused).
     pub material: Vec<u32>,
     /// Σ lights Σ points Shade/N of the visible light points, red.
@@ -175,6 +178,7 @@ impl HitBatch {
         self.normal_x.resize(n, 0.0);
         self.normal_y.resize(n, 0.0);
         self.normal_z.resize(n, 0.0);
+        self.offset.resize(n, 0.0);
         self.material.resize(n, 0);
         self.direct_r.resize(n, 0.0);
         self.direct_g.resize(n, 0.0);
@@ -191,6 +195,16 @@ impl HitBatch {
     #[inline]
     pub fn normal(&self, i: usize) -> Vec3 {
         Vec3::new(self.normal_x[i], self.normal_y[i], self.normal_z[i])
+    }
+
+    /// Hit `i` as the spawn functions take it.
+    #[inline]
+    pub fn surface(&self, i: usize) -> SurfaceHit {
+        SurfaceHit {
+            point: self.point(i),
+            normal: self.normal(i),
+            offset: self.offset[i],
+        }
     }
 
     /// Direct light gathered at hit `i`.
@@ -211,7 +225,7 @@ impl HitBatch {
 pub struct ShadowQueue {
     /// Entries in use.
     pub len: usize,
-    /// Origin x (the hit point).
+    /// Origin x (the hit point, offset off its surface).
     pub origin_x: Vec<f32>,
     /// Origin y.
     pub origin_y: Vec<f32>,
@@ -223,7 +237,7 @@ pub struct ShadowQueue {
     pub direction_y: Vec<f32>,
     /// Direction z.
     pub direction_z: Vec<f32>,
-    /// Distance to the light point minus T_MIN (0 for a dead lane).
+    /// Distance to the end of the shadow ray (`spawn::ShadowRay::tmax`; 0 for a dead lane).
     pub tmax: Vec<f32>,
     /// n·l; the entry is a ray only when it is > 0.
     pub n_dot_l: Vec<f32>,

@@ -769,8 +769,9 @@ impl MeshBvh {
                         }
                         let take_lanes = MASK_LANES[take as usize];
                         best.t = take_lanes.select(t, best.t);
-                        // next_up(t) as bits + 1: t > T_MIN > 0 here, and finite (t < limit).
-                        const _: () = assert!(T_MIN > 0.0);
+                        // next_up(t) as bits + 1: t > T_MIN ≥ 0 here (so t is positive, not
+                        // −0.0), and finite (t < limit).
+                        const _: () = assert!(T_MIN >= 0.0);
                         let up: f32x8 = wide::bytemuck::cast(
                             wide::bytemuck::cast::<f32x8, wide::u32x8>(t) + wide::u32x8::ONE,
                         );

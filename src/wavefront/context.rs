@@ -9,6 +9,9 @@ use crate::sampling::{LightSampler, SOBOL_SEED_DIM, SampleKey, hash, strata_grid
 use crate::scene::{LightShape, Material, Scene, Triangle};
 use crate::settings::{RenderSettings, ShadowMode};
 use crate::shading::AMBIENT;
+use crate::spawn::{
+    SurfaceHit, light_offset, on_plane, on_sphere, sphere_offset, triangle_offset, triangle_plane,
+};
 use glam::Vec3;
 use std::time::Duration;
 
@@ -24,7 +27,7 @@ pub struct MaterialTerms {
     pub diffuse: Vec3,
     /// kr.
     pub reflective: Vec3,
-    /// AMBIENT · kd: what every hit gets.
+    /// ambient ⊙ kd: what every hit gets.
     pub ambient: Vec3,
     /// AMBIENT · ke: Shade's first term.
     pub ambient_emitted: Vec3,
@@ -37,12 +40,12 @@ pub struct MaterialTerms {
 }
 
 impl MaterialTerms {
-    /// The terms of `m`.
-    pub fn new(m: &Material) -> MaterialTerms {
+    /// The terms of `m` under the ambient light `ambient`.
+    pub fn new(m: &Material, ambient: Vec3) -> MaterialTerms {
         MaterialTerms {
             diffuse: m.diffuse,
             reflective: m.reflective,
-            ambient: AMBIENT * m.diffuse,
+            ambient: ambient * m.diffuse,
             ambient_emitted: AMBIENT * m.emitted,
             specular: 0.8 * m.reflective,
             shininess: m.shininess(),
@@ -60,14 +63,20 @@ pub struct LightTerms {
     pub centroid: Vec3,
     /// (corner, edge_u, edge_v) when the light is a parallelogram.
     pub parallelogram: Option<(Vec3, Vec3, Vec3)>,
+    /// `spawn::light_offset`: how far off the light shadow rays end.
+    pub end_offset: f32,
 }
 
-/// What the intersect stage reads of a hit triangle: its normal and material, 16 bytes where
-/// `Triangle` is 56, so a hit's lookup touches one cache line of a 3.5× denser array.
+/// What the intersect stage reads of a hit triangle: its normal, plane, offset and material,
+/// 24 bytes where `Triangle` is 56, so a hit's lookup touches one cache line of a denser array.
 #[derive(Clone, Copy, Debug)]
 pub struct TriangleShading {
     /// `Triangle::normal`.
     pub normal: Vec3,
+    /// `spawn::triangle_plane`: the hit point is put back on this plane.
+    pub plane: f32,
+    /// `spawn::triangle_offset`.
+    pub offset: f32,
     /// `Triangle::material`.
     pub material: u32,
 }
@@ -108,7 +117,12 @@ impl<'a> Context<'a> {
     pub fn new(scene: &'a Scene, settings: &'a RenderSettings) -> Self {
         let accel = (scene.triangles.len() >= BVH_MIN_TRIANGLES).then(|| MeshBvh::new(scene));
         let bvh_build_time = accel.as_ref().map_or(Duration::ZERO, |a| a.build_time);
-        let materials = scene.materials.iter().map(MaterialTerms::new).collect();
+        let ambient = Vec3::from_array(settings.ambient);
+        let materials = scene
+            .materials
+            .iter()
+            .map(|m| MaterialTerms::new(m, ambient))
+            .collect();
         let lights = scene
             .lights
             .iter()
@@ -123,6 +137,7 @@ impl<'a> Context<'a> {
                     } => Some((origin, edge_u, edge_v)),
                     LightShape::Fan { .. } => None,
                 },
+                end_offset: light_offset(l),
             })
             .collect();
         let points_per_light = settings.points_per_light();
@@ -146,6 +161,8 @@ impl<'a> Context<'a> {
                 .iter()
                 .map(|t| TriangleShading {
                     normal: t.normal,
+                    plane: triangle_plane(t),
+                    offset: triangle_offset(t),
                     material: t.material,
                 })
                 .collect(),
@@ -201,16 +218,32 @@ impl<'a> Context<'a> {
         self.settings.sampler == LightSampler::Stratified
     }
 
-    /// Geometric normal (front side, as `geometry::geometric_normal`) and material index of
-    /// primitive `prim` hit at `point`.
+    /// The hit on primitive `prim` at `p0` (origin + t·direction), put back on its surface,
+    /// and its material index: `spawn::surface_hit` from this context's tables.
     #[inline]
-    pub fn surface(&self, prim: u32, point: Vec3) -> (Vec3, u32) {
+    pub fn surface(&self, prim: u32, p0: Vec3) -> (SurfaceHit, u32) {
         let p = prim as usize;
         match self.triangle_shading.get(p) {
-            Some(t) => (t.normal, t.material),
+            Some(t) => (
+                SurfaceHit {
+                    point: on_plane(p0, t.normal, t.plane),
+                    normal: t.normal,
+                    offset: t.offset,
+                },
+                t.material,
+            ),
             None => {
                 let s = &self.scene.spheres[p - self.triangle_shading.len()];
-                ((point - s.center) / s.radius, s.material)
+                let (point, normal) = on_sphere(p0, s);
+                let offset = sphere_offset(s);
+                (
+                    SurfaceHit {
+                        point,
+                        normal,
+                        offset,
+                    },
+                    s.material,
+                )
             }
         }
     }

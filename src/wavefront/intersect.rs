@@ -1,5 +1,5 @@
-//! Stage 2, intersect: the closest hit of every ray, then what shading needs at it (point,
-//! normal flipped for two-sided faces, material).
+//! Stage 2, intersect: the closest hit of every ray, then what shading needs at it (point put
+//! back on its surface, normal flipped for two-sided faces, offset, material).
 //!
 //! Small scenes (below `BVH_MIN_TRIANGLES` triangles) go through the 8-wide kernel over every
 //! primitive; meshes go through the engine's 8-wide BVH (`bvh::MeshBvh`): camera rays in
@@ -90,6 +90,7 @@ pub fn closest(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch) {
         &mut hits.normal_y[..n],
         &mut hits.normal_z[..n],
     );
+    let offset = &mut hits.offset[..n];
     let material = &mut hits.material[..n];
     for i in 0..n {
         let prim = prims[i];
@@ -97,13 +98,14 @@ pub fn closest(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch) {
             continue;
         }
         let d = Vec3::new(dx[i], dy[i], dz[i]);
-        let point = Vec3::new(ox[i], oy[i], oz[i]) + t[i] * d;
-        let (mut normal, m) = ctx.surface(prim, point);
+        let (hit, m) = ctx.surface(prim, Vec3::new(ox[i], oy[i], oz[i]) + t[i] * d);
+        let mut normal = hit.normal;
         if two_sided && (prim as usize) < scene.triangles.len() && normal.dot(d) > 0.0 {
             normal = -normal;
         }
-        (px[i], py[i], pz[i]) = (point.x, point.y, point.z);
+        (px[i], py[i], pz[i]) = (hit.point.x, hit.point.y, hit.point.z);
         (nx[i], ny[i], nz[i]) = (normal.x, normal.y, normal.z);
+        offset[i] = hit.offset;
         material[i] = m;
     }
 }

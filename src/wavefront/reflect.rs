@@ -4,7 +4,7 @@
 use super::batch::{HitBatch, RayBatch};
 use super::context::Context;
 use crate::scene::NO_HIT;
-use crate::shading::reflect;
+use crate::spawn::mirror_ray;
 
 /// Fills `next` (depth `rays.bounce + 1`) and returns how many mirror rays it holds.
 pub fn mirror_rays(ctx: &Context, rays: &RayBatch, hits: &HitBatch, next: &mut RayBatch) -> u64 {
@@ -20,10 +20,10 @@ pub fn mirror_rays(ctx: &Context, rays: &RayBatch, hits: &HitBatch, next: &mut R
         if !m.is_reflective {
             continue;
         }
-        let direction = reflect(rays.direction(i), hits.normal(i));
+        let ray = mirror_ray(&hits.surface(i), rays.direction(i));
         next.push(
-            hits.point(i),
-            direction,
+            ray.origin,
+            ray.direction,
             rays.throughput(i) * m.reflective,
             rays.path(i),
         );

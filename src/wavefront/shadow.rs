@@ -2,7 +2,8 @@
 //!
 //! ```text
 //! for each group of hits whose shadow rays fit the queue:
-//!     spawn:   for hit, for light, for point j < N:  l, dist, n·l;  queue it if n·l > 0
+//!     spawn:   for hit, for light, for point j < N:  the shadow ray of `spawn::shadow_ray`
+//!              (l, dist, n·l), queued when the point is above the tangent plane
 //!     occlude: 8 queued rays at a time, stop at the first blocker; small scenes test only the
 //!              triangles that can shadow a light (`geometry::shadow_casters`), meshes go one
 //!              ray at a time through `bvh::MeshBvh`, 8 boxes or 8 triangles per test
@@ -20,9 +21,10 @@
 use super::batch::{HitBatch, RayBatch, ShadowQueue};
 use super::context::{Context, MaterialTerms};
 use super::simd::{self, LANES, LightBlock, RayColumns};
-use crate::geometry::{T_MIN, casters};
+use crate::geometry::casters;
 use crate::sampling::{SampleKey, mix32, square_sample};
 use crate::scene::NO_HIT;
+use crate::spawn::{falloff, light_end, shadow_ray};
 use glam::Vec3;
 
 /// The hash state of a SampleKey before its dimension is mixed in: `sampling::hash(key, dim)`
@@ -84,8 +86,7 @@ fn spawn(
         return 0;
     }
     let mut cast = 0;
-    let point = hits.point(i);
-    let n = hits.normal(i);
+    let hit = hits.surface(i);
     let count = ctx.points_per_light;
     for (li, light) in ctx.lights.iter().enumerate() {
         let key = SampleKey {
@@ -95,6 +96,7 @@ fn spawn(
             light: li as u32,
             seed: ctx.settings.seed,
         };
+        let end = light_end(&ctx.scene.lights[li], light.end_offset, hit.point);
         match (
             ctx.samples_lights() && ctx.simd_light_sampling(),
             light.parallelogram,
@@ -111,9 +113,10 @@ fn spawn(
                 for j0 in (0..count).step_by(LANES) {
                     let target = simd::light_points8(&LightBlock { j0, ..block });
                     let lanes = ((count - j0) as usize).min(LANES);
-                    let (l, tmax, n_dot_l, live) = simd::shadow_rays8(point, n, &target, lanes);
+                    let (from, l, tmax, n_dot_l, live) =
+                        simd::shadow_rays8(&hit, &target, end, light.end_offset, lanes);
                     if live != 0 {
-                        queue.push_block(point, &l, &tmax, &n_dot_l, i as u32, li as u32);
+                        queue.push_block(from, &l, &tmax, &n_dot_l, i as u32, li as u32);
                         cast += live.count_ones() as u64;
                     }
                 }
@@ -126,13 +129,9 @@ fn spawn(
                     } else {
                         light.centroid
                     };
-                    let to_light = target - point;
-                    let dist = to_light.length();
-                    let l = to_light / dist;
-                    let n_dot_l = n.dot(l);
-                    // Above the tangent plane by more than T_MIN, as in the reference.
-                    if n.dot(to_light) > T_MIN {
-                        queue.push(point, l, dist - T_MIN, n_dot_l, i as u32, li as u32);
+                    if let Some(s) = shadow_ray(&hit, target, end, light.end_offset) {
+                        let l = s.ray.direction;
+                        queue.push(s.ray.origin, l, s.tmax, s.n_dot_l, i as u32, li as u32);
                         cast += 1;
                     }
                 }
@@ -189,6 +188,8 @@ fn shade(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch, queue: &ShadowQueu
         {
             let i = queue.path[q] as usize;
             let m = &ctx.materials[hits.material[i] as usize];
+            let model = ctx.settings.light_model;
+            let falloffs = std::array::from_fn(|k| falloff(model, queue.tmax[q + k]));
             let c = simd::shade8(
                 m,
                 hits.normal(i),
@@ -201,6 +202,7 @@ fn shade(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch, queue: &ShadowQueu
                 &queue.n_dot_l[q..end],
                 &queue.blocked[q..end],
                 ctx.lights[queue.light[q] as usize].color,
+                &falloffs,
                 weight,
             );
             // In lane order, like the reference's loop; lanes that add nothing hold −0.0.
@@ -217,7 +219,8 @@ fn shade(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch, queue: &ShadowQueu
         if !queue.blocked[q] && queue.n_dot_l[q] > 0.0 {
             let i = queue.path[q] as usize;
             let m = &ctx.materials[hits.material[i] as usize];
-            let light_color = ctx.lights[queue.light[q] as usize].color;
+            let light_color = ctx.lights[queue.light[q] as usize].color
+                * falloff(ctx.settings.light_model, queue.tmax[q]);
             let c = shade_terms(
                 m,
                 hits.normal(i),

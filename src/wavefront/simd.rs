@@ -21,6 +21,7 @@
 use super::context::MaterialTerms;
 use crate::geometry::{EDGE_EPSILON, T_MIN};
 use crate::scene::{NO_HIT, Sphere, Triangle};
+use crate::spawn::SurfaceHit;
 use glam::Vec3;
 use wide::{f32x8, i32x8, u32x8};
 
@@ -243,31 +244,52 @@ fn triangle8_blocks(tri: &Triangle, r: &Rays8, tmax: f32x8, two_sided: bool) -> 
     moller_trumbore8_blocks(&TriangleLanes::splat_triangle(tri, r), tmax, two_sided)
 }
 
-/// Ray–sphere for 8 rays; lane k equals `intersect_sphere(sphere, ray_k, tmax_k)`.
+/// Ray–sphere for 8 rays; lane k equals `intersect_sphere(sphere, ray_k, tmax_k)`: the stable
+/// form, see there.
 ///
 /// ```text
-/// oc = o − c; a = d·d; b = oc·d; c = oc·oc − r²; disc = b² − a·c
-/// near = (−b − √disc)/a; far = (−b + √disc)/a; t = near > T_MIN ? near : far
-/// hit = disc ≥ 0 ∧ T_MIN < t < tmax   → t, else ∞
+/// oc = o − c; a = d·d; b = oc·d; f = oc − (b/a)·d; disc = a·(r² − f·f)
+/// q = −(b + sign(b)·√disc); t0 = (oc·oc − r²)/q; t1 = q/a; near, far = sorted(t0, t1)
+/// t = near > T_MIN ? near : far;  hit = disc ≥ 0 ∧ T_MIN < t < tmax   → t, else ∞
 /// ```
 #[inline(always)]
 pub fn sphere8(s: &Sphere, r: &Rays8, tmax: f32x8) -> f32x8 {
+    let (oc, a, b, disc) = sphere8_disc(s, r);
+    let ok = disc.simd_ge(f32x8::ZERO);
+    let root = disc.sqrt();
+    // copysign(√disc, b): the sign bit of b on the magnitude of √disc.
+    let sign = f32x8::splat(-0.0);
+    let signed_root = (root & !sign) | (b & sign);
+    let q = -(b + signed_root);
+    let r2 = f32x8::splat(s.radius * s.radius);
+    let c = (oc[0] * oc[0] + oc[1] * oc[1] + oc[2] * oc[2]) - r2;
+    let t0 = c / q;
+    let t1 = q / a;
+    let first = t0.simd_lt(t1);
+    let near = first.select(t0, t1);
+    let far = first.select(t1, t0);
+    let t_min = f32x8::splat(T_MIN);
+    let t = near.simd_gt(t_min).select(near, far);
+    let hit = ok & t.simd_gt(t_min) & t.simd_lt(tmax);
+    hit.select(t, f32x8::splat(f32::INFINITY))
+}
+
+/// oc, a, b and the stable discriminant a·(r² − f·f) of 8 rays against `s`, in
+/// `intersect_sphere`'s operations.
+#[inline(always)]
+fn sphere8_disc(s: &Sphere, r: &Rays8) -> ([f32x8; 3], f32x8, f32x8, f32x8) {
     let ocx = r.ox - f32x8::splat(s.center.x);
     let ocy = r.oy - f32x8::splat(s.center.y);
     let ocz = r.oz - f32x8::splat(s.center.z);
     let a = r.dx * r.dx + r.dy * r.dy + r.dz * r.dz;
     let b = ocx * r.dx + ocy * r.dy + ocz * r.dz;
-    let c = (ocx * ocx + ocy * ocy + ocz * ocz) - f32x8::splat(s.radius * s.radius);
-    let disc = b * b - a * c;
-    let ok = disc.simd_ge(f32x8::ZERO);
-    let root = disc.sqrt();
-    let nb = -b;
-    let near = (nb - root) / a;
-    let far = (nb + root) / a;
-    let t_min = f32x8::splat(T_MIN);
-    let t = near.simd_gt(t_min).select(near, far);
-    let hit = ok & t.simd_gt(t_min) & t.simd_lt(tmax);
-    hit.select(t, f32x8::splat(f32::INFINITY))
+    let k = b / a;
+    let fx = ocx - k * r.dx;
+    let fy = ocy - k * r.dy;
+    let fz = ocz - k * r.dz;
+    let r2 = f32x8::splat(s.radius * s.radius);
+    let disc = a * (r2 - (fx * fx + fy * fy + fz * fz));
+    ([ocx, ocy, ocz], a, b, disc)
 }
 
 /// Closest hit of every ray against every primitive, in the reference's order (triangles by
@@ -376,17 +398,10 @@ fn occluded8(
 
 /// The lanes `s` blocks: `sphere8(..) < tmax`, but returning early when no lane's
 /// discriminant is ≥ 0 (most shadow rays miss most spheres; that skips the square root and
-/// both divisions).
+/// the last two divisions).
 #[inline(always)]
 fn sphere8_blocks(s: &Sphere, r: &Rays8, tmax: f32x8) -> u32 {
-    let ocx = r.ox - f32x8::splat(s.center.x);
-    let ocy = r.oy - f32x8::splat(s.center.y);
-    let ocz = r.oz - f32x8::splat(s.center.z);
-    let a = r.dx * r.dx + r.dy * r.dy + r.dz * r.dz;
-    let b = ocx * r.dx + ocy * r.dy + ocz * r.dz;
-    let c = (ocx * ocx + ocy * ocy + ocz * ocz) - f32x8::splat(s.radius * s.radius);
-    let disc = b * b - a * c;
-    if disc.simd_ge(f32x8::ZERO).none() {
+    if sphere8_disc(s, r).3.simd_ge(f32x8::ZERO).none() {
         return 0;
     }
     sphere8(s, r, tmax).simd_lt(tmax).to_bitmask()
@@ -585,33 +600,37 @@ fn parallelogram_points8(
     ]
 }
 
-/// Shadow rays from `point` (normal `n`) to 8 targets, the first `lanes` of them real: unit
-/// directions l, tmax = dist − T_MIN and n·l, each lane equal to the reference's
-/// `to_light = target − point; dist = |to_light|; l = to_light / dist; n·l`. Lanes whose
-/// target is not more than T_MIN above the tangent plane (n·to_light ≤ T_MIN: the reference
-/// casts no ray) or past `lanes` come back dead: tmax = 0, n·l = 0.
-/// Also returns the bitmask of live lanes.
+/// Shadow rays from `hit` to 8 light points, the first `lanes` of them real: lane k equals
+/// `spawn::shadow_ray(hit, target_k, end, end_offset)` (origin `hit.offset` off the surface,
+/// unit direction l, tmax the distance to `target + end`, and n·l). Lanes whose point is not
+/// above the tangent plane by more than the two offsets (the twin returns `None`) or past
+/// `lanes` come back dead: tmax = 0, n·l = 0. Also returns the origin and the bitmask of live
+/// lanes.
 #[inline]
 #[allow(clippy::type_complexity)]
 pub fn shadow_rays8(
-    point: Vec3,
-    n: Vec3,
+    hit: &SurfaceHit,
     target: &[[f32; LANES]; 3],
+    end: Vec3,
+    end_offset: f32,
     lanes: usize,
-) -> ([[f32; LANES]; 3], [f32; LANES], [f32; LANES], u32) {
-    let x = f32x8::new(target[0]) - f32x8::splat(point.x);
-    let y = f32x8::new(target[1]) - f32x8::splat(point.y);
-    let z = f32x8::new(target[2]) - f32x8::splat(point.z);
+) -> (Vec3, [[f32; LANES]; 3], [f32; LANES], [f32; LANES], u32) {
+    let n = hit.normal;
+    let origin = hit.point + hit.offset * n;
+    let x = (f32x8::new(target[0]) + f32x8::splat(end.x)) - f32x8::splat(origin.x);
+    let y = (f32x8::new(target[1]) + f32x8::splat(end.y)) - f32x8::splat(origin.y);
+    let z = (f32x8::new(target[2]) + f32x8::splat(end.z)) - f32x8::splat(origin.z);
+    let above = f32x8::splat(n.x) * x + f32x8::splat(n.y) * y + f32x8::splat(n.z) * z;
     let dist = (x * x + y * y + z * z).sqrt();
     let (lx, ly, lz) = (x / dist, y / dist, z / dist);
     let n_dot_l = f32x8::splat(n.x) * lx + f32x8::splat(n.y) * ly + f32x8::splat(n.z) * lz;
     let first = f32x8::new(LANE_INDEX).simd_lt(f32x8::splat(lanes as f32));
-    let above = f32x8::splat(n.x) * x + f32x8::splat(n.y) * y + f32x8::splat(n.z) * z;
-    let live = above.simd_gt(f32x8::splat(T_MIN)) & first;
+    let live = above.simd_gt(f32x8::splat(hit.offset + end_offset)) & first;
     let zero = f32x8::ZERO;
     (
+        origin,
         [lx.to_array(), ly.to_array(), lz.to_array()],
-        live.select(dist - f32x8::splat(T_MIN), zero).to_array(),
+        live.select(dist, zero).to_array(),
         live.select(n_dot_l, zero).to_array(),
         live.to_bitmask(),
     )
@@ -632,16 +651,23 @@ pub fn shade8(
     n_dot_l: &[f32],
     blocked: &[bool],
     light_color: Vec3,
+    falloff: &[f32; LANES],
     weight: f32,
 ) -> [[f32; LANES]; 3] {
     let ndl = load(n_dot_l, 0, 0.0);
+    // Each lane's light colour Lc · falloff (`spawn::falloff`: exactly Lc in the lab's model).
+    let f = f32x8::new(*falloff);
+    let lc = [
+        f32x8::splat(light_color.x) * f,
+        f32x8::splat(light_color.y) * f,
+        f32x8::splat(light_color.z) * f,
+    ];
     let open = f32x8::new(std::array::from_fn(|k| if blocked[k] { 0.0 } else { 1.0 }));
     let adds = ndl.simd_gt(f32x8::ZERO) & open.simd_gt(f32x8::ZERO);
     let nothing = f32x8::splat(-0.0);
-    let lit = light_color * m.diffuse;
-    let cr = f32x8::splat(m.ambient_emitted.x) + f32x8::splat(lit.x) * ndl;
-    let cg = f32x8::splat(m.ambient_emitted.y) + f32x8::splat(lit.y) * ndl;
-    let cb = f32x8::splat(m.ambient_emitted.z) + f32x8::splat(lit.z) * ndl;
+    let cr = f32x8::splat(m.ambient_emitted.x) + lc[0] * f32x8::splat(m.diffuse.x) * ndl;
+    let cg = f32x8::splat(m.ambient_emitted.y) + lc[1] * f32x8::splat(m.diffuse.y) * ndl;
+    let cb = f32x8::splat(m.ambient_emitted.z) + lc[2] * f32x8::splat(m.diffuse.z) * ndl;
     let positive = m.shininess > 0.0;
     let w = f32x8::splat(weight);
     if positive && !m.is_reflective {
@@ -669,12 +695,14 @@ pub fn shade8(
     }
     let on = f32x8::new(with_highlight).simd_gt(f32x8::ZERO);
     let s = f32x8::new(spec) * ndl;
-    let sc = light_color * m.specular;
-    let add = |c: f32x8, sc: f32| adds.select(on.select(c + f32x8::splat(sc) * s, c) * w, nothing);
+    let sc = m.specular;
+    let add = |c: f32x8, lc: f32x8, sc: f32| {
+        adds.select(on.select(c + lc * f32x8::splat(sc) * s, c) * w, nothing)
+    };
     [
-        add(cr, sc.x).to_array(),
-        add(cg, sc.y).to_array(),
-        add(cb, sc.z).to_array(),
+        add(cr, lc[0], sc.x).to_array(),
+        add(cg, lc[1], sc.y).to_array(),
+        add(cb, lc[2], sc.z).to_array(),
     ]
 }
 
