@@ -188,12 +188,13 @@ pub fn shadow_ray(hit: &SurfaceHit, target: Vec3, end: Vec3, end_offset: f32) ->
     })
 }
 
-/// The factor on a light's colour Lc for a light point at distance `dist`: 1 in the lab's
-/// model, 1/(π·d²) in RPI's.
+/// The factor on a light's colour Lc = 0.2·ke·area for a light point at distance `dist`: 1 in
+/// the lab's model; in RPI's, whose light colour is ke·area/(π·d²) (its `raytracer.cpp` has no
+/// 0.2), 1/(0.2·π·d²).
 #[inline]
 pub fn falloff(model: LightModel, dist: f32) -> f32 {
     match model {
         LightModel::Lab => 1.0,
-        LightModel::Rpi => 1.0 / (std::f32::consts::PI * dist * dist),
+        LightModel::Rpi => 1.0 / (0.2 * std::f32::consts::PI * dist * dist),
     }
 }

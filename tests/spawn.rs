@@ -66,10 +66,10 @@ fn mirror_and_shadow_rays_leave_a_sphere_at_every_scale() {
             }
             // A light point anywhere above the tangent plane, near or far, grazing or not.
             let target = hit.point + rng.direction() * (s * 4.0 * rng.next());
-            if let Some(shadow) = shadow_ray(&hit, target, Vec3::ZERO, 0.0) {
-                if intersect_sphere(&sphere, &shadow.ray, shadow.tmax) < shadow.tmax {
-                    shadow_rehits += 1;
-                }
+            if let Some(shadow) = shadow_ray(&hit, target, Vec3::ZERO, 0.0)
+                && intersect_sphere(&sphere, &shadow.ray, shadow.tmax) < shadow.tmax
+            {
+                shadow_rehits += 1;
             }
         }
         assert!(hits > RAYS / 2, "scale {s}: only {hits} camera hits");
@@ -239,10 +239,10 @@ fn two_sided_faces_do_not_shadow_themselves_or_their_other_half() {
                 self_hits += 1;
             }
             let target = surface.point + rng.direction() * (3.0 * s);
-            if let Some(shadow) = shadow_ray(&surface, target, Vec3::ZERO, 0.0) {
-                if accel.occluded(&scene, &shadow.ray, shadow.tmax, true) {
-                    self_hits += 1;
-                }
+            if let Some(shadow) = shadow_ray(&surface, target, Vec3::ZERO, 0.0)
+                && accel.occluded(&scene, &shadow.ray, shadow.tmax, true)
+            {
+                self_hits += 1;
             }
         }
         assert_eq!(self_hits, 0, "scale {s}: rays met the quad they left");
