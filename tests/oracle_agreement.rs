@@ -31,7 +31,7 @@ const SCALES: [f32; 5] = [1e-3, 1e-1, 1.0, 10.0, 1e3];
 /// The largest fraction of a case's pixels the ambiguity rule may exclude.
 const MAX_EXCLUDED: f64 = 0.02;
 /// Image size of the matrix: small enough for 120 cases, large enough for the 2% cap to bite.
-const SIZE: (u32, u32) = (96, 96);
+const SIZE: (u32, u32) = (128, 128);
 
 /// Every `scenes/*.obj`, by file name.
 fn scenes() -> Vec<(String, Scene)> {

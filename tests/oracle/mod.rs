@@ -5,11 +5,22 @@
 //! used. Slow (every ray tests every primitive of the clusters it can reach) and meant to be
 //! obviously right.
 //!
+//! # The model
+//! trace(ray) = background on a miss; else ambient⊙kd + kr⊙trace(mirror ray) (if kr ≠ 0 and
+//! bounces remain) + Σ lights Σ_{j<N} Shade(l_j)/N over the points with n·l > 0 that are
+//! visible (every such point when shadows are off; the area centroid alone when hard), with
+//! Shade(l) = 0.2·ke + Lc⊙kd·(n·l) + Lc⊙(0.8·kr)·max(0, e·r)^(5/(g + 0.01))·(n·l),
+//! r = normalize(2(n·l)n − l), e = −ray direction. Lc is the light's colour (lab) or that divided
+//! by π·d², d the distance to the light point (RPI). The ambient light comes from the settings;
+//! the surface's own emission 0.2·ke does not depend on it or on the light model.
+//!
 //! # Exact semantics
 //! Camera rays count hits at t > 0. A secondary ray starts exactly at its hit point and never
 //! hits the surface it leaves, except that a ray leaving a sphere into it meets its far side at
 //! t = −2(oc·d)/(d·d). A shadow ray to p at distance d is blocked by a hit with 0 < t < d. Light
 //! counts only where n·l > 0. Ties go to the lowest primitive id (triangles, then spheres).
+//! Faces are hit from the front only (n from the counter-clockwise winding) unless two-sided,
+//! where the shading normal faces the ray; spheres from both sides, with the outward normal.
 //!
 //! f64 is exact enough to decide all of this except on the boundaries themselves, which the
 //! oracle handles in two bands, both relative to the scene's size L (its bounding-box diagonal):
@@ -22,11 +33,14 @@
 //!
 //! # The ambiguity rule
 //! A pixel is excluded from comparison when either:
-//! 1. **a discrete decision is close** (margin below `DECISION_MARGIN` = 1e-5) anywhere in its
-//!    path tree: a ray within 1e-5 (barycentric) of a hit or near-hit triangle's edge, within
-//!    1e-5·r of a sphere's silhouette, meeting a one-sided face at |cos| < 1e-5, two hits of
-//!    different primitives within 1e-5·L of each other, a blocker within 1e-5·L of either end of
-//!    a shadow segment, or |n·l| < 1e-5 where that light sample is worth more than `TOLERANCE`/8;
+//! 1. **a discrete decision is close** anywhere in its path tree, camera, mirror and shadow rays
+//!    alike: a ray within 1e-5 (barycentric) of the edge of a triangle it hits or nearly hits
+//!    (edges shared by two triangles of the same polygon do not count: crossing them changes
+//!    nothing), within 1e-5·r of a sphere's silhouette, meeting a one-sided face at
+//!    |cos| < 1e-5; two hits of different primitives within 1e-5·L of each other, or exactly
+//!    tied unless both belong to one polygon; a hit or a blocker within 1e-5·L of the ray's
+//!    origin or of its light point; or |n·l| < 1e-5 where that light sample is worth more than
+//!    `TOLERANCE`/8 (a surface's own emission rides on that decision);
 //! 2. **it is ill-conditioned**: re-rendering it with every camera ray turned by
 //!    `CAMERA_JITTER` = 1e-6 rad (four times: ±right, ±up) moves some channel by more than
 //!    `CONDITIONING` = 5e-4. The engines' camera rays and hit points are f32, about 2e-7 off in
@@ -37,6 +51,8 @@
 //!
 //! Callers must cap how many pixels are excluded (the agreement test fails above 2%).
 #![allow(dead_code)]
+// `!(x <= limit)` is on purpose: a NaN counts as beyond the limit.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
@@ -226,7 +242,7 @@ impl OracleImage {
                 None => counts.push((r, 1)),
             }
         }
-        counts.sort_by(|a, b| b.1.cmp(&a.1));
+        counts.sort_by_key(|&(_, c)| std::cmp::Reverse(c));
         counts
     }
 }
@@ -667,7 +683,8 @@ impl<'a> Oracle<'a> {
             if c.t > best + near {
                 continue;
             }
-            if c.hit && c.t <= best + zero && !same_polygon(c.prim, chosen.unwrap()) {
+            let tied = c.hit && c.t <= best + zero;
+            if tied && c.prim != chosen.unwrap() && !same_polygon(c.prim, chosen.unwrap()) {
                 // Coincident surfaces: the lowest id is the rule, but f32 engines see
                 // whichever rounds nearer.
                 check.flag("an exact tie between different surfaces");
