@@ -2,10 +2,13 @@
 //! sphere (a penumbra). Its exact value is 0.2·kd + Lc⊙kd·I, where I is the light-averaged
 //! n·l over the visible part of the light; this file computes I independently on a fine grid
 //! with its own segment–sphere test. Then, for each sampler, the mean over many seeds of the
-//! reference's N = 4 estimate must match I, and a high-N estimate, within ~5 standard errors
-//! taken from the sample variance. A pentagonal light checks the fan sampler the same way.
+//! reference's N = 4 estimate must match I, and the f64 oracle's high-N estimate
+//! (tests/oracle/mod.rs), within ~5 standard errors of the mean taken from the sample variance. A pentagonal light checks the fan sampler the same way.
+
+mod oracle;
 
 use glam::{DVec3, Vec3};
+use oracle::Oracle;
 use raywave::reference::Reference;
 use raywave::sampling::LightSampler;
 use raywave::scene::{Scene, parse_scene_str};
@@ -125,6 +128,21 @@ fn mean_and_se(scene: &Scene, sampler: LightSampler, n: u32, seeds: u32) -> (f64
     (m, (var / xs.len() as f64).sqrt())
 }
 
+/// The f64 oracle's estimate of I for `n` stratified points, as (mean, standard error of the
+/// mean) over `seeds` seeds: the converged value, from an evaluator independent of the engines.
+fn oracle_mean_and_se(scene: &Scene, n: u32, seeds: u32) -> (f64, f64) {
+    let lc = 0.2 * KE * scene.lights[0].area as f64;
+    let xs: Vec<f64> = (0..seeds)
+        .map(|seed| {
+            let s = settings(LightSampler::Stratified, n, seed);
+            (Oracle::new(scene, &s).pixel(0).x - 0.2 * KD) / (lc * KD)
+        })
+        .collect();
+    let m = xs.iter().sum::<f64>() / xs.len() as f64;
+    let var = xs.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (xs.len() - 1) as f64;
+    (m, (var / xs.len() as f64).sqrt())
+}
+
 /// |a − b| within `k` combined standard errors, with a float-rounding floor of 1e-5.
 fn agree(what: &str, (a, se_a): (f64, f64), (b, se_b): (f64, f64), k: f64) {
     let bound = k * (se_a * se_a + se_b * se_b).sqrt() + 1e-5;
@@ -159,8 +177,8 @@ fn check_unbiased(scene: &Scene, exact: (f64, f64), max_se_ratio: f64) {
     agree("stratified N=6 vs exact", odd, truth, 5.0);
     let prime = mean_and_se(scene, LightSampler::Stratified, 7, seeds);
     agree("stratified N=7 vs exact", prime, truth, 5.0);
-    // A high-N estimate: stratified N = 1024 over a few seeds.
-    let high = mean_and_se(scene, LightSampler::Stratified, 1024, 16);
+    // A high-N estimate from the f64 oracle: stratified N = 1024 over a few seeds.
+    let high = oracle_mean_and_se(scene, 1024, 16);
     agree("stratified N=4 vs N=1024", stratified, high, 5.0);
     agree("N=1024 vs exact", high, truth, 5.0);
     eprintln!(
