@@ -149,11 +149,11 @@ impl RenderArgs {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Defaults {
-    /// raywave's own: `RenderSettings::default()`, the lab's third run line at 512×512.
+    /// raywave's own, the lab's third run line: 512×512, 5 bounces, soft shadows (16 points).
     Raywave,
-    /// The lab's ArgParser (`DefaultValues`): chosen by the lab's single-dash spellings.
+    /// The lab's ArgParser: 100×100, 0 bounces, hard shadows, white background.
     Lab,
-    /// RPI's 2023 ArgParser (`ArgParser::DefaultValues`): chosen by its double-dash spellings.
+    /// RPI's 2023 ArgParser: 500×500, 0 bounces, no shadow test, ambient 0.1, RPI's light model.
     Rpi,
 }
 
@@ -352,7 +352,12 @@ impl ImageArgs {
         let shadow_samples = match (self.shadow_samples, shadows) {
             (Some(n), _) => n,
             (None, ShadowMode::Soft) => {
-                pick(None, d.shadow_samples, "shadow samples", &mut defaulted)
+                // The lab's and RPI's count, 0, is no count: theirs is raywave's too.
+                let name = match defaults {
+                    Defaults::Raywave => "shadow samples",
+                    _ => "shadow samples (raywave's 16)",
+                };
+                pick(None, d.shadow_samples, name, &mut defaulted)
             }
             (None, _) => d.shadow_samples,
         };

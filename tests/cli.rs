@@ -122,6 +122,13 @@ fn lab_run_line_3() {
     // Nothing left to the lab's defaults but those that match raywave's fixed lab look.
     assert!(stdout.contains("ambient 0.2 0.2 0.2"), "{stdout}");
     assert!(stdout.contains("model lab"), "{stdout}");
+    // -soft_shadow without a count: the lab's 0 is no count, so raywave's 16 points, and the
+    // summary says whose they are.
+    assert!(stdout.contains("soft, 16 stratified points"), "{stdout}");
+    assert!(
+        stdout.contains("(--defaults lab) for shadow samples (raywave's 16), aa, ambient"),
+        "{stdout}"
+    );
 }
 
 #[test]
