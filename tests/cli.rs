@@ -627,6 +627,19 @@ fn light_model_and_ambient_reach_the_settings() {
     );
     assert_eq!(json["settings"]["light_model"], "lab");
 
+    // `bench` takes the lab's spellings and defaults too.
+    let out = raywave(
+        dir.path(),
+        &words("bench -input cornell_box.obj -size 4 4 -ambient_light 0 0 0 --runs 1 --json - -q"),
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(json["setup"]["settings"]["bounces"], 0);
+    assert_eq!(json["setup"]["settings"]["shadows"], "hard");
+    assert_eq!(
+        json["setup"]["settings"]["ambient"],
+        serde_json::json!([0.0, 0.0, 0.0])
+    );
     // `bench` and `variance` take --light-model too.
     let out = raywave(
         dir.path(),

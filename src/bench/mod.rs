@@ -36,6 +36,9 @@ pub const DEFAULT_THRESHOLD_PCT: f64 = 40.0;
 pub struct BenchArgs {
     /// Scene file (.obj); without one, the built-in lab Cornell box with mirror spheres.
     pub scene: Option<PathBuf>,
+    /// The lab's `-input FILE` (same as the positional SCENE).
+    #[arg(long = "input", hide = true, conflicts_with = "scene")]
+    pub input: Option<PathBuf>,
     /// Size, bounces, shadows and sampling, as for `raywave render`.
     #[command(flatten)]
     pub image: crate::cli::ImageArgs,
@@ -112,7 +115,7 @@ pub fn run(args: &BenchArgs) -> Result<Outcome> {
     if let Some(p) = args.json.as_ref().filter(|p| p.as_os_str() != "-") {
         crate::film::check_output_dir(p)?;
     }
-    let (scene, text) = match &args.scene {
+    let (scene, text) = match args.scene.as_ref().or(args.input.as_ref()) {
         Some(path) => {
             let scene = Scene::load_with(path, &args.image.parse_options())?;
             let text =
