@@ -813,6 +813,10 @@ mod tests {
             args("--defaults raywave -num_bounces 1"),
             "raywave render --defaults raywave --bounces 1"
         );
+        assert_eq!(
+            args("--num_bounces 1 --defaults=lab"),
+            "raywave render --bounces 1 --defaults=lab"
+        );
     }
 
     #[test]
@@ -833,6 +837,8 @@ mod tests {
             "-num_bounces 1 --bounces 2",
             "-soft_shadow --shadows hard",
             "-frobnicate",
+            "-output a.png -o b.png",
+            "-input a.obj -i b.obj",
         ] {
             assert!(norm(line).is_err(), "{line}");
         }

@@ -220,7 +220,7 @@ fn render(args: &RenderArgs) -> Result<()> {
         batch_size: args.batch_size,
     };
     if let Some(path) = &args.stats_json {
-        let json = stats_json(&scene, &settings, &run, &report);
+        let json = stats_json(&scene, &effective, &run, &report);
         raywave::film::write_atomically(path, |w| {
             serde_json::to_writer_pretty(&mut *w, &json)?;
             Ok(writeln!(w)?)
@@ -415,10 +415,11 @@ fn print_stats(report: &Report) -> Result<()> {
 
 fn stats_json(
     scene: &Scene,
-    settings: &RenderSettings,
+    effective: &Effective,
     run: &RunInfo,
     report: &Report,
 ) -> serde_json::Value {
+    let settings = &effective.settings;
     let kinds: serde_json::Map<String, serde_json::Value> = report
         .kinds()
         .iter()
@@ -459,6 +460,7 @@ fn stats_json(
             "bvh_build_seconds": bvh_build_seconds,
         },
         "settings": settings,
+        "defaults": { "from": effective.defaults, "for": effective.defaulted },
         "seconds": report.seconds,
         "rays": kinds,
         "stages": stages,

@@ -613,6 +613,11 @@ fn light_model_and_ambient_reach_the_settings() {
         json["settings"]["ambient"],
         serde_json::json!([0.5, 0.25, 0.0])
     );
+    assert_eq!(json["defaults"]["from"], "raywave");
+    assert_eq!(
+        json["defaults"]["for"],
+        serde_json::json!(["bounces", "shadows", "shadow samples", "aa", "background"])
+    );
     // The lab's spelling of the ambient light too.
     let out = raywave(
         dir.path(),
