@@ -56,11 +56,7 @@ impl Film {
 
     /// Writes an 8-bit image; the format follows the extension (png, ppm).
     pub fn write_ldr(&self, path: &Path, tone: ToneMap) -> Result<()> {
-        let format = ldr_format(path)?;
-        let img = self.to_rgb8(tone);
-        write_atomically(path, |w| {
-            img.write_to(w, format).map_err(anyhow::Error::from)
-        })
+        write_rgb8(&self.to_rgb8(tone), path)
     }
 
     /// Reads a colour PFM as written by `write_hdr` (little-endian, rows bottom to top).
@@ -148,15 +144,64 @@ impl Film {
     }
 }
 
+/// An 8-bit image format raywave writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LdrFormat {
+    /// PNG, through the `image` crate.
+    Png,
+    /// Binary PPM (`P6`). Written here rather than by the `image` crate, whose PNM encoder
+    /// wrote a `P7` PAM header, which PPM readers reject.
+    Ppm,
+}
+
 /// The 8-bit format for an output path, or an error naming what is accepted.
-pub fn ldr_format(path: &Path) -> Result<image::ImageFormat> {
+pub fn ldr_format(path: &Path) -> Result<LdrFormat> {
     match extension(path).as_deref() {
-        Some("png") => Ok(image::ImageFormat::Png),
-        Some("ppm") => Ok(image::ImageFormat::Pnm),
+        Some("png") => Ok(LdrFormat::Png),
+        Some("ppm") => Ok(LdrFormat::Ppm),
         _ => bail!(
             "cannot write {}: expected an output file ending in .png or .ppm (use --hdr for .pfm or .exr)",
             path.display()
         ),
+    }
+}
+
+/// What `-o FILE` writes: an 8-bit image, or (for `.pfm` and `.exr`) only the linear floats.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum OutputFormat {
+    /// A tone-mapped 8-bit image.
+    Ldr(LdrFormat),
+    /// Linear floats, and no 8-bit image beside them.
+    Linear,
+}
+
+/// The format of an `-o` path, or an error naming the extensions accepted.
+pub fn output_format(path: &Path) -> Result<OutputFormat> {
+    match extension(path).as_deref() {
+        Some("png") => Ok(OutputFormat::Ldr(LdrFormat::Png)),
+        Some("ppm") => Ok(OutputFormat::Ldr(LdrFormat::Ppm)),
+        Some("pfm" | "exr") => Ok(OutputFormat::Linear),
+        _ => bail!(
+            "cannot write {}: expected an output file ending in .png or .ppm (8-bit), or .pfm or .exr (linear floats only)",
+            path.display()
+        ),
+    }
+}
+
+/// Writes an 8-bit image whole or not at all; the format follows the extension (png, ppm).
+pub fn write_rgb8(img: &image::RgbImage, path: &Path) -> Result<()> {
+    match ldr_format(path)? {
+        LdrFormat::Png => write_atomically(path, |w| {
+            img.write_to(w, image::ImageFormat::Png)
+                .map_err(anyhow::Error::from)
+        }),
+        LdrFormat::Ppm => write_atomically(path, |w| {
+            // Netpbm's binary pixmap: magic, width, height, maxval, one whitespace byte, then
+            // the RGB bytes row by row from the top.
+            write!(w, "P6\n{} {}\n255\n", img.width(), img.height())?;
+            w.write_all(img.as_raw())?;
+            Ok(())
+        }),
     }
 }
 

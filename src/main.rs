@@ -4,12 +4,14 @@
 use anyhow::{Context, Result};
 use clap::Parser;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use raywave::cli::{Cli, Command, Engine, MeshgenArgs, RenderArgs, UsageError};
+use raywave::cli::{
+    BackgroundSource, Cli, Command, Effective, Engine, MeshgenArgs, RenderArgs, UsageError,
+};
 use raywave::debug_view::RayRecorder;
-use raywave::film::{check_hdr_path, check_output_dir, ldr_format};
+use raywave::film::{OutputFormat, check_hdr_path, check_output_dir, output_format};
 use raywave::reference::Reference;
 use raywave::scene::Scene;
-use raywave::settings::{RenderSettings, ShadowMode};
+use raywave::settings::{LightModel, RenderSettings, ShadowMode};
 use raywave::stats::RayCounts;
 use raywave::variance::command::VarianceArgs;
 use raywave::wavefront::stats::RenderStats;
@@ -35,7 +37,18 @@ macro_rules! print {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse_from(raywave::cli::normalize_args(std::env::args_os()));
+    let normalized = match raywave::cli::normalize_args(std::env::args_os()) {
+        Ok(n) => n,
+        Err(e) => {
+            eprintln!("error: {e}\n\nFor more information, try '--help'.");
+            return ExitCode::from(2);
+        }
+    };
+    let cli = Cli::parse_from(normalized.args);
+    // Lab and RPI flags accepted without effect: one line each, like the scene's warnings.
+    for note in &normalized.notes {
+        eprintln!("note: {note}");
+    }
     let result = match cli.command {
         Command::Render(args) => render(&args),
         Command::Info => info(),
@@ -105,20 +118,21 @@ fn thread_pool(threads: Option<u32>) -> Result<rayon::ThreadPool> {
 
 fn render(args: &RenderArgs) -> Result<()> {
     // Check everything that can fail cheaply before the long part.
-    ldr_format(&args.output).map_err(|e| UsageError::from_error(&e))?;
+    let format = output_format(&args.output).map_err(|e| UsageError::from_error(&e))?;
     check_output_dir(&args.output)?;
     if let Some(hdr) = &args.hdr {
         check_hdr_path(hdr).map_err(|e| UsageError::from_error(&e))?;
         check_output_dir(hdr)?;
     }
     let scene = match args.scene_path() {
-        Some(path) => Scene::load(path)?,
+        Some(path) => Scene::load_with(path, &args.image.parse_options())?,
         None => Scene::builtin_default(),
     };
     for w in &scene.warnings {
         eprintln!("{w}");
     }
-    let settings = args.settings(scene.background.map(|c| c.to_array()));
+    let effective = args.settings(scene.background.map(|c| c.to_array()));
+    let settings = effective.settings.clone();
     if let Some(px) = &args.debug_pixel
         && (px[0] >= settings.width || px[1] >= settings.height)
     {
@@ -160,7 +174,10 @@ fn render(args: &RenderArgs) -> Result<()> {
         }
     };
 
-    let mut img = film.to_rgb8(args.tonemap);
+    let mut img = match format {
+        OutputFormat::Ldr(_) => Some(film.to_rgb8(args.tonemap)),
+        OutputFormat::Linear => None,
+    };
     if let Some(px) = &args.debug_pixel {
         let mut recorder = RayRecorder {
             miss_length: 10.0,
@@ -175,14 +192,25 @@ fn render(args: &RenderArgs) -> Result<()> {
             px[0], px[1], colour
         );
         print!("{}", recorder.report(&scene));
-        let camera =
-            raywave::camera::CameraRays::new(&scene.camera, settings.width, settings.height);
-        recorder.draw(&mut img, &camera);
+        match &mut img {
+            Some(img) => {
+                let camera = raywave::camera::CameraRays::new(
+                    &scene.camera,
+                    settings.width,
+                    settings.height,
+                );
+                recorder.draw(img, &camera);
+            }
+            None => eprintln!(
+                "note: the rays are drawn only over an 8-bit image; {} holds the linear image alone",
+                args.output.display()
+            ),
+        }
     }
-    raywave::film::write_atomically(&args.output, |w| {
-        img.write_to(w, ldr_format(&args.output)?)
-            .map_err(anyhow::Error::from)
-    })?;
+    match &img {
+        Some(img) => raywave::film::write_rgb8(img, &args.output)?,
+        None => film.write_hdr(&args.output)?,
+    }
     if let Some(hdr) = &args.hdr {
         film.write_hdr(hdr)?;
     }
@@ -192,14 +220,14 @@ fn render(args: &RenderArgs) -> Result<()> {
         batch_size: args.batch_size,
     };
     if let Some(path) = &args.stats_json {
-        let json = stats_json(&scene, &settings, &run, &report);
+        let json = stats_json(&scene, &effective, &run, &report);
         raywave::film::write_atomically(path, |w| {
             serde_json::to_writer_pretty(&mut *w, &json)?;
             Ok(writeln!(w)?)
         })?;
     }
     if !args.quiet {
-        summary(&scene, &settings, &run, &report)?;
+        summary(&scene, &effective, &run, &report)?;
         let extra = args
             .hdr
             .as_ref()
@@ -229,7 +257,8 @@ fn progress_bar(len: u64, unit: &str, quiet: bool) -> ProgressBar {
     bar
 }
 
-fn summary(scene: &Scene, s: &RenderSettings, run: &RunInfo, report: &Report) -> Result<()> {
+fn summary(scene: &Scene, effective: &Effective, run: &RunInfo, report: &Report) -> Result<()> {
+    let s = &effective.settings;
     let shadows = match s.shadows {
         ShadowMode::Off => "off (every light visible)".to_string(),
         ShadowMode::Hard => "hard (light centroids)".to_string(),
@@ -246,8 +275,12 @@ fn summary(scene: &Scene, s: &RenderSettings, run: &RunInfo, report: &Report) ->
         raywave::simd_path(),
         run.threads
     );
+    let rings = match scene.ring_count {
+        0 => String::new(),
+        n => format!("; {n} ring(s) cut into faces"),
+    };
     println!(
-        "scene   {}: {} faces ({} triangles), {} spheres, {} light(s), {} camera",
+        "scene   {}: {} faces ({} triangles{rings}), {} spheres, {} light(s), {} camera",
         scene.source,
         scene.face_count,
         scene.triangles.len(),
@@ -260,9 +293,43 @@ fn summary(scene: &Scene, s: &RenderSettings, run: &RunInfo, report: &Report) ->
         }
     );
     println!(
-        "render  {}×{}, {} bounces, shadows {shadows}, {} aa sample(s), seed {}",
-        s.width, s.height, s.bounces, s.aa_samples, s.seed
+        "render  {}×{}, {} bounces, shadows {shadows}, {} aa sample(s), seed {}, {} faces",
+        s.width,
+        s.height,
+        s.bounces,
+        s.aa_samples,
+        s.seed,
+        if s.two_sided {
+            "two-sided"
+        } else {
+            "one-sided"
+        }
     );
+    let model = match s.light_model {
+        LightModel::Lab => "lab (no fall-off)",
+        LightModel::Rpi => "rpi (divided by π·d²)",
+    };
+    let background = match effective.background {
+        BackgroundSource::Flag => "flag",
+        BackgroundSource::Scene => "scene",
+        BackgroundSource::Defaults => "default",
+    };
+    let [r, g, b] = s.background;
+    let [ar, ag, ab] = s.ambient;
+    println!(
+        "light   model {model}, ambient {ar} {ag} {ab}, background {r} {g} {b} ({background})"
+    );
+    let defaulted = if effective.defaulted.is_empty() {
+        "none needed: flags set every setting".to_string()
+    } else {
+        format!(
+            "{} (--defaults {}) for {}",
+            effective.defaults.owner(),
+            effective.defaults.name(),
+            effective.defaulted.join(", ")
+        )
+    };
+    println!("default {defaulted}");
     let counts = &report.counts;
     println!(
         "rays    {} total: {} camera, {} shadow, {} reflection",
@@ -348,10 +415,11 @@ fn print_stats(report: &Report) -> Result<()> {
 
 fn stats_json(
     scene: &Scene,
-    settings: &RenderSettings,
+    effective: &Effective,
     run: &RunInfo,
     report: &Report,
 ) -> serde_json::Value {
+    let settings = &effective.settings;
     let kinds: serde_json::Map<String, serde_json::Value> = report
         .kinds()
         .iter()
@@ -392,6 +460,7 @@ fn stats_json(
             "bvh_build_seconds": bvh_build_seconds,
         },
         "settings": settings,
+        "defaults": { "from": effective.defaults, "for": effective.defaulted },
         "seconds": report.seconds,
         "rays": kinds,
         "stages": stages,

@@ -23,7 +23,8 @@ pub enum LightModel {
     /// The lab's: Lc = 0.2·ke·area, with no fall-off with distance.
     #[default]
     Lab,
-    /// RPI's framework: Lc = 0.2·ke·area divided by π·d², d the distance to the light point.
+    /// RPI's framework (`RayTracer::TraceRay`): Lc = ke·area / (π·d²), with no 0.2 factor, d
+    /// the distance to the light point (docs/SHADING.md).
     Rpi,
 }
 

@@ -36,6 +36,9 @@ pub const DEFAULT_THRESHOLD_PCT: f64 = 40.0;
 pub struct BenchArgs {
     /// Scene file (.obj); without one, the built-in lab Cornell box with mirror spheres.
     pub scene: Option<PathBuf>,
+    /// The lab's `-input FILE` (same as the positional SCENE).
+    #[arg(long = "input", hide = true, conflicts_with = "scene")]
+    pub input: Option<PathBuf>,
     /// Size, bounces, shadows and sampling, as for `raywave render`.
     #[command(flatten)]
     pub image: crate::cli::ImageArgs,
@@ -76,10 +79,10 @@ fn parse_threshold(s: &str) -> Result<f64, String> {
 }
 
 impl BenchArgs {
-    /// The render settings, defaulted like `raywave render`'s (the same `ImageArgs`).
+    /// The render settings, defaulted like `raywave render`'s (the same `ImageArgs`), with or
+    /// without a scene file.
     pub fn settings(&self, scene_background: Option<[f32; 3]>) -> RenderSettings {
-        let background = scene_background.unwrap_or(RenderSettings::default().background);
-        self.image.settings(self.scene.is_some(), background)
+        self.image.resolve(scene_background).settings
     }
 }
 
@@ -112,9 +115,9 @@ pub fn run(args: &BenchArgs) -> Result<Outcome> {
     if let Some(p) = args.json.as_ref().filter(|p| p.as_os_str() != "-") {
         crate::film::check_output_dir(p)?;
     }
-    let (scene, text) = match &args.scene {
+    let (scene, text) = match args.scene.as_ref().or(args.input.as_ref()) {
         Some(path) => {
-            let scene = Scene::load(path)?;
+            let scene = Scene::load_with(path, &args.image.parse_options())?;
             let text =
                 std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?;
             (scene, text)
@@ -314,9 +317,17 @@ pub fn report(r: &BenchRecord) -> String {
         ShadowMode::Hard => "hard".to_string(),
         ShadowMode::Off => "off".to_string(),
     };
+    // The lighting is named only when it is not the lab's (the records of before it existed).
+    let lab = RenderSettings::default();
+    let lighting = if (s.light_model, s.ambient) == (lab.light_model, lab.ambient) {
+        String::new()
+    } else {
+        let [r, g, b] = s.ambient;
+        format!(", light model {:?}, ambient {r} {g} {b}", s.light_model).to_lowercase()
+    };
     let _ = writeln!(
         out,
-        "scene   {} · {}×{}, {} bounces, shadows {shadows}, {} aa · medians of {} run(s)",
+        "scene   {} · {}×{}, {} bounces, shadows {shadows}, {} aa{lighting} · medians of {} run(s)",
         r.setup.scene.source, s.width, s.height, s.bounces, s.aa_samples, r.runs
     );
     let _ = writeln!(

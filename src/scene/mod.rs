@@ -7,7 +7,10 @@
 
 mod parse;
 
-pub use parse::{ParseError, SceneError, Warning, parse_scene_str};
+pub use parse::{
+    ParseError, ParseOptions, RPI_RING_SEGMENTS, SceneError, Warning, parse_scene_str,
+    parse_scene_str_with,
+};
 
 use glam::Vec3;
 use std::path::Path;
@@ -186,6 +189,8 @@ pub struct Scene {
     pub face_count: usize,
     /// Number of faces that were quads.
     pub quad_count: usize,
+    /// Number of RPI cylinder rings (`r` lines), each cut into quads counted in `face_count`.
+    pub ring_count: usize,
     /// The camera from the file, or the lab's automatic one.
     pub camera: Camera,
     /// True when the file had a camera block.
@@ -197,8 +202,14 @@ pub struct Scene {
 }
 
 impl Scene {
-    /// Reads and parses a scene file; errors name the file and line.
+    /// Reads and parses a scene file with the default [`ParseOptions`]; errors name the file
+    /// and line.
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
+        Scene::load_with(path, &ParseOptions::default())
+    }
+
+    /// Reads and parses a scene file; errors name the file and line.
+    pub fn load_with(path: &Path, options: &ParseOptions) -> Result<Scene, SceneError> {
         let file = path.display().to_string();
         let bytes = std::fs::read(path).map_err(|source| SceneError::Io {
             path: file.clone(),
@@ -212,7 +223,7 @@ impl Scene {
                 file: file.clone(),
             }
         })?;
-        Ok(parse_scene_str(&text, &file)?)
+        Ok(parse_scene_str_with(&text, &file, options)?)
     }
 
     /// The built-in default: the lab's Cornell box with three mirror spheres.

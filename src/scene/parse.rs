@@ -5,6 +5,9 @@
 //!
 //! Geometry is assembled after the whole file is read, so that `m i` may name a material that is
 //! declared further down; the error for a bad index still points at the `m` line.
+//!
+//! The few choices the command line makes about geometry (how finely an RPI ring is cut into
+//! quads) come in as [`ParseOptions`], since the file is read before the render settings exist.
 
 use super::{Camera, Light, LightShape, Material, Scene, Sphere, Triangle};
 use glam::Vec3;
@@ -56,6 +59,26 @@ impl fmt::Display for Warning {
     }
 }
 
+/// What the command line decides about the geometry of a file.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ParseOptions {
+    /// Quads around an RPI cylinder ring (`r` line), per side: RPI's
+    /// `-cylinder_ring_rasterization`.
+    pub ring_segments: u32,
+}
+
+/// RPI's ArgParser default for `-cylinder_ring_rasterization`.
+pub const RPI_RING_SEGMENTS: u32 = 20;
+
+impl Default for ParseOptions {
+    /// RPI's defaults.
+    fn default() -> Self {
+        ParseOptions {
+            ring_segments: RPI_RING_SEGMENTS,
+        }
+    }
+}
+
 /// A polygon as read, before triangulation.
 struct Face {
     corners: Vec<Vec3>,
@@ -72,6 +95,7 @@ struct CameraBlock {
 
 struct Parser<'a> {
     file: &'a str,
+    options: ParseOptions,
     vertices: Vec<Vec3>,
     materials: Vec<Material>,
     /// The `m i` selection and the line it was made on (checked against the materials at the end).
@@ -79,25 +103,41 @@ struct Parser<'a> {
     material_refs: Vec<(u32, usize)>,
     faces: Vec<Face>,
     spheres: Vec<(Sphere, usize)>,
+    /// Corners of ring quads: not numbered vertices (an `f` line cannot name them), but part
+    /// of the bounding box the lab's automatic camera frames.
+    ring_points: Vec<Vec3>,
+    rings: usize,
     camera: Option<Camera>,
     background: Option<Vec3>,
     warnings: Vec<Warning>,
     camera_block: Option<CameraBlock>,
 }
 
-/// Parses scene text; `file` is used in messages only.
+/// Parses scene text with the default [`ParseOptions`]; `file` is used in messages only.
 pub fn parse_scene_str(text: &str, file: &str) -> Result<Scene, ParseError> {
+    parse_scene_str_with(text, file, &ParseOptions::default())
+}
+
+/// Parses scene text; `file` is used in messages only.
+pub fn parse_scene_str_with(
+    text: &str,
+    file: &str,
+    options: &ParseOptions,
+) -> Result<Scene, ParseError> {
     // Editors on Windows start UTF-8 files with a byte-order mark; it is not part of the first
     // keyword (left in, it turned the first `material` into an unknown keyword).
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut p = Parser {
         file,
+        options: *options,
         vertices: Vec::new(),
         materials: Vec::new(),
         active_material: None,
         material_refs: Vec::new(),
         faces: Vec::new(),
         spheres: Vec::new(),
+        ring_points: Vec::new(),
+        rings: 0,
         camera: None,
         background: None,
         warnings: Vec::new(),
@@ -291,6 +331,7 @@ impl Parser<'_> {
                     line,
                 ));
             }
+            "r" => self.ring(line, args)?,
             "m" => {
                 let token = args.first().copied().unwrap_or("the end of the line");
                 let index: u32 = token.parse().map_err(|_| {
@@ -394,6 +435,16 @@ impl Parser<'_> {
             corners.push(self.vertices[(resolved - 1) as usize]);
         }
         let material = self.active_material(line, "face")?;
+        self.push_face(line, corners, material)
+    }
+
+    /// Adds a polygon, refusing one without area.
+    fn push_face(
+        &mut self,
+        line: usize,
+        corners: Vec<Vec3>,
+        material: u32,
+    ) -> Result<(), ParseError> {
         let area = newell_normal(&corners).length() * 0.5;
         let scale = corners
             .iter()
@@ -412,6 +463,79 @@ impl Parser<'_> {
             material,
             line,
         });
+        Ok(())
+    }
+
+    /// An RPI cylinder ring, `r cx cy cz height inner_radius outer_radius`: a tube about the
+    /// vertical axis through the centre, cut into quads the way RPI's
+    /// `CylinderRing::addRasterizedFaces` does. Around the axis there are `ring_segments`
+    /// steps; each step gives four quads (outer wall, top, inner wall, bottom), all facing out
+    /// of the solid. An inner radius of 0 makes a solid cylinder: no inner wall, and the top
+    /// and bottom steps are triangles.
+    fn ring(&mut self, line: usize, args: &[&str]) -> Result<(), ParseError> {
+        if args.len() != 6 {
+            return Err(self.error(
+                line,
+                format!(
+                    "expected `r cx cy cz height inner_radius outer_radius` (6 numbers), found {} value(s)",
+                    args.len()
+                ),
+            ));
+        }
+        let center = self.vec3(line, "r", &args[..3])?;
+        let height = number(self.file, line, "the height of `r`", Some(args[3]))?;
+        let inner = number(self.file, line, "the inner radius of `r`", Some(args[4]))?;
+        let outer = number(self.file, line, "the outer radius of `r`", Some(args[5]))?;
+        if height <= 0.0 {
+            return Err(self.error(
+                line,
+                format!("expected a positive ring height, found {height}"),
+            ));
+        }
+        if inner < 0.0 || outer <= inner {
+            return Err(self.error(
+                line,
+                format!(
+                    "expected ring radii with 0 <= inner < outer, found inner {inner} and outer {outer}"
+                ),
+            ));
+        }
+        let material = self.active_material(line, "ring")?;
+        let n = self.options.ring_segments.max(3);
+        // Per step i, four corners in RPI's order: outer bottom, outer top, inner top, inner
+        // bottom. x = r·cos θ, z = −r·sin θ, as in RPI's ComputeCylinderRingPoint.
+        let corner = |i: u32, k: usize| -> Vec3 {
+            let theta = std::f64::consts::TAU * f64::from(i % n) / f64::from(n);
+            let (radius, dy) = match k {
+                0 => (outer, -0.5 * height),
+                1 => (outer, 0.5 * height),
+                2 => (inner, 0.5 * height),
+                _ => (inner, -0.5 * height),
+            };
+            let r = f64::from(radius);
+            center + Vec3::new((r * theta.cos()) as f32, dy, (-r * theta.sin()) as f32)
+        };
+        for i in 0..n {
+            for k in 0..4 {
+                if inner == 0.0 && k == 2 {
+                    continue; // the inner wall of a solid cylinder has no area
+                }
+                let mut corners = vec![
+                    corner(i, k),
+                    corner(i + 1, k),
+                    corner(i + 1, (k + 1) % 4),
+                    corner(i, (k + 1) % 4),
+                ];
+                // With inner radius 0 the top and bottom quads meet the axis in one point.
+                corners.dedup();
+                if corners.len() > 2 && corners.first() == corners.last() {
+                    corners.pop();
+                }
+                self.ring_points.extend_from_slice(&corners);
+                self.push_face(line, corners, material)?;
+            }
+        }
+        self.rings += 1;
         Ok(())
     }
 
@@ -552,7 +676,7 @@ impl Parser<'_> {
         if self.faces.is_empty() && self.spheres.is_empty() {
             return Err(self.error(
                 last_line,
-                "expected at least one face (`f`) or sphere (`s`), found none".into(),
+                "expected at least one face (`f`), sphere (`s`) or ring (`r`), found none".into(),
             ));
         }
         let mut scene = Scene {
@@ -561,6 +685,7 @@ impl Parser<'_> {
             background: self.background,
             camera_from_file: self.camera.is_some(),
             face_count: self.faces.len(),
+            ring_count: self.rings,
             ..Scene::default()
         };
         let mut warnings = self.warnings;
@@ -607,9 +732,11 @@ impl Parser<'_> {
         }
         scene.spheres = self.spheres.iter().map(|(s, _)| *s).collect();
         scene.warnings = warnings;
+        let mut points = self.vertices;
+        points.extend_from_slice(&self.ring_points);
         scene.camera = self
             .camera
-            .unwrap_or_else(|| lab_camera(&self.vertices, &scene.spheres));
+            .unwrap_or_else(|| lab_camera(&points, &scene.spheres));
         Ok(scene)
     }
 }
@@ -706,5 +833,81 @@ fn lab_camera(vertices: &[Vec3], spheres: &[Sphere]) -> Camera {
         point_of_interest: poi,
         up: Vec3::Y,
         fov: 20f32.to_radians(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const HEAD: &str = "material\ndiffuse 1 1 1\nm 0\n";
+
+    fn ring_scene(ring: &str, segments: u32) -> Result<Scene, ParseError> {
+        parse_scene_str_with(
+            &format!("{HEAD}{ring}\n"),
+            "ring.obj",
+            &ParseOptions {
+                ring_segments: segments,
+            },
+        )
+    }
+
+    #[test]
+    fn a_ring_is_four_quads_per_segment_facing_out_of_the_solid() {
+        let (center, height, inner, outer) = (Vec3::new(1.0, 2.0, -1.0), 0.5, 0.8, 1.2);
+        for segments in [3, 8, RPI_RING_SEGMENTS] {
+            let scene = ring_scene("r 1 2 -1 0.5 0.8 1.2", segments).unwrap();
+            assert_eq!(scene.ring_count, 1);
+            assert_eq!(scene.face_count, 4 * segments as usize);
+            assert_eq!(scene.quad_count, scene.face_count);
+            assert_eq!(scene.triangles.len(), 2 * scene.face_count);
+            for t in &scene.triangles {
+                let c = t.v0 + (t.e1 + t.e2) / 3.0 - center;
+                let radial = Vec3::new(c.x, 0.0, c.z).normalize();
+                let n = t.normal;
+                let corners = [t.v0, t.v0 + t.e1, t.v0 + t.e2].map(|v| v - center);
+                let widest = corners
+                    .iter()
+                    .map(|v| Vec3::new(v.x, 0.0, v.z).length())
+                    .fold(0.0, f32::max);
+                let out = if (c.y.abs() - 0.5 * height).abs() < 1e-5 {
+                    Vec3::new(0.0, c.y.signum(), 0.0) // top or bottom
+                } else if widest > 0.5 * (inner + outer) {
+                    radial // outer wall
+                } else {
+                    -radial // inner wall: faces the hole
+                };
+                assert!(n.dot(out) > 0.7, "{n} should face {out} at {c}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_solid_ring_has_no_inner_wall() {
+        let scene = ring_scene("r 0 0 0 1 0 1", 6).unwrap();
+        // Per segment: outer wall (quad), top and bottom (triangles at the axis).
+        assert_eq!(scene.face_count, 3 * 6);
+        assert_eq!(scene.quad_count, 6);
+    }
+
+    #[test]
+    fn ring_errors_name_the_line() {
+        for (ring, needle) in [
+            ("r 0 0 0 1 1", "6 numbers"),
+            ("r 0 0 0 0 1 2", "positive ring height"),
+            ("r 0 0 0 1 2 1", "inner < outer"),
+            ("r 0 0 0 1 -1 1", "inner < outer"),
+            ("r 0 0 x 1 0 1", "3rd number of `r`"),
+        ] {
+            let e = ring_scene(ring, 20).unwrap_err().to_string();
+            assert!(
+                e.starts_with("ring.obj:4:") && e.contains(needle),
+                "{ring}: {e}"
+            );
+        }
+        let e = parse_scene_str("r 0 0 0 1 0 1\n", "ring.obj")
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("ring.obj:1:") && e.contains("ring"), "{e}");
     }
 }

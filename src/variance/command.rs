@@ -48,6 +48,10 @@ pub struct VarianceArgs {
     /// Always render the converged reference, ignoring and not writing the cache.
     #[arg(long)]
     pub no_cache: bool,
+    /// How a light's colour reaches a point: lab (no fall-off) or rpi (divided by π·d², as
+    /// RPI's framework does).
+    #[arg(long, value_enum, default_value = "lab")]
+    pub light_model: crate::settings::LightModel,
     /// The engine that renders the images (both draw the same samples).
     #[arg(long, value_enum, default_value = "wavefront")]
     pub engine: crate::cli::Engine,
@@ -145,6 +149,7 @@ pub fn run(args: &VarianceArgs, engine: &str, render: &RenderFn) -> Result<()> {
         width: args.size[0],
         height: args.size[1],
         bounces: args.bounces,
+        light_model: args.light_model,
         background: scene
             .background
             .map(|c| c.to_array())
