@@ -740,7 +740,6 @@ fn rpi_style_room_is_blown_out_under_the_lab_light_model() {
 }
 
 #[test]
-#[ignore = "needs the engines to honour settings.light_model"]
 fn rpi_style_room_is_not_blown_out_under_the_rpi_light_model() {
     // Under RPI's model (the light's ke·area divided by π·d²) the same room is lit but not
     // burnt: in a simple estimate (direct light from the centroid, ambient 0.2) about 0.5% of

@@ -10,8 +10,8 @@
 //! bounces remain) + Σ lights Σ_{j<N} Shade(l_j)/N over the points with n·l > 0 that are
 //! visible (every such point when shadows are off; the area centroid alone when hard), with
 //! Shade(l) = 0.2·ke + Lc⊙kd·(n·l) + Lc⊙(0.8·kr)·max(0, e·r)^(5/(g + 0.01))·(n·l),
-//! r = normalize(2(n·l)n − l), e = −ray direction. Lc is the light's colour (lab) or that divided
-//! by π·d², d the distance to the light point (RPI). The ambient light comes from the settings;
+//! r = normalize(2(n·l)n − l), e = −ray direction. Lc is the light's colour 0.2·ke·area (lab), or
+//! ke·area/(π·d²), d the distance to the light point (RPI: no 0.2). The ambient light comes from the settings;
 //! the surface's own emission 0.2·ke does not depend on it or on the light model.
 //!
 //! # Exact semantics
@@ -622,7 +622,7 @@ impl<'a> Oracle<'a> {
                 let n_dot_l = above / dist;
                 let lc = match s.light_model {
                     LightModel::Lab => lamp.color,
-                    LightModel::Rpi => lamp.color / (std::f64::consts::PI * dist * dist),
+                    LightModel::Rpi => lamp.color / (0.2 * std::f64::consts::PI * dist * dist),
                 };
                 if n_dot_l.abs() < DECISION_MARGIN {
                     // The decision n·l > 0 is close; it matters only if the sample is worth
