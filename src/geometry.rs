@@ -122,6 +122,8 @@ pub fn intersect_sphere(sphere: &Sphere, ray: &Ray, tmax: f32) -> f32 {
 /// How the reference finds hits: every primitive in turn, or a BVH over the triangles.
 pub struct Accel {
     bvh: Option<CwBvh>,
+    /// The power of two the tree's coordinates are scaled by (`bvh_scale`).
+    scale: f32,
     /// Without a BVH, the triangles that shadow rays test when faces are one-sided (see
     /// `shadow_casters`).
     casters: Vec<Triangle>,
@@ -135,14 +137,17 @@ impl Accel {
         if scene.triangles.len() < BVH_MIN_TRIANGLES {
             return Accel {
                 bvh: None,
+                scale: 1.0,
                 casters: shadow_casters(scene),
                 build_time: Duration::ZERO,
             };
         }
         let start = std::time::Instant::now();
-        let bvh = build_cwbvh(scene);
+        let scale = bvh_scale(scene);
+        let bvh = build_cwbvh_scaled(scene, scale);
         Accel {
             bvh: Some(bvh),
+            scale,
             casters: Vec::new(),
             build_time: start.elapsed(),
         }
@@ -173,7 +178,10 @@ impl Accel {
                 // triangle id, as in the loop above, whatever order the CWBVH visits them in:
                 // obvhs keeps only strictly closer hits, so the pair (t, id) is tracked here.
                 // The wavefront engine's own BVH breaks ties the same way.
-                let bray = obvhs_ray(ray, best.t);
+                // The tree works in coordinates scaled by `self.scale`, and so do the
+                // distances it is given back: a power of two, so both ways are exact.
+                let scale = self.scale;
+                let bray = obvhs_ray_scaled(ray, best.t, scale);
                 let mut hit = RayHit::none();
                 bvh.ray_traverse(bray, &mut hit, |_, id| {
                     let prim = bvh.primitive_indices[id];
@@ -184,10 +192,11 @@ impl Accel {
                     };
                     let t =
                         intersect_triangle(&scene.triangles[prim as usize], ray, limit, two_sided);
-                    if t < best.t || (t == best.t && prim < best.prim) {
+                    // A miss is t = ∞, which ties an infinite best.t: it must not count.
+                    if t < best.t || (t == best.t && t < f32::INFINITY && prim < best.prim) {
                         best = Hit { t, prim };
                     }
-                    t
+                    t * scale
                 });
             }
         }
@@ -217,14 +226,17 @@ impl Accel {
             None => casters(scene, &self.casters, two_sided)
                 .iter()
                 .any(|tri| intersect_triangle(tri, ray, tmax, two_sided) < tmax),
-            Some(bvh) => !bvh.ray_traverse_miss(obvhs_ray(ray, tmax), |_, id| {
-                intersect_triangle(
-                    &scene.triangles[bvh.primitive_indices[id] as usize],
-                    ray,
-                    tmax,
-                    two_sided,
-                )
-            }),
+            Some(bvh) => {
+                !bvh.ray_traverse_miss(obvhs_ray_scaled(ray, tmax, self.scale), |_, id| {
+                    self.scale
+                        * intersect_triangle(
+                            &scene.triangles[bvh.primitive_indices[id] as usize],
+                            ray,
+                            tmax,
+                            two_sided,
+                        )
+                })
+            }
         }
     }
 }
@@ -299,13 +311,38 @@ pub fn casters<'a>(scene: &'a Scene, casters: &'a [Triangle], two_sided: bool) -
 /// The CWBVH over a scene's triangles, with the preset every raywave BVH uses
 /// (`medium_build`); `bvh.primitive_indices` maps its leaves back to `scene.triangles`.
 pub fn build_cwbvh(scene: &Scene) -> CwBvh {
+    build_cwbvh_scaled(scene, 1.0)
+}
+
+/// The power of two that brings a scene's largest triangle coordinate to about 2^16.
+///
+/// obvhs's CWBVH node test clamps a ray's entry distance to an absolute 1e-4
+/// (`cwbvh::node::EPSILON`), so a box nearer than that along a ray is skipped: in a scene a
+/// thousand times smaller than the lab's, hits were lost (hundreds of pixels against the f64
+/// oracle). The reference builds and walks the tree in coordinates scaled by this factor,
+/// where 1e-4 is 1.5e-9 of the scene; a power of two changes no bits.
+pub fn bvh_scale(scene: &Scene) -> f32 {
+    let largest = scene
+        .triangles
+        .iter()
+        .flat_map(|t| [t.v0, t.v0 + t.e1, t.v0 + t.e2])
+        .fold(0.0f32, |m, v| m.max(v.abs().max_element()));
+    if !(largest.is_finite() && largest > 0.0) {
+        return 1.0;
+    }
+    let exponent = (16 - largest.log2().ceil() as i32).clamp(-100, 100);
+    2f32.powi(exponent)
+}
+
+/// `build_cwbvh` over the triangles scaled by `scale` (a power of two).
+pub fn build_cwbvh_scaled(scene: &Scene, scale: f32) -> CwBvh {
     let tris: Vec<obvhs::triangle::Triangle> = scene
         .triangles
         .iter()
         .map(|t| obvhs::triangle::Triangle {
-            v0: t.v0.into(),
-            v1: (t.v0 + t.e1).into(),
-            v2: (t.v0 + t.e2).into(),
+            v0: (t.v0 * scale).into(),
+            v1: ((t.v0 + t.e1) * scale).into(),
+            v2: ((t.v0 + t.e2) * scale).into(),
         })
         .collect();
     let mut core = Duration::ZERO;
@@ -320,10 +357,16 @@ pub fn build_cwbvh(scene: &Scene) -> CwBvh {
 /// lie in (half of the axis-aligned rays in tests/mesh_bvh.rs). Only the traversal sees this
 /// ray; the triangle tests use the caller's.
 pub fn obvhs_ray(ray: &Ray, tmax: f32) -> obvhs::ray::Ray {
+    obvhs_ray_scaled(ray, tmax, 1.0)
+}
+
+/// `obvhs_ray` in coordinates scaled by `scale` (a power of two): the origin and distances
+/// scale, the direction does not.
+pub fn obvhs_ray_scaled(ray: &Ray, tmax: f32, scale: f32) -> obvhs::ray::Ray {
     obvhs::ray::Ray::new(
-        Vec3A::from(ray.origin),
+        Vec3A::from(ray.origin * scale),
         Vec3A::from(ray.direction + Vec3::ZERO),
-        T_MIN,
-        tmax,
+        T_MIN * scale,
+        tmax * scale,
     )
 }

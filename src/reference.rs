@@ -20,7 +20,7 @@ use crate::scene::Scene;
 use crate::settings::{RenderSettings, ShadowMode};
 use crate::shading::shade;
 use crate::spawn::{
-    SurfaceHit, falloff, light_end, light_offset, mirror_ray, shadow_ray, surface_hit,
+    SHADOW_TMAX, SurfaceHit, falloff, light_end, light_offset, mirror_ray, shadow_ray, surface_hit,
 };
 use crate::stats::RayCounts;
 use glam::Vec3;
@@ -199,7 +199,7 @@ impl<'a> Reference<'a> {
                         let blocked = self.accel.occluded(
                             self.scene,
                             &shadow.ray,
-                            shadow.tmax,
+                            SHADOW_TMAX,
                             settings.two_sided,
                         );
                         log.shadow_ray(key.bounce, li as u32, from, target, Some(blocked));
@@ -207,8 +207,8 @@ impl<'a> Reference<'a> {
                     }
                 };
                 if visible {
-                    let light_color = light.color * falloff(settings.light_model, shadow.tmax);
-                    let l = shadow.ray.direction;
+                    let light_color = light.color * falloff(settings.light_model, shadow.dist);
+                    let l = shadow.l;
                     sum +=
                         shade(material, surface.normal, e, l, shadow.n_dot_l, light_color) * weight;
                 }

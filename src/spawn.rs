@@ -6,8 +6,9 @@
 //!          p  = p0 projected onto the plane, or c + r·normalize(p0 − c) on a sphere
 //!          δ  = 2^-18 · (magnitude of the primitive's coordinates)  ≥ 10 × the error of p
 //! mirror:  origin p ± δ·n on the side the mirror ray leaves to, t > 0
-//! shadow:  from x' = p + δ·n to p' = q + δ_q·n_q (q on the light, pushed off the light's plane
-//!          towards x), cast when n·(p' − x') > δ + δ_q, blocked by a hit in (0, |p' − x'|)
+//! shadow:  from x' = p + δ·n to q' = q + δ_q·n_q (q on the light, pushed off the light's plane
+//!          towards p), cast when n·(q' − x') > δ + δ_q, blocked by a hit on that segment;
+//!          shaded with the exact l = normalize(q − p) and |q − p|
 //! ```
 //!
 //! This is pbrt-v4's scheme (`OffsetRayOrigin`, `SpawnRayTo`) with a simpler bound: the error of
@@ -152,19 +153,26 @@ pub fn light_end(light: &Light, offset: f32, point: Vec3) -> Vec3 {
     }
 }
 
+/// A shadow ray is blocked by a hit with t in (0, `SHADOW_TMAX`): its direction runs from its
+/// start to its end.
+pub const SHADOW_TMAX: f32 = 1.0;
+
 /// A shadow ray and what shading needs of it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ShadowRay {
-    /// From `hit.offset` off the surface towards the light point, unit direction l.
+    /// The segment tested for blockers: from `hit.offset` off the surface to `end` off the light
+    /// point, as origin and direction (end − start, not unit), blocked in (0, `SHADOW_TMAX`).
     pub ray: Ray,
-    /// Blocked by a hit in (0, tmax): the distance to the end `target + end`.
-    pub tmax: f32,
+    /// The Shade formula's l, from the hit point itself: normalize(target − point).
+    pub l: Vec3,
+    /// |target − point|, for the light model's fall-off.
+    pub dist: f32,
     /// n·l.
     pub n_dot_l: f32,
 }
 
 /// The shadow ray from `hit` to the light point `target` (`end` from `light_end`, `end_offset`
-/// its length), or `None` when the point is not above the tangent plane by more than the two
+/// its length), or `None` when the segment's end is not above the tangent plane by more than the two
 /// offsets (for a light's own points, and coplanar lights, n·l is 0 up to rounding: a rounding-
 /// positive n·l would add a speckle). Written once, for every engine: the 8-wide twin is
 /// `wavefront::simd::shadow_rays8`.
@@ -172,18 +180,20 @@ pub struct ShadowRay {
 #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(x > y)` is on purpose: NaN casts no ray
 pub fn shadow_ray(hit: &SurfaceHit, target: Vec3, end: Vec3, end_offset: f32) -> Option<ShadowRay> {
     let origin = hit.point + hit.offset * hit.normal;
-    let to_light = (target + end) - origin;
-    if !(hit.normal.dot(to_light) > hit.offset + end_offset) {
+    let segment = (target + end) - origin;
+    if !(hit.normal.dot(segment) > hit.offset + end_offset) {
         return None;
     }
+    let to_light = target - hit.point;
     let dist = to_light.length();
     let l = to_light / dist;
     Some(ShadowRay {
         ray: Ray {
             origin,
-            direction: l,
+            direction: segment,
         },
-        tmax: dist,
+        l,
+        dist,
         n_dot_l: hit.normal.dot(l),
     })
 }

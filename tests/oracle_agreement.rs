@@ -422,12 +422,13 @@ fn a_pentagonal_light_matches_the_oracle() {
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
-/// RPI's light model (Lc/(π·d²) per light point) and a coloured ambient light.
+/// RPI's light model (ke·area/(π·d²) per light point) and a coloured ambient light, on the
+/// RPI-style scene (emitted 20–70, a camera block) among others.
 #[test]
 fn light_model_and_ambient_match_the_oracle() {
     let settings = RenderSettings {
-        width: 32,
-        height: 32,
+        width: 64,
+        height: 64,
         bounces: 3,
         shadows: ShadowMode::Soft,
         shadow_samples: 4,
@@ -437,10 +438,9 @@ fn light_model_and_ambient_match_the_oracle() {
         ..RenderSettings::default()
     };
     let mut failures = Vec::new();
-    for (name, scene) in scenes()
-        .into_iter()
-        .filter(|(n, _)| n == "camera_block.obj" || n == "two_lights.obj")
-    {
+    for (name, scene) in scenes().into_iter().filter(|(n, _)| {
+        ["camera_block.obj", "two_lights.obj", "rpi_style_room.obj"].contains(&n.as_str())
+    }) {
         let image = Oracle::new(&scene, &settings).render();
         failures.extend(run_case(
             &format!("{name} rpi ambient"),

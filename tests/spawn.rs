@@ -10,7 +10,8 @@ use glam::Vec3;
 use raywave::geometry::{Accel, Ray, intersect_sphere};
 use raywave::scene::{Scene, Sphere};
 use raywave::spawn::{
-    SurfaceHit, light_end, light_offset, mirror_ray, shadow_ray, sphere_offset, surface_hit,
+    SHADOW_TMAX, SurfaceHit, light_end, light_offset, mirror_ray, shadow_ray, sphere_offset,
+    surface_hit,
 };
 
 const SCALES: [f32; 5] = [1e-3, 1e-1, 1.0, 10.0, 1e3];
@@ -67,7 +68,7 @@ fn mirror_and_shadow_rays_leave_a_sphere_at_every_scale() {
             // A light point anywhere above the tangent plane, near or far, grazing or not.
             let target = hit.point + rng.direction() * (s * 4.0 * rng.next());
             if let Some(shadow) = shadow_ray(&hit, target, Vec3::ZERO, 0.0)
-                && intersect_sphere(&sphere, &shadow.ray, shadow.tmax) < shadow.tmax
+                && intersect_sphere(&sphere, &shadow.ray, SHADOW_TMAX) < SHADOW_TMAX
             {
                 shadow_rehits += 1;
             }
@@ -191,7 +192,7 @@ fn shadow_rays_end_before_the_light_even_at_grazing_angles() {
             let Some(shadow) = shadow_ray(&floor, light.point(u, v), end, end_offset) else {
                 continue;
             };
-            if accel.occluded(&scene, &shadow.ray, shadow.tmax, false) {
+            if accel.occluded(&scene, &shadow.ray, SHADOW_TMAX, false) {
                 blocked += 1;
             }
         }
@@ -240,7 +241,7 @@ fn two_sided_faces_do_not_shadow_themselves_or_their_other_half() {
             }
             let target = surface.point + rng.direction() * (3.0 * s);
             if let Some(shadow) = shadow_ray(&surface, target, Vec3::ZERO, 0.0)
-                && accel.occluded(&scene, &shadow.ray, shadow.tmax, true)
+                && accel.occluded(&scene, &shadow.ray, SHADOW_TMAX, true)
             {
                 self_hits += 1;
             }

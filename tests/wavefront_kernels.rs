@@ -461,7 +461,8 @@ proptest! {
             let lanes = ((count - j0) as usize).min(8);
             let hit = SurfaceHit { point, normal: n, offset };
             let end = end * 0.01;
-            let (from, l, tmax, ndl, live) = simd::shadow_rays8(&hit, &pts, end, end_offset, lanes);
+            let block = simd::shadow_rays8(&hit, &pts, end, end_offset, lanes);
+            let (l, seg, live) = (block.l, block.segment, block.live);
             for k in 0..lanes {
                 let (u, v) = square_sample(sampler, &key, j0 + k as u32, count);
                 let target = lamp.point(u, v);
@@ -470,14 +471,17 @@ proptest! {
                 let want = shadow_ray(&hit, target, end, end_offset);
                 prop_assert_eq!(live & (1 << k) != 0, want.is_some());
                 if let Some(want) = want {
-                    prop_assert_eq!(from.to_array().map(f32::to_bits),
+                    prop_assert_eq!(block.origin.to_array().map(f32::to_bits),
                         want.ray.origin.to_array().map(f32::to_bits));
-                    prop_assert_eq!([l[0][k], l[1][k], l[2][k]].map(f32::to_bits),
+                    prop_assert_eq!([seg[0][k], seg[1][k], seg[2][k]].map(f32::to_bits),
                         want.ray.direction.to_array().map(f32::to_bits));
-                    prop_assert_eq!(tmax[k].to_bits(), want.tmax.to_bits());
-                    prop_assert_eq!(ndl[k].to_bits(), want.n_dot_l.to_bits());
+                    prop_assert_eq!([l[0][k], l[1][k], l[2][k]].map(f32::to_bits),
+                        want.l.to_array().map(f32::to_bits));
+                    prop_assert_eq!(block.tmax[k], raywave::spawn::SHADOW_TMAX);
+                    prop_assert_eq!(block.dist[k].to_bits(), want.dist.to_bits());
+                    prop_assert_eq!(block.n_dot_l[k].to_bits(), want.n_dot_l.to_bits());
                 } else {
-                    prop_assert_eq!((tmax[k], ndl[k]), (0.0, 0.0));
+                    prop_assert_eq!((block.tmax[k], block.n_dot_l[k]), (0.0, 0.0));
                 }
             }
             for k in lanes..8 {

@@ -12,7 +12,7 @@ use crate::geometry::Accel;
 use crate::sampling::{LightSampler, SampleKey, square_sample};
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
-use crate::spawn::{light_end, light_offset, mirror_ray, shadow_ray, surface_hit};
+use crate::spawn::{SHADOW_TMAX, light_end, light_offset, mirror_ray, shadow_ray, surface_hit};
 use rayon::prelude::*;
 
 /// Per-pixel region membership.
@@ -88,9 +88,9 @@ fn classify(
                 let (u, v) = square_sample(LightSampler::Stratified, &key, j, points);
                 // Spawned as the renderers spawn it: no ray below the tangent plane.
                 let shadow = shadow_ray(&surface, light.point(u, v), end, end_offset);
-                if shadow
-                    .is_some_and(|s| !accel.occluded(scene, &s.ray, s.tmax, settings.two_sided))
-                {
+                if shadow.is_some_and(|s| {
+                    !accel.occluded(scene, &s.ray, SHADOW_TMAX, settings.two_sided)
+                }) {
                     visible += 1;
                 }
             }

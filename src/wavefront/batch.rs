@@ -5,7 +5,7 @@
 //! Buffers are allocated once per worker and reused (`clear` keeps the capacity), so the memory
 //! of a render is bounded by the batch size, not by the image.
 
-use crate::spawn::SurfaceHit;
+use crate::spawn::{SHADOW_TMAX, ShadowRay, SurfaceHit};
 use glam::Vec3;
 
 /// Paths in flight at one depth: their current ray and what they carry.
@@ -231,14 +231,22 @@ pub struct ShadowQueue {
     pub origin_y: Vec<f32>,
     /// Origin z.
     pub origin_z: Vec<f32>,
-    /// Unit direction to the light point x (the Shade formula's l).
+    /// The segment to test, end − origin (`spawn::ShadowRay::ray`), x.
+    pub segment_x: Vec<f32>,
+    /// Segment y.
+    pub segment_y: Vec<f32>,
+    /// Segment z.
+    pub segment_z: Vec<f32>,
+    /// `spawn::SHADOW_TMAX` for a ray, 0 for a dead lane.
+    pub tmax: Vec<f32>,
+    /// Unit direction from the hit point to the light point x (the Shade formula's l).
     pub direction_x: Vec<f32>,
     /// Direction y.
     pub direction_y: Vec<f32>,
     /// Direction z.
     pub direction_z: Vec<f32>,
-    /// Distance to the end of the shadow ray (`spawn::ShadowRay::tmax`; 0 for a dead lane).
-    pub tmax: Vec<f32>,
+    /// Distance from the hit point to the light point (the light model's fall-off).
+    pub dist: Vec<f32>,
     /// n·l; the entry is a ray only when it is > 0.
     pub n_dot_l: Vec<f32>,
     /// Index of the hit (in the current `HitBatch`) that casts the ray.
@@ -268,9 +276,13 @@ impl ShadowQueue {
                 &mut self.origin_x,
                 &mut self.origin_y,
                 &mut self.origin_z,
+                &mut self.segment_x,
+                &mut self.segment_y,
+                &mut self.segment_z,
                 &mut self.direction_x,
                 &mut self.direction_y,
                 &mut self.direction_z,
+                &mut self.dist,
                 &mut self.tmax,
                 &mut self.n_dot_l,
             ] {
@@ -289,41 +301,42 @@ impl ShadowQueue {
 
     /// Queues one shadow ray.
     #[inline]
-    pub fn push(&mut self, origin: Vec3, l: Vec3, tmax: f32, n_dot_l: f32, path: u32, light: u32) {
+    pub fn push(&mut self, ray: &ShadowRay, path: u32, light: u32) {
         let i = self.len;
-        self.origin_x[i] = origin.x;
-        self.origin_y[i] = origin.y;
-        self.origin_z[i] = origin.z;
-        self.direction_x[i] = l.x;
-        self.direction_y[i] = l.y;
-        self.direction_z[i] = l.z;
-        self.tmax[i] = tmax;
-        self.n_dot_l[i] = n_dot_l;
+        self.origin_x[i] = ray.ray.origin.x;
+        self.origin_y[i] = ray.ray.origin.y;
+        self.origin_z[i] = ray.ray.origin.z;
+        self.segment_x[i] = ray.ray.direction.x;
+        self.segment_y[i] = ray.ray.direction.y;
+        self.segment_z[i] = ray.ray.direction.z;
+        self.tmax[i] = SHADOW_TMAX;
+        self.direction_x[i] = ray.l.x;
+        self.direction_y[i] = ray.l.y;
+        self.direction_z[i] = ray.l.z;
+        self.dist[i] = ray.dist;
+        self.n_dot_l[i] = ray.n_dot_l;
         self.path[i] = path;
         self.light[i] = light;
         self.len = i + 1;
     }
 
-    /// Queues 8 lanes from one origin (dead lanes already carry `n_dot_l = 0`, `tmax = 0`).
+    /// Queues 8 lanes from one origin (`simd::shadow_rays8`'s block: dead lanes already carry
+    /// `n_dot_l = 0`, `tmax = 0`).
     #[inline]
-    pub fn push_block(
-        &mut self,
-        origin: Vec3,
-        l: &[[f32; 8]; 3],
-        tmax: &[f32; 8],
-        n_dot_l: &[f32; 8],
-        path: u32,
-        light: u32,
-    ) {
+    pub fn push_block(&mut self, block: &ShadowBlock, path: u32, light: u32) {
         let r = self.len..self.len + 8;
-        self.origin_x[r.clone()].fill(origin.x);
-        self.origin_y[r.clone()].fill(origin.y);
-        self.origin_z[r.clone()].fill(origin.z);
-        self.direction_x[r.clone()].copy_from_slice(&l[0]);
-        self.direction_y[r.clone()].copy_from_slice(&l[1]);
-        self.direction_z[r.clone()].copy_from_slice(&l[2]);
-        self.tmax[r.clone()].copy_from_slice(tmax);
-        self.n_dot_l[r.clone()].copy_from_slice(n_dot_l);
+        self.origin_x[r.clone()].fill(block.origin.x);
+        self.origin_y[r.clone()].fill(block.origin.y);
+        self.origin_z[r.clone()].fill(block.origin.z);
+        self.segment_x[r.clone()].copy_from_slice(&block.segment[0]);
+        self.segment_y[r.clone()].copy_from_slice(&block.segment[1]);
+        self.segment_z[r.clone()].copy_from_slice(&block.segment[2]);
+        self.tmax[r.clone()].copy_from_slice(&block.tmax);
+        self.direction_x[r.clone()].copy_from_slice(&block.l[0]);
+        self.direction_y[r.clone()].copy_from_slice(&block.l[1]);
+        self.direction_z[r.clone()].copy_from_slice(&block.l[2]);
+        self.dist[r.clone()].copy_from_slice(&block.dist);
+        self.n_dot_l[r.clone()].copy_from_slice(&block.n_dot_l);
         self.path[r.clone()].fill(path);
         self.light[r].fill(light);
         self.len += 8;
@@ -338,6 +351,26 @@ impl ShadowQueue {
             self.direction_z[i],
         )
     }
+}
+
+/// Eight shadow rays from one hit to one light, as `simd::shadow_rays8` makes them: lane k is
+/// `spawn::shadow_ray`'s answer for point k, or a dead lane (tmax = 0, n·l = 0).
+#[derive(Clone, Copy, Debug)]
+pub struct ShadowBlock {
+    /// The rays' common origin, off the surface.
+    pub origin: Vec3,
+    /// Segment (end − origin) x, y, z per lane.
+    pub segment: [[f32; 8]; 3],
+    /// `SHADOW_TMAX` for a live lane, 0 for a dead one.
+    pub tmax: [f32; 8],
+    /// l x, y, z per lane.
+    pub l: [[f32; 8]; 3],
+    /// |target − point| per lane.
+    pub dist: [f32; 8],
+    /// n·l per lane (0 when dead).
+    pub n_dot_l: [f32; 8],
+    /// Live lanes as a bitmask.
+    pub live: u32,
 }
 
 /// Per camera sample of a tile: the radiance gathered so far.

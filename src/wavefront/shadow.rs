@@ -113,11 +113,10 @@ fn spawn(
                 for j0 in (0..count).step_by(LANES) {
                     let target = simd::light_points8(&LightBlock { j0, ..block });
                     let lanes = ((count - j0) as usize).min(LANES);
-                    let (from, l, tmax, n_dot_l, live) =
-                        simd::shadow_rays8(&hit, &target, end, light.end_offset, lanes);
-                    if live != 0 {
-                        queue.push_block(from, &l, &tmax, &n_dot_l, i as u32, li as u32);
-                        cast += live.count_ones() as u64;
+                    let block = simd::shadow_rays8(&hit, &target, end, light.end_offset, lanes);
+                    if block.live != 0 {
+                        queue.push_block(&block, i as u32, li as u32);
+                        cast += block.live.count_ones() as u64;
                     }
                 }
             }
@@ -130,8 +129,7 @@ fn spawn(
                         light.centroid
                     };
                     if let Some(s) = shadow_ray(&hit, target, end, light.end_offset) {
-                        let l = s.ray.direction;
-                        queue.push(s.ray.origin, l, s.tmax, s.n_dot_l, i as u32, li as u32);
+                        queue.push(&s, i as u32, li as u32);
                         cast += 1;
                     }
                 }
@@ -153,9 +151,9 @@ fn occlude(ctx: &Context, queue: &mut ShadowQueue) {
             &queue.origin_z[..n],
         ],
         direction: [
-            &queue.direction_x[..n],
-            &queue.direction_y[..n],
-            &queue.direction_z[..n],
+            &queue.segment_x[..n],
+            &queue.segment_y[..n],
+            &queue.segment_z[..n],
         ],
         tmax: &queue.tmax[..n],
     };
@@ -189,7 +187,7 @@ fn shade(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch, queue: &ShadowQueu
             let i = queue.path[q] as usize;
             let m = &ctx.materials[hits.material[i] as usize];
             let model = ctx.settings.light_model;
-            let falloffs = std::array::from_fn(|k| falloff(model, queue.tmax[q + k]));
+            let falloffs = std::array::from_fn(|k| falloff(model, queue.dist[q + k]));
             let c = simd::shade8(
                 m,
                 hits.normal(i),
@@ -220,7 +218,7 @@ fn shade(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch, queue: &ShadowQueu
             let i = queue.path[q] as usize;
             let m = &ctx.materials[hits.material[i] as usize];
             let light_color = ctx.lights[queue.light[q] as usize].color
-                * falloff(ctx.settings.light_model, queue.tmax[q]);
+                * falloff(ctx.settings.light_model, queue.dist[q]);
             let c = shade_terms(
                 m,
                 hits.normal(i),

@@ -18,10 +18,11 @@
 //! sentinel. Batches whose length is not a multiple of 8 are padded with lanes that cannot hit
 //! (tmax = 0, NaN directions), and the padding is never stored back.
 
+use super::batch::ShadowBlock;
 use super::context::MaterialTerms;
 use crate::geometry::{EDGE_EPSILON, T_MIN};
 use crate::scene::{NO_HIT, Sphere, Triangle};
-use crate::spawn::SurfaceHit;
+use crate::spawn::{SHADOW_TMAX, SurfaceHit};
 use glam::Vec3;
 use wide::{f32x8, i32x8, u32x8};
 
@@ -602,38 +603,46 @@ fn parallelogram_points8(
 
 /// Shadow rays from `hit` to 8 light points, the first `lanes` of them real: lane k equals
 /// `spawn::shadow_ray(hit, target_k, end, end_offset)` (origin `hit.offset` off the surface,
-/// unit direction l, tmax the distance to `target + end`, and n·l). Lanes whose point is not
-/// above the tangent plane by more than the two offsets (the twin returns `None`) or past
-/// `lanes` come back dead: tmax = 0, n·l = 0. Also returns the origin and the bitmask of live
-/// lanes.
+/// segment to `target + end`, and the exact l, |target − point| and n·l). Lanes whose segment
+/// does not rise above the tangent plane by more than the two offsets (the twin returns
+/// `None`) or past `lanes` come back dead: tmax = 0, n·l = 0.
 #[inline]
-#[allow(clippy::type_complexity)]
 pub fn shadow_rays8(
     hit: &SurfaceHit,
     target: &[[f32; LANES]; 3],
     end: Vec3,
     end_offset: f32,
     lanes: usize,
-) -> (Vec3, [[f32; LANES]; 3], [f32; LANES], [f32; LANES], u32) {
+) -> ShadowBlock {
     let n = hit.normal;
     let origin = hit.point + hit.offset * n;
-    let x = (f32x8::new(target[0]) + f32x8::splat(end.x)) - f32x8::splat(origin.x);
-    let y = (f32x8::new(target[1]) + f32x8::splat(end.y)) - f32x8::splat(origin.y);
-    let z = (f32x8::new(target[2]) + f32x8::splat(end.z)) - f32x8::splat(origin.z);
-    let above = f32x8::splat(n.x) * x + f32x8::splat(n.y) * y + f32x8::splat(n.z) * z;
+    let (tx, ty, tz) = (
+        f32x8::new(target[0]),
+        f32x8::new(target[1]),
+        f32x8::new(target[2]),
+    );
+    let sx = (tx + f32x8::splat(end.x)) - f32x8::splat(origin.x);
+    let sy = (ty + f32x8::splat(end.y)) - f32x8::splat(origin.y);
+    let sz = (tz + f32x8::splat(end.z)) - f32x8::splat(origin.z);
+    let above = f32x8::splat(n.x) * sx + f32x8::splat(n.y) * sy + f32x8::splat(n.z) * sz;
+    let x = tx - f32x8::splat(hit.point.x);
+    let y = ty - f32x8::splat(hit.point.y);
+    let z = tz - f32x8::splat(hit.point.z);
     let dist = (x * x + y * y + z * z).sqrt();
     let (lx, ly, lz) = (x / dist, y / dist, z / dist);
     let n_dot_l = f32x8::splat(n.x) * lx + f32x8::splat(n.y) * ly + f32x8::splat(n.z) * lz;
     let first = f32x8::new(LANE_INDEX).simd_lt(f32x8::splat(lanes as f32));
     let live = above.simd_gt(f32x8::splat(hit.offset + end_offset)) & first;
     let zero = f32x8::ZERO;
-    (
+    ShadowBlock {
         origin,
-        [lx.to_array(), ly.to_array(), lz.to_array()],
-        live.select(dist, zero).to_array(),
-        live.select(n_dot_l, zero).to_array(),
-        live.to_bitmask(),
-    )
+        segment: [sx.to_array(), sy.to_array(), sz.to_array()],
+        tmax: live.select(f32x8::splat(SHADOW_TMAX), zero).to_array(),
+        l: [lx.to_array(), ly.to_array(), lz.to_array()],
+        dist: dist.to_array(),
+        n_dot_l: live.select(n_dot_l, zero).to_array(),
+        live: live.to_bitmask(),
+    }
 }
 
 /// Shade · weight of 8 shadow rays cast from one hit towards one light: lane k equals
