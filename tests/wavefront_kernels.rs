@@ -398,7 +398,9 @@ proptest! {
         let ndl: Vec<f32> = ls.iter().map(|&l| n.dot(l)).collect();
         let blocked: Vec<bool> = (0..8).map(|k| blocked_bits & (1 << k) != 0).collect();
         let falloff: [f32; 8] = std::array::from_fn(|k| falloffs[k]);
-        let got = simd::shade8(&terms, n, e, [&lx, &ly, &lz], &ndl, &blocked, lc.abs(), &falloff, weight);
+        let lab = falloffs.iter().all(|&f| f == 1.0);
+        let got = simd::shade8(&terms, n, e, [&lx, &ly, &lz], &ndl, &blocked, lc.abs(),
+            (!lab).then_some(&falloff), weight);
         for k in 0..8 {
             if !(ndl[k] > 0.0) || blocked[k] {
                 // Adds nothing: exactly −0.0, the identity of addition.

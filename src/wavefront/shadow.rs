@@ -24,6 +24,7 @@ use super::simd::{self, LANES, LightBlock, RayColumns};
 use crate::geometry::casters;
 use crate::sampling::{SampleKey, mix32, square_sample};
 use crate::scene::NO_HIT;
+use crate::settings::LightModel;
 use crate::spawn::{falloff, light_end, shadow_ray};
 use glam::Vec3;
 
@@ -187,7 +188,10 @@ fn shade(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch, queue: &ShadowQueu
             let i = queue.path[q] as usize;
             let m = &ctx.materials[hits.material[i] as usize];
             let model = ctx.settings.light_model;
-            let falloffs = std::array::from_fn(|k| falloff(model, queue.dist[q + k]));
+            let falloffs: Option<[f32; LANES]> = match model {
+                LightModel::Lab => None,
+                LightModel::Rpi => Some(std::array::from_fn(|k| falloff(model, queue.dist[q + k]))),
+            };
             let c = simd::shade8(
                 m,
                 hits.normal(i),
@@ -200,7 +204,7 @@ fn shade(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch, queue: &ShadowQueu
                 &queue.n_dot_l[q..end],
                 &queue.blocked[q..end],
                 ctx.lights[queue.light[q] as usize].color,
-                &falloffs,
+                falloffs.as_ref(),
                 weight,
             );
             // In lane order, like the reference's loop; lanes that add nothing hold −0.0.

@@ -621,9 +621,10 @@ pub fn shadow_rays8(
         f32x8::new(target[1]),
         f32x8::new(target[2]),
     );
-    let sx = (tx + f32x8::splat(end.x)) - f32x8::splat(origin.x);
-    let sy = (ty + f32x8::splat(end.y)) - f32x8::splat(origin.y);
-    let sz = (tz + f32x8::splat(end.z)) - f32x8::splat(origin.z);
+    let to_end = end - origin;
+    let sx = tx + f32x8::splat(to_end.x);
+    let sy = ty + f32x8::splat(to_end.y);
+    let sz = tz + f32x8::splat(to_end.z);
     let above = f32x8::splat(n.x) * sx + f32x8::splat(n.y) * sy + f32x8::splat(n.z) * sz;
     let x = tx - f32x8::splat(hit.point.x);
     let y = ty - f32x8::splat(hit.point.y);
@@ -660,17 +661,27 @@ pub fn shade8(
     n_dot_l: &[f32],
     blocked: &[bool],
     light_color: Vec3,
-    falloff: &[f32; LANES],
+    falloff: Option<&[f32; LANES]>,
     weight: f32,
 ) -> [[f32; LANES]; 3] {
     let ndl = load(n_dot_l, 0, 0.0);
-    // Each lane's light colour Lc · falloff (`spawn::falloff`: exactly Lc in the lab's model).
-    let f = f32x8::new(*falloff);
-    let lc = [
-        f32x8::splat(light_color.x) * f,
-        f32x8::splat(light_color.y) * f,
-        f32x8::splat(light_color.z) * f,
-    ];
+    // Each lane's light colour: Lc · falloff (`spawn::falloff`), or Lc itself in the lab's
+    // model, whose fall-off is exactly 1 (x · 1 = x, so both give the twin's bits).
+    let lc = {
+        let splat = |c: f32| f32x8::splat(c);
+        let (r, g, b) = (
+            splat(light_color.x),
+            splat(light_color.y),
+            splat(light_color.z),
+        );
+        match falloff {
+            None => [r, g, b],
+            Some(f) => {
+                let f = f32x8::new(*f);
+                [r * f, g * f, b * f]
+            }
+        }
+    };
     let open = f32x8::new(std::array::from_fn(|k| if blocked[k] { 0.0 } else { 1.0 }));
     let adds = ndl.simd_gt(f32x8::ZERO) & open.simd_gt(f32x8::ZERO);
     let nothing = f32x8::splat(-0.0);
