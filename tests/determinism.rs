@@ -27,6 +27,7 @@ fn soft_settings(seed: u32) -> RenderSettings {
         background: [0.2, 0.1, 0.6],
         seed,
         two_sided: false,
+        ..RenderSettings::default()
     }
 }
 

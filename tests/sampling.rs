@@ -137,6 +137,7 @@ fn antialiased_pixel_over_an_edge_is_the_area_mix() {
             background: bg.to_array(),
             seed: 5,
             two_sided: false,
+            ..RenderSettings::default()
         };
         let got = Reference::new(&scene, &settings).pixel(0, &mut RayCounts::default(), &mut ());
         if aa == 1 {

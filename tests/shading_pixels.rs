@@ -86,6 +86,7 @@ fn settings(shadows: ShadowMode, bounces: u32) -> RenderSettings {
         background: [0.25, 0.5, 0.75],
         seed: 0,
         two_sided: false,
+        ..RenderSettings::default()
     }
 }
 

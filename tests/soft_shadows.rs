@@ -99,6 +99,7 @@ fn settings(sampler: LightSampler, n: u32, seed: u32) -> RenderSettings {
         background: [0.0; 3],
         seed,
         two_sided: false,
+        ..RenderSettings::default()
     }
 }
 

@@ -44,6 +44,7 @@ fn modes() -> Vec<RenderSettings> {
         background: [0.2, 0.1, 0.6],
         seed: 3,
         two_sided: false,
+        ..RenderSettings::default()
     };
     let soft = |n, sampler| RenderSettings {
         shadows: ShadowMode::Soft,
