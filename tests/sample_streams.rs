@@ -500,10 +500,11 @@ fn camera_offsets(
 #[test]
 fn camera_rays_fill_their_strata_uniformly() {
     let scene = corridor();
-    for (aa, size) in [(16u32, 24u32), (8, 32)] {
+    // Non-square images, wider and taller: the screen mapping divides by max(w, h).
+    for (aa, width, height) in [(16u32, 24u32, 18u32), (8, 24, 36)] {
         let s = RenderSettings {
-            width: size,
-            height: size,
+            width,
+            height,
             shadows: ShadowMode::Off,
             ..settings(LightSampler::Stratified, 1, aa, 5)
         };
