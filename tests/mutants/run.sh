@@ -4,12 +4,13 @@
 # applies: the code moved; re-plant it by hand) or NO-BUILD (the mutant does not compile).
 #
 #   tests/mutants/run.sh                            every patch in tests/mutants/
-#   tests/mutants/run.sh tests/mutants/light_key_reference.patch ...
+#   tests/mutants/run.sh tests/mutants/planted_light_key.patch ...
 #   RAYWAVE_MUTANT_TESTS="sampling" tests/mutants/run.sh P.patch   other tests than the patch's
 #
-# A patch is `git diff` output after two header lines, "Mutant: what changed" and
-# "Tests: test-file names", which `git apply` skips. Run it from a clean work tree: it refuses
-# to start when src/ has uncommitted changes, and it always reverts what it applied.
+# A patch is `git diff` output after two header lines, "Mutant: what changed" and "Tests:
+# test-file names" (`lib` for the unit tests in src/), which `git apply` skips. Run it from a
+# clean work tree: it refuses to start when src/ has uncommitted changes, and it always reverts
+# what it applied. Each mutant rebuilds the library in release: about a minute on 2 cores.
 set -u
 cd "$(git rev-parse --show-toplevel)" || exit 2
 if ! git diff --quiet -- src; then
@@ -27,7 +28,9 @@ for patch in "$@"; do
         continue
     fi
     args=""
-    for t in $tests; do args="$args --test $t"; done
+    for t in $tests; do
+        if [ "$t" = lib ]; then args="$args --lib"; else args="$args --test $t"; fi
+    done
     # shellcheck disable=SC2086 # one argument per word on purpose
     if ! cargo test --release --no-fail-fast $args --no-run >"$log" 2>&1; then
         result="NO-BUILD  $name"
