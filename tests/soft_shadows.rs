@@ -98,7 +98,6 @@ fn settings(sampler: LightSampler, n: u32, seed: u32) -> RenderSettings {
         aa_samples: 1,
         background: [0.0; 3],
         seed,
-        two_sided: false,
         ..RenderSettings::default()
     }
 }
