@@ -23,7 +23,7 @@
 
 use glam::{DVec2, DVec3};
 use raywave::camera::CameraRays;
-use raywave::geometry::{Hit, Ray, T_MIN};
+use raywave::geometry::{Hit, Ray};
 use raywave::reference::{Reference, TraceLog};
 use raywave::sampling::{LightSampler, strata_grid};
 use raywave::scene::{LightShape, Scene, parse_scene_str};
@@ -137,6 +137,20 @@ fn light_uv(scene: &Scene, light: u32, p: DVec3) -> DVec2 {
     DVec2::new((c * x - b * y) / det, (a * y - b * x) / det)
 }
 
+/// Where the ray from `origin` along `l` meets the plane of light `light`, in f64.
+fn on_light_plane(scene: &Scene, light: u32, origin: DVec3, l: DVec3) -> DVec3 {
+    let LightShape::Parallelogram {
+        origin: corner,
+        edge_u,
+        edge_v,
+    } = scene.lights[light as usize].shape
+    else {
+        panic!("the corridor's lights are parallelograms");
+    };
+    let n = edge_u.as_dvec3().cross(edge_v.as_dvec3());
+    origin + l * (n.dot(corner.as_dvec3() - origin) / n.dot(l))
+}
+
 /// Keeps the streams that got all `n` points (a point below a hit's tangent plane casts no ray).
 fn complete(points: BTreeMap<Stream, Vec<DVec2>>, n: u32) -> BTreeMap<Stream, Vec<DVec2>> {
     points
@@ -229,14 +243,14 @@ fn wavefront_draws(scene: &Scene, s: &RenderSettings) -> Drawn {
                 bounce: rays.bounce,
                 light: queue.light[q],
             };
-            // The light point is where the ray would end: origin + l·(tmax + T_MIN).
+            // The light point is where the ray meets the light's plane (not read from tmax, so
+            // the test does not depend on how the engine shortens the ray).
             let origin = DVec3::new(
                 queue.origin_x[q] as f64,
                 queue.origin_y[q] as f64,
                 queue.origin_z[q] as f64,
             );
-            let target =
-                origin + queue.direction(q).as_dvec3() * (queue.tmax[q] as f64 + T_MIN as f64);
+            let target = on_light_plane(scene, stream.light, origin, queue.direction(q).as_dvec3());
             let uv = light_uv(scene, stream.light, target);
             drawn.points.entry(stream).or_default().push(uv);
         }
