@@ -3,7 +3,8 @@
 //! σ²_ref the reference's own per-pixel error variance, P pixels in the region; a pixel's three
 //! channels count once, being correlated). A bound built from the standard deviation instead is
 //! √(P·K) times looser (about 100× at the study's sizes) and flags nothing; these tests pin the
-//! bound to a hand computation and make the study flag samplers whose bias is known.
+//! bound to a hand computation and make the study flag samplers whose bias is known. Also by
+//! hand: the converged reference's own noise estimate, and a zero MSE left out of the fit.
 
 mod common;
 
