@@ -472,3 +472,35 @@ PerspectiveCamera {
         "{speckled} of 576 pixels on the light are not 0.2·kd"
     );
 }
+
+#[test]
+fn no_highlight_when_the_viewer_is_behind_the_mirror_direction() {
+    // A glossy floor point near the corner, seen from low down on the light's side: e·r < 0, so
+    // max(0, e·r) gives no highlight, where |e·r|^s would add a visible one. The twin tests
+    // cannot tell: the wavefront engine's `shade_terms` would make the same mistake if it were
+    // made in both.
+    let kr = Vec3::new(0.4, 0.5, 0.6);
+    let g = 1.0;
+    let p = Vec3::new(0.9, 0.0, 0.9);
+    let eye = p + 3.0 * Vec3::new(-1.0, 0.05, -1.0);
+    let s = scene(kr, g, "", "", eye, p);
+    let n = Vec3::Y;
+    let e = (eye - p).normalize();
+    let l = (CENTROID - p).normalize();
+    let r = (2.0 * n.dot(l) * n - l).normalize();
+    assert!(e.dot(r) < -0.4, "e·r = {}", e.dot(r));
+    let lost_sign = LC * (0.8 * kr) * (-e.dot(r)).powf(5.0 / (g + 0.01)) * n.dot(l);
+    assert!(lost_sign.min_element() > 1e-3, "{lost_sign}");
+    let want = 0.2 * FLOOR_KD + LC * FLOOR_KD * n.dot(l);
+    assert_close(
+        want,
+        0.2 * FLOOR_KD + shade_by_hand(FLOOR_KD, kr, Vec3::ZERO, g, n, e, l, LC),
+        "by hand",
+    );
+    let got = render_pixel(&s, &settings(ShadowMode::Hard, 0), 0);
+    assert_close(
+        got,
+        want,
+        "glossy floor, viewer behind the mirror direction",
+    );
+}
