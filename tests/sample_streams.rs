@@ -243,13 +243,10 @@ fn wavefront_draws(scene: &Scene, s: &RenderSettings) -> Drawn {
                 bounce: rays.bounce,
                 light: queue.light[q],
             };
-            // The light point is where the ray meets the light's plane (not read from tmax, so
-            // the test does not depend on how the engine shortens the ray).
-            let origin = DVec3::new(
-                queue.origin_x[q] as f64,
-                queue.origin_y[q] as f64,
-                queue.origin_z[q] as f64,
-            );
+            // The light point is where the Shade formula's l, which runs from the hit point
+            // itself, meets the light's plane (not read from the tested segment, so the test
+            // does not depend on where the engine starts and ends that segment).
+            let origin = hits.point(i).as_dvec3();
             let target = on_light_plane(scene, stream.light, origin, queue.direction(q).as_dvec3());
             let uv = light_uv(scene, stream.light, target);
             drawn.points.entry(stream).or_default().push(uv);
