@@ -219,8 +219,10 @@ impl HitBatch {
 ///
 /// The columns keep a fixed length (the capacity) and `len` says how many entries are in use,
 /// so stages write 8 lanes at a time without growing vectors. An entry is a live ray only when
-/// `n_dot_l > 0`: the SIMD spawn writes whole 8-lane blocks and marks the lanes whose light
-/// point is behind the surface (or past the last point) dead with `n_dot_l = 0`, `tmax = 0`.
+/// `tmax > 0`: the SIMD spawn writes whole 8-lane blocks and marks the lanes whose light
+/// point is behind the surface (or past the last point) dead with `tmax = 0`. n·l is not kept:
+/// the shade step computes it from l in the spawn's operations (every column written costs the
+/// store-bound spawn; docs/PERFORMANCE.md).
 #[derive(Clone, Debug, Default)]
 pub struct ShadowQueue {
     /// Entries in use.
@@ -245,10 +247,10 @@ pub struct ShadowQueue {
     pub direction_y: Vec<f32>,
     /// Direction z.
     pub direction_z: Vec<f32>,
-    /// Distance from the hit point to the light point (the light model's fall-off).
+    /// Distance from the hit point to the light point, for the light model's fall-off: kept only
+    /// under a model that has one (empty under the lab's, which saves a column of writes: 7% of
+    /// the shadow stage).
     pub dist: Vec<f32>,
-    /// n·l; the entry is a ray only when it is > 0.
-    pub n_dot_l: Vec<f32>,
     /// Index of the hit (in the current `HitBatch`) that casts the ray.
     pub path: Vec<u32>,
     /// Light index.
@@ -268,9 +270,11 @@ impl ShadowQueue {
         self.len == 0
     }
 
-    /// Empties the queue and makes room for `capacity` entries.
-    pub fn reset(&mut self, capacity: usize) {
+    /// Empties the queue and makes room for `capacity` entries, with the `dist` column only
+    /// when `with_dist` (a light model with fall-off).
+    pub fn reset(&mut self, capacity: usize, with_dist: bool) {
         self.len = 0;
+        self.dist.resize(if with_dist { capacity } else { 0 }, 0.0);
         if self.tmax.len() != capacity {
             for c in [
                 &mut self.origin_x,
@@ -282,9 +286,7 @@ impl ShadowQueue {
                 &mut self.direction_x,
                 &mut self.direction_y,
                 &mut self.direction_z,
-                &mut self.dist,
                 &mut self.tmax,
-                &mut self.n_dot_l,
             ] {
                 c.resize(capacity, 0.0);
             }
@@ -313,15 +315,16 @@ impl ShadowQueue {
         self.direction_x[i] = ray.l.x;
         self.direction_y[i] = ray.l.y;
         self.direction_z[i] = ray.l.z;
-        self.dist[i] = ray.dist;
-        self.n_dot_l[i] = ray.n_dot_l;
+        if let Some(d) = self.dist.get_mut(i) {
+            *d = ray.dist;
+        }
         self.path[i] = path;
         self.light[i] = light;
         self.len = i + 1;
     }
 
     /// Queues 8 lanes from one origin (`simd::shadow_rays8`'s block: dead lanes already carry
-    /// `n_dot_l = 0`, `tmax = 0`).
+    /// `tmax = 0`).
     #[inline]
     pub fn push_block(&mut self, block: &ShadowBlock, path: u32, light: u32) {
         let r = self.len..self.len + 8;
@@ -335,8 +338,9 @@ impl ShadowQueue {
         self.direction_x[r.clone()].copy_from_slice(&block.l[0]);
         self.direction_y[r.clone()].copy_from_slice(&block.l[1]);
         self.direction_z[r.clone()].copy_from_slice(&block.l[2]);
-        self.dist[r.clone()].copy_from_slice(&block.dist);
-        self.n_dot_l[r.clone()].copy_from_slice(&block.n_dot_l);
+        if !self.dist.is_empty() {
+            self.dist[r.clone()].copy_from_slice(&block.dist);
+        }
         self.path[r.clone()].fill(path);
         self.light[r].fill(light);
         self.len += 8;
@@ -367,8 +371,6 @@ pub struct ShadowBlock {
     pub l: [[f32; 8]; 3],
     /// |target − point| per lane.
     pub dist: [f32; 8],
-    /// n·l per lane (0 when dead).
-    pub n_dot_l: [f32; 8],
     /// Live lanes as a bitmask.
     pub live: u32,
 }

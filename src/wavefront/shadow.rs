@@ -55,7 +55,10 @@ pub fn direct_light(
     }
     // Room for one hit's rays at least, each light's points padded to whole 8-lane blocks.
     let per_hit = ctx.lights.len() * (ctx.points_per_light as usize).div_ceil(LANES) * LANES;
-    queue.reset(capacity.max(per_hit));
+    queue.reset(
+        capacity.max(per_hit),
+        ctx.settings.light_model != LightModel::Lab,
+    );
     let mut cast = 0;
     let mut next = 0;
     while next < n {
@@ -201,7 +204,7 @@ fn shade(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch, queue: &ShadowQueu
                     &queue.direction_y[q..end],
                     &queue.direction_z[q..end],
                 ],
-                &queue.n_dot_l[q..end],
+                &queue.tmax[q..end],
                 &queue.blocked[q..end],
                 ctx.lights[queue.light[q] as usize].color,
                 falloffs.as_ref(),
@@ -218,19 +221,18 @@ fn shade(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch, queue: &ShadowQueu
             q = end;
             continue;
         }
-        if !queue.blocked[q] && queue.n_dot_l[q] > 0.0 {
-            let i = queue.path[q] as usize;
+        let i = queue.path[q] as usize;
+        let (n, l) = (hits.normal(i), queue.direction(q));
+        let n_dot_l = n.dot(l);
+        if queue.tmax[q] > 0.0 && !queue.blocked[q] && n_dot_l > 0.0 {
             let m = &ctx.materials[hits.material[i] as usize];
-            let light_color = ctx.lights[queue.light[q] as usize].color
-                * falloff(ctx.settings.light_model, queue.dist[q]);
-            let c = shade_terms(
-                m,
-                hits.normal(i),
-                -rays.direction(i),
-                queue.direction(q),
-                queue.n_dot_l[q],
-                light_color,
-            ) * weight;
+            let model = ctx.settings.light_model;
+            let fall = match model {
+                LightModel::Lab => 1.0,
+                LightModel::Rpi => falloff(model, queue.dist[q]),
+            };
+            let light_color = ctx.lights[queue.light[q] as usize].color * fall;
+            let c = shade_terms(m, n, -rays.direction(i), l, n_dot_l, light_color) * weight;
             hits.direct_r[i] += c.x;
             hits.direct_g[i] += c.y;
             hits.direct_b[i] += c.z;
