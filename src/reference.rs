@@ -20,7 +20,7 @@ use crate::scene::Scene;
 use crate::settings::{RenderSettings, ShadowMode};
 use crate::shading::shade;
 use crate::spawn::{
-    SHADOW_TMAX, SurfaceHit, falloff, light_end, light_offset, mirror_ray, shadow_ray, surface_hit,
+    SurfaceHit, falloff, light_end, light_offset, mirror_ray, shadow_ray, surface_hit,
 };
 use crate::stats::RayCounts;
 use glam::Vec3;
@@ -176,7 +176,7 @@ impl<'a> Reference<'a> {
                 ..key
             };
             let end_offset = self.light_offsets[li];
-            let end = light_end(light, end_offset, surface.point);
+            let end = light_end(light, end_offset, surface);
             for j in 0..count {
                 let target = match settings.shadows {
                     ShadowMode::Soft => {
@@ -185,7 +185,7 @@ impl<'a> Reference<'a> {
                     }
                     _ => light.centroid,
                 };
-                let Some(shadow) = shadow_ray(surface, target, end, end_offset) else {
+                let Some(shadow) = shadow_ray(surface, target, &end) else {
                     continue;
                 };
                 let from = shadow.ray.origin;
@@ -199,7 +199,7 @@ impl<'a> Reference<'a> {
                         let blocked = self.accel.occluded(
                             self.scene,
                             &shadow.ray,
-                            SHADOW_TMAX,
+                            shadow.tmax,
                             settings.two_sided,
                         );
                         log.shadow_ray(key.bounce, li as u32, from, target, Some(blocked));
@@ -208,7 +208,7 @@ impl<'a> Reference<'a> {
                 };
                 if visible {
                     let light_color = light.color * falloff(settings.light_model, shadow.dist);
-                    let l = shadow.l;
+                    let l = shadow.ray.direction;
                     sum +=
                         shade(material, surface.normal, e, l, shadow.n_dot_l, light_color) * weight;
                 }

@@ -6,18 +6,24 @@
 //!          p  = p0 projected onto the plane, or c + r·normalize(p0 − c) on a sphere
 //!          δ  = 2^-18 · (magnitude of the primitive's coordinates)  ≥ 10 × the error of p
 //! mirror:  origin p ± δ·n on the side the mirror ray leaves to, t > 0
-//! shadow:  from x' = p + δ·n to q' = q + δ_q·n_q (q on the light, pushed off the light's plane
-//!          towards p), cast when n·(q' − x') > δ + δ_q, blocked by a hit on that segment;
-//!          shaded with the exact l = normalize(q − p) and |q − p|
+//! shadow:  l = normalize(q − p) to the light point q; cast when n·(q − p) > δ + δ_q; from
+//!          x' = p + δ·n along l, blocked by a hit before the light's plane moved towards p by
+//!          δ + δ_q (δ_q: the light's own offset)
 //! ```
 //!
-//! This is pbrt-v4's scheme (`OffsetRayOrigin`, `SpawnRayTo`) with a simpler bound: the error of
-//! a point put back on its surface is a few ulps of the largest coordinate involved, so one
-//! offset per primitive, relative to its coordinates, covers it with a tenfold margin. Both ends
-//! scale with the scene, so an image does not change when the scene is scaled. Ending the shadow
-//! ray at p', off the light's plane on the near side, is what lets the interval be exactly
-//! (0, |p' − x'|): at a grazing angle the error of where the ray crosses the light's plane grows
-//! as 1/|l·n_q|, and so does the distance between p' and that plane along the ray.
+//! This is pbrt-v4's scheme (`OffsetRayOrigin`, and `SpawnRayTo`'s end off the light) with a
+//! simpler bound: the error of a point put back on its surface is a few ulps of the largest
+//! coordinate involved, so one offset per primitive, relative to its coordinates, covers it
+//! with a tenfold margin. Both ends scale with the scene, so an image does not change when the
+//! scene is scaled. Ending the shadow ray at the moved plane is what lets the light's own face
+//! be tested (meshes): at a grazing angle the error of where the ray crosses the light's plane
+//! grows as 1/|l·n_q|, and so does the distance between that crossing and the ray's end.
+//!
+//! The shadow ray runs along the Shade formula's own l, so the offsets change which blockers
+//! are found within δ of either end, never how a visible point is shaded, and the queue of the
+//! wavefront engine keeps one direction per ray. (A first version shot the ray from x' to the
+//! moved light point and kept both that segment and l: its extra columns of stores cost the
+//! store-bound shadow stage 12%.)
 //!
 //! Rejected: a larger absolute epsilon on t (the lab's 1e-4: wrong at some scale, whichever
 //! value), and carrying the id of the surface a ray leaves (exact for spheres, but a coplanar
@@ -142,58 +148,82 @@ pub fn light_offset(light: &Light) -> f32 {
     OFFSET_SCALE * m
 }
 
-/// Where a shadow ray from `point` ends relative to its point on `light`: `offset` off the
-/// light's plane, on `point`'s side (a planar light, so one side for all its points).
-#[inline]
-pub fn light_end(light: &Light, offset: f32, point: Vec3) -> Vec3 {
-    if light.normal.dot(point - light.centroid) >= 0.0 {
-        offset * light.normal
-    } else {
-        -offset * light.normal
-    }
+/// Where shadow rays from one hit to one light end: the light's plane moved towards the hit by
+/// the two offsets, as its unit normal facing the hit and the hit's origin's height above it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightEnd {
+    /// The light's normal, turned to face the hit (a planar light: one side for all points).
+    pub normal: Vec3,
+    /// Height of the ray origin (`hit.offset` off the surface) above the moved plane.
+    pub height: f32,
+    /// The two offsets added: a point must be this far above the tangent plane.
+    pub margin: f32,
 }
 
-/// A shadow ray is blocked by a hit with t in (0, `SHADOW_TMAX`): its direction runs from its
-/// start to its end.
-pub const SHADOW_TMAX: f32 = 1.0;
+/// The end of shadow rays from `hit` to `light` (whose `light_offset` is `end_offset`): the
+/// light's plane moved towards the hit by `end_offset + hit.offset`. (Moving it by both
+/// offsets makes every ray end before its light point, whatever the angle between the
+/// surface and the light: `shadow_ray`.)
+#[inline]
+pub fn light_end(light: &Light, end_offset: f32, hit: &SurfaceHit) -> LightEnd {
+    let normal = if light.normal.dot(hit.point - light.centroid) >= 0.0 {
+        light.normal
+    } else {
+        -light.normal
+    };
+    let margin = end_offset + hit.offset;
+    let origin = hit.point + hit.offset * hit.normal;
+    LightEnd {
+        normal,
+        height: normal.dot(origin - light.centroid) - margin,
+        margin,
+    }
+}
 
 /// A shadow ray and what shading needs of it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ShadowRay {
-    /// The segment tested for blockers: from `hit.offset` off the surface to `end` off the light
-    /// point, as origin and direction (end − start, not unit), blocked in (0, `SHADOW_TMAX`).
+    /// From `hit.offset` off the surface, along l.
     pub ray: Ray,
-    /// The Shade formula's l, from the hit point itself: normalize(target − point).
-    pub l: Vec3,
+    /// Blocked by a hit with t in (0, tmax): where the ray meets the light's moved plane.
+    pub tmax: f32,
     /// |target − point|, for the light model's fall-off.
     pub dist: f32,
     /// n·l.
     pub n_dot_l: f32,
 }
 
-/// The shadow ray from `hit` to the light point `target` (`end` from `light_end`, `end_offset`
-/// its length), or `None` when the segment's end is not above the tangent plane by more than the two
-/// offsets (for a light's own points, and coplanar lights, n·l is 0 up to rounding: a rounding-
-/// positive n·l would add a speckle). Written once, for every engine: the 8-wide twin is
+/// The shadow ray from `hit` to the light point `target` (`end` from `light_end`), or `None`
+/// when the point is not above the tangent plane by more than the two offsets (for a light's
+/// own points, and coplanar lights, n·l is 0 up to rounding: a rounding-positive n·l would add
+/// a speckle) or the ray's origin is not above the light's moved plane.
+///
+/// l = normalize(target − point) is the Shade formula's, from the hit point itself; the ray runs
+/// along it from `hit.offset` off the surface, so it is l shifted by at most that offset, and
+/// ends where it meets the light's plane moved towards the hit by the two offsets. At a
+/// grazing angle the error of where a ray crosses the light's plane grows as 1/|l·n_L|, and so
+/// does the distance between that crossing and the ray's end: the light, and faces coplanar
+/// with it, never block their own points. Written once, for every engine: the 8-wide twin is
 /// `wavefront::simd::shadow_rays8`.
 #[inline]
 #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(x > y)` is on purpose: NaN casts no ray
-pub fn shadow_ray(hit: &SurfaceHit, target: Vec3, end: Vec3, end_offset: f32) -> Option<ShadowRay> {
-    let origin = hit.point + hit.offset * hit.normal;
-    // end − origin is the same for all of a light's points: the 8-wide twin computes it once.
-    let segment = target + (end - origin);
-    if !(hit.normal.dot(segment) > hit.offset + end_offset) {
+pub fn shadow_ray(hit: &SurfaceHit, target: Vec3, end: &LightEnd) -> Option<ShadowRay> {
+    let to_light = target - hit.point;
+    if !(hit.normal.dot(to_light) > end.margin) {
         return None;
     }
-    let to_light = target - hit.point;
     let dist = to_light.length();
     let l = to_light / dist;
+    let tmax = end.height / -end.normal.dot(l);
+    if !(tmax > 0.0) {
+        return None;
+    }
     Some(ShadowRay {
         ray: Ray {
-            origin,
-            direction: segment,
+            origin: hit.point + hit.offset * hit.normal,
+            direction: l,
         },
-        l,
+        tmax,
         dist,
         n_dot_l: hit.normal.dot(l),
     })

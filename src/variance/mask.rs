@@ -12,7 +12,7 @@ use crate::geometry::Accel;
 use crate::sampling::{LightSampler, SampleKey, square_sample};
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
-use crate::spawn::{SHADOW_TMAX, light_end, light_offset, mirror_ray, shadow_ray, surface_hit};
+use crate::spawn::{light_end, light_offset, mirror_ray, shadow_ray, surface_hit};
 use rayon::prelude::*;
 
 /// Per-pixel region membership.
@@ -82,14 +82,14 @@ fn classify(
                 seed: 0x6d61_736b,
             };
             let end_offset = light_offset(light);
-            let end = light_end(light, end_offset, surface.point);
+            let end = light_end(light, end_offset, &surface);
             let mut visible = 0;
             for j in 0..points {
                 let (u, v) = square_sample(LightSampler::Stratified, &key, j, points);
                 // Spawned as the renderers spawn it: no ray below the tangent plane.
-                let shadow = shadow_ray(&surface, light.point(u, v), end, end_offset);
+                let shadow = shadow_ray(&surface, light.point(u, v), &end);
                 if shadow.is_some_and(|s| {
-                    !accel.occluded(scene, &s.ray, SHADOW_TMAX, settings.two_sided)
+                    !accel.occluded(scene, &s.ray, s.tmax, settings.two_sided)
                 }) {
                     visible += 1;
                 }

@@ -5,7 +5,7 @@
 //! Buffers are allocated once per worker and reused (`clear` keeps the capacity), so the memory
 //! of a render is bounded by the batch size, not by the image.
 
-use crate::spawn::{SHADOW_TMAX, ShadowRay, SurfaceHit};
+use crate::spawn::{ShadowRay, SurfaceHit};
 use glam::Vec3;
 
 /// Paths in flight at one depth: their current ray and what they carry.
@@ -233,23 +233,18 @@ pub struct ShadowQueue {
     pub origin_y: Vec<f32>,
     /// Origin z.
     pub origin_z: Vec<f32>,
-    /// The segment to test, end − origin (`spawn::ShadowRay::ray`), x.
-    pub segment_x: Vec<f32>,
-    /// Segment y.
-    pub segment_y: Vec<f32>,
-    /// Segment z.
-    pub segment_z: Vec<f32>,
-    /// `spawn::SHADOW_TMAX` for a ray, 0 for a dead lane.
-    pub tmax: Vec<f32>,
-    /// Unit direction from the hit point to the light point x (the Shade formula's l).
+    /// Unit direction to the light point x (the Shade formula's l, from the hit point itself).
     pub direction_x: Vec<f32>,
     /// Direction y.
     pub direction_y: Vec<f32>,
     /// Direction z.
     pub direction_z: Vec<f32>,
+    /// Where the ray meets the light's moved plane (`spawn::ShadowRay::tmax`); 0 for a dead
+    /// lane.
+    pub tmax: Vec<f32>,
     /// Distance from the hit point to the light point, for the light model's fall-off: kept only
-    /// under a model that has one (empty under the lab's, which saves a column of writes: 7% of
-    /// the shadow stage).
+    /// under a model that has one (empty under the lab's: every column the spawn writes costs
+    /// the store-bound shadow stage, 7% for this one).
     pub dist: Vec<f32>,
     /// Index of the hit (in the current `HitBatch`) that casts the ray.
     pub path: Vec<u32>,
@@ -280,9 +275,6 @@ impl ShadowQueue {
                 &mut self.origin_x,
                 &mut self.origin_y,
                 &mut self.origin_z,
-                &mut self.segment_x,
-                &mut self.segment_y,
-                &mut self.segment_z,
                 &mut self.direction_x,
                 &mut self.direction_y,
                 &mut self.direction_z,
@@ -308,13 +300,10 @@ impl ShadowQueue {
         self.origin_x[i] = ray.ray.origin.x;
         self.origin_y[i] = ray.ray.origin.y;
         self.origin_z[i] = ray.ray.origin.z;
-        self.segment_x[i] = ray.ray.direction.x;
-        self.segment_y[i] = ray.ray.direction.y;
-        self.segment_z[i] = ray.ray.direction.z;
-        self.tmax[i] = SHADOW_TMAX;
-        self.direction_x[i] = ray.l.x;
-        self.direction_y[i] = ray.l.y;
-        self.direction_z[i] = ray.l.z;
+        self.direction_x[i] = ray.ray.direction.x;
+        self.direction_y[i] = ray.ray.direction.y;
+        self.direction_z[i] = ray.ray.direction.z;
+        self.tmax[i] = ray.tmax;
         if let Some(d) = self.dist.get_mut(i) {
             *d = ray.dist;
         }
@@ -331,13 +320,10 @@ impl ShadowQueue {
         self.origin_x[r.clone()].fill(block.origin.x);
         self.origin_y[r.clone()].fill(block.origin.y);
         self.origin_z[r.clone()].fill(block.origin.z);
-        self.segment_x[r.clone()].copy_from_slice(&block.segment[0]);
-        self.segment_y[r.clone()].copy_from_slice(&block.segment[1]);
-        self.segment_z[r.clone()].copy_from_slice(&block.segment[2]);
-        self.tmax[r.clone()].copy_from_slice(&block.tmax);
         self.direction_x[r.clone()].copy_from_slice(&block.l[0]);
         self.direction_y[r.clone()].copy_from_slice(&block.l[1]);
         self.direction_z[r.clone()].copy_from_slice(&block.l[2]);
+        self.tmax[r.clone()].copy_from_slice(&block.tmax);
         if !self.dist.is_empty() {
             self.dist[r.clone()].copy_from_slice(&block.dist);
         }
@@ -358,17 +344,15 @@ impl ShadowQueue {
 }
 
 /// Eight shadow rays from one hit to one light, as `simd::shadow_rays8` makes them: lane k is
-/// `spawn::shadow_ray`'s answer for point k, or a dead lane (tmax = 0, n·l = 0).
+/// `spawn::shadow_ray`'s answer for point k, or a dead lane (tmax = 0).
 #[derive(Clone, Copy, Debug)]
 pub struct ShadowBlock {
     /// The rays' common origin, off the surface.
     pub origin: Vec3,
-    /// Segment (end − origin) x, y, z per lane.
-    pub segment: [[f32; 8]; 3],
-    /// `SHADOW_TMAX` for a live lane, 0 for a dead one.
-    pub tmax: [f32; 8],
     /// l x, y, z per lane.
     pub l: [[f32; 8]; 3],
+    /// tmax per lane, 0 for a dead one.
+    pub tmax: [f32; 8],
     /// |target − point| per lane.
     pub dist: [f32; 8],
     /// Live lanes as a bitmask.

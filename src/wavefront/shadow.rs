@@ -100,7 +100,7 @@ fn spawn(
             light: li as u32,
             seed: ctx.settings.seed,
         };
-        let end = light_end(&ctx.scene.lights[li], light.end_offset, hit.point);
+        let end = light_end(&ctx.scene.lights[li], light.end_offset, &hit);
         match (
             ctx.samples_lights() && ctx.simd_light_sampling(),
             light.parallelogram,
@@ -117,7 +117,7 @@ fn spawn(
                 for j0 in (0..count).step_by(LANES) {
                     let target = simd::light_points8(&LightBlock { j0, ..block });
                     let lanes = ((count - j0) as usize).min(LANES);
-                    let block = simd::shadow_rays8(&hit, &target, end, light.end_offset, lanes);
+                    let block = simd::shadow_rays8(&hit, &target, &end, lanes);
                     if block.live != 0 {
                         queue.push_block(&block, i as u32, li as u32);
                         cast += block.live.count_ones() as u64;
@@ -132,7 +132,7 @@ fn spawn(
                     } else {
                         light.centroid
                     };
-                    if let Some(s) = shadow_ray(&hit, target, end, light.end_offset) {
+                    if let Some(s) = shadow_ray(&hit, target, &end) {
                         queue.push(&s, i as u32, li as u32);
                         cast += 1;
                     }
@@ -155,9 +155,9 @@ fn occlude(ctx: &Context, queue: &mut ShadowQueue) {
             &queue.origin_z[..n],
         ],
         direction: [
-            &queue.segment_x[..n],
-            &queue.segment_y[..n],
-            &queue.segment_z[..n],
+            &queue.direction_x[..n],
+            &queue.direction_y[..n],
+            &queue.direction_z[..n],
         ],
         tmax: &queue.tmax[..n],
     };

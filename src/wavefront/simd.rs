@@ -22,7 +22,7 @@ use super::batch::ShadowBlock;
 use super::context::MaterialTerms;
 use crate::geometry::{EDGE_EPSILON, T_MIN};
 use crate::scene::{NO_HIT, Sphere, Triangle};
-use crate::spawn::{SHADOW_TMAX, SurfaceHit};
+use crate::spawn::{LightEnd, SurfaceHit};
 use glam::Vec3;
 use wide::{f32x8, i32x8, u32x8};
 
@@ -613,43 +613,31 @@ fn parallelogram_points8(
 }
 
 /// Shadow rays from `hit` to 8 light points, the first `lanes` of them real: lane k equals
-/// `spawn::shadow_ray(hit, target_k, end, end_offset)` (origin `hit.offset` off the surface,
-/// segment to `target + end`, and the exact l and |target − point|; n·l is left to the shade
-/// step). Lanes whose segment does not rise above the tangent plane by more than the two offsets
-/// (the twin returns `None`) or past `lanes` come back dead: tmax = 0.
+/// `spawn::shadow_ray(hit, target_k, end)` (l, tmax and the distance; the origin is the
+/// block's). Lanes for which the twin returns `None`, or past `lanes`, come back dead: tmax = 0.
 #[inline]
 pub fn shadow_rays8(
     hit: &SurfaceHit,
     target: &[[f32; LANES]; 3],
-    end: Vec3,
-    end_offset: f32,
+    end: &LightEnd,
     lanes: usize,
 ) -> ShadowBlock {
     let n = hit.normal;
-    let origin = hit.point + hit.offset * n;
-    let (tx, ty, tz) = (
-        f32x8::new(target[0]),
-        f32x8::new(target[1]),
-        f32x8::new(target[2]),
-    );
-    let to_end = end - origin;
-    let sx = tx + f32x8::splat(to_end.x);
-    let sy = ty + f32x8::splat(to_end.y);
-    let sz = tz + f32x8::splat(to_end.z);
-    let above = f32x8::splat(n.x) * sx + f32x8::splat(n.y) * sy + f32x8::splat(n.z) * sz;
-    let x = tx - f32x8::splat(hit.point.x);
-    let y = ty - f32x8::splat(hit.point.y);
-    let z = tz - f32x8::splat(hit.point.z);
+    let x = f32x8::new(target[0]) - f32x8::splat(hit.point.x);
+    let y = f32x8::new(target[1]) - f32x8::splat(hit.point.y);
+    let z = f32x8::new(target[2]) - f32x8::splat(hit.point.z);
+    let above = f32x8::splat(n.x) * x + f32x8::splat(n.y) * y + f32x8::splat(n.z) * z;
     let dist = (x * x + y * y + z * z).sqrt();
     let (lx, ly, lz) = (x / dist, y / dist, z / dist);
+    let m = end.normal;
+    let toward = f32x8::splat(m.x) * lx + f32x8::splat(m.y) * ly + f32x8::splat(m.z) * lz;
+    let tmax = f32x8::splat(end.height) / -toward;
     let first = f32x8::new(LANE_INDEX).simd_lt(f32x8::splat(lanes as f32));
-    let live = above.simd_gt(f32x8::splat(hit.offset + end_offset)) & first;
-    let zero = f32x8::ZERO;
+    let live = above.simd_gt(f32x8::splat(end.margin)) & tmax.simd_gt(f32x8::ZERO) & first;
     ShadowBlock {
-        origin,
-        segment: [sx.to_array(), sy.to_array(), sz.to_array()],
-        tmax: live.select(f32x8::splat(SHADOW_TMAX), zero).to_array(),
+        origin: hit.point + hit.offset * n,
         l: [lx.to_array(), ly.to_array(), lz.to_array()],
+        tmax: live.select(tmax, f32x8::ZERO).to_array(),
         dist: dist.to_array(),
         live: live.to_bitmask(),
     }
