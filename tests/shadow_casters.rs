@@ -9,7 +9,7 @@ use common::Rng;
 use glam::Vec3;
 use raywave::geometry::{Accel, Ray, intersect_sphere, intersect_triangle, shadow_casters};
 use raywave::scene::{Scene, parse_scene_str};
-use raywave::spawn::{SHADOW_TMAX, SurfaceHit, light_end, light_offset, shadow_ray};
+use raywave::spawn::{SurfaceHit, light_end, light_offset, shadow_ray};
 use std::fmt::Write;
 use std::path::Path;
 
@@ -99,9 +99,9 @@ fn segment(scene: &Scene, from: Vec3, to: Vec3) -> (Ray, f32) {
         offset: 0.0,
     };
     let end_offset = light_offset(light);
-    let end = light_end(light, end_offset, from);
-    let s = shadow_ray(&start, to, end, end_offset).expect("a segment to the light");
-    (s.ray, SHADOW_TMAX)
+    let end = light_end(light, end_offset, &start);
+    let s = shadow_ray(&start, to, &end).expect("a segment to the light");
+    (s.ray, s.tmax)
 }
 
 /// Random triangles in a cube of half-size 2, a random parallelogram light and a sphere.

@@ -10,7 +10,7 @@ use glam::Vec3;
 use raywave::geometry::{Accel, Ray, intersect_sphere};
 use raywave::scene::{Scene, Sphere};
 use raywave::spawn::{
-    SHADOW_TMAX, SurfaceHit, light_end, light_offset, mirror_ray, shadow_ray, sphere_offset,
+    LightEnd, SurfaceHit, light_end, light_offset, mirror_ray, shadow_ray, sphere_offset,
     surface_hit,
 };
 
@@ -40,6 +40,17 @@ fn camera_hit(rng: &mut Rng, sphere: &Sphere, eye: Vec3) -> Option<(Ray, f32)> {
     t.is_finite().then_some((ray, t))
 }
 
+/// The end of a shadow ray to `target` as if it were a small light facing the hit.
+fn towards(hit: &SurfaceHit, target: Vec3) -> LightEnd {
+    let normal = (hit.point - target).normalize();
+    let origin = hit.point + hit.offset * hit.normal;
+    LightEnd {
+        normal,
+        height: normal.dot(origin - target) - hit.offset,
+        margin: hit.offset,
+    }
+}
+
 fn sphere_scene(sphere: Sphere) -> Scene {
     Scene {
         spheres: vec![sphere],
@@ -67,8 +78,8 @@ fn mirror_and_shadow_rays_leave_a_sphere_at_every_scale() {
             }
             // A light point anywhere above the tangent plane, near or far, grazing or not.
             let target = hit.point + rng.direction() * (s * 4.0 * rng.next());
-            if let Some(shadow) = shadow_ray(&hit, target, Vec3::ZERO, 0.0)
-                && intersect_sphere(&sphere, &shadow.ray, SHADOW_TMAX) < SHADOW_TMAX
+            if let Some(shadow) = shadow_ray(&hit, target, &towards(&hit, target))
+                && intersect_sphere(&sphere, &shadow.ray, shadow.tmax) < shadow.tmax
             {
                 shadow_rehits += 1;
             }
@@ -188,11 +199,11 @@ fn shadow_rays_end_before_the_light_even_at_grazing_angles() {
             let light = &scene.lights[((rng.next() * count as f32) as usize).min(count - 1)];
             let (u, v) = (rng.next(), rng.next());
             let end_offset = light_offset(light);
-            let end = light_end(light, end_offset, floor.point);
-            let Some(shadow) = shadow_ray(&floor, light.point(u, v), end, end_offset) else {
+            let end = light_end(light, end_offset, &floor);
+            let Some(shadow) = shadow_ray(&floor, light.point(u, v), &end) else {
                 continue;
             };
-            if accel.occluded(&scene, &shadow.ray, SHADOW_TMAX, false) {
+            if accel.occluded(&scene, &shadow.ray, shadow.tmax, false) {
                 blocked += 1;
             }
         }
@@ -240,8 +251,8 @@ fn two_sided_faces_do_not_shadow_themselves_or_their_other_half() {
                 self_hits += 1;
             }
             let target = surface.point + rng.direction() * (3.0 * s);
-            if let Some(shadow) = shadow_ray(&surface, target, Vec3::ZERO, 0.0)
-                && accel.occluded(&scene, &shadow.ray, SHADOW_TMAX, true)
+            if let Some(shadow) = shadow_ray(&surface, target, &towards(&surface, target))
+                && accel.occluded(&scene, &shadow.ray, shadow.tmax, true)
             {
                 self_hits += 1;
             }

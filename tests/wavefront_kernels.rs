@@ -14,7 +14,7 @@ use raywave::geometry::{self, Accel, Ray, intersect_sphere, intersect_triangle, 
 use raywave::sampling::{LightSampler, SampleKey, square_sample, strata_grid, uniform};
 use raywave::scene::{Light, LightShape, Material, NO_HIT, Scene, Sphere, Triangle};
 use raywave::shading::shade;
-use raywave::spawn::{SurfaceHit, shadow_ray};
+use raywave::spawn::{SurfaceHit, light_end, shadow_ray};
 use raywave::wavefront::context::MaterialTerms;
 use raywave::wavefront::shadow::{key_prefix, shade_terms};
 use raywave::wavefront::simd::{self, BlockSampler, LightBlock, RayColumns, lanes};
@@ -400,7 +400,7 @@ proptest! {
         let blocked: Vec<bool> = (0..8).map(|k| blocked_bits & (1 << k) != 0).collect();
         let falloff: [f32; 8] = std::array::from_fn(|k| falloffs[k]);
         let lab = falloffs.iter().all(|&f| f == 1.0);
-        // Dead lanes carry tmax = 0, live ones `spawn::SHADOW_TMAX`.
+        // Dead lanes carry tmax = 0, live ones a positive tmax.
         let tmax: Vec<f32> = (0..8).map(|k| if dead_bits & (1 << k) != 0 { 0.0 } else { 1.0 }).collect();
         let got = simd::shade8(&terms, n, e, [&lx, &ly, &lz], &tmax, &blocked, lc.abs(),
             (!lab).then_some(&falloff), weight);
@@ -422,7 +422,7 @@ proptest! {
         pixel in any::<u32>(), sample in 0u32..4, bounce in 0u32..6, light in 0u32..3, seed in any::<u32>(),
         count in 1u32..80, which in 0usize..4,
         origin in vec3(), edge_u in vec3(), edge_v in vec3(), point in vec3(), n in vec3(),
-        offset in prop_oneof![Just(0.0f32), 0.0f32..0.01], end in vec3(),
+        offset in prop_oneof![Just(0.0f32), 0.0f32..0.01],
         end_offset in prop_oneof![Just(0.0f32), 0.0f32..0.01],
     ) {
         let key = SampleKey { pixel, sample, bounce, light, seed };
@@ -465,24 +465,22 @@ proptest! {
             let pts = simd::light_points8(&block);
             let lanes = ((count - j0) as usize).min(8);
             let hit = SurfaceHit { point, normal: n, offset };
-            let end = end * 0.01;
-            let block = simd::shadow_rays8(&hit, &pts, end, end_offset, lanes);
-            let (l, seg, live) = (block.l, block.segment, block.live);
+            let end = light_end(&lamp, end_offset, &hit);
+            let block = simd::shadow_rays8(&hit, &pts, &end, lanes);
+            let (l, live) = (block.l, block.live);
             for k in 0..lanes {
                 let (u, v) = square_sample(sampler, &key, j0 + k as u32, count);
                 let target = lamp.point(u, v);
                 prop_assert_eq!([pts[0][k], pts[1][k], pts[2][k]].map(f32::to_bits),
                     target.to_array().map(f32::to_bits));
-                let want = shadow_ray(&hit, target, end, end_offset);
+                let want = shadow_ray(&hit, target, &end);
                 prop_assert_eq!(live & (1 << k) != 0, want.is_some());
                 if let Some(want) = want {
                     prop_assert_eq!(block.origin.to_array().map(f32::to_bits),
                         want.ray.origin.to_array().map(f32::to_bits));
-                    prop_assert_eq!([seg[0][k], seg[1][k], seg[2][k]].map(f32::to_bits),
-                        want.ray.direction.to_array().map(f32::to_bits));
                     prop_assert_eq!([l[0][k], l[1][k], l[2][k]].map(f32::to_bits),
-                        want.l.to_array().map(f32::to_bits));
-                    prop_assert_eq!(block.tmax[k], raywave::spawn::SHADOW_TMAX);
+                        want.ray.direction.to_array().map(f32::to_bits));
+                    prop_assert_eq!(block.tmax[k].to_bits(), want.tmax.to_bits());
                     prop_assert_eq!(block.dist[k].to_bits(), want.dist.to_bits());
                 } else {
                     prop_assert_eq!(block.tmax[k], 0.0);

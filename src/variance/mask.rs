@@ -88,9 +88,9 @@ fn classify(
                 let (u, v) = square_sample(LightSampler::Stratified, &key, j, points);
                 // Spawned as the renderers spawn it: no ray below the tangent plane.
                 let shadow = shadow_ray(&surface, light.point(u, v), &end);
-                if shadow.is_some_and(|s| {
-                    !accel.occluded(scene, &s.ray, s.tmax, settings.two_sided)
-                }) {
+                if shadow
+                    .is_some_and(|s| !accel.occluded(scene, &s.ray, s.tmax, settings.two_sided))
+                {
                     visible += 1;
                 }
             }
