@@ -148,14 +148,15 @@ pub fn light_offset(light: &Light) -> f32 {
     OFFSET_SCALE * m
 }
 
-/// Where shadow rays from one hit to one light end: the light's plane moved towards the hit by
-/// the two offsets, as its unit normal facing the hit and the hit's origin's height above it.
+/// Where shadow rays from one hit to one light end: where they meet the light's plane moved
+/// towards the hit by the two offsets.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LightEnd {
-    /// The light's normal, turned to face the hit (a planar light: one side for all points).
-    pub normal: Vec3,
-    /// Height of the ray origin (`hit.offset` off the surface) above the moved plane.
-    pub height: f32,
+    /// tmax / |target − point|: the ray from the offset origin along l meets the moved plane at
+    /// height(origin) / cos, and cos = h / |target − point| for every point of the light's
+    /// plane (h: the hit point's height above it), so one ratio per (hit, light) serves all
+    /// its points. ≤ 0 or NaN when the hit is not above the moved plane.
+    pub ratio: f32,
     /// The two offsets added: a point must be this far above the tangent plane.
     pub margin: f32,
 }
@@ -173,9 +174,9 @@ pub fn light_end(light: &Light, end_offset: f32, hit: &SurfaceHit) -> LightEnd {
     };
     let margin = end_offset + hit.offset;
     let origin = hit.point + hit.offset * hit.normal;
+    let height = normal.dot(origin - light.centroid) - margin;
     LightEnd {
-        normal,
-        height: normal.dot(origin - light.centroid) - margin,
+        ratio: height / normal.dot(hit.point - light.centroid),
         margin,
     }
 }
@@ -214,7 +215,7 @@ pub fn shadow_ray(hit: &SurfaceHit, target: Vec3, end: &LightEnd) -> Option<Shad
     }
     let dist = to_light.length();
     let l = to_light / dist;
-    let tmax = end.height / -end.normal.dot(l);
+    let tmax = dist * end.ratio;
     if !(tmax > 0.0) {
         return None;
     }

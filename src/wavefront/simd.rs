@@ -20,7 +20,7 @@
 
 use super::batch::ShadowBlock;
 use super::context::MaterialTerms;
-use crate::geometry::{EDGE_EPSILON, T_MIN};
+use crate::geometry::{EDGE_EPSILON, MISS_MARGIN, T_MIN};
 use crate::scene::{NO_HIT, Sphere, Triangle};
 use crate::spawn::{LightEnd, SurfaceHit};
 use glam::Vec3;
@@ -416,9 +416,6 @@ fn sphere8_blocks(s: &Sphere, r: &Rays8, tmax: f32x8) -> u32 {
     sphere8(s, r, tmax).simd_lt(tmax).to_bitmask()
 }
 
-/// The relative margin of `sphere8_blocks`'s early test: 2^-16.
-const MISS_MARGIN: f32 = 1.0 / 65_536.0;
-
 /// Chris Wellons' `lowbias32`, 8 lanes; twin of `sampling::mix32`.
 #[inline(always)]
 fn mix32x8(mut x: u32x8) -> u32x8 {
@@ -629,9 +626,7 @@ pub fn shadow_rays8(
     let above = f32x8::splat(n.x) * x + f32x8::splat(n.y) * y + f32x8::splat(n.z) * z;
     let dist = (x * x + y * y + z * z).sqrt();
     let (lx, ly, lz) = (x / dist, y / dist, z / dist);
-    let m = end.normal;
-    let toward = f32x8::splat(m.x) * lx + f32x8::splat(m.y) * ly + f32x8::splat(m.z) * lz;
-    let tmax = f32x8::splat(end.height) / -toward;
+    let tmax = dist * f32x8::splat(end.ratio);
     let first = f32x8::new(LANE_INDEX).simd_lt(f32x8::splat(lanes as f32));
     let live = above.simd_gt(f32x8::splat(end.margin)) & tmax.simd_gt(f32x8::ZERO) & first;
     ShadowBlock {
