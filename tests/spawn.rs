@@ -40,13 +40,14 @@ fn camera_hit(rng: &mut Rng, sphere: &Sphere, eye: Vec3) -> Option<(Ray, f32)> {
     t.is_finite().then_some((ray, t))
 }
 
-/// The end of a shadow ray to `target` as if it were a small light facing the hit.
+/// The end of a shadow ray to `target` as if it were a small light facing the hit (its plane
+/// through `target`, perpendicular to the ray), as `spawn::light_end` computes it.
 fn towards(hit: &SurfaceHit, target: Vec3) -> LightEnd {
     let normal = (hit.point - target).normalize();
     let origin = hit.point + hit.offset * hit.normal;
+    let height = normal.dot(origin - target) - hit.offset;
     LightEnd {
-        normal,
-        height: normal.dot(origin - target) - hit.offset,
+        ratio: height / normal.dot(hit.point - target),
         margin: hit.offset,
     }
 }
