@@ -112,11 +112,7 @@ pub fn intersect_sphere(sphere: &Sphere, ray: &Ray, tmax: f32) -> f32 {
     // Most rays miss most spheres: the textbook discriminant, which needs no division, proves
     // it with a margin (`MISS_MARGIN`), and the stable one is computed only for the rest.
     let oc2 = oc.length_squared();
-    let c = oc2 - r2;
-    // Or the sphere is behind the ray: from outside it (c > 0) and going away (b > 0), both
-    // roots below are negative (q < 0), from these very values. Every shadow and mirror ray
-    // leaving a sphere's outside is such a ray for that sphere.
-    if (c > 0.0 && b > 0.0) || b * b - a * c + MISS_MARGIN * (a * (oc2 + r2)) < 0.0 {
+    if b * b - a * (oc2 - r2) + MISS_MARGIN * (a * (oc2 + r2)) < 0.0 {
         return f32::INFINITY;
     }
     // One division for 1/a, used twice (a multiply is cheaper than a division, and the extra
@@ -128,6 +124,7 @@ pub fn intersect_sphere(sphere: &Sphere, ray: &Ray, tmax: f32) -> f32 {
         return f32::INFINITY;
     }
     let q = -(b + disc.sqrt().copysign(b));
+    let c = oc2 - r2;
     let (t0, t1) = (c / q, q * inv_a);
     let (near, far) = if t0 < t1 { (t0, t1) } else { (t1, t0) };
     let t = if near > T_MIN { near } else { far };

@@ -407,14 +407,10 @@ fn sphere8_blocks(s: &Sphere, r: &Rays8, tmax: f32x8) -> u32 {
     let b = ocx * r.dx + ocy * r.dy + ocz * r.dz;
     let oc2 = ocx * ocx + ocy * ocy + ocz * ocz;
     let r2 = f32x8::splat(s.radius * s.radius);
-    let c = oc2 - r2;
-    let naive = b * b - a * c;
+    let naive = b * b - a * (oc2 - r2);
     let margin = f32x8::splat(MISS_MARGIN) * (a * (oc2 + r2));
-    // Or the sphere is behind the ray (as in `intersect_sphere`): from outside it and going
-    // away, both of `sphere8`'s roots are negative, from these very values of b and c.
-    let behind = c.simd_gt(f32x8::ZERO) & b.simd_gt(f32x8::ZERO);
     // NaN compares false: such a lane is not proven a miss and goes to the exact test.
-    if ((naive + margin).simd_lt(f32x8::ZERO) | behind).all() {
+    if (naive + margin).simd_lt(f32x8::ZERO).all() {
         return 0;
     }
     sphere8(s, r, tmax).simd_lt(tmax).to_bitmask()
