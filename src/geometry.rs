@@ -11,7 +11,7 @@
 //! 10). Instead hit points are put back on their surface and secondary rays start a bound on that
 //! error away from it (`crate::spawn`), and the sphere test is the numerically stable one.
 
-use crate::scene::{LightShape, NO_HIT, Scene, Sphere, Triangle};
+use crate::scene::{Light, NO_HIT, Scene, Sphere, Triangle};
 use glam::{Vec3, Vec3A};
 use obvhs::{BvhBuildParams, cwbvh::CwBvh, ray::RayHit};
 use std::time::Duration;
@@ -260,10 +260,13 @@ impl Accel {
 /// The triangles that can block a shadow ray toward one of the scene's lights when faces are
 /// one-sided: every triangle except those with every light wholly on their front side.
 ///
-/// A shadow ray runs from a point x to a point p on a light and is blocked in (T_MIN,
-/// |p − x| − T_MIN). A one-sided face is hit only from its front, by a ray going from its front
-/// half-space to its back one, so it meets the face's plane at or beyond p when p is on the
-/// front side or on the plane: such a face can never block it. The lab's box shows why this
+/// A shadow ray runs from a point x towards a point p on a light (`spawn::shadow_ray`: from
+/// just off the surface, parallel to x → p, ending before the light's plane). A one-sided face
+/// is hit only from its front, by a ray going from its front half-space to its back one, so it
+/// meets the face's plane at or beyond p when p is on the front side or on the plane: such a
+/// face can never block it (exactly for faces at right angles to the light or coplanar with
+/// it; within the ray's offset, 2^-18 of the scene, for a face touching the light at another
+/// angle). The lab's box shows why this
 /// matters: its light is a wall of the box, so the light lies on or in front of every wall's
 /// plane and no wall can shadow it; only the spheres can. Signed distances are taken in f64
 /// with a tolerance of 1e-6 of the light corner's coordinates and distance from the face, so a
@@ -271,26 +274,7 @@ impl Accel {
 /// in front of it despite rounding in the face's edges. Both engines test this same list, so they still agree bit for bit; with
 /// `--two-sided` every triangle is tested.
 pub fn shadow_casters(scene: &Scene) -> Vec<Triangle> {
-    let corners: Vec<Vec3> = scene
-        .lights
-        .iter()
-        .flat_map(|light| match &light.shape {
-            LightShape::Parallelogram {
-                origin,
-                edge_u,
-                edge_v,
-            } => vec![
-                *origin,
-                *origin + *edge_u,
-                *origin + *edge_v,
-                *origin + *edge_u + *edge_v,
-            ],
-            LightShape::Fan { triangles, .. } => triangles
-                .iter()
-                .flat_map(|&(a, e1, e2)| [a, a + e1, a + e2])
-                .collect(),
-        })
-        .collect();
+    let corners: Vec<Vec3> = scene.lights.iter().flat_map(Light::corners).collect();
     scene
         .triangles
         .iter()
@@ -330,6 +314,11 @@ pub fn build_cwbvh(scene: &Scene) -> CwBvh {
     build_cwbvh_scaled(scene, 1.0)
 }
 
+/// The larger of `m` and `v`'s largest absolute coordinate: fold a set of points with it.
+pub fn largest_coordinate(m: f32, v: Vec3) -> f32 {
+    m.max(v.abs().max_element())
+}
+
 /// The power of two that brings a scene's largest triangle coordinate to about 2^16.
 ///
 /// obvhs's CWBVH node test clamps a ray's entry distance to an absolute 1e-4
@@ -342,7 +331,7 @@ pub fn bvh_scale(scene: &Scene) -> f32 {
         .triangles
         .iter()
         .flat_map(|t| [t.v0, t.v0 + t.e1, t.v0 + t.e2])
-        .fold(0.0f32, |m, v| m.max(v.abs().max_element()));
+        .fold(0.0f32, largest_coordinate);
     if !(largest.is_finite() && largest > 0.0) {
         return 1.0;
     }

@@ -7,7 +7,7 @@
 //! ```text
 //! trace(ray, bounce):
 //!   no hit -> background
-//!   hit    -> 0.2·kd
+//!   hit    -> ambient ⊙ kd
 //!           + kr ⊙ trace(reflected ray, bounce + 1)        if kr ≠ 0 and bounce < max bounces
 //!           + Σ lights Σ j<N  Shade(l_j) / N                if n·l_j > 0 and p_j is visible
 //! ```
@@ -135,13 +135,7 @@ impl<'a> Reference<'a> {
         if !hit.is_hit() {
             return self.settings.background();
         }
-        let mut surface = surface_hit(self.scene, hit.prim, ray, hit.t);
-        if self.settings.two_sided
-            && (hit.prim as usize) < self.scene.triangles.len()
-            && surface.normal.dot(ray.direction) > 0.0
-        {
-            surface.normal = -surface.normal;
-        }
+        let surface = surface_hit(self.scene, hit.prim, ray, hit.t, self.settings.two_sided);
         let material = self.scene.material_of(hit.prim);
         let mut color = Vec3::from_array(self.settings.ambient) * material.diffuse;
         if material.is_reflective() && key.bounce < self.settings.bounces {

@@ -7,7 +7,8 @@
 use crate::scene::Material;
 use glam::Vec3;
 
-/// The fixed ambient factor: a hit always gets 0.2·kd.
+/// The lab's 0.2: its fixed ambient light (every hit gets 0.2·kd unless `-ambient_light` says
+/// otherwise, `RenderSettings::ambient`) and the factor on a surface's own emission in Shade.
 pub const AMBIENT: f32 = 0.2;
 
 /// The lab's Shade for one light direction `l` (unit) with `n·l = n_dot_l > 0`, already known

@@ -29,8 +29,8 @@
 //! value), and carrying the id of the surface a ray leaves (exact for spheres, but a coplanar
 //! neighbour, e.g. a quad's other half with two-sided faces, is still met at t ≈ 0).
 
-use crate::geometry::Ray;
-use crate::scene::{Light, LightShape, Scene, Sphere, Triangle};
+use crate::geometry::{Ray, largest_coordinate};
+use crate::scene::{Light, Scene, Sphere, Triangle};
 use crate::settings::LightModel;
 use crate::shading::reflect;
 use glam::Vec3;
@@ -71,40 +71,52 @@ pub fn sphere_offset(s: &Sphere) -> f32 {
     OFFSET_SCALE * (s.center.abs().max_element() + s.radius)
 }
 
-/// `p0` moved along the unit normal onto the plane n·p = `plane`.
+/// The hit at `p0` on a triangle with unit normal `normal`, plane constant `plane`
+/// (`triangle_plane`) and `offset` (`triangle_offset`): `p0` moved along the normal onto the
+/// plane.
 #[inline]
-pub fn on_plane(p0: Vec3, normal: Vec3, plane: f32) -> Vec3 {
-    p0 - (normal.dot(p0) - plane) * normal
+pub fn triangle_hit(p0: Vec3, normal: Vec3, plane: f32, offset: f32) -> SurfaceHit {
+    SurfaceHit {
+        point: p0 - (normal.dot(p0) - plane) * normal,
+        normal,
+        offset,
+    }
 }
 
-/// `p0` moved radially onto the sphere, with the outward unit normal there.
+/// The hit at `p0` on a sphere: `p0` moved radially onto it, with the outward unit normal there.
 #[inline]
-pub fn on_sphere(p0: Vec3, s: &Sphere) -> (Vec3, Vec3) {
+pub fn sphere_hit(p0: Vec3, s: &Sphere) -> SurfaceHit {
     let u = (p0 - s.center).normalize();
-    (s.center + s.radius * u, u)
+    SurfaceHit {
+        point: s.center + s.radius * u,
+        normal: u,
+        offset: sphere_offset(s),
+    }
 }
 
 /// The hit of `ray` at distance `t` on primitive `prim`, put back on its surface, with the
-/// front (triangles) or outward (spheres) normal and the offset of rays leaving it.
-pub fn surface_hit(scene: &Scene, prim: u32, ray: &Ray, t: f32) -> SurfaceHit {
+/// front (triangles) or outward (spheres) normal and the offset of rays leaving it; with
+/// `two_sided`, a triangle's normal is turned to face the ray.
+pub fn surface_hit(scene: &Scene, prim: u32, ray: &Ray, t: f32, two_sided: bool) -> SurfaceHit {
     let p0 = ray.origin + t * ray.direction;
-    let p = prim as usize;
-    match scene.triangles.get(p) {
-        Some(tri) => SurfaceHit {
-            point: on_plane(p0, tri.normal, triangle_plane(tri)),
-            normal: tri.normal,
-            offset: triangle_offset(tri),
-        },
-        None => {
-            let s = &scene.spheres[p - scene.triangles.len()];
-            let (point, normal) = on_sphere(p0, s);
-            SurfaceHit {
-                point,
-                normal,
-                offset: sphere_offset(s),
-            }
-        }
+    match scene.triangles.get(prim as usize) {
+        Some(tri) => face_the_ray(
+            triangle_hit(p0, tri.normal, triangle_plane(tri), triangle_offset(tri)),
+            ray.direction,
+            two_sided,
+        ),
+        None => sphere_hit(p0, &scene.spheres[prim as usize - scene.triangles.len()]),
     }
+}
+
+/// A two-sided face's hit with its normal turned to face a ray of direction `d` (the shading
+/// normal, and the side secondary rays leave to); `hit` itself when not `two_sided`.
+#[inline]
+pub fn face_the_ray(mut hit: SurfaceHit, d: Vec3, two_sided: bool) -> SurfaceHit {
+    if two_sided && hit.normal.dot(d) > 0.0 {
+        hit.normal = -hit.normal;
+    }
+    hit
 }
 
 /// The mirror ray of a ray with direction `d` at `hit`: d reflected about the normal, starting
@@ -126,26 +138,7 @@ pub fn mirror_ray(hit: &SurfaceHit, d: Vec3) -> Ray {
 
 /// The offset of shadow rays' ends on a light: `OFFSET_SCALE` × its largest corner coordinate.
 pub fn light_offset(light: &Light) -> f32 {
-    let largest = |m: f32, c: Vec3| m.max(c.abs().max_element());
-    let m = match &light.shape {
-        LightShape::Parallelogram {
-            origin,
-            edge_u,
-            edge_v,
-        } => [
-            *origin,
-            *origin + *edge_u,
-            *origin + *edge_v,
-            *origin + *edge_u + *edge_v,
-        ]
-        .into_iter()
-        .fold(0.0, largest),
-        LightShape::Fan { triangles, .. } => triangles
-            .iter()
-            .flat_map(|&(a, e1, e2)| [a, a + e1, a + e2])
-            .fold(0.0, largest),
-    };
-    OFFSET_SCALE * m
+    OFFSET_SCALE * light.corners().into_iter().fold(0.0, largest_coordinate)
 }
 
 /// Where shadow rays from one hit to one light end: where they meet the light's plane moved
@@ -155,7 +148,7 @@ pub struct LightEnd {
     /// tmax / |target − point|: the ray from the offset origin along l meets the moved plane at
     /// height(origin) / cos, and cos = h / |target − point| for every point of the light's
     /// plane (h: the hit point's height above it), so one ratio per (hit, light) serves all
-    /// its points. ≤ 0 or NaN when the hit is not above the moved plane.
+    /// its points. ≤ 0 when the hit is not above the moved plane (no ray is cast).
     pub ratio: f32,
     /// The two offsets added: a point must be this far above the tangent plane.
     pub margin: f32,
@@ -175,8 +168,10 @@ pub fn light_end(light: &Light, end_offset: f32, hit: &SurfaceHit) -> LightEnd {
     let margin = end_offset + hit.offset;
     let origin = hit.point + hit.offset * hit.normal;
     let height = normal.dot(origin - light.centroid) - margin;
+    // A hit on the light's plane (h = ±0) casts no ray to it: ratio 0, never +∞ from −0.0.
+    let h = normal.dot(hit.point - light.centroid);
     LightEnd {
-        ratio: height / normal.dot(hit.point - light.centroid),
+        ratio: if h > 0.0 { height / h } else { 0.0 },
         margin,
     }
 }

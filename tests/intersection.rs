@@ -210,7 +210,7 @@ fn sphere_normal_is_outward_even_from_inside() {
     let hit = accel.closest(&s, &r, f32::INFINITY, false);
     assert_eq!(hit.prim, 0);
     assert!((hit.t - 2.0).abs() < 1e-6);
-    let n = raywave::spawn::surface_hit(&s, hit.prim, &r, hit.t).normal;
+    let n = raywave::spawn::surface_hit(&s, hit.prim, &r, hit.t, false).normal;
     assert!(n.distance(Vec3::Y) < 1e-6, "{n}");
 }
 

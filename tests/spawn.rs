@@ -71,7 +71,7 @@ fn mirror_and_shadow_rays_leave_a_sphere_at_every_scale() {
             };
             hits += 1;
             let scene = sphere_scene(sphere);
-            let hit = surface_hit(&scene, 0, &ray, t);
+            let hit = surface_hit(&scene, 0, &ray, t, false);
             // Hit from outside, so the mirror ray goes out and can never meet the sphere again.
             let mirror = mirror_ray(&hit, ray.direction);
             if intersect_sphere(&sphere, &mirror, f32::INFINITY).is_finite() {
@@ -106,7 +106,7 @@ fn hit_points_are_put_back_on_the_sphere() {
             let Some((ray, t)) = camera_hit(&mut rng, &sphere, eye) else {
                 continue;
             };
-            let hit = surface_hit(&sphere_scene(sphere), 0, &ray, t);
+            let hit = surface_hit(&sphere_scene(sphere), 0, &ray, t, false);
             let off = (hit.point.as_dvec3() - sphere.center.as_dvec3()).length()
                 - f64::from(sphere.radius);
             worst = worst.max(off.abs() / f64::from(sphere_offset(&sphere)));
@@ -135,7 +135,7 @@ fn a_mirror_ray_inside_a_sphere_meets_its_far_side() {
             };
             let t = intersect_sphere(&sphere, &ray, f32::INFINITY);
             assert!(t.is_finite());
-            let hit = surface_hit(&sphere_scene(sphere), 0, &ray, t);
+            let hit = surface_hit(&sphere_scene(sphere), 0, &ray, t, false);
             let mirror = mirror_ray(&hit, ray.direction);
             let t2 = intersect_sphere(&sphere, &mirror, f32::INFINITY);
             // The chord from a point on the sphere along d has length 2r·|n·d| (in f64).
@@ -243,10 +243,7 @@ fn two_sided_faces_do_not_shadow_themselves_or_their_other_half() {
             if !hit.is_hit() {
                 continue;
             }
-            let mut surface = surface_hit(&scene, hit.prim, &ray, hit.t);
-            if surface.normal.dot(ray.direction) > 0.0 {
-                surface.normal = -surface.normal;
-            }
+            let surface = surface_hit(&scene, hit.prim, &ray, hit.t, true);
             let mirror = mirror_ray(&surface, ray.direction);
             if accel.closest(&scene, &mirror, f32::INFINITY, true).is_hit() {
                 self_hits += 1;

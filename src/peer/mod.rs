@@ -190,7 +190,7 @@ impl RaySets {
                 origin: batch.origin(i),
                 direction: batch.direction(i),
             };
-            let hit = surface_hit(scene, prim, &ray, t);
+            let hit = surface_hit(scene, prim, &ray, t, false);
             // Every ray leaves the surface on the side it goes to, as the renderers' do, but
             // `LEAVE` off it: these are benchmark inputs, and a random direction grazing a
             // curved mesh meets the next triangle at t ≈ 1e-6, where the engines' box tests

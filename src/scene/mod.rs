@@ -124,6 +124,26 @@ pub struct Light {
 }
 
 impl Light {
+    /// The light's corners: a parallelogram's four, or every corner of its fan triangles.
+    pub fn corners(&self) -> Vec<Vec3> {
+        match &self.shape {
+            LightShape::Parallelogram {
+                origin,
+                edge_u,
+                edge_v,
+            } => vec![
+                *origin,
+                *origin + *edge_u,
+                *origin + *edge_v,
+                *origin + *edge_u + *edge_v,
+            ],
+            LightShape::Fan { triangles, .. } => triangles
+                .iter()
+                .flat_map(|&(a, e1, e2)| [a, a + e1, a + e2])
+                .collect(),
+        }
+    }
+
     /// Maps (u, v) in [0, 1)² to a point on the light, uniformly by area.
     #[inline]
     pub fn point(&self, u: f32, v: f32) -> Vec3 {

@@ -66,13 +66,7 @@ fn classify(
             break;
         }
         any_hit = true;
-        let mut surface = surface_hit(scene, hit.prim, &ray, hit.t);
-        if settings.two_sided
-            && (hit.prim as usize) < scene.triangles.len()
-            && surface.normal.dot(ray.direction) > 0.0
-        {
-            surface.normal = -surface.normal;
-        }
+        let surface = surface_hit(scene, hit.prim, &ray, hit.t, settings.two_sided);
         for (li, light) in scene.lights.iter().enumerate() {
             let key = SampleKey {
                 pixel,

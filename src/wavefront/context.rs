@@ -10,7 +10,7 @@ use crate::scene::{LightShape, Material, Scene, Triangle};
 use crate::settings::{RenderSettings, ShadowMode};
 use crate::shading::AMBIENT;
 use crate::spawn::{
-    SurfaceHit, light_offset, on_plane, on_sphere, sphere_offset, triangle_offset, triangle_plane,
+    SurfaceHit, light_offset, sphere_hit, triangle_hit, triangle_offset, triangle_plane,
 };
 use glam::Vec3;
 use std::time::Duration;
@@ -224,26 +224,10 @@ impl<'a> Context<'a> {
     pub fn surface(&self, prim: u32, p0: Vec3) -> (SurfaceHit, u32) {
         let p = prim as usize;
         match self.triangle_shading.get(p) {
-            Some(t) => (
-                SurfaceHit {
-                    point: on_plane(p0, t.normal, t.plane),
-                    normal: t.normal,
-                    offset: t.offset,
-                },
-                t.material,
-            ),
+            Some(t) => (triangle_hit(p0, t.normal, t.plane, t.offset), t.material),
             None => {
                 let s = &self.scene.spheres[p - self.triangle_shading.len()];
-                let (point, normal) = on_sphere(p0, s);
-                let offset = sphere_offset(s);
-                (
-                    SurfaceHit {
-                        point,
-                        normal,
-                        offset,
-                    },
-                    s.material,
-                )
+                (sphere_hit(p0, s), s.material)
             }
         }
     }

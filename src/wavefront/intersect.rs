@@ -14,6 +14,7 @@ use super::bvh::MeshBvh;
 use super::context::Context;
 use super::simd::{self, RayColumns};
 use crate::scene::{NO_HIT, Scene};
+use crate::spawn::face_the_ray;
 use glam::Vec3;
 
 /// The ray columns of a batch.
@@ -99,12 +100,10 @@ pub fn closest(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch) {
         }
         let d = Vec3::new(dx[i], dy[i], dz[i]);
         let (hit, m) = ctx.surface(prim, Vec3::new(ox[i], oy[i], oz[i]) + t[i] * d);
-        let mut normal = hit.normal;
-        if two_sided && (prim as usize) < scene.triangles.len() && normal.dot(d) > 0.0 {
-            normal = -normal;
-        }
+        let triangle = (prim as usize) < scene.triangles.len();
+        let hit = face_the_ray(hit, d, two_sided && triangle);
         (px[i], py[i], pz[i]) = (hit.point.x, hit.point.y, hit.point.z);
-        (nx[i], ny[i], nz[i]) = (normal.x, normal.y, normal.z);
+        (nx[i], ny[i], nz[i]) = (hit.normal.x, hit.normal.y, hit.normal.z);
         offset[i] = hit.offset;
         material[i] = m;
     }

@@ -3,7 +3,8 @@
 //! ```text
 //! for each group of hits whose shadow rays fit the queue:
 //!     spawn:   for hit, for light, for point j < N:  the shadow ray of `spawn::shadow_ray`
-//!              (l, dist, n·l), queued when the point is above the tangent plane
+//!              (origin, l, tmax), queued when it has one (the point far enough above the
+//!              tangent plane, the hit above the light's moved plane)
 //!     occlude: 8 queued rays at a time, stop at the first blocker; small scenes test only the
 //!              triangles that can shadow a light (`geometry::shadow_casters`), meshes go one
 //!              ray at a time through `bvh::MeshBvh`, 8 boxes or 8 triangles per test
@@ -170,7 +171,8 @@ fn occlude(ctx: &Context, queue: &mut ShadowQueue) {
             two_sided,
             blocked,
         ),
-        // Dead entries (n·l ≤ 0) carry tmax = 0, which `MeshBvh::occluded` skips.
+        // Dead entries (no ray: `spawn::shadow_ray` gave none) carry tmax = 0, which
+        // `MeshBvh::occluded` skips.
         Some(bvh) => bvh.occluded(scene, &cols, two_sided, blocked),
     }
 }
@@ -180,6 +182,7 @@ fn occlude(ctx: &Context, queue: &mut ShadowQueue) {
 /// lane by lane in order.
 fn shade(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch, queue: &ShadowQueue) {
     let weight = 1.0 / ctx.points_per_light as f32;
+    let model = ctx.settings.light_model;
     let mut q = 0;
     while q < queue.len {
         let end = q + LANES;
@@ -190,11 +193,9 @@ fn shade(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch, queue: &ShadowQueu
         {
             let i = queue.path[q] as usize;
             let m = &ctx.materials[hits.material[i] as usize];
-            let model = ctx.settings.light_model;
-            let falloffs: Option<[f32; LANES]> = match model {
-                LightModel::Lab => None,
-                LightModel::Rpi => Some(std::array::from_fn(|k| falloff(model, queue.dist[q + k]))),
-            };
+            // Distances are kept only under a light model with fall-off (`ShadowQueue::dist`).
+            let falloffs: Option<[f32; LANES]> = (!queue.dist.is_empty())
+                .then(|| std::array::from_fn(|k| falloff(model, queue.dist[q + k])));
             let c = simd::shade8(
                 m,
                 hits.normal(i),
@@ -226,11 +227,7 @@ fn shade(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch, queue: &ShadowQueu
         let n_dot_l = n.dot(l);
         if queue.tmax[q] > 0.0 && !queue.blocked[q] && n_dot_l > 0.0 {
             let m = &ctx.materials[hits.material[i] as usize];
-            let model = ctx.settings.light_model;
-            let fall = match model {
-                LightModel::Lab => 1.0,
-                LightModel::Rpi => falloff(model, queue.dist[q]),
-            };
+            let fall = queue.dist.get(q).map_or(1.0, |&d| falloff(model, d));
             let light_color = ctx.lights[queue.light[q] as usize].color * fall;
             let c = shade_terms(m, n, -rays.direction(i), l, n_dot_l, light_color) * weight;
             hits.direct_r[i] += c.x;

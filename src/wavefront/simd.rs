@@ -390,7 +390,7 @@ fn occluded8(
 }
 
 /// The lanes `s` blocks: `sphere8(..) < tmax`, but returning early when no lane can hit
-/// (most shadow rays miss most spheres; that skips the square root and all three divisions).
+/// (most shadow rays miss most spheres; that skips the square root and both divisions).
 ///
 /// The early test is the textbook discriminant N = b² − a·c, which needs no division, with a
 /// margin: N < −2^-16·a·(|oc|² + r²) proves the stable discriminant negative too, since each
