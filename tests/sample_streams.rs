@@ -232,8 +232,8 @@ fn wavefront_draws(scene: &Scene, s: &RenderSettings) -> Drawn {
         let capacity = rays.len() * scene.lights.len() * (n as usize).div_ceil(8) * 8;
         shadow::direct_light(&ctx, &rays, &mut hits, &mut queue, capacity);
         for q in 0..queue.len {
-            // Dead lanes (no ray: the point is below the tangent plane, or padding) have tmax 0.
-            if queue.tmax[q] <= 0.0 {
+            // Dead lanes (no ray: the point is below the tangent plane, or padding) have n·l 0.
+            if queue.n_dot_l[q] <= 0.0 {
                 continue;
             }
             let i = queue.path[q] as usize;

@@ -400,12 +400,12 @@ proptest! {
         let blocked: Vec<bool> = (0..8).map(|k| blocked_bits & (1 << k) != 0).collect();
         let falloff: [f32; 8] = std::array::from_fn(|k| falloffs[k]);
         let lab = falloffs.iter().all(|&f| f == 1.0);
-        // Dead lanes carry tmax = 0, live ones a positive tmax.
-        let tmax: Vec<f32> = (0..8).map(|k| if dead_bits & (1 << k) != 0 { 0.0 } else { 1.0 }).collect();
-        let got = simd::shade8(&terms, n, e, [&lx, &ly, &lz], &tmax, &blocked, lc.abs(),
+        // Dead lanes carry n·l = 0.
+        let ndl: Vec<f32> = (0..8).map(|k| if dead_bits & (1 << k) != 0 { 0.0 } else { ndl[k] }).collect();
+        let got = simd::shade8(&terms, n, e, [&lx, &ly, &lz], &ndl, &blocked, lc.abs(),
             (!lab).then_some(&falloff), weight);
         for k in 0..8 {
-            if !(ndl[k] > 0.0) || blocked[k] || tmax[k] == 0.0 {
+            if !(ndl[k] > 0.0) || blocked[k] {
                 // Adds nothing: exactly −0.0, the identity of addition.
                 prop_assert_eq!([got[0][k], got[1][k], got[2][k]].map(f32::to_bits),
                     [(-0.0f32).to_bits(); 3]);
@@ -481,9 +481,10 @@ proptest! {
                     prop_assert_eq!([l[0][k], l[1][k], l[2][k]].map(f32::to_bits),
                         want.ray.direction.to_array().map(f32::to_bits));
                     prop_assert_eq!(block.tmax[k].to_bits(), want.tmax.to_bits());
+                    prop_assert_eq!(block.n_dot_l[k].to_bits(), want.n_dot_l.to_bits());
                     prop_assert_eq!(block.dist[k].to_bits(), want.dist.to_bits());
                 } else {
-                    prop_assert_eq!(block.tmax[k], 0.0);
+                    prop_assert_eq!((block.tmax[k], block.n_dot_l[k]), (0.0, 0.0));
                 }
             }
             for k in lanes..8 {

@@ -219,10 +219,10 @@ impl HitBatch {
 ///
 /// The columns keep a fixed length (the capacity) and `len` says how many entries are in use,
 /// so stages write 8 lanes at a time without growing vectors. An entry is a live ray only when
-/// `tmax > 0`: the SIMD spawn writes whole 8-lane blocks and marks the lanes whose light
-/// point is behind the surface (or past the last point) dead with `tmax = 0`. n·l is not kept:
-/// the shade step computes it from l in the spawn's operations (every column written costs the
-/// store-bound spawn; docs/PERFORMANCE.md).
+/// `n_dot_l > 0`: the SIMD spawn writes whole 8-lane blocks and marks the lanes that cast no
+/// ray (the point not far enough above the surface, the hit not above the light's moved plane,
+/// or past the last point) dead with `n_dot_l = 0` and `tmax = 0`. The spawn is bound by its
+/// stores, so no column is kept that shading can do without (docs/PERFORMANCE.md).
 #[derive(Clone, Debug, Default)]
 pub struct ShadowQueue {
     /// Entries in use.
@@ -246,6 +246,9 @@ pub struct ShadowQueue {
     /// under a model that has one (empty under the lab's: every column the spawn writes costs
     /// the store-bound shadow stage, 7% for this one).
     pub dist: Vec<f32>,
+    /// n·l; the entry is a ray only when it is > 0. (Diffuse shading reads this column alone:
+    /// recomputing it from l read three.)
+    pub n_dot_l: Vec<f32>,
     /// Index of the hit (in the current `HitBatch`) that casts the ray.
     pub path: Vec<u32>,
     /// Light index.
@@ -279,6 +282,7 @@ impl ShadowQueue {
                 &mut self.direction_y,
                 &mut self.direction_z,
                 &mut self.tmax,
+                &mut self.n_dot_l,
             ] {
                 c.resize(capacity, 0.0);
             }
@@ -304,6 +308,7 @@ impl ShadowQueue {
         self.direction_y[i] = ray.ray.direction.y;
         self.direction_z[i] = ray.ray.direction.z;
         self.tmax[i] = ray.tmax;
+        self.n_dot_l[i] = ray.n_dot_l;
         if let Some(d) = self.dist.get_mut(i) {
             *d = ray.dist;
         }
@@ -313,7 +318,7 @@ impl ShadowQueue {
     }
 
     /// Queues 8 lanes from one origin (`simd::shadow_rays8`'s block: dead lanes already carry
-    /// `tmax = 0`).
+    /// `n_dot_l = 0`, `tmax = 0`).
     #[inline]
     pub fn push_block(&mut self, block: &ShadowBlock, path: u32, light: u32) {
         let r = self.len..self.len + 8;
@@ -324,6 +329,7 @@ impl ShadowQueue {
         self.direction_y[r.clone()].copy_from_slice(&block.l[1]);
         self.direction_z[r.clone()].copy_from_slice(&block.l[2]);
         self.tmax[r.clone()].copy_from_slice(&block.tmax);
+        self.n_dot_l[r.clone()].copy_from_slice(&block.n_dot_l);
         if !self.dist.is_empty() {
             self.dist[r.clone()].copy_from_slice(&block.dist);
         }
@@ -344,7 +350,7 @@ impl ShadowQueue {
 }
 
 /// Eight shadow rays from one hit to one light, as `simd::shadow_rays8` makes them: lane k is
-/// `spawn::shadow_ray`'s answer for point k, or a dead lane (tmax = 0).
+/// `spawn::shadow_ray`'s answer for point k, or a dead lane (tmax = 0, n·l = 0).
 #[derive(Clone, Copy, Debug)]
 pub struct ShadowBlock {
     /// The rays' common origin, off the surface.
@@ -353,6 +359,8 @@ pub struct ShadowBlock {
     pub l: [[f32; 8]; 3],
     /// tmax per lane, 0 for a dead one.
     pub tmax: [f32; 8],
+    /// n·l per lane, 0 for a dead one.
+    pub n_dot_l: [f32; 8],
     /// |target − point| per lane.
     pub dist: [f32; 8],
     /// Live lanes as a bitmask.

@@ -205,7 +205,7 @@ fn shade(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch, queue: &ShadowQueu
                     &queue.direction_y[q..end],
                     &queue.direction_z[q..end],
                 ],
-                &queue.tmax[q..end],
+                &queue.n_dot_l[q..end],
                 &queue.blocked[q..end],
                 ctx.lights[queue.light[q] as usize].color,
                 falloffs.as_ref(),
@@ -222,10 +222,9 @@ fn shade(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch, queue: &ShadowQueu
             q = end;
             continue;
         }
-        let i = queue.path[q] as usize;
-        let (n, l) = (hits.normal(i), queue.direction(q));
-        let n_dot_l = n.dot(l);
-        if queue.tmax[q] > 0.0 && !queue.blocked[q] && n_dot_l > 0.0 {
+        if !queue.blocked[q] && queue.n_dot_l[q] > 0.0 {
+            let i = queue.path[q] as usize;
+            let (n, l, n_dot_l) = (hits.normal(i), queue.direction(q), queue.n_dot_l[q]);
             let m = &ctx.materials[hits.material[i] as usize];
             let fall = queue.dist.get(q).map_or(1.0, |&d| falloff(model, d));
             let light_color = ctx.lights[queue.light[q] as usize].color * fall;

@@ -626,6 +626,7 @@ pub fn shadow_rays8(
     let above = f32x8::splat(n.x) * x + f32x8::splat(n.y) * y + f32x8::splat(n.z) * z;
     let dist = (x * x + y * y + z * z).sqrt();
     let (lx, ly, lz) = (x / dist, y / dist, z / dist);
+    let n_dot_l = f32x8::splat(n.x) * lx + f32x8::splat(n.y) * ly + f32x8::splat(n.z) * lz;
     let tmax = dist * f32x8::splat(end.ratio);
     let first = f32x8::new(LANE_INDEX).simd_lt(f32x8::splat(lanes as f32));
     let live = above.simd_gt(f32x8::splat(end.margin)) & tmax.simd_gt(f32x8::ZERO) & first;
@@ -633,6 +634,7 @@ pub fn shadow_rays8(
         origin: hit.point + hit.offset * n,
         l: [lx.to_array(), ly.to_array(), lz.to_array()],
         tmax: live.select(tmax, f32x8::ZERO).to_array(),
+        n_dot_l: live.select(n_dot_l, f32x8::ZERO).to_array(),
         dist: dist.to_array(),
         live: live.to_bitmask(),
     }
@@ -640,8 +642,8 @@ pub fn shadow_rays8(
 
 /// Shade · weight of 8 shadow rays cast from one hit towards one light: lane k equals
 /// `shadow::shade_terms(m, n, e, l_k, n·l_k, light_color) * weight` bit for bit (`powf`
-/// runs per lane, in scalar, only where the scalar twin calls it). Lanes that add nothing (dead:
-/// tmax = 0; n·l ≤ 0; or `blocked`) come back as −0.0, the exact identity of IEEE addition (x + −0 = x for
+/// runs per lane, in scalar, only where the scalar twin calls it). Lanes that add nothing (dead,
+/// n·l ≤ 0, or `blocked`) come back as −0.0, the exact identity of IEEE addition (x + −0 = x for
 /// every x, −0 included), so the caller adds all 8 lanes in order without a branch.
 #[inline]
 #[allow(clippy::too_many_arguments)]
@@ -650,15 +652,13 @@ pub fn shade8(
     n: Vec3,
     e: Vec3,
     l: [&[f32]; 3],
-    tmax: &[f32],
+    n_dot_l: &[f32],
     blocked: &[bool],
     light_color: Vec3,
     falloff: Option<&[f32; LANES]>,
     weight: f32,
 ) -> [[f32; LANES]; 3] {
-    let (lx, ly, lz) = (load(l[0], 0, 0.0), load(l[1], 0, 0.0), load(l[2], 0, 0.0));
-    // n·l in the spawn's operations (`spawn::shadow_ray`), so the queue need not keep it.
-    let ndl = f32x8::splat(n.x) * lx + f32x8::splat(n.y) * ly + f32x8::splat(n.z) * lz;
+    let ndl = load(n_dot_l, 0, 0.0);
     // Each lane's light colour: Lc · falloff (`spawn::falloff`), or Lc itself in the lab's
     // model, whose fall-off is exactly 1 (x · 1 = x, so both give the twin's bits).
     let lc = {
@@ -677,8 +677,7 @@ pub fn shade8(
         }
     };
     let open = f32x8::new(std::array::from_fn(|k| if blocked[k] { 0.0 } else { 1.0 }));
-    let live = load(tmax, 0, 0.0).simd_gt(f32x8::ZERO);
-    let adds = live & ndl.simd_gt(f32x8::ZERO) & open.simd_gt(f32x8::ZERO);
+    let adds = ndl.simd_gt(f32x8::ZERO) & open.simd_gt(f32x8::ZERO);
     let nothing = f32x8::splat(-0.0);
     let cr = f32x8::splat(m.ambient_emitted.x) + lc[0] * f32x8::splat(m.diffuse.x) * ndl;
     let cg = f32x8::splat(m.ambient_emitted.y) + lc[1] * f32x8::splat(m.diffuse.y) * ndl;
@@ -689,6 +688,7 @@ pub fn shade8(
         let out = |c: f32x8| adds.select(c * w, nothing).to_array();
         return [out(cr), out(cg), out(cb)];
     }
+    let (lx, ly, lz) = (load(l[0], 0, 0.0), load(l[1], 0, 0.0), load(l[2], 0, 0.0));
     // r = normalize(2(n·l) n − l), glam's normalize: v · (1 / |v|).
     let k = f32x8::splat(2.0) * ndl;
     let rx = k * f32x8::splat(n.x) - lx;
