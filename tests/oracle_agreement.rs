@@ -13,7 +13,10 @@
 // `!(d <= TOLERANCE)` is on purpose: a NaN difference counts as a difference.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+mod common;
 mod oracle;
+
+use common::bundled_scenes;
 
 use glam::{DVec3, Vec3};
 use oracle::{ILL_CONDITIONED, Oracle, OracleImage, TOLERANCE, scaled};
@@ -32,27 +35,6 @@ const SCALES: [f32; 5] = [1e-3, 1e-1, 1.0, 10.0, 1e3];
 const MAX_EXCLUDED: f64 = 0.02;
 /// Image size of the matrix: small enough for 120 cases, large enough for the 2% cap to bite.
 const SIZE: (u32, u32) = (128, 128);
-
-/// Every `scenes/*.obj`, by file name.
-fn scenes() -> Vec<(String, Scene)> {
-    let mut paths: Vec<_> = std::fs::read_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes"))
-        .expect("scenes/ exists")
-        .map(|e| e.expect("dir entry").path())
-        .filter(|p| p.extension().is_some_and(|e| e == "obj"))
-        .collect();
-    paths.sort();
-    assert!(
-        paths.len() >= 5,
-        "expected the lab's scenes, found {paths:?}"
-    );
-    paths
-        .iter()
-        .map(|p| {
-            let name = p.file_name().unwrap().to_string_lossy().into_owned();
-            (name, Scene::load(p).expect("bundled scene parses"))
-        })
-        .collect()
-}
 
 /// The lab's three shadow modes with 5 bounces (mirror chains are where the shared bug is).
 fn modes() -> Vec<(&'static str, RenderSettings)> {
@@ -215,7 +197,7 @@ fn every_scene_mode_and_scale_matches_the_oracle() {
     let start = Instant::now();
     let mut failures = Vec::new();
     let mut excluded = (0usize, 0usize);
-    for (name, scene) in scenes() {
+    for (name, scene) in bundled_scenes() {
         for (mode, settings) in modes() {
             let unit = Oracle::new(&scene, &settings).render();
             for scale in SCALES {
@@ -254,7 +236,7 @@ fn every_scene_mode_and_scale_matches_the_oracle() {
 #[test]
 fn the_rule_leaves_room_for_rounding() {
     let mut failures = Vec::new();
-    for (name, scene) in scenes() {
+    for (name, scene) in bundled_scenes() {
         for (mode, settings) in modes() {
             let exact = Oracle::new(&scene, &settings).render();
             let rounded = Oracle::new(&scene, &settings).with_rounding(2e-7);
@@ -330,7 +312,7 @@ fn other_settings_match_the_oracle() {
         ),
     ];
     let mut failures = Vec::new();
-    for (name, scene) in scenes()
+    for (name, scene) in bundled_scenes()
         .into_iter()
         .filter(|(n, _)| n == "cornell_box_reflective_spheres.obj" || n == "l.obj")
     {
@@ -438,7 +420,7 @@ fn light_model_and_ambient_match_the_oracle() {
         ..RenderSettings::default()
     };
     let mut failures = Vec::new();
-    for (name, scene) in scenes().into_iter().filter(|(n, _)| {
+    for (name, scene) in bundled_scenes().into_iter().filter(|(n, _)| {
         ["camera_block.obj", "two_lights.obj", "rpi_style_room.obj"].contains(&n.as_str())
     }) {
         let image = Oracle::new(&scene, &settings).render();

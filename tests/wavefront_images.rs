@@ -5,6 +5,9 @@
 // `!(d <= 1e-4)` is on purpose: a NaN difference counts as a difference.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+mod common;
+
+use common::bundled_scenes;
 use glam::Vec3;
 use raywave::film::Film;
 use raywave::reference::Reference;
@@ -13,23 +16,6 @@ use raywave::scene::{Scene, parse_scene_str};
 use raywave::settings::{RenderSettings, ShadowMode};
 use raywave::stats::RayCounts;
 use raywave::wavefront::Wavefront;
-
-fn scenes() -> Vec<Scene> {
-    let mut paths: Vec<_> = std::fs::read_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes"))
-        .expect("scenes/ exists")
-        .map(|e| e.expect("dir entry").path())
-        .filter(|p| p.extension().is_some_and(|e| e == "obj"))
-        .collect();
-    paths.sort();
-    assert!(
-        paths.len() >= 5,
-        "expected the lab's scenes, found {paths:?}"
-    );
-    paths
-        .iter()
-        .map(|p| Scene::load(p).expect("bundled scene parses"))
-        .collect()
-}
 
 /// The lab's modes, on a small image.
 fn modes() -> Vec<RenderSettings> {
@@ -126,7 +112,7 @@ fn assert_equivalent(scene: &Scene, s: &RenderSettings, batch: usize) {
 
 #[test]
 fn every_scene_and_mode_matches_the_reference() {
-    for scene in scenes() {
+    for (_, scene) in bundled_scenes() {
         for s in modes() {
             assert_equivalent(&scene, &s, 64);
         }

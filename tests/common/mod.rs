@@ -4,7 +4,7 @@
 
 use glam::Vec3;
 use raywave::geometry::Ray;
-use raywave::scene::Triangle;
+use raywave::scene::{Scene, Triangle};
 
 /// The triangle v0 v1 v2 (front side counter-clockwise), material 0; a degenerate one gets a
 /// zero normal (the kernels never read it).
@@ -60,4 +60,25 @@ impl Rng {
     pub fn point(&mut self, half: f32) -> Vec3 {
         self.in_box(Vec3::splat(-half), Vec3::splat(half))
     }
+}
+
+/// Every bundled `scenes/*.obj`, by file name, in name order (a scene added there is covered).
+pub fn bundled_scenes() -> Vec<(String, Scene)> {
+    let mut paths: Vec<_> = std::fs::read_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes"))
+        .expect("scenes/ exists")
+        .map(|e| e.expect("dir entry").path())
+        .filter(|p| p.extension().is_some_and(|e| e == "obj"))
+        .collect();
+    paths.sort();
+    assert!(
+        paths.len() >= 5,
+        "expected the lab's scenes, found {paths:?}"
+    );
+    paths
+        .iter()
+        .map(|p| {
+            let name = p.file_name().unwrap().to_string_lossy().into_owned();
+            (name, Scene::load(p).expect("bundled scene parses"))
+        })
+        .collect()
 }
