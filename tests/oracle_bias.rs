@@ -12,14 +12,17 @@
 //! against a midpoint-rule integral of the closed form. The lab's own N = 1 strategy (the
 //! light's centre) must miss the converged value by more than 50 such standard errors.
 
+mod common;
 mod oracle;
+
+use common::{PENTAGON, SQUARE};
 
 use glam::DVec3;
 use oracle::Oracle;
 use raywave::reference::Reference;
 use raywave::sampling::LightSampler;
 use raywave::scene::{Scene, parse_scene_str};
-use raywave::settings::{RenderSettings, ShadowMode};
+use raywave::settings::RenderSettings;
 use raywave::stats::RayCounts;
 
 /// Image size of the analytic scene (its camera maps pixels to floor points in closed form).
@@ -36,17 +39,6 @@ const K: f64 = 5.0;
 const KE: f64 = 10.0;
 /// The floor's kd.
 const KD: f64 = 0.5;
-
-/// The square light's corners (x, z), counter-clockwise seen from below.
-const SQUARE: &[(f64, f64)] = &[(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)];
-/// The square with its (0.5, 0.5) corner cut along x + z = 0.7: a pentagon, sampled by the fan.
-const PENTAGON: &[(f64, f64)] = &[
-    (-0.5, -0.5),
-    (0.5, -0.5),
-    (0.5, 0.2),
-    (0.2, 0.5),
-    (-0.5, 0.5),
-];
 
 /// The analytic scene with the given light; a camera 10 above the origin looks straight down
 /// (screen up = −z) with a 1.5 half-width at the floor.
@@ -99,16 +91,7 @@ fn floor_point(column: u32, row: u32) -> DVec3 {
 
 /// Soft shadows with `n` points of `sampler`, no bounces.
 fn settings(sampler: LightSampler, n: u32, seed: u32) -> RenderSettings {
-    RenderSettings {
-        width: SIZE,
-        height: SIZE,
-        bounces: 0,
-        shadows: ShadowMode::Soft,
-        shadow_samples: n,
-        sampler,
-        seed,
-        ..RenderSettings::default()
-    }
+    common::soft_settings(SIZE, sampler, n, seed)
 }
 
 /// (mean, standard error of the mean) of `values`.

@@ -10,6 +10,7 @@
 //! sampler biased in either one moves the mean. A camera 10 above the origin looks straight down
 //! (screen up = −z) with a 1.5 half-width at the floor.
 
+mod common;
 mod oracle;
 
 use glam::Vec3;
@@ -17,7 +18,7 @@ use oracle::Oracle;
 use raywave::reference::Reference;
 use raywave::sampling::{LightSampler, SampleKey, square_sample, strata_grid};
 use raywave::scene::{Scene, parse_scene_str};
-use raywave::settings::{RenderSettings, ShadowMode};
+use raywave::settings::RenderSettings;
 use raywave::stats::RayCounts;
 use raywave::variance::{Region, penumbra_mask};
 
@@ -69,17 +70,9 @@ fn floor_xz(column: u32, row: u32) -> (f32, f32) {
     (x, z)
 }
 
+/// Soft shadows with `n` points of `sampler`, no bounces.
 fn settings(sampler: LightSampler, n: u32, seed: u32) -> RenderSettings {
-    RenderSettings {
-        width: SIZE,
-        height: SIZE,
-        bounces: 0,
-        shadows: ShadowMode::Soft,
-        shadow_samples: n,
-        sampler,
-        seed,
-        ..RenderSettings::default()
-    }
+    common::soft_settings(SIZE, sampler, n, seed)
 }
 
 #[test]

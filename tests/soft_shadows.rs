@@ -5,7 +5,10 @@
 //! reference's N = 4 estimate must match I, and the f64 oracle's high-N estimate
 //! (tests/oracle/mod.rs), within ~5 standard errors of the mean taken from the sample variance. A pentagonal light checks the fan sampler the same way.
 
+mod common;
 mod oracle;
+
+use common::{PENTAGON, SQUARE};
 
 use glam::{DVec3, Vec3};
 use oracle::Oracle;
@@ -49,16 +52,6 @@ fn scene(light_corners: &[(f64, f64)]) -> Scene {
     );
     parse_scene_str(&text, "penumbra.obj").unwrap()
 }
-
-const SQUARE: &[(f64, f64)] = &[(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)];
-/// The square with its (0.5, 0.5) corner cut off along x + z = 0.7: a convex pentagon.
-const PENTAGON: &[(f64, f64)] = &[
-    (-0.5, -0.5),
-    (0.5, -0.5),
-    (0.5, 0.2),
-    (0.2, 0.5),
-    (-0.5, 0.5),
-];
 
 /// Does the segment p -> q pass through the blocker? (Both ends are outside it.)
 fn blocked(q: DVec3) -> bool {

@@ -310,7 +310,8 @@ impl Hits {
     }
 }
 
-/// obvhs's CWBVH over a scene's triangles, traced one ray at a time: the baseline of issue 3.
+/// obvhs's CWBVH over a scene's triangles, traced one ray at a time: the baseline the mesh targets
+/// are measured against.
 pub struct ObvhsMesh {
     /// The BVH (primitive indices map back to `Scene::triangles`).
     pub bvh: CwBvh,

@@ -82,3 +82,34 @@ pub fn bundled_scenes() -> Vec<(String, Scene)> {
         })
         .collect()
 }
+
+/// A square light's corners (x, z), counter-clockwise seen from below.
+pub const SQUARE: &[(f64, f64)] = &[(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)];
+/// The square with its (0.5, 0.5) corner cut along x + z = 0.7: a convex pentagon, sampled by
+/// the fan.
+pub const PENTAGON: &[(f64, f64)] = &[
+    (-0.5, -0.5),
+    (0.5, -0.5),
+    (0.5, 0.2),
+    (0.2, 0.5),
+    (-0.5, 0.5),
+];
+
+/// A `size`² image with soft shadows from `n` points of `sampler`, no bounces, seed `seed`.
+pub fn soft_settings(
+    size: u32,
+    sampler: raywave::sampling::LightSampler,
+    n: u32,
+    seed: u32,
+) -> raywave::settings::RenderSettings {
+    raywave::settings::RenderSettings {
+        width: size,
+        height: size,
+        bounces: 0,
+        shadows: raywave::settings::ShadowMode::Soft,
+        shadow_samples: n,
+        sampler,
+        seed,
+        ..raywave::settings::RenderSettings::default()
+    }
+}
