@@ -46,8 +46,16 @@ pub struct SurfaceHit {
     pub point: Vec3,
     /// Unit shading normal (front side or outward; the caller flips two-sided faces).
     pub normal: Vec3,
-    /// How far off the surface secondary rays start (`offset_of`).
+    /// How far off the surface secondary rays start (`triangle_offset`, `sphere_offset`).
     pub offset: f32,
+}
+
+impl SurfaceHit {
+    /// Where a ray leaving on the normal's side starts: `offset` off the surface.
+    #[inline]
+    pub fn leaving_point(&self) -> Vec3 {
+        self.point + self.offset * self.normal
+    }
 }
 
 /// The plane constant n·v0 of a triangle: its points p have n·p = n·v0.
@@ -160,16 +168,17 @@ pub struct LightEnd {
 /// surface and the light: `shadow_ray`.)
 #[inline]
 pub fn light_end(light: &Light, end_offset: f32, hit: &SurfaceHit) -> LightEnd {
-    let normal = if light.normal.dot(hit.point - light.centroid) >= 0.0 {
-        light.normal
+    // The hit's height above the light's plane, h, and the light's normal turned to face it
+    // (negating the normal negates the product exactly, so h = |that product|).
+    let side = light.normal.dot(hit.point - light.centroid);
+    let (normal, h) = if side >= 0.0 {
+        (light.normal, side)
     } else {
-        -light.normal
+        (-light.normal, -side)
     };
     let margin = end_offset + hit.offset;
-    let origin = hit.point + hit.offset * hit.normal;
-    let height = normal.dot(origin - light.centroid) - margin;
+    let height = normal.dot(hit.leaving_point() - light.centroid) - margin;
     // A hit on the light's plane (h = ±0) casts no ray to it: ratio 0, never +∞ from −0.0.
-    let h = normal.dot(hit.point - light.centroid);
     LightEnd {
         ratio: if h > 0.0 { height / h } else { 0.0 },
         margin,
@@ -216,7 +225,7 @@ pub fn shadow_ray(hit: &SurfaceHit, target: Vec3, end: &LightEnd) -> Option<Shad
     }
     Some(ShadowRay {
         ray: Ray {
-            origin: hit.point + hit.offset * hit.normal,
+            origin: hit.leaving_point(),
             direction: l,
         },
         tmax,

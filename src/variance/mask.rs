@@ -35,11 +35,23 @@ impl Regions {
 /// such as 1024 keeps every stratum a square).
 pub fn penumbra_mask(scene: &Scene, settings: &RenderSettings, points: u32) -> Regions {
     let accel = Accel::new(scene);
+    // `spawn::light_offset` of every light, once, as the renderers keep them.
+    let end_offsets: Vec<f32> = scene.lights.iter().map(light_offset).collect();
     let camera = CameraRays::new(&scene.camera, settings.width, settings.height);
     let pixels = settings.width * settings.height;
     let classes: Vec<(bool, bool)> = (0..pixels)
         .into_par_iter()
-        .map(|pixel| classify(scene, settings, &accel, &camera, pixel, points))
+        .map(|pixel| {
+            classify(
+                scene,
+                settings,
+                &accel,
+                &camera,
+                &end_offsets,
+                pixel,
+                points,
+            )
+        })
         .collect();
     Regions {
         penumbra: classes.iter().map(|c| c.0).collect(),
@@ -52,6 +64,7 @@ fn classify(
     settings: &RenderSettings,
     accel: &Accel,
     camera: &CameraRays,
+    end_offsets: &[f32],
     pixel: u32,
     points: u32,
 ) -> (bool, bool) {
@@ -75,8 +88,7 @@ fn classify(
                 light: li as u32,
                 seed: 0x6d61_736b,
             };
-            let end_offset = light_offset(light);
-            let end = light_end(light, end_offset, &surface);
+            let end = light_end(light, end_offsets[li], &surface);
             let mut visible = 0;
             for j in 0..points {
                 let (u, v) = square_sample(LightSampler::Stratified, &key, j, points);

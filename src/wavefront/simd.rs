@@ -630,7 +630,7 @@ pub fn shadow_rays8(
     let first = f32x8::new(LANE_INDEX).simd_lt(f32x8::splat(lanes as f32));
     let live = above.simd_gt(f32x8::splat(end.margin)) & tmax.simd_gt(f32x8::ZERO) & first;
     ShadowBlock {
-        origin: hit.point + hit.offset * n,
+        origin: hit.leaving_point(),
         l: [lx.to_array(), ly.to_array(), lz.to_array()],
         tmax: live.select(tmax, f32x8::ZERO).to_array(),
         n_dot_l: live.select(n_dot_l, f32x8::ZERO).to_array(),
