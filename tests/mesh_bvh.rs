@@ -8,42 +8,20 @@
 
 mod common;
 
-use common::{Rng, ray, triangle};
+use common::strategies::{any_f32, vec3};
+use common::{Rng, edge_rays, ray, scene_of, triangle};
 use glam::Vec3;
 use proptest::prelude::*;
 use raywave::geometry::{Accel, Ray, intersect_triangle};
 use raywave::meshgen::cornell_box_mesh_spheres;
-use raywave::scene::{Material, NO_HIT, Scene, Sphere, Triangle, parse_scene_str};
+use raywave::scene::{NO_HIT, Scene, Sphere, Triangle, parse_scene_str};
 use raywave::wavefront::bvh::{MeshBvh, lanes};
 use raywave::wavefront::simd::RayColumns;
 
 const NAN: f32 = f32::NAN;
 const INF: f32 = f32::INFINITY;
-
-/// Rays on the kernel's edges for the unit triangle (0,0,0) (1,0,0) (0,1,0), front +z.
-fn edge_rays() -> Vec<Ray> {
-    vec![
-        ray([0.25, 0.25, 1.0], [0.0, 0.0, -1.0]),
-        ray([0.25, 0.25, -1.0], [0.0, 0.0, 1.0]),
-        ray([0.25, 0.25, 0.0], [0.0, 0.0, -1.0]), // starting on the surface
-        ray([0.25, 0.25, 5e-5], [0.0, 0.0, -1.0]),
-        ray([0.25, 0.25, 2e-4], [0.0, 0.0, -1.0]),
-        ray([-1.0, 0.25, 0.0], [1.0, 0.0, 0.0]), // grazing, in the plane
-        ray([-1.0, 0.25, 1e-7], [1.0, 0.0, -1e-7]),
-        ray([0.0, 0.0, 1.0], [0.0, 0.0, -1.0]), // corner
-        ray([0.5, 0.5, 1.0], [0.0, 0.0, -1.0]), // hypotenuse
-        ray([0.5, -0.0, 1.0], [-0.0, 0.0, -1.0]),
-        ray([0.25, 0.25, 1.0], [-0.0, -0.0, -1.0]),
-        ray([NAN, 0.25, 1.0], [0.0, 0.0, -1.0]),
-        ray([0.25, 0.25, 1.0], [0.0, NAN, -1.0]),
-        ray([INF, 0.25, 1.0], [0.0, 0.0, -1.0]),
-        ray([0.25, 0.25, 1.0], [0.0, 0.0, -INF]),
-        ray([0.25, 0.25, 1.0], [0.0, 0.0, 0.0]),
-        ray([0.25, 0.25, 1e30], [0.0, 0.0, -1.0]),
-        ray([0.25, 0.25, 1.0], [0.0, 0.0, -1e-30]),
-        ray([1.0, 1.0, 1.0], [-0.57735, -0.57735, -0.57735]),
-    ]
-}
+/// Random coordinates lie in [−HALF, HALF): the generated meshes' scale.
+const HALF: f32 = 10.0;
 
 fn edge_triangles() -> Vec<Triangle> {
     vec![
@@ -109,34 +87,15 @@ fn leaf_kernels_equal_scalar_on_edge_cases() {
     }
 }
 
-fn finite() -> impl Strategy<Value = f32> {
-    -10.0f32..10.0
-}
-
-fn vec3() -> impl Strategy<Value = Vec3> {
-    (finite(), finite(), finite()).prop_map(|(x, y, z)| Vec3::new(x, y, z))
-}
-
-fn any_f32() -> impl Strategy<Value = f32> {
-    prop_oneof![
-        8 => finite(),
-        1 => Just(0.0f32),
-        1 => Just(-0.0f32),
-        1 => Just(INF),
-        1 => Just(-INF),
-        1 => Just(NAN),
-    ]
-}
-
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(512))]
 
     #[test]
     fn leaf_kernels_equal_scalar_on_random_input(
-        verts in prop::collection::vec((vec3(), vec3(), vec3()), 0..=8),
-        o in (any_f32(), any_f32(), any_f32()),
-        d in (any_f32(), any_f32(), any_f32()),
-        tmax in prop_oneof![3 => 0.0f32..30.0, 1 => Just(INF), 1 => any_f32()],
+        verts in prop::collection::vec((vec3(HALF), vec3(HALF), vec3(HALF)), 0..=8),
+        o in (any_f32(HALF), any_f32(HALF), any_f32(HALF)),
+        d in (any_f32(HALF), any_f32(HALF), any_f32(HALF)),
+        tmax in prop_oneof![3 => 0.0f32..30.0, 1 => Just(INF), 1 => any_f32(HALF)],
         two_sided: bool,
     ) {
         let tris: Vec<Triangle> = verts.iter().map(|&(a, b, c)| triangle(a, b, c)).collect();
@@ -146,8 +105,8 @@ proptest! {
 
     #[test]
     fn leaf_kernels_equal_scalar_on_rays_that_hit(
-        verts in prop::collection::vec((vec3(), vec3(), vec3()), 1..=8),
-        o in vec3(),
+        verts in prop::collection::vec((vec3(HALF), vec3(HALF), vec3(HALF)), 1..=8),
+        o in vec3(HALF),
         (a, b) in (0.0f32..1.0, 0.0f32..1.0),
         tmax in prop_oneof![Just(INF), 0.0f32..30.0],
         two_sided: bool,
@@ -157,15 +116,6 @@ proptest! {
         let target = tris[0].v0 + a * (1.0 - b) * tris[0].e1 + a * b * tris[0].e2;
         let r = Ray { origin: o, direction: (target - o).normalize_or_zero() };
         check_leaf(&tris, &r, tmax, two_sided);
-    }
-}
-
-fn scene_of(triangles: Vec<Triangle>, spheres: Vec<Sphere>) -> Scene {
-    Scene {
-        triangles,
-        spheres,
-        materials: vec![Material::default()],
-        ..Scene::default()
     }
 }
 
