@@ -22,7 +22,9 @@
 //!
 //! See docs/BENCHMARKING.md ("The variance suite").
 
-use criterion::{BenchmarkId, Criterion, Throughput};
+mod common;
+
+use criterion::{BenchmarkId, Throughput};
 use raywave::film::Film;
 use raywave::sampling::LightSampler;
 use raywave::scene::Scene;
@@ -251,13 +253,7 @@ fn judge(before: f64, now: f64, tolerance: f64) -> (f64, Verdict) {
 }
 
 fn main() {
-    let mut c = Criterion::default()
-        .sample_size(10)
-        .warm_up_time(Duration::from_millis(500))
-        .measurement_time(Duration::from_secs(2))
-        // The plotters backend panics without system fonts (FontUnavailable) on this machine.
-        .without_plots()
-        .configure_from_args();
+    let mut c = common::criterion_for_frames(Duration::from_millis(500));
     let scene = Scene::builtin_default();
     let config = study_config(&scene);
     let bench_config = BenchConfig {
