@@ -1,10 +1,12 @@
 //! Helpers shared by the integration tests (each test file that needs them declares
 //! `mod common;`), one file per idea: `rays` (constructors and the edge-case table),
-//! `scenes` (bare and bundled scenes, the bias tests' lights and settings), `strategies`
+//! `scenes` (bare and bundled scenes, the bias tests' lights and settings), `analytic` (the
+//! closed-form penumbra scene), `strategies`
 //! (proptest inputs), `random` (seeded inputs from `rand`), `bin` (running the binary in a
 //! scratch directory).
 #![allow(dead_code, unused_imports)]
 
+pub mod analytic;
 pub mod bin;
 pub mod random;
 pub mod rays;
