@@ -46,7 +46,7 @@ const RECORD: &str = concat!(
 const RECORD_COMMAND: &str = "RAYWAVE_RECORD=1 cargo bench --bench variance -- --test";
 /// Image size: 4096 pixels keep CI's one-shot run to a few seconds on 2 cores.
 const SIZE: u32 = 64;
-/// The budgets on the penumbra.
+/// The study's budgets on the penumbra.
 const BUDGETS: [u32; 2] = [16, 64];
 /// Seeds (independent images) per (sampler, N) in each MSE.
 const SEEDS: u32 = 4;

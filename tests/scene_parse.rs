@@ -1,4 +1,4 @@
-//! The scene format of issue 2: the lab's five seed scenes, every scene in `scenes/`, every
+//! The scene format (docs/SCENE_FORMAT.md): the lab's five seed scenes, every scene in `scenes/`, every
 //! parse error (each must name `file:line` and say what was expected), and the extensions
 //! (comments, continuations, relative indices, polygons, the RPI camera block and materials).
 

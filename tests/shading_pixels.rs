@@ -1,6 +1,6 @@
-//! Pixels computed by hand from issue 2's formulas, compared with the reference renderer to
-//! 1e-5. Every expected value is built here from the formula, with this file's own vector
-//! arithmetic, never through `raywave::shading`.
+//! Pixels computed by hand from the lab's Shade formulas (docs/SHADING.md), compared with the
+//! reference renderer to 1e-5. Every expected value is built here from the formula, with this
+//! file's own vector arithmetic, never through `raywave::shading`.
 //!
 //! The scenes are small: a floor (y = 0, facing up), a 1 × 1 light at y = 2 facing down, and
 //! whatever the test adds. A 1 × 1 image sends its only ray from the camera position straight
@@ -102,7 +102,7 @@ fn assert_close(got: Vec3, want: Vec3, what: &str) {
     );
 }
 
-/// Hand-written Shade for one light point, straight from the issue's formula.
+/// Hand-written Shade for one light point, straight from the lab's formula.
 fn shade_by_hand(
     kd: Vec3,
     kr: Vec3,
