@@ -568,38 +568,68 @@ fn lab_camera_frames_the_bounding_box() {
     assert_eq!(s.camera.up, Vec3::Y);
 }
 
+/// What a scene file holds, counted by hand from the file.
+struct Contents {
+    name: &'static str,
+    materials: usize,
+    faces: usize,
+    quads: usize,
+    triangles: usize,
+    spheres: usize,
+    lights: usize,
+    camera_from_file: bool,
+}
+
 #[test]
 fn the_projects_own_scenes_have_the_expected_contents() {
-    // (file, materials, faces, quads, triangles, spheres, lights, camera from file), counted
-    // by hand from the files; a scene not (yet) in scenes/ is skipped.
-    let expected: &[(&str, usize, usize, usize, usize, usize, usize, bool)] = &[
-        ("two_lights.obj", 8, 7, 7, 14, 2, 2, false),
-        ("camera_block.obj", 5, 6, 6, 12, 2, 1, true),
-        (
-            "mesh_spheres_small.obj",
-            8,
-            390,
-            294,
-            2 * 294 + 96,
-            0,
-            1,
-            false,
-        ),
+    // A scene not (yet) in scenes/ is skipped.
+    let expected = [
+        Contents {
+            name: "two_lights.obj",
+            materials: 8,
+            faces: 7,
+            quads: 7,
+            triangles: 14,
+            spheres: 2,
+            lights: 2,
+            camera_from_file: false,
+        },
+        Contents {
+            name: "camera_block.obj",
+            materials: 5,
+            faces: 6,
+            quads: 6,
+            triangles: 12,
+            spheres: 2,
+            lights: 1,
+            camera_from_file: true,
+        },
+        Contents {
+            name: "mesh_spheres_small.obj",
+            materials: 8,
+            faces: 390,
+            quads: 294,
+            triangles: 2 * 294 + 96,
+            spheres: 0,
+            lights: 1,
+            camera_from_file: false,
+        },
     ];
-    for &(name, materials, faces, quads, triangles, spheres, lights, camera) in expected {
+    for want in &expected {
+        let name = want.name;
         let path = manifest_dir().join("scenes").join(name);
         if !path.exists() {
             println!("skipped: scenes/{name} is absent");
             continue;
         }
         let s = Scene::load(&path).unwrap_or_else(|e| panic!("{name}: {e}"));
-        assert_eq!(s.materials.len(), materials, "{name}");
-        assert_eq!(s.face_count, faces, "{name}");
-        assert_eq!(s.quad_count, quads, "{name}");
-        assert_eq!(s.triangles.len(), triangles, "{name}");
-        assert_eq!(s.spheres.len(), spheres, "{name}");
-        assert_eq!(s.lights.len(), lights, "{name}");
-        assert_eq!(s.camera_from_file, camera, "{name}");
+        assert_eq!(s.materials.len(), want.materials, "{name}");
+        assert_eq!(s.face_count, want.faces, "{name}");
+        assert_eq!(s.quad_count, want.quads, "{name}");
+        assert_eq!(s.triangles.len(), want.triangles, "{name}");
+        assert_eq!(s.spheres.len(), want.spheres, "{name}");
+        assert_eq!(s.lights.len(), want.lights, "{name}");
+        assert_eq!(s.camera_from_file, want.camera_from_file, "{name}");
         assert!(s.warnings.is_empty(), "{name}: {:?}", s.warnings);
         if name == "camera_block.obj" {
             assert_eq!(s.camera.position, Vec3::new(0.7, 0.35, 4.2));
