@@ -1,7 +1,35 @@
 //! Scenes and settings shared by the tests: bare scenes from primitives, the bundled scenes,
 //! the bias tests' light shapes and soft-shadow settings.
 
-use raywave::scene::{Material, Scene, Sphere, Triangle};
+use raywave::scene::{Material, Scene, Sphere, Triangle, parse_scene_str};
+
+/// A white diffuse material block, every key spelled out, for scene texts built in tests.
+pub const WHITE_MATERIAL: &str =
+    "material\ndiffuse 1 1 1\nreflective 0 0 0\nemitted 0 0 0\nglossiness 0\n";
+
+/// Parses `text` as `f.obj`, which must fail at `line` with an error whose text starts with
+/// `f.obj:LINE:`, says what was expected and mentions every needle; returns that text.
+pub fn error_at(text: &str, line: usize, needles: &[&str]) -> String {
+    let err = match parse_scene_str(text, "f.obj") {
+        Ok(_) => panic!("expected an error at line {line}, parsed fine:\n{text}"),
+        Err(e) => e,
+    };
+    assert_eq!(err.file, "f.obj");
+    assert_eq!(err.line, line, "wrong line in `{err}` for:\n{text}");
+    let msg = err.to_string();
+    assert!(
+        msg.starts_with(&format!("f.obj:{line}: ")),
+        "`{msg}` does not start with f.obj:{line}:"
+    );
+    assert!(
+        msg.contains("expected"),
+        "`{msg}` does not say what was expected"
+    );
+    for needle in needles {
+        assert!(msg.contains(needle), "`{msg}` does not mention `{needle}`");
+    }
+    msg
+}
 
 /// A scene of just these primitives, with one default material.
 pub fn scene_of(triangles: Vec<Triangle>, spheres: Vec<Sphere>) -> Scene {
