@@ -583,6 +583,7 @@ fn far_origins_on_the_chain_keep_brute_force_t() {
         for (i, (r, tmax)) in rays.iter().enumerate() {
             let (t, prim) = brute_force(&scene, r, *tmax, two_sided);
             let one = bvh.closest_triangle(r, *tmax, two_sided);
+            assert_eq!(bvh.occluded_triangle(r, *tmax, two_sided), prim != NO_HIT);
             for hit in [(one.t, one.prim), packets[i]] {
                 assert_eq!(
                     hit.0.to_bits(),
