@@ -29,6 +29,8 @@
 //! `RAYWAVE_MESH=12k` (or `1M`) limits either mode to one scene. The test mode ignores both
 //! switches.
 
+mod common;
+
 use criterion::{BenchmarkId, Criterion, Throughput};
 use raywave::bench::record::median;
 use raywave::meshgen::{bands_for, cornell_box_mesh_spheres, triangle_count};
@@ -306,11 +308,9 @@ fn interleaved(s: &Setup, ctx: &Context, rounds: usize) {
 }
 
 fn main() {
-    // criterion's test mode: `cargo bench -- --test`, or `cargo test --all-targets`, which runs
-    // the bench binary without the `--bench` flag that `cargo bench` passes. It ignores the
-    // RAYWAVE_* switches, so that CI's run stays short whatever the environment.
-    let args: Vec<String> = std::env::args().collect();
-    let test_mode = args.iter().any(|a| a == "--test") || !args.iter().any(|a| a == "--bench");
+    // The test mode ignores the RAYWAVE_* switches, so that CI's run stays short whatever the
+    // environment.
+    let test_mode = common::test_mode();
     // RAYWAVE_MESH=12k or 1M: one scene only, in either mode.
     let only = if test_mode {
         String::new()
@@ -331,13 +331,7 @@ fn main() {
         _ => None,
     };
     let size = if test_mode { TEST_SIZE } else { SIZE };
-    let mut c = Criterion::default()
-        .sample_size(10)
-        .warm_up_time(Duration::from_millis(300))
-        .measurement_time(Duration::from_secs(2))
-        // The plotters backend panics without system fonts (FontUnavailable) on this machine.
-        .without_plots()
-        .configure_from_args();
+    let mut c = common::criterion_for_frames(Duration::from_millis(300));
     eprintln!("machine: {}, simd {}", cpu_model(), raywave::simd_path());
     for (label, target) in [("12k", 12_000), ("1M", 1_000_000)] {
         if !only.is_empty() && only != label {

@@ -17,6 +17,8 @@
 //! `cargo bench --bench scaling` (rounds: `RAYWAVE_ROUNDS`, default 9); under `cargo test` or
 //! `-- --test` it runs one round at 64² with a short loop, to keep the code from rotting.
 
+mod common;
+
 use raywave::bench::record::median;
 use raywave::scene::Scene;
 use raywave::settings::RenderSettings;
@@ -32,9 +34,7 @@ const BATCH_SIZES: [usize; 3] = [1024, 2048, DEFAULT_BATCH_SIZE];
 const CEILING_STEPS: u64 = 300_000_000;
 
 fn main() {
-    let args: Vec<String> = std::env::args().collect();
-    let test_mode = args.iter().any(|a| a == "--test") || !args.iter().any(|a| a == "--bench");
-    let (size, steps, rounds) = if test_mode {
+    let (size, steps, rounds) = if common::test_mode() {
         (64, 100_000, 1)
     } else {
         let rounds = match std::env::var("RAYWAVE_ROUNDS") {

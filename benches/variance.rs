@@ -22,7 +22,9 @@
 //!
 //! See docs/BENCHMARKING.md ("The variance suite").
 
-use criterion::{BenchmarkId, Criterion, Throughput};
+mod common;
+
+use criterion::{BenchmarkId, Throughput};
 use raywave::film::Film;
 use raywave::sampling::LightSampler;
 use raywave::scene::Scene;
@@ -44,7 +46,7 @@ const RECORD: &str = concat!(
 const RECORD_COMMAND: &str = "RAYWAVE_RECORD=1 cargo bench --bench variance -- --test";
 /// Image size: 4096 pixels keep CI's one-shot run to a few seconds on 2 cores.
 const SIZE: u32 = 64;
-/// The budgets on the penumbra.
+/// The study's budgets on the penumbra.
 const BUDGETS: [u32; 2] = [16, 64];
 /// Seeds (independent images) per (sampler, N) in each MSE.
 const SEEDS: u32 = 4;
@@ -251,13 +253,7 @@ fn judge(before: f64, now: f64, tolerance: f64) -> (f64, Verdict) {
 }
 
 fn main() {
-    let mut c = Criterion::default()
-        .sample_size(10)
-        .warm_up_time(Duration::from_millis(500))
-        .measurement_time(Duration::from_secs(2))
-        // The plotters backend panics without system fonts (FontUnavailable) on this machine.
-        .without_plots()
-        .configure_from_args();
+    let mut c = common::criterion_for_frames(Duration::from_millis(500));
     let scene = Scene::builtin_default();
     let config = study_config(&scene);
     let bench_config = BenchConfig {

@@ -6,6 +6,8 @@
 //!
 //! `cargo bench --bench wavefront` (add `-- stages` or `-- frame` to pick a group).
 
+mod common;
+
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use raywave::scene::Scene;
 use raywave::settings::RenderSettings;
@@ -97,8 +99,7 @@ fn frame(c: &mut Criterion) {
 
 criterion_group! {
     name = benches;
-    // No plots: criterion's plotters backend needs system fonts this machine does not have.
-    config = Criterion::default().without_plots();
+    config = common::criterion();
     targets = stages, frame
 }
 criterion_main!(benches);

@@ -9,6 +9,8 @@
 
 use serde::{Deserialize, Serialize};
 
+pub mod rng;
+
 /// The `light` value used for the camera's own dimensions.
 pub const CAMERA_LIGHT: u32 = u32::MAX;
 

@@ -2,24 +2,29 @@
 //! --compare exit 3 with its table; different settings are refused (exit 1); a missing record
 //! names its file and how to create it. Tiny images and one run: no timing is asserted.
 
-use std::path::Path;
-use std::process::{Command, Output};
+mod common;
 
+use common::bin::{stderr, stdout};
+use std::path::Path;
+use std::process::Output;
+
+/// `raywave bench` on a tiny image, one run, with `args` after.
 fn raywave(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_raywave"))
-        .arg("bench")
-        .args(["--size", "32", "32", "--runs", "1", "--bounces", "2"])
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("run raywave")
+    let bench = [
+        "bench",
+        "--size",
+        "32",
+        "32",
+        "--runs",
+        "1",
+        "--bounces",
+        "2",
+    ];
+    common::bin::raywave(dir, &[&bench[..], args].concat())
 }
 
 fn text(out: &Output) -> (String, String) {
-    (
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
+    (stdout(out), stderr(out))
 }
 
 #[test]

@@ -17,8 +17,10 @@
 //! run from here (it would wait on the target directory's lock this test build holds).
 
 use std::collections::BTreeSet;
+mod common;
+
+use common::bin::{raywave, stderr, stdout};
 use std::path::Path;
-use std::process::Command;
 
 const DOC: &str = include_str!("../docs/BENCHMARKING.md");
 const ROOT: &str = env!("CARGO_MANIFEST_DIR");
@@ -327,15 +329,9 @@ fn raywave_commands_run_in_page_order() {
             "`{command}`: quoting, pipes and redirections are not supported here"
         );
         let args = shorten(&words);
-        let out = Command::new(env!("CARGO_BIN_EXE_raywave"))
-            .args(&args[1..])
-            .current_dir(dir.path())
-            .output()
-            .expect("run raywave");
-        let (stdout, stderr) = (
-            String::from_utf8_lossy(&out.stdout),
-            String::from_utf8_lossy(&out.stderr),
-        );
+        let flags: Vec<&str> = args[1..].iter().map(String::as_str).collect();
+        let out = raywave(dir.path(), &flags);
+        let (stdout, stderr) = (stdout(&out), stderr(&out));
         let code = out.status.code();
         // A comparison of sub-millisecond renders may call noise a regression (exit 3); it must
         // still have compared.

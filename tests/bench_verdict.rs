@@ -10,6 +10,8 @@ use raywave::settings::RenderSettings;
 use raywave::stats::RayCounts;
 
 /// A record whose total runs at `total` rays/s and whose one stage at `stage` rays/s.
+// A deliberate twin of the `record` in src/bench/compare.rs's unit tests: an integration test
+// cannot reach `#[cfg(test)]` code, and this one builds the record through the public API only.
 fn record(total: f64, stage: f64) -> BenchRecord {
     let rays = RayCounts {
         camera: 100,

@@ -1,35 +1,12 @@
 //! The command line: the lab's three run lines verbatim with the lab's defaults, every lab and
-//! RPI flag, whose defaults apply, the no-argument run, usage errors (exit 2), scene errors
-//! (exit 1, file:line, no output left behind), output formats and checks that happen before
-//! the render.
+//! RPI flag, whose defaults apply, the no-argument run and the output formats. Its failures
+//! (usage errors, scene and output errors caught before the render) are in `cli_errors.rs`.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-use std::time::{Duration, Instant};
+mod common;
 
-fn scenes() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes")
-}
-
-fn raywave(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_raywave"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("run raywave")
-}
-
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
-
-fn stdout(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
-
-fn words(line: &str) -> Vec<&str> {
-    line.split_whitespace().collect()
-}
+use common::bin::{dir_with, files_in, raywave, stderr, stdout, words};
+use std::path::Path;
+use std::process::Output;
 
 /// The summary line starting with `label`.
 fn summary_line(out: &Output, label: &str) -> String {
@@ -38,25 +15,6 @@ fn summary_line(out: &Output, label: &str) -> String {
         .find(|l| l.starts_with(label))
         .unwrap_or_else(|| panic!("no `{label}` line in {}", stdout(out)))
         .to_string()
-}
-
-/// A temp dir holding copies of the given scenes.
-fn dir_with(names: &[&str]) -> tempfile::TempDir {
-    let dir = tempfile::tempdir().unwrap();
-    for name in names {
-        std::fs::copy(scenes().join(name), dir.path().join(name)).unwrap();
-    }
-    dir
-}
-
-/// Only the files a test expects: no `render.png`, no leftover temporary files.
-fn files_in(dir: &Path) -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    v.sort();
-    v
 }
 
 fn check_lab_image(dir: &Path, size: (u32, u32)) -> image::RgbImage {
@@ -160,209 +118,6 @@ fn no_argument_run_writes_render_png() {
     let img = check_lab_image(dir.path(), (512, 512));
     assert_eq!(img.get_pixel(0, 0).0, LAB_BACKGROUND);
     assert_eq!(files_in(dir.path()), ["render.png"]);
-}
-
-#[test]
-fn bad_flags_are_usage_errors_with_exit_code_2() {
-    let dir = dir_with(&["cornell_box.obj"]);
-    let cases: &[&[&str]] = &[
-        &["--frobnicate"],
-        &["-frobnicate"],
-        &["--size", "0", "10"],
-        &["--size", "10", "0"],
-        &["--size", "abc", "5"],
-        &["--size", "5"],
-        &["--shadows", "maybe"],
-        &["--background", "1", "nan", "0"],
-        &["--background", "1", "inf", "0"],
-        &["--background", "1", "-1", "0"],
-        &["--background", "1", "0"],
-        &["--shadow-samples", "0"],
-        &["--bounces", "-1"],
-        &["--threads", "0"],
-        &["--sampler", "best"],
-        &["-size", "200"],
-        &["-num_bounces", "x"],
-        &["-num_bounces", "-1"],
-        &["-background_color", "1", "0"],
-        &["-ambient_light", "1", "nan", "0"],
-        &["-sphere_rasterization", "16"],
-        &["-num_photons_to_shoot", "many"],
-        &["--num_glossy_samples"],
-        // The lab's and RPI 2023's spellings on one line.
-        &["-num_bounces", "1", "--num_shadow_samples", "4"],
-        // One setting twice under two spellings.
-        &["-num_bounces", "1", "--bounces", "2"],
-        &["-soft_shadow", "--shadows", "hard"],
-        &["-input", "cornell_box.obj", "-i", "cornell_box.obj"],
-        &["--light-model", "phong"],
-        &["--ambient", "1", "-1", "0"],
-        &["--ring-segments", "2"],
-        &["--defaults", "pbrt"],
-        &["cornell_box.obj", "--aa", "0"],
-    ];
-    for args in cases {
-        let out = raywave(dir.path(), args);
-        assert_eq!(
-            out.status.code(),
-            Some(2),
-            "{args:?}: expected exit 2, got {:?}: {}",
-            out.status,
-            stderr(&out)
-        );
-        // clap prints the usage line for unknown or missing arguments, and for a bad value the
-        // flag, what was expected and a pointer to --help.
-        let err = stderr(&out);
-        assert!(err.starts_with("error:"), "{args:?}: {err}");
-        assert!(
-            err.contains("Usage:") || err.contains("--help"),
-            "{args:?}: no usage message: {err}"
-        );
-        assert!(
-            !dir.path().join("render.png").exists(),
-            "{args:?} wrote an image"
-        );
-    }
-}
-
-#[test]
-fn bad_scene_exits_1_with_file_line_and_leaves_no_output() {
-    let dir = tempfile::tempdir().unwrap();
-    let text = "material\ndiffuse 1 1 1\nm 0\nv 0 0 0\nv 1 0 0\nv 0 1 zero\nf 1 2 3\n";
-    std::fs::write(dir.path().join("bad.obj"), text).unwrap();
-    let out = raywave(dir.path(), &["bad.obj", "--size", "8", "8"]);
-    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
-    let err = stderr(&out);
-    assert!(err.contains("bad.obj:6:"), "{err}");
-    assert!(err.contains("zero"), "{err}");
-    assert!(!err.contains("panicked"), "{err}");
-    assert_eq!(
-        files_in(dir.path()),
-        ["bad.obj"],
-        "an output file was left behind"
-    );
-
-    // With the lab's spelling and -o too.
-    let out = raywave(dir.path(), &["-input", "bad.obj", "-o", "out.png"]);
-    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
-    assert_eq!(files_in(dir.path()), ["bad.obj"]);
-
-    // An existing output file is left untouched.
-    std::fs::write(dir.path().join("render.png"), b"precious").unwrap();
-    let out = raywave(dir.path(), &["bad.obj", "--size", "8", "8"]);
-    assert_eq!(out.status.code(), Some(1));
-    assert_eq!(
-        std::fs::read(dir.path().join("render.png")).unwrap(),
-        b"precious"
-    );
-    assert_eq!(files_in(dir.path()), ["bad.obj", "render.png"]);
-}
-
-#[test]
-fn missing_scene_file_exits_1_and_names_it() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = raywave(dir.path(), &["nothere.obj", "--size", "8", "8"]);
-    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
-    assert!(stderr(&out).contains("nothere.obj"), "{}", stderr(&out));
-    assert!(files_in(dir.path()).is_empty());
-    // A directory instead of a file: not an empty scene.
-    std::fs::create_dir(dir.path().join("sub.obj")).unwrap();
-    let out = raywave(dir.path(), &["sub.obj", "--size", "8", "8"]);
-    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
-    assert_eq!(files_in(dir.path()), ["sub.obj"]);
-}
-
-#[test]
-fn nonexistent_output_directory_fails_before_rendering() {
-    // A 16384² soft-shadowed render would take many minutes: failing within seconds shows the
-    // check happens first.
-    let dir = dir_with(&["cornell_box.obj"]);
-    let start = Instant::now();
-    let out = raywave(
-        dir.path(),
-        &[
-            "cornell_box.obj",
-            "--size",
-            "16384",
-            "16384",
-            "--shadows",
-            "soft",
-            "-o",
-            "no/such/dir/out.png",
-        ],
-    );
-    assert!(
-        start.elapsed() < Duration::from_secs(10),
-        "it rendered first"
-    );
-    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
-    assert!(stderr(&out).contains("no/such/dir"), "{}", stderr(&out));
-    assert_eq!(files_in(dir.path()), ["cornell_box.obj"]);
-    // The same for --hdr.
-    let out = raywave(
-        dir.path(),
-        &[
-            "cornell_box.obj",
-            "--size",
-            "16384",
-            "16384",
-            "--hdr",
-            "no/such/dir/out.pfm",
-        ],
-    );
-    assert!(
-        start.elapsed() < Duration::from_secs(20),
-        "it rendered first"
-    );
-    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
-    assert_eq!(files_in(dir.path()), ["cornell_box.obj"]);
-}
-
-#[test]
-fn output_path_that_is_a_directory_fails_before_rendering() {
-    let dir = dir_with(&["cornell_box.obj"]);
-    std::fs::create_dir(dir.path().join("d.png")).unwrap();
-    let start = Instant::now();
-    let out = raywave(
-        dir.path(),
-        &[
-            "cornell_box.obj",
-            "--size",
-            "16384",
-            "16384",
-            "--shadows",
-            "soft",
-            "-o",
-            "d.png",
-        ],
-    );
-    assert!(
-        start.elapsed() < Duration::from_secs(10),
-        "it rendered first"
-    );
-    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
-    assert!(stderr(&out).contains("d.png"), "{}", stderr(&out));
-    assert_eq!(files_in(dir.path()), ["cornell_box.obj", "d.png"]);
-}
-
-#[test]
-fn bad_output_extension_fails_before_rendering() {
-    let dir = dir_with(&["cornell_box.obj"]);
-    let out = raywave(
-        dir.path(),
-        &[
-            "cornell_box.obj",
-            "--size",
-            "16384",
-            "16384",
-            "-o",
-            "out.jpg",
-        ],
-    );
-    // A flag value raywave cannot use is a usage error, like clap's own: exit 2.
-    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
-    assert!(stderr(&out).contains("out.jpg"));
-    assert_eq!(files_in(dir.path()), ["cornell_box.obj"]);
 }
 
 #[test]
@@ -698,21 +453,6 @@ fn pfm_and_exr_outputs_are_written_alone() {
     assert_eq!(img.dimensions(), (6, 4));
     // No 8-bit image beside them, and no temporary file left.
     assert_eq!(files_in(dir.path()), ["a.exr", "a.pfm", "cornell_box.obj"]);
-}
-
-#[test]
-fn ring_scene_errors_name_file_and_line() {
-    let dir = tempfile::tempdir().unwrap();
-    let text = "material\ndiffuse 1 1 1\nm 0\nr 0 0 0 1 2 1\n";
-    std::fs::write(dir.path().join("ring.obj"), text).unwrap();
-    let out = raywave(dir.path(), &words("ring.obj --size 8 8"));
-    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
-    let err = stderr(&out);
-    assert!(
-        err.contains("ring.obj:4:") && err.contains("inner < outer"),
-        "{err}"
-    );
-    assert_eq!(files_in(dir.path()), ["ring.obj"]);
 }
 
 /// The fraction of pixels with a channel at 255, and with a channel at 16 or more.

@@ -6,13 +6,13 @@ use raywave::reference::Reference;
 use raywave::sampling::LightSampler;
 use raywave::scene::Scene;
 use raywave::settings::{RenderSettings, ShadowMode};
+mod common;
+
+use common::bin::{raywave, scenes, stderr, stdout};
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 fn scene_path(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("scenes")
-        .join(name)
+    scenes().join(name)
 }
 
 fn soft_settings(seed: u32) -> RenderSettings {
@@ -82,16 +82,11 @@ fn reference_is_bit_identical_across_runs_and_thread_counts() {
 }
 
 fn run(dir: &Path, args: &[&str]) -> Vec<u8> {
-    let out = Command::new(env!("CARGO_BIN_EXE_raywave"))
-        .args(args)
-        .arg("--quiet")
-        .current_dir(dir)
-        .output()
-        .expect("run raywave");
+    let out = raywave(dir, &[args, &["--quiet"]].concat());
     assert!(
         out.status.success(),
         "raywave {args:?} failed: {}",
-        String::from_utf8_lossy(&out.stderr)
+        stderr(&out)
     );
     let name = args[args.iter().position(|a| *a == "-o").unwrap() + 1];
     std::fs::read(dir.join(name)).unwrap()
@@ -99,11 +94,8 @@ fn run(dir: &Path, args: &[&str]) -> Vec<u8> {
 
 /// The binary's engines, found from its help so the test follows the CLI.
 fn engines() -> Vec<Option<&'static str>> {
-    let help = Command::new(env!("CARGO_BIN_EXE_raywave"))
-        .args(["render", "--help"])
-        .output()
-        .unwrap();
-    if String::from_utf8_lossy(&help.stdout).contains("--engine") {
+    let help = raywave(&std::env::temp_dir(), &["render", "--help"]);
+    if stdout(&help).contains("--engine") {
         vec![None, Some("reference"), Some("wavefront")]
     } else {
         vec![None]

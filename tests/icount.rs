@@ -144,6 +144,8 @@ fn icount_region_reference(reference: &Reference, out: &mut [glam::Vec3]) {
     black_box(6u8);
 }
 
+// The mesh regions are deliberate twins of `intersect` and `shadow`: a symbol of their own, so
+// callgrind counts the mesh scene's BVH walk apart from the lab scene's.
 #[inline(never)]
 fn icount_region_intersect_mesh(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch) {
     intersect::closest(ctx, black_box(rays), hits);

@@ -2,7 +2,11 @@
 //! diagonal, grazing rays, spheres from outside, inside and behind, NaN and infinite input,
 //! and the t > 1e-4 rule. Expected distances are worked out by hand in each test.
 
+mod common;
+
+use common::{TestRng, seeded};
 use glam::Vec3;
+use rand::RngExt;
 use raywave::geometry::{Accel, Ray, T_MIN, intersect_sphere, intersect_triangle};
 use raywave::scene::{NO_HIT, Scene, Sphere, parse_scene_str};
 
@@ -342,42 +346,30 @@ fn bvh_and_brute_force_agree_on_a_mesh() {
     assert!(hits > 1000, "{hits}");
 }
 
-/// A small deterministic generator for the randomized tables below.
-struct Rng(u32);
-
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 = raywave::sampling::mix32(self.0.wrapping_add(0x9e37_79b9));
-        (self.0 >> 8) as f64 / 16_777_216.0
-    }
-    fn vec(&mut self, scale: f64) -> glam::DVec3 {
-        glam::DVec3::new(
-            (self.next() * 2.0 - 1.0) * scale,
-            (self.next() * 2.0 - 1.0) * scale,
-            (self.next() * 2.0 - 1.0) * scale,
-        )
-    }
+/// A point in the cube [−scale, scale]³.
+fn vec(rng: &mut TestRng, scale: f64) -> glam::DVec3 {
+    glam::DVec3::from_array(std::array::from_fn(|_| rng.random_range(-scale..scale)))
 }
 
 #[test]
 fn triangle_kernel_matches_an_independent_f64_plane_test() {
     // Intersect the plane in f64, then barycentric coordinates by areas; only cases that are
     // clearly inside or clearly outside (margin 1e-3) are checked.
-    let mut rng = Rng(99);
+    let mut rng = seeded(99);
     let (mut hits, mut misses, mut backs) = (0, 0, 0);
     for _ in 0..20000 {
         // Every input is rounded to f32 first, so the f64 answer is for the kernel's inputs.
         let f = |v: glam::DVec3| v.as_vec3().as_dvec3();
-        let a = f(rng.vec(2.0));
-        let e1 = f(rng.vec(2.0) - a);
-        let e2 = f(rng.vec(2.0) - a);
+        let a = f(vec(&mut rng, 2.0));
+        let e1 = f(vec(&mut rng, 2.0) - a);
+        let e2 = f(vec(&mut rng, 2.0) - a);
         let (b, c) = (a + e1, a + e2);
         let n = e1.cross(e2);
         if n.length() < 0.1 {
             continue;
         }
-        let origin = f(rng.vec(4.0));
-        let target = a + rng.next() * 1.4 * e1 + rng.next() * 1.4 * e2 - 0.2 * e1;
+        let origin = f(vec(&mut rng, 4.0));
+        let target = a + rng.random::<f64>() * 1.4 * e1 + rng.random::<f64>() * 1.4 * e2 - 0.2 * e1;
         let d = f((target - origin).normalize());
         let denom = n.dot(d);
         // Near-grazing rays amplify the rounding inside the kernel: skip them.
@@ -447,14 +439,14 @@ fn triangle_kernel_matches_an_independent_f64_plane_test() {
 
 #[test]
 fn sphere_kernel_matches_an_independent_f64_root() {
-    let mut rng = Rng(7);
+    let mut rng = seeded(7);
     let (mut hits, mut misses, mut inside) = (0, 0, 0);
     for _ in 0..20000 {
         let f = |v: glam::DVec3| v.as_vec3().as_dvec3();
-        let center = f(rng.vec(2.0));
-        let radius = (0.1 + rng.next() * 1.5) as f32 as f64;
-        let origin = f(rng.vec(4.0));
-        let d = f((center + rng.vec(2.0) - origin).normalize());
+        let center = f(vec(&mut rng, 2.0));
+        let radius = (0.1 + rng.random::<f64>() * 1.5) as f32 as f64;
+        let origin = f(vec(&mut rng, 4.0));
+        let d = f((center + vec(&mut rng, 2.0) - origin).normalize());
         // |o + t d − c|² = r²  ->  t² + 2 b t + c0 = 0 with b = (o − c)·d.
         let oc = origin - center;
         let b = oc.dot(d);

@@ -1,10 +1,10 @@
 //! Soft shadows are unbiased, with the converged value taken from the f64 oracle
 //! (`tests/oracle/mod.rs`) rather than from the engine under test.
 //!
-//! The scene is tests/sampling_study.rs's closed-form penumbra: a floor at y = 0, a light at
-//! y = 2 over x, z ∈ [−0.5, 0.5] (a square, or a pentagon for the fan map), and a blocker at
-//! y = 1 covering x + z < 0, so a floor point (x, z) sees the light point (lx, lz) exactly when
-//! lx + lz ≥ −(x + z). A pixel in the penumbra is rendered by the reference engine with N = 4
+//! The scene is the closed-form penumbra of `tests/common/analytic.rs`: a floor at y = 0, a
+//! light at y = 2 over x, z ∈ [−0.5, 0.5] (a square, or a pentagon for the fan map), and a
+//! blocker at y = 1 covering x + z < 0, so a floor point (x, z) sees the light point (lx, lz)
+//! exactly when lx + lz ≥ −(x + z). A pixel in the penumbra is rendered by the reference engine with N = 4
 //! points per light for `SEEDS` seeds; its mean must match the oracle's converged value (the
 //! mean over `TRUTH_SEEDS` seeds of N = 4096 stratified points, in f64) within
 //! `K` = 5 standard errors of the difference, each standard error being the sample standard
@@ -15,18 +15,16 @@
 mod common;
 mod oracle;
 
+use common::analytic::{KD, KE, SIZE, floor_point, scene, settings};
 use common::{PENTAGON, SQUARE};
 
 use glam::DVec3;
 use oracle::Oracle;
 use raywave::reference::Reference;
 use raywave::sampling::LightSampler;
-use raywave::scene::{Scene, parse_scene_str};
-use raywave::settings::RenderSettings;
+use raywave::scene::Scene;
 use raywave::stats::RayCounts;
 
-/// Image size of the analytic scene (its camera maps pixels to floor points in closed form).
-const SIZE: u32 = 64;
 /// Seeds averaged for the engine's N = 4 estimate.
 const SEEDS: u32 = 100_000;
 /// Seeds averaged for the oracle's converged value.
@@ -35,64 +33,6 @@ const TRUTH_SEEDS: u32 = 64;
 const TRUTH_N: u32 = 4096;
 /// Standard errors allowed between an unbiased sampler's mean and the converged value.
 const K: f64 = 5.0;
-/// The light's ke: Lc = 0.2 · 10 · area.
-const KE: f64 = 10.0;
-/// The floor's kd.
-const KD: f64 = 0.5;
-
-/// The analytic scene with the given light; a camera 10 above the origin looks straight down
-/// (screen up = −z) with a 1.5 half-width at the floor.
-fn scene(light: &[(f64, f64)]) -> Scene {
-    let mut text = format!(
-        "PerspectiveCamera {{
-           camera_position 0 10 0
-           point_of_interest 0 0 0
-           up 0 0 -1
-           angle {}
-         }}
-         material
-         emitted {KE} {KE} {KE}
-         material
-         diffuse {KD} {KD} {KD}
-         material
-         diffuse 0.5 0.5 0.5
-         v -3 0 -3
-         v -3 0 3
-         v 3 0 3
-         v 3 0 -3
-         m 1
-         f 1 2 3 4
-         v -10 1 -10
-         v 10 1 -10
-         v -10 1 10
-         m 2
-         f 5 6 7
-         m 0
-        ",
-        2.0 * 0.15f64.atan()
-    );
-    for (x, z) in light {
-        text += &format!("v {x} 2 {z}\n");
-    }
-    text += "f";
-    for k in 0..light.len() {
-        text += &format!(" {}", 8 + k);
-    }
-    parse_scene_str(&text, "analytic.obj").expect("analytic scene parses")
-}
-
-/// The floor point seen through the centre of pixel (column, row from the top).
-fn floor_point(column: u32, row: u32) -> DVec3 {
-    let x = (2.0 * (column as f64 + 0.5) / SIZE as f64 - 1.0) * 1.5;
-    let j = SIZE - 1 - row;
-    let z = -(2.0 * (j as f64 + 0.5) / SIZE as f64 - 1.0) * 1.5;
-    DVec3::new(x, 0.0, z)
-}
-
-/// Soft shadows with `n` points of `sampler`, no bounces.
-fn settings(sampler: LightSampler, n: u32, seed: u32) -> RenderSettings {
-    common::soft_settings(SIZE, sampler, n, seed)
-}
 
 /// (mean, standard error of the mean) of `values`.
 fn mean_and_se(values: &[f64]) -> (f64, f64) {

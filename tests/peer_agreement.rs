@@ -15,7 +15,7 @@ use raywave::wavefront::context::Context;
 
 const SIZE: u32 = 96;
 const SEED: u64 = 0x5eed;
-/// The bar: agreement on more than 99.99% of rays.
+/// The bar: agreement on more than 99.99% of rays.
 const MIN_AGREEMENT: f64 = 0.9999;
 
 fn mesh_scene() -> Scene {

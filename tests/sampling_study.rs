@@ -1,19 +1,15 @@
-//! Issue 4: every sampler is unbiased and keeps its points on the light; the penumbra mask
-//! matches a scene whose penumbra is known in closed form; the study's budget matching.
-//!
-//! The analytic scene: a floor at y = 0 (facing up), a 1 × 1 light at y = 2 over
-//! x, z ∈ [−0.5, 0.5] (facing down) and a blocker at y = 1 covering the half-plane x + z < 0
-//! (facing down, so shadow rays meet its front). A shadow ray from floor point (x, z) to light
-//! point (lx, lz) crosses y = 1 at ((x + lx)/2, (z + lz)/2), so it is blocked exactly when
-//! lx + lz < −(x + z). With s = x + z the floor is fully lit for s > 1, in umbra for s < −1 and
-//! in penumbra between. The edge runs diagonally so that both light coordinates matter: a
-//! sampler biased in either one moves the mean. A camera 10 above the origin looks straight down
-//! (screen up = −z) with a 1.5 half-width at the floor.
+//! Every sampler is unbiased and keeps its points on the light; the penumbra mask matches a
+//! scene whose penumbra is known in closed form (`tests/common/analytic.rs`, with the 1 × 1
+//! light: lit for s = x + z > 1, umbra for s < −1, penumbra between); the study's budget
+//! matching.
 
 mod common;
 mod oracle;
 
-use glam::Vec3;
+use common::SQUARE;
+use common::analytic::{self, SIZE, floor_point, settings};
+
+use glam::{DVec3, Vec3};
 use oracle::Oracle;
 use raywave::reference::Reference;
 use raywave::sampling::{LightSampler, SampleKey, square_sample, strata_grid};
@@ -22,68 +18,15 @@ use raywave::settings::RenderSettings;
 use raywave::stats::RayCounts;
 use raywave::variance::{Region, penumbra_mask};
 
-const SIZE: u32 = 64;
-
-fn analytic_scene() -> Scene {
-    let half_angle = 0.15f32.atan(); // tan = 1.5 / 10
-    let text = format!(
-        "PerspectiveCamera {{
-           camera_position 0 10 0
-           point_of_interest 0 0 0
-           up 0 0 -1
-           angle {}
-         }}
-         material
-         emitted 10 10 10
-         material
-         diffuse 0.5 0.5 0.5
-         material
-         diffuse 0.5 0.5 0.5
-         v -0.5 2 -0.5
-         v 0.5 2 -0.5
-         v 0.5 2 0.5
-         v -0.5 2 0.5
-         m 0
-         f 1 2 3 4
-         v -3 0 -3
-         v -3 0 3
-         v 3 0 3
-         v 3 0 -3
-         m 1
-         f 5 6 7 8
-         v -10 1 -10
-         v 10 1 -10
-         v -10 1 10
-         m 2
-         f 9 10 11
-        ",
-        2.0 * half_angle
-    );
-    parse_scene_str(&text, "analytic.obj").expect("analytic scene parses")
-}
-
-/// The floor point (x, z) seen through the centre of pixel (column, row from the top).
-fn floor_xz(column: u32, row: u32) -> (f32, f32) {
-    let x = (2.0 * (column as f32 + 0.5) / SIZE as f32 - 1.0) * 1.5;
-    let j = SIZE - 1 - row; // counted from the bottom
-    let z = -(2.0 * (j as f32 + 0.5) / SIZE as f32 - 1.0) * 1.5;
-    (x, z)
-}
-
-/// Soft shadows with `n` points of `sampler`, no bounces.
-fn settings(sampler: LightSampler, n: u32, seed: u32) -> RenderSettings {
-    common::soft_settings(SIZE, sampler, n, seed)
-}
-
 #[test]
 fn penumbra_mask_matches_the_closed_form() {
-    let scene = analytic_scene();
+    let scene = analytic::scene(SQUARE);
     let regions = penumbra_mask(&scene, &settings(LightSampler::Stratified, 1, 0), 1024);
     let mut checked = [0; 3];
     for row in 0..SIZE {
         for column in 0..SIZE {
             let p = (row * SIZE + column) as usize;
-            let (x, z) = floor_xz(column, row);
+            let DVec3 { x, z, .. } = floor_point(column, row);
             let s = x + z;
             // Stay a pixel and a stratum away from the two edges, where the answer is a tie.
             if (s.abs() - 1.0).abs() < 0.1 {
@@ -147,10 +90,10 @@ fn oracle_mean(scene: &Scene, n: u32, seeds: u32, pixel: u32) -> (f64, f64) {
 
 #[test]
 fn every_sampler_is_unbiased_on_a_penumbra_pixel() {
-    let scene = analytic_scene();
+    let scene = analytic::scene(SQUARE);
     // Pixel (35, 36) sees (0.164, 0.211), s = x + z ≈ 0.375: well inside the penumbra.
     let pixel = 36 * SIZE + 35;
-    let (x, z) = floor_xz(35, 36);
+    let DVec3 { x, z, .. } = floor_point(35, 36);
     assert!((x + z - 0.375).abs() < 0.01, "{x} {z}");
     let (truth, truth_se) = oracle_mean(&scene, 4096, 8, pixel);
     for sampler in LightSampler::ALL {
@@ -172,7 +115,7 @@ fn every_sampler_is_unbiased_on_a_penumbra_pixel() {
 #[test]
 fn the_lab_strategy_is_biased_at_one_sample_and_says_so() {
     // N = 1 puts the single point at the light's centre: a hard shadow, not the soft one.
-    let scene = analytic_scene();
+    let scene = analytic::scene(SQUARE);
     let pixel = 36 * SIZE + 35;
     let (truth, truth_se) = oracle_mean(&scene, 4096, 8, pixel);
     let (lab, _) = pixel_mean(&scene, LightSampler::Lab, 1, 2, pixel);
@@ -347,11 +290,11 @@ fn matching_budget_inverts_the_fits() {
 }
 
 /// The whole study, end to end, on the lab's scene at a small size with the wavefront engine:
-/// the issue's floor (random's penumbra slope −1 ± 0.1, stratified's at most −1.35, stratified
+/// the study's floor (random's penumbra slope −1 ± 0.1, stratified's at most −1.35, stratified
 /// MSE at most 1/3 of random's at N = 64, no unbiased sampler flagged) and the output files.
 /// Deterministic for fixed seeds, and it fails if stratification breaks (slope → −1).
 #[test]
-fn the_study_meets_the_issue_floor_and_writes_its_outputs() {
+fn the_study_meets_its_floor_and_writes_its_outputs() {
     use raywave::variance::{StudyConfig, run_study};
     use raywave::wavefront::{DEFAULT_BATCH_SIZE, Wavefront};
     let scene = Scene::builtin_default();

@@ -1,6 +1,6 @@
-//! Pixels computed by hand from issue 2's formulas, compared with the reference renderer to
-//! 1e-5. Every expected value is built here from the formula, with this file's own vector
-//! arithmetic, never through `raywave::shading`.
+//! Pixels computed by hand from the lab's Shade formulas (docs/SHADING.md), compared with the
+//! reference renderer to 1e-5. Every expected value is built here from the formula, with this
+//! file's own vector arithmetic, never through `raywave::shading`.
 //!
 //! The scenes are small: a floor (y = 0, facing up), a 1 × 1 light at y = 2 facing down, and
 //! whatever the test adds. A 1 × 1 image sends its only ray from the camera position straight
@@ -102,21 +102,43 @@ fn assert_close(got: Vec3, want: Vec3, what: &str) {
     );
 }
 
-/// Hand-written Shade for one light point, straight from the issue's formula.
-fn shade_by_hand(
+/// A surface's material terms as Shade reads them.
+struct Surface {
     kd: Vec3,
     kr: Vec3,
     ke: Vec3,
     g: f32,
-    n: Vec3,
-    e: Vec3,
-    l: Vec3,
-    lc: Vec3,
-) -> Vec3 {
+}
+
+/// Hand-written Shade for one light point, straight from the lab's formula: normal n, unit
+/// vectors e to the eye and l to the light point, light colour lc.
+fn shade_by_hand(m: Surface, n: Vec3, e: Vec3, l: Vec3, lc: Vec3) -> Vec3 {
     let ndl = n.dot(l).max(0.0);
     let r = (2.0 * n.dot(l) * n - l).normalize();
-    let spec = e.dot(r).max(0.0).powf(5.0 / (g + 0.01));
-    0.2 * ke + lc * kd * ndl + lc * (0.8 * kr) * spec * ndl
+    let spec = e.dot(r).max(0.0).powf(5.0 / (m.g + 0.01));
+    0.2 * m.ke + lc * m.kd * ndl + lc * (0.8 * m.kr) * spec * ndl
+}
+
+/// The floor's material with reflective `kr` and glossiness `g`.
+fn glossy_floor(kr: Vec3, g: f32) -> Surface {
+    Surface {
+        kd: FLOOR_KD,
+        kr,
+        ke: Vec3::ZERO,
+        g,
+    }
+}
+
+/// The mirror floor (reflective `kr`, glossiness 0) at p, seen along d, lit by the light's
+/// centroid.
+fn mirror_floor_by_hand(kr: Vec3, p: Vec3, d: Vec3) -> Vec3 {
+    shade_by_hand(
+        glossy_floor(kr, 0.0),
+        Vec3::Y,
+        -d,
+        (CENTROID - p).normalize(),
+        LC,
+    )
 }
 
 #[test]
@@ -144,7 +166,7 @@ fn glossy_floor_highlight_without_bounces() {
     let n = Vec3::Y;
     let e = (eye - p).normalize();
     let l = (CENTROID - p).normalize();
-    let want = 0.2 * FLOOR_KD + shade_by_hand(FLOOR_KD, kr, Vec3::ZERO, g, n, e, l, LC);
+    let want = 0.2 * FLOOR_KD + shade_by_hand(glossy_floor(kr, g), n, e, l, LC);
     // Make sure the highlight is a real part of the value being checked.
     let r = (2.0 * n.dot(l) * n - l).normalize();
     assert!(e.dot(r).powf(5.0 / (g + 0.01)) > 0.5);
@@ -214,28 +236,19 @@ fn mirror_floor_reflects_a_known_wall() {
     // l = (0, 1, 1)/√2, n = +z: n·l = 1/√2.
     let at_q = 0.2 * wall_kd
         + shade_by_hand(
-            wall_kd,
-            Vec3::ZERO,
-            Vec3::ZERO,
-            0.0,
+            Surface {
+                kd: wall_kd,
+                kr: Vec3::ZERO,
+                ke: Vec3::ZERO,
+                g: 0.0,
+            },
             Vec3::Z,
             -reflected,
             (CENTROID - q).normalize(),
             LC,
         );
     assert!((Vec3::Z.dot((CENTROID - q).normalize()) - 0.5f32.sqrt()).abs() < 1e-6);
-    let at_p = 0.2 * FLOOR_KD
-        + kr * at_q
-        + shade_by_hand(
-            FLOOR_KD,
-            kr,
-            Vec3::ZERO,
-            0.0,
-            Vec3::Y,
-            -d,
-            (CENTROID - p).normalize(),
-            LC,
-        );
+    let at_p = 0.2 * FLOOR_KD + kr * at_q + mirror_floor_by_hand(kr, p, d);
     let got = render_pixel(&s, &settings(ShadowMode::Hard, 1), 0);
     assert_close(got, at_p, "mirror with 1 bounce");
     // With no bounce, the wall's contribution disappears.
@@ -253,18 +266,7 @@ fn mirror_reflecting_the_sky_returns_kr_times_background() {
     let s = scene(kr, 0.0, "", "", eye, p);
     let d = (p - eye).normalize();
     let bg = Vec3::new(0.25, 0.5, 0.75);
-    let want = 0.2 * FLOOR_KD
-        + kr * bg
-        + shade_by_hand(
-            FLOOR_KD,
-            kr,
-            Vec3::ZERO,
-            0.0,
-            Vec3::Y,
-            -d,
-            (CENTROID - p).normalize(),
-            LC,
-        );
+    let want = 0.2 * FLOOR_KD + kr * bg + mirror_floor_by_hand(kr, p, d);
     let got = render_pixel(&s, &settings(ShadowMode::Hard, 3), 0);
     assert_close(got, want, "mirror to sky");
 }
@@ -494,7 +496,7 @@ fn no_highlight_when_the_viewer_is_behind_the_mirror_direction() {
     let want = 0.2 * FLOOR_KD + LC * FLOOR_KD * n.dot(l);
     assert_close(
         want,
-        0.2 * FLOOR_KD + shade_by_hand(FLOOR_KD, kr, Vec3::ZERO, g, n, e, l, LC),
+        0.2 * FLOOR_KD + shade_by_hand(glossy_floor(kr, g), n, e, l, LC),
         "by hand",
     );
     let got = render_pixel(&s, &settings(ShadowMode::Hard, 0), 0);

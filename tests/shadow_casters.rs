@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::Rng;
+use common::{Draw, TestRng, seeded};
 use glam::Vec3;
 use raywave::geometry::{Accel, Ray, intersect_sphere, intersect_triangle, shadow_casters};
 use raywave::scene::{Scene, parse_scene_str};
@@ -105,7 +105,7 @@ fn segment(scene: &Scene, from: Vec3, to: Vec3) -> (Ray, f32) {
 }
 
 /// Random triangles in a cube of half-size 2, a random parallelogram light and a sphere.
-fn random_scene(rng: &mut Rng, triangles: usize) -> Scene {
+fn random_scene(rng: &mut TestRng, triangles: usize) -> Scene {
     let mut text =
         String::from("material\ndiffuse 1 1 1\nemitted 1 1 1\nmaterial\ndiffuse 1 1 1\n");
     let light = rng.point(2.0);
@@ -130,7 +130,7 @@ fn random_scene(rng: &mut Rng, triangles: usize) -> Scene {
 
 #[test]
 fn culling_changes_only_rounding_hits_on_the_light_points_plane() {
-    let mut rng = Rng(0x5eed_2026);
+    let mut rng = seeded(0x5eed_2026);
     let (mut rays, mut blocked, mut culled, mut total, mut grazing) = (0, 0, 0, 0, 0);
     for _ in 0..200 {
         let scene = random_scene(&mut rng, 24);
@@ -142,7 +142,7 @@ fn culling_changes_only_rounding_hits_on_the_light_points_plane() {
         let light = &scene.lights[0];
         for _ in 0..500 {
             let from = rng.point(2.5);
-            let to = light.point(rng.next(), rng.next());
+            let to = light.point(rng.unit(), rng.unit());
             let (ray, tmax) = segment(&scene, from, to);
             let dist = tmax;
             let expected = blocked_unculled(&scene, &ray, tmax);

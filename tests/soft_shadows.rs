@@ -62,6 +62,8 @@ fn blocked(q: DVec3) -> bool {
 
 /// (I, visible fraction) by the midpoint rule on a fine grid over the light's bounding square,
 /// keeping the points for which `inside` holds.
+// Alike in shape to oracle_bias.rs's `closed_form` on purpose: each file computes its truth
+// its own way (here a segment–sphere test, there the blocker's half-plane), so they stay apart.
 fn exact(inside: impl Fn(f64, f64) -> bool) -> (f64, f64) {
     let n = 1200;
     let (mut sum, mut visible, mut total) = (0.0, 0usize, 0usize);

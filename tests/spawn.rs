@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{Rng, triangle};
+use common::{Draw, TestRng, seeded, triangle};
 use glam::Vec3;
 use raywave::geometry::{Accel, Ray, intersect_sphere};
 use raywave::scene::{Scene, Sphere};
@@ -19,10 +19,10 @@ const RAYS: usize = 20_000;
 
 /// A sphere of the lab's size and place (radius 0.25 to 0.45, centre within the unit box),
 /// scaled by `s`, and an eye 8·s away, as the lab's camera is.
-fn sphere_and_eye(rng: &mut Rng, s: f32) -> (Sphere, Vec3) {
+fn sphere_and_eye(rng: &mut TestRng, s: f32) -> (Sphere, Vec3) {
     let sphere = Sphere {
         center: rng.point(0.6) * s,
-        radius: (0.25 + 0.2 * rng.next()) * s,
+        radius: (0.25 + 0.2 * rng.unit()) * s,
         material: 0,
     };
     let eye = rng.direction() * (8.0 * s);
@@ -30,7 +30,7 @@ fn sphere_and_eye(rng: &mut Rng, s: f32) -> (Sphere, Vec3) {
 }
 
 /// A camera ray from `eye` towards a random point of the sphere's disc, and where it hits.
-fn camera_hit(rng: &mut Rng, sphere: &Sphere, eye: Vec3) -> Option<(Ray, f32)> {
+fn camera_hit(rng: &mut TestRng, sphere: &Sphere, eye: Vec3) -> Option<(Ray, f32)> {
     let aim = sphere.center + rng.point(sphere.radius * 0.999);
     let ray = Ray {
         origin: eye,
@@ -62,7 +62,7 @@ fn sphere_scene(sphere: Sphere) -> Scene {
 #[test]
 fn mirror_and_shadow_rays_leave_a_sphere_at_every_scale() {
     for s in SCALES {
-        let mut rng = Rng(0x5eed ^ s.to_bits() as u64);
+        let mut rng = seeded(0x5eed ^ s.to_bits() as u64);
         let (mut mirror_rehits, mut shadow_rehits, mut hits) = (0, 0, 0);
         for _ in 0..RAYS {
             let (sphere, eye) = sphere_and_eye(&mut rng, s);
@@ -78,7 +78,7 @@ fn mirror_and_shadow_rays_leave_a_sphere_at_every_scale() {
                 mirror_rehits += 1;
             }
             // A light point anywhere above the tangent plane, near or far, grazing or not.
-            let target = hit.point + rng.direction() * (s * 4.0 * rng.next());
+            let target = hit.point + rng.direction() * (s * 4.0 * rng.unit());
             if let Some(shadow) = shadow_ray(&hit, target, &towards(&hit, target))
                 && intersect_sphere(&sphere, &shadow.ray, shadow.tmax) < shadow.tmax
             {
@@ -99,7 +99,7 @@ fn hit_points_are_put_back_on_the_sphere() {
     // The camera ray's raw hit point was 4e-5 inside a lab sphere 8 units away; put back on
     // the surface it is within a few ulps of it, far closer than the offset.
     for s in SCALES {
-        let mut rng = Rng(0xb0b ^ s.to_bits() as u64);
+        let mut rng = seeded(0xb0b ^ s.to_bits() as u64);
         let mut worst = 0.0f64;
         for _ in 0..RAYS {
             let (sphere, eye) = sphere_and_eye(&mut rng, s);
@@ -121,7 +121,7 @@ fn hit_points_are_put_back_on_the_sphere() {
 #[test]
 fn a_mirror_ray_inside_a_sphere_meets_its_far_side() {
     for s in SCALES {
-        let mut rng = Rng(0x1ed ^ s.to_bits() as u64);
+        let mut rng = seeded(0x1ed ^ s.to_bits() as u64);
         for _ in 0..2_000 {
             let sphere = Sphere {
                 center: rng.point(0.6) * s,
@@ -185,11 +185,11 @@ fn shadow_rays_end_before_the_light_even_at_grazing_angles() {
             accel.uses_bvh(),
             "every triangle is tested, the light's own included"
         );
-        let mut rng = Rng(0x119 ^ s.to_bits() as u64);
+        let mut rng = seeded(0x119 ^ s.to_bits() as u64);
         let mut blocked = 0;
         for _ in 0..RAYS {
             // A floor point, some far off to the side so that rays reach the light grazing.
-            let spread = if rng.next() < 0.5 { 1.0 } else { 40.0 };
+            let spread = if rng.unit() < 0.5 { 1.0 } else { 40.0 };
             let p = rng.point(spread * s);
             let floor = SurfaceHit {
                 point: Vec3::new(p.x, p.y, -s),
@@ -197,8 +197,8 @@ fn shadow_rays_end_before_the_light_even_at_grazing_angles() {
                 offset: raywave::spawn::OFFSET_SCALE * s * spread,
             };
             let count = scene.lights.len();
-            let light = &scene.lights[((rng.next() * count as f32) as usize).min(count - 1)];
-            let (u, v) = (rng.next(), rng.next());
+            let light = &scene.lights[((rng.unit() * count as f32) as usize).min(count - 1)];
+            let (u, v) = (rng.unit(), rng.unit());
             let end_offset = light_offset(light);
             let end = light_end(light, end_offset, &floor);
             let Some(shadow) = shadow_ray(&floor, light.point(u, v), &end) else {
@@ -230,11 +230,11 @@ fn two_sided_faces_do_not_shadow_themselves_or_their_other_half() {
             ..Scene::default()
         };
         let accel = Accel::new(&scene);
-        let mut rng = Rng(0x25 ^ s.to_bits() as u64);
+        let mut rng = seeded(0x25 ^ s.to_bits() as u64);
         let mut self_hits = 0;
         for _ in 0..RAYS {
             let eye = rng.direction() * (8.0 * s);
-            let aim = Vec3::new(rng.next() * 2.0 - 1.0, rng.next() * 2.0 - 1.0, 0.3) * s;
+            let aim = Vec3::new(rng.unit() * 2.0 - 1.0, rng.unit() * 2.0 - 1.0, 0.3) * s;
             let ray = Ray {
                 origin: eye,
                 direction: (aim - eye).normalize(),

@@ -8,7 +8,7 @@
 
 mod common;
 
-use common::Rng;
+use common::{Draw, seeded};
 use glam::Vec3;
 use raywave::film::Film;
 use raywave::sampling::LightSampler;
@@ -65,11 +65,11 @@ fn bias_bound_matches_a_hand_computation() {
 /// K images of P grey pixels: reference 0.5, each value 0.5 + δ + uniform noise in (−a, a)
 /// from a fixed seed.
 fn noisy_images(p: usize, k: usize, delta: f32, a: f32, seed: u64) -> Vec<Vec<Vec3>> {
-    let mut rng = Rng(seed);
+    let mut rng = seeded(seed);
     (0..k)
         .map(|_| {
             (0..p)
-                .map(|_| Vec3::splat(0.5 + delta + a * (2.0 * rng.next() - 1.0)))
+                .map(|_| Vec3::splat(0.5 + delta + a * (2.0 * rng.unit() - 1.0)))
                 .collect()
         })
         .collect()

@@ -7,12 +7,13 @@
 
 mod common;
 
-use common::{ray, triangle};
+use common::strategies::{any_f32, vec3};
+use common::{edge_rays, ray, scene_of, triangle};
 use glam::Vec3;
 use proptest::prelude::*;
 use raywave::geometry::{self, Accel, Ray, intersect_sphere, intersect_triangle, shadow_casters};
 use raywave::sampling::{LightSampler, SampleKey, square_sample, strata_grid, uniform};
-use raywave::scene::{Light, LightShape, Material, NO_HIT, Scene, Sphere, Triangle};
+use raywave::scene::{Light, LightShape, Material, NO_HIT, Scene, Sphere};
 use raywave::shading::shade;
 use raywave::spawn::{SurfaceHit, light_end, shadow_ray};
 use raywave::wavefront::context::MaterialTerms;
@@ -21,39 +22,8 @@ use raywave::wavefront::simd::{self, BlockSampler, LightBlock, RayColumns, lanes
 
 const NAN: f32 = f32::NAN;
 const INF: f32 = f32::INFINITY;
-
-/// Rays chosen to sit on the kernels' edges for the unit triangle (0,0,0) (1,0,0) (0,1,0),
-/// whose front faces +z, and the unit sphere at the origin.
-fn edge_rays() -> Vec<Ray> {
-    let s = std::f32::consts::FRAC_1_SQRT_2;
-    vec![
-        ray([0.25, 0.25, 1.0], [0.0, 0.0, -1.0]), // axis-aligned, straight through
-        ray([0.25, 0.25, -1.0], [0.0, 0.0, 1.0]), // from behind
-        ray([0.25, 0.25, 0.0], [0.0, 0.0, -1.0]), // starting on the surface
-        ray([0.25, 0.25, 5e-5], [0.0, 0.0, -1.0]), // close above the surface
-        ray([0.25, 0.25, 1e-30], [0.0, 0.0, -1.0]), // a tiny distance above
-        ray([-1.0, 0.25, 0.0], [1.0, 0.0, 0.0]),  // grazing, in the plane
-        ray([-1.0, 0.25, 1e-7], [1.0, 0.0, -1e-7]), // nearly grazing
-        ray([0.0, 0.0, 1.0], [0.0, 0.0, -1.0]),   // through a corner
-        ray([0.5, 0.5, 1.0], [0.0, 0.0, -1.0]),   // through the hypotenuse
-        ray([1.0, 0.0, 1.0], [0.0, 0.0, -1.0]),   // another corner
-        ray([0.5, -0.0, 1.0], [-0.0, 0.0, -1.0]), // −0.0 on an edge
-        ray([0.25, 0.25, 1.0], [-0.0, -0.0, -1.0]), // −0.0 direction components
-        ray([NAN, 0.25, 1.0], [0.0, 0.0, -1.0]),  // NaN origin
-        ray([0.25, 0.25, 1.0], [0.0, NAN, -1.0]), // NaN direction
-        ray([INF, 0.25, 1.0], [0.0, 0.0, -1.0]),  // infinite origin
-        ray([0.25, 0.25, 1.0], [0.0, 0.0, -INF]), // infinite direction
-        ray([0.25, 0.25, 1.0], [0.0, 0.0, 0.0]),  // zero direction
-        ray([0.0, 0.0, 3.0], [0.0, 0.0, -1.0]),   // sphere: through the centre
-        ray([0.0, 0.0, 0.0], [s, s, 0.0]),        // sphere: from the centre
-        ray([1.0, 0.0, 0.0], [0.0, 1.0, 0.0]),    // sphere: tangent, on the surface
-        ray([1.0, 0.0, 0.0], [1.0, 0.0, 0.0]),    // sphere: leaving from the surface
-        ray([1.0, 0.0, 0.0], [-1.0, 0.0, 0.0]),   // sphere: entering from the surface
-        ray([1.0, -2.0, 0.0], [0.0, 1.0, 0.0]),   // sphere: grazing
-        ray([0.25, 0.25, 1e30], [0.0, 0.0, -1.0]), // far away
-        ray([0.25, 0.25, 1.0], [0.0, 0.0, -1e-30]), // tiny direction
-    ]
-}
+/// Random coordinates lie in [−HALF, HALF): around the unit triangle and sphere.
+const HALF: f32 = 2.0;
 
 fn tmaxes() -> [f32; 6] {
     [INF, 1.0, 0.5, 0.0, -1.0, NAN]
@@ -117,15 +87,6 @@ fn sphere_kernel_equals_scalar_on_edge_cases() {
             |r, tm| lanes::sphere(&sphere, r, tm),
             |r, tm| intersect_sphere(&sphere, r, tm),
         );
-    }
-}
-
-fn scene_of(triangles: Vec<Triangle>, spheres: Vec<Sphere>) -> Scene {
-    Scene {
-        triangles,
-        spheres,
-        materials: vec![Material::default()],
-        ..Scene::default()
     }
 }
 
@@ -298,35 +259,16 @@ fn batch_kernels_on_empty_and_one_primitive_scenes() {
     check_batch(&twin, &rays, false);
 }
 
-fn finite() -> impl Strategy<Value = f32> {
-    -2.0f32..2.0
-}
-
-fn vec3() -> impl Strategy<Value = Vec3> {
-    (finite(), finite(), finite()).prop_map(|(x, y, z)| Vec3::new(x, y, z))
-}
-
-fn any_f32() -> impl Strategy<Value = f32> {
-    prop_oneof![
-        8 => finite(),
-        1 => Just(0.0f32),
-        1 => Just(-0.0f32),
-        1 => Just(f32::NAN),
-        1 => Just(f32::INFINITY),
-        1 => any::<f32>(),
-    ]
-}
-
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(256))]
 
     #[test]
     fn kernels_equal_scalar_on_random_input(
-        v in [vec3(), vec3(), vec3()],
-        center in vec3(),
+        v in [vec3(HALF), vec3(HALF), vec3(HALF)],
+        center in vec3(HALF),
         radius in 0.01f32..2.0,
-        origins in proptest::collection::vec([any_f32(), any_f32(), any_f32()], 8),
-        dirs in proptest::collection::vec(vec3(), 8),
+        origins in proptest::collection::vec([any_f32(HALF), any_f32(HALF), any_f32(HALF)], 8),
+        dirs in proptest::collection::vec(vec3(HALF), 8),
         tmax in proptest::collection::vec(prop_oneof![Just(INF), 0.0f32..4.0], 8),
         two_sided in any::<bool>(),
     ) {
@@ -347,8 +289,8 @@ proptest! {
 
     #[test]
     fn batches_equal_scalar_on_random_scenes(
-        tris in proptest::collection::vec([vec3(), vec3(), vec3()], 0..6),
-        spheres in proptest::collection::vec((vec3(), 0.05f32..0.8), 0..4),
+        tris in proptest::collection::vec([vec3(HALF), vec3(HALF), vec3(HALF)], 0..6),
+        spheres in proptest::collection::vec((vec3(HALF), 0.05f32..0.8), 0..4),
         n in 0usize..40,
         seed in any::<u32>(),
     ) {
@@ -365,9 +307,9 @@ proptest! {
 
     #[test]
     fn shade_terms_equals_shade(
-        kd in vec3(), kr in prop_oneof![Just(Vec3::ZERO), vec3()], ke in vec3(),
+        kd in vec3(HALF), kr in prop_oneof![Just(Vec3::ZERO), vec3(HALF)], ke in vec3(HALF),
         g in prop_oneof![Just(0.0f32), Just(1.0f32), 0.0f32..1.0, -0.5f32..0.0],
-        n in vec3(), e in vec3(), l in vec3(), lc in vec3(),
+        n in vec3(HALF), e in vec3(HALF), l in vec3(HALF), lc in vec3(HALF),
     ) {
         let m = Material { diffuse: kd.abs(), reflective: kr.abs(), emitted: ke.abs(), glossiness: g };
         let terms = MaterialTerms::new(&m, Vec3::splat(raywave::shading::AMBIENT));
@@ -382,9 +324,9 @@ proptest! {
 
     #[test]
     fn shade8_equals_shade_terms_lane_by_lane(
-        kd in vec3(), kr in prop_oneof![Just(Vec3::ZERO), vec3()], ke in vec3(),
+        kd in vec3(HALF), kr in prop_oneof![Just(Vec3::ZERO), vec3(HALF)], ke in vec3(HALF),
         g in prop_oneof![Just(0.0f32), Just(1.0f32), 0.0f32..1.0, -0.5f32..0.0],
-        n in vec3(), e in vec3(), ls in proptest::collection::vec(vec3(), 8), lc in vec3(),
+        n in vec3(HALF), e in vec3(HALF), ls in proptest::collection::vec(vec3(HALF), 8), lc in vec3(HALF),
         weight in prop_oneof![Just(1.0f32), Just(1.0 / 64.0), 0.001f32..1.0],
         blocked_bits in prop_oneof![Just(0u32), any::<u32>()],
         dead_bits in prop_oneof![Just(0u32), any::<u32>()],
@@ -421,7 +363,7 @@ proptest! {
     fn simd_light_points_equal_scalar_sampling(
         pixel in any::<u32>(), sample in 0u32..4, bounce in 0u32..6, light in 0u32..3, seed in any::<u32>(),
         count in 1u32..80, which in 0usize..4,
-        origin in vec3(), edge_u in vec3(), edge_v in vec3(), point in vec3(), n in vec3(),
+        origin in vec3(HALF), edge_u in vec3(HALF), edge_v in vec3(HALF), point in vec3(HALF), n in vec3(HALF),
         offset in prop_oneof![Just(0.0f32), 0.0f32..0.01],
         end_offset in prop_oneof![Just(0.0f32), 0.0f32..0.01],
     ) {

@@ -861,7 +861,9 @@ impl<'a> Oracle<'a> {
     }
 }
 
-/// A deterministic pseudo-random vector in [−1, 1]³, hashed from the bits of `v`.
+/// A deterministic pseudo-random vector in [−1, 1]³, hashed from the bits of `v`: a pure
+/// function of the point (the same point is always perturbed alike), so a hash, not a seeded
+/// `rand` generator.
 fn noise(v: DVec3) -> DVec3 {
     let mut h = v.x.to_bits() ^ v.y.to_bits().rotate_left(21) ^ v.z.to_bits().rotate_left(42);
     let mut next = || {
