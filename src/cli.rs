@@ -100,25 +100,7 @@ pub struct RenderArgs {
     pub stats_json: Option<PathBuf>,
 }
 
-/// The renderers.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Engine {
-    /// Structure-of-arrays batches through 8-wide SIMD stages (the default).
-    Wavefront,
-    /// The scalar recursive renderer, one ray at a time: the whole-image twin.
-    Reference,
-}
-
-impl Engine {
-    /// The name used on the command line and in reports.
-    pub fn name(self) -> &'static str {
-        match self {
-            Engine::Wavefront => "wavefront",
-            Engine::Reference => "reference",
-        }
-    }
-}
+pub use crate::engine::Engine;
 
 fn parse_colour_component(s: &str) -> Result<f32, String> {
     match s.parse::<f32>() {

@@ -10,6 +10,7 @@ pub mod bench;
 pub mod camera;
 pub mod cli;
 pub mod debug_view;
+pub mod engine;
 pub mod film;
 pub mod geometry;
 pub mod machine;

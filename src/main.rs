@@ -5,9 +5,10 @@ use anyhow::{Context, Result};
 use clap::Parser;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use raywave::cli::{
-    BackgroundSource, Cli, Command, Effective, Engine, MeshgenArgs, RenderArgs, UsageError,
+    BackgroundSource, Cli, Command, Effective, MeshgenArgs, RenderArgs, UsageError,
 };
 use raywave::debug_view::RayRecorder;
+use raywave::engine::Engine;
 use raywave::film::{OutputFormat, check_hdr_path, check_output_dir, output_format};
 use raywave::reference::Reference;
 use raywave::scene::Scene;
@@ -15,7 +16,6 @@ use raywave::settings::{LightModel, RenderSettings, ShadowMode};
 use raywave::stats::RayCounts;
 use raywave::variance::command::VarianceArgs;
 use raywave::wavefront::stats::RenderStats;
-use raywave::wavefront::{DEFAULT_BATCH_SIZE, Wavefront};
 use std::io::Write;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -98,14 +98,9 @@ fn meshgen(args: &MeshgenArgs) -> Result<()> {
 
 fn variance(args: &VarianceArgs) -> Result<()> {
     let pool = thread_pool(args.threads)?;
-    let render = |scene: &Scene, settings: &RenderSettings| match args.engine {
-        Engine::Reference => Reference::new(scene, settings).render(&|| {}),
-        Engine::Wavefront => {
-            let (film, stats) = Wavefront::new(scene, settings, DEFAULT_BATCH_SIZE).render(&|| {});
-            (film, stats.counts)
-        }
-    };
-    pool.install(|| raywave::variance::command::run(args, args.engine.name(), &render))
+    let engine = args.engine;
+    let render = |scene: &Scene, settings: &RenderSettings| engine.image(scene, settings);
+    pool.install(|| raywave::variance::command::run(args, engine.name(), &render))
 }
 
 fn thread_pool(threads: Option<u32>) -> Result<rayon::ThreadPool> {
@@ -148,31 +143,23 @@ fn render(args: &RenderArgs) -> Result<()> {
     let pool = thread_pool(args.threads)?;
     let threads = pool.current_num_threads();
 
-    let (film, report) = match args.engine {
-        Engine::Reference => {
-            let progress = progress_bar(settings.height as u64, "rows", args.quiet);
-            let start = Instant::now();
-            let reference = Reference::new(&scene, &settings);
-            let (film, counts) = pool.install(|| reference.render(&|| progress.inc(1)));
-            let seconds = start.elapsed().as_secs_f64();
-            progress.finish_and_clear();
-            (film, Report::new(counts, seconds, None))
-        }
-        Engine::Wavefront => {
-            let engine = Wavefront::new(&scene, &settings, args.batch_size as usize);
-            let progress = progress_bar(engine.tile_count() as u64, "tiles", args.quiet);
-            let start = Instant::now();
-            let (film, stats) = pool.install(|| engine.render(&|| progress.inc(1)));
-            let seconds = start.elapsed().as_secs_f64();
-            progress.finish_and_clear();
-            let bvh = engine
-                .context()
-                .accel
-                .is_some()
-                .then_some(engine.context().bvh_build_time.as_secs_f64());
-            (film, Report::new(stats.counts, seconds, Some((stats, bvh))))
-        }
+    // The reference's set-up (its BVH for meshes) is timed with its render; the wavefront
+    // engine's BVH build is reported on its own.
+    let setup_start = Instant::now();
+    let engine = args
+        .engine
+        .prepare(&scene, &settings, args.batch_size as usize);
+    let (units, unit) = engine.work_units(&settings);
+    let progress = progress_bar(units, unit, args.quiet);
+    let start = match engine.engine() {
+        Engine::Reference => setup_start,
+        Engine::Wavefront => Instant::now(),
     };
+    let (film, stats) = pool.install(|| engine.render(&|| progress.inc(1)));
+    let seconds = start.elapsed().as_secs_f64();
+    progress.finish_and_clear();
+    let stages = engine.bvh_build_seconds().map(|bvh| (stats, bvh));
+    let report = Report::new(stats.counts, seconds, stages);
 
     let mut img = match format {
         OutputFormat::Ldr(_) => Some(film.to_rgb8(args.tonemap)),

@@ -11,11 +11,11 @@
 pub mod compare;
 pub mod record;
 
+use crate::engine::{Engine, Prepared};
 use crate::film::Film;
-use crate::reference::Reference;
 use crate::scene::{BUILTIN_CORNELL_BOX, Scene};
 use crate::settings::{RenderSettings, ShadowMode};
-use crate::wavefront::{DEFAULT_BATCH_SIZE, Wavefront};
+use crate::wavefront::DEFAULT_BATCH_SIZE;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use record::{
@@ -241,52 +241,38 @@ fn short(commit: &str) -> &str {
 
 /// One untimed render per engine, then `runs` interleaved timed renders of each.
 fn measure(scene: &Scene, settings: &RenderSettings, runs: u32) -> Vec<EngineRecord> {
-    let reference = Reference::new(scene, settings);
-    let wavefront = Wavefront::new(scene, settings, DEFAULT_BATCH_SIZE);
-    let time_reference = || {
+    let engines = [Engine::Reference, Engine::Wavefront]
+        .map(|engine| engine.prepare(scene, settings, DEFAULT_BATCH_SIZE));
+    let time = |engine: &Prepared| {
         let start = Instant::now();
-        let (film, counts) = reference.render(&|| {});
+        let (film, stats) = engine.render(&|| {});
         let seconds = start.elapsed().as_secs_f64();
         drop::<Film>(film);
-        Measurement {
-            seconds,
-            rays: counts,
-            rays_per_second: KindRates::new(&counts, seconds),
-            stages: Vec::new(),
-        }
-    };
-    let time_wavefront = || {
-        let start = Instant::now();
-        let (film, stats) = wavefront.render(&|| {});
-        let seconds = start.elapsed().as_secs_f64();
-        drop::<Film>(film);
+        let stages = match engine.engine() {
+            Engine::Wavefront => stats.stage_rows().iter().map(StageFigure::from).collect(),
+            Engine::Reference => Vec::new(),
+        };
         Measurement {
             seconds,
             rays: stats.counts,
             rays_per_second: KindRates::new(&stats.counts, seconds),
-            stages: stats
-                .stage_rows()
-                .into_iter()
-                .map(|r| StageFigure {
-                    stage: r.stage.to_string(),
-                    rays: r.rays,
-                    thread_seconds: r.thread_seconds,
-                    rays_per_thread_second: r.rays_per_thread_second,
-                })
-                .collect(),
+            stages,
         }
     };
-    time_reference();
-    time_wavefront();
-    let (mut r, mut w) = (Vec::new(), Vec::new());
-    for _ in 0..runs {
-        r.push(time_reference());
-        w.push(time_wavefront());
+    for engine in &engines {
+        time(engine);
     }
-    [("reference", r), ("wavefront", w)]
-        .into_iter()
+    let mut measured = [Vec::new(), Vec::new()];
+    for _ in 0..runs {
+        for (engine, runs) in engines.iter().zip(&mut measured) {
+            runs.push(time(engine));
+        }
+    }
+    engines
+        .iter()
+        .zip(measured)
         .map(|(engine, runs)| EngineRecord {
-            engine: engine.to_string(),
+            engine: engine.engine().name().to_string(),
             median: Measurement::median_of(&runs),
             runs,
         })
