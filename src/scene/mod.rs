@@ -230,20 +230,20 @@ impl Scene {
 
     /// Reads and parses a scene file; errors name the file and line.
     pub fn load_with(path: &Path, options: &ParseOptions) -> Result<Scene, SceneError> {
-        let file = path.display().to_string();
-        let bytes = std::fs::read(path).map_err(|source| SceneError::Io {
-            path: file.clone(),
-            source,
-        })?;
-        let text = String::from_utf8(bytes).map_err(|e| {
-            let valid = &e.as_bytes()[..e.utf8_error().valid_up_to()];
+        Ok(load_scene(Some(path), options)?.scene)
+    }
+
+    /// Parses a scene file's bytes; `file` names it in errors.
+    fn from_bytes(bytes: &[u8], file: &str, options: &ParseOptions) -> Result<Scene, SceneError> {
+        let text = std::str::from_utf8(bytes).map_err(|e| {
+            let valid = &bytes[..e.valid_up_to()];
             ParseError {
                 line: 1 + valid.iter().filter(|&&b| b == b'\n').count(),
                 message: "expected UTF-8 text, found a byte that is not UTF-8".into(),
-                file: file.clone(),
+                file: file.to_string(),
             }
         })?;
-        Ok(parse_scene_str_with(&text, &file, options)?)
+        Ok(parse_scene_str_with(text, file, options)?)
     }
 
     /// The built-in default: the lab's Cornell box with three mirror spheres.
@@ -270,6 +270,34 @@ impl Scene {
         };
         &self.materials[m as usize]
     }
+}
+
+/// A scene and the bytes it was parsed from (what caches and bench records key on).
+#[derive(Clone, Debug)]
+pub struct SceneFile {
+    /// The parsed scene, its warnings included.
+    pub scene: Scene,
+    /// The file's bytes, or [`BUILTIN_CORNELL_BOX`]'s.
+    pub bytes: Vec<u8>,
+}
+
+/// Reads the scene file once (the built-in scene without a path) and parses it; errors name
+/// the file and line. The scene's warnings are kept in `Scene::warnings` for the caller to
+/// print.
+pub fn load_scene(path: Option<&Path>, options: &ParseOptions) -> Result<SceneFile, SceneError> {
+    let Some(path) = path else {
+        return Ok(SceneFile {
+            scene: Scene::builtin_default(),
+            bytes: BUILTIN_CORNELL_BOX.as_bytes().to_vec(),
+        });
+    };
+    let file = path.display().to_string();
+    let bytes = std::fs::read(path).map_err(|source| SceneError::Io {
+        path: file.clone(),
+        source,
+    })?;
+    let scene = Scene::from_bytes(&bytes, &file, options)?;
+    Ok(SceneFile { scene, bytes })
 }
 
 /// The lab's `cornell_box_reflective_spheres.obj`, compiled in, with the background of the lab's
