@@ -33,10 +33,9 @@ pub struct ImageOptions {
 }
 
 /// Whose defaults fill the settings that no flag sets.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Defaults {
     /// raywave's own, the lab's third run line: 512×512, 5 bounces, soft shadows (16 points).
-    #[default]
     Raywave,
     /// The lab's ArgParser: 100×100, 0 bounces, hard shadows, white background.
     Lab,
