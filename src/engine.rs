@@ -142,3 +142,47 @@ pub fn thread_pool(threads: Option<u32>) -> anyhow::Result<rayon::ThreadPool> {
     }
     anyhow::Context::context(builder.build(), "cannot start the worker threads")
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn both_engines_render_the_same_rays_through_the_facade() {
+        let scene = Scene::builtin_default();
+        let settings = RenderSettings {
+            width: 12,
+            height: 8,
+            shadow_samples: 2,
+            ..RenderSettings::default()
+        };
+        let calls = std::sync::atomic::AtomicU64::new(0);
+        let count = || {
+            calls.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        };
+        for engine in [Engine::Wavefront, Engine::Reference] {
+            calls.store(0, std::sync::atomic::Ordering::Relaxed);
+            let prepared = engine.prepare(&scene, &settings, 16);
+            assert_eq!(prepared.engine(), engine);
+            let (units, _) = prepared.work_units(&settings);
+            let (film, stats) = prepared.render(&count);
+            assert_eq!(calls.load(std::sync::atomic::Ordering::Relaxed), units);
+            assert_eq!((film.width, film.height), (12, 8));
+            assert_eq!(stats.counts.camera, 96);
+            assert_eq!(engine.image(&scene, &settings).1, stats.counts);
+        }
+        assert_eq!(
+            Engine::Reference
+                .prepare(&scene, &settings, 16)
+                .bvh_build_seconds(),
+            None
+        );
+        assert_eq!(
+            Engine::Reference
+                .render(&scene, &settings, 16, &|| {})
+                .1
+                .stage_time,
+            RenderStats::default().stage_time
+        );
+    }
+}

@@ -307,3 +307,37 @@ pub const BUILTIN_CORNELL_BOX: &str = concat!(
     include_str!("../../scenes/cornell_box_reflective_spheres.obj"),
     "\n# The lab's run line for this scene passes -background_color 0.2 0.1 0.6\nbackground_color 0.2 0.1 0.6\n"
 );
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn load_scene_returns_the_bytes_it_parsed() {
+        let builtin = load_scene(None, &ParseOptions::default()).unwrap();
+        assert_eq!(builtin.bytes, BUILTIN_CORNELL_BOX.as_bytes());
+        assert_eq!(builtin.scene.triangles, Scene::builtin_default().triangles);
+
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("box.obj");
+        std::fs::write(&path, BUILTIN_CORNELL_BOX).unwrap();
+        let file = load_scene(Some(&path), &ParseOptions::default()).unwrap();
+        assert_eq!(file.bytes, BUILTIN_CORNELL_BOX.as_bytes());
+        assert_eq!(file.scene.triangles, builtin.scene.triangles);
+        assert_eq!(file.scene.source, path.display().to_string());
+    }
+
+    #[test]
+    fn load_scene_names_the_file_it_cannot_read_or_decode() {
+        let dir = tempfile::tempdir().unwrap();
+        let missing = dir.path().join("missing.obj");
+        let e = load_scene(Some(&missing), &ParseOptions::default()).unwrap_err();
+        assert!(e.to_string().contains("missing.obj"), "{e}");
+
+        let binary = dir.path().join("binary.obj");
+        std::fs::write(&binary, b"v 0 0 0\n\xff\n").unwrap();
+        let e = load_scene(Some(&binary), &ParseOptions::default()).unwrap_err();
+        assert!(e.to_string().contains("binary.obj"), "{e}");
+        assert!(e.to_string().contains("UTF-8"), "{e}");
+    }
+}
