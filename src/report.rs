@@ -128,3 +128,63 @@ impl RenderRecord {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_file_keeps_its_keys_sorted_and_names_no_host() {
+        let counts = RayCounts {
+            camera: 4,
+            shadow: 6,
+            reflection: 2,
+        };
+        let record = RenderRecord {
+            raywave: "0",
+            machine: Machine {
+                hostname: String::new(),
+                ..Machine::current()
+            },
+            simd: "scalar",
+            threads: 1,
+            engine: Engine::Reference,
+            batch_size: 8,
+            scene: SceneFigures {
+                source: "s".into(),
+                triangles: 1,
+                spheres: 0,
+                lights: 0,
+                bvh: None,
+                bvh_build_seconds: None,
+            },
+            settings: RenderSettings::default(),
+            defaults: DefaultsUsed {
+                from: "raywave",
+                settings: vec!["size"],
+            },
+            seconds: 2.0,
+            rays: KindFigures::new(&counts, 2.0),
+            stages: None,
+        };
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("s.json");
+        record.write(&path).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        let top: Vec<&str> = text
+            .lines()
+            .filter(|l| l.starts_with("  \"") && !l.starts_with("   "))
+            .map(|l| l.trim().split('"').nth(1).unwrap())
+            .collect();
+        let mut sorted = top.clone();
+        sorted.sort_unstable();
+        assert_eq!(top, sorted);
+        assert!(!text.contains("hostname"));
+        assert!(text.contains("\"for\": [\n      \"size\"\n    ]"), "{text}");
+        let json: serde_json::Value = serde_json::from_str(&text).unwrap();
+        assert_eq!(json["rays"]["total"]["rays"], 12);
+        assert_eq!(json["rays"]["shadow"]["rays_per_second"], 3.0);
+        assert_eq!(json["engine"], "reference");
+        assert!(json["stages"].is_null() && json["scene"]["bvh"].is_null());
+    }
+}
