@@ -332,7 +332,11 @@ fn main() {
     };
     let size = if test_mode { TEST_SIZE } else { SIZE };
     let mut c = common::criterion_for_frames(Duration::from_millis(300));
-    eprintln!("machine: {}, simd {}", cpu_model(), raywave::simd_path());
+    eprintln!(
+        "machine: {}, simd {}",
+        raywave::machine::cpu_model(),
+        raywave::simd_path()
+    );
     for (label, target) in [("12k", 12_000), ("1M", 1_000_000)] {
         if !only.is_empty() && only != label {
             continue;
@@ -361,16 +365,4 @@ fn main() {
 fn exit_with(message: &str) -> ! {
     eprintln!("mesh_rays: {message}");
     std::process::exit(2)
-}
-
-fn cpu_model() -> String {
-    std::fs::read_to_string("/proc/cpuinfo")
-        .ok()
-        .and_then(|text| {
-            text.lines()
-                .find(|l| l.starts_with("model name"))
-                .and_then(|l| l.split(':').nth(1))
-                .map(|m| m.trim().to_string())
-        })
-        .unwrap_or_else(|| "unknown CPU".into())
 }

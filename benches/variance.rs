@@ -25,13 +25,13 @@
 mod common;
 
 use criterion::{BenchmarkId, Throughput};
+use raywave::engine::Engine;
 use raywave::film::Film;
 use raywave::sampling::LightSampler;
 use raywave::scene::Scene;
 use raywave::settings::RenderSettings;
 use raywave::stats::RayCounts;
 use raywave::variance::{StudyConfig, converged_reference, error_stats, penumbra_mask};
-use raywave::wavefront::{DEFAULT_BATCH_SIZE, Wavefront};
 use serde::{Deserialize, Serialize};
 use std::hint::black_box;
 use std::path::{Path, PathBuf};
@@ -114,8 +114,7 @@ fn study_config(scene: &Scene) -> StudyConfig {
 }
 
 fn render(scene: &Scene, settings: &RenderSettings) -> (Film, RayCounts) {
-    let (film, stats) = Wavefront::new(scene, settings, DEFAULT_BATCH_SIZE).render(&|| {});
-    (film, stats.counts)
+    Engine::Wavefront.image(scene, settings)
 }
 
 /// The converged reference is cached next to the bench executable (`target/release/`); its

@@ -21,7 +21,7 @@ pub struct Film {
 }
 
 /// How linear values become 8-bit pixels.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum ToneMap {
     /// The lab's look: clamp to [0, 1], no gamma.

@@ -8,20 +8,24 @@
 
 pub mod bench;
 pub mod camera;
-pub mod cli;
 pub mod debug_view;
+pub mod engine;
+pub mod error;
 pub mod film;
 pub mod geometry;
 pub mod machine;
 pub mod meshgen;
+pub mod options;
 pub mod peer;
 pub mod reference;
+pub mod report;
 pub mod sampling;
 pub mod scene;
 pub mod settings;
 pub mod shading;
 pub mod spawn;
 pub mod stats;
+pub mod terminal;
 pub mod variance;
 pub mod wavefront;
 

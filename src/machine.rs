@@ -1,6 +1,8 @@
 //! What machine a measurement ran on: host name, CPU model, logical CPUs. Shared by
 //! `--stats-json` and `raywave bench`.
 
+use serde::{Deserialize, Serialize};
+
 /// The CPU's model name from /proc/cpuinfo, where there is one.
 pub fn cpu_model() -> String {
     std::fs::read_to_string("/proc/cpuinfo")
@@ -29,4 +31,33 @@ pub fn logical_cpus() -> usize {
     std::thread::available_parallelism()
         .map(|n| n.get())
         .unwrap_or(1)
+}
+
+/// The machine a measurement ran on, as `--stats-json` files and bench records name it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Machine {
+    /// Host name (empty, and then left out, in `--stats-json`, which has never named it).
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub hostname: String,
+    /// CPU model from /proc/cpuinfo.
+    pub cpu: String,
+    /// Logical CPUs available.
+    pub logical_cpus: usize,
+    /// `std::env::consts::OS`.
+    pub os: String,
+    /// `std::env::consts::ARCH`.
+    pub arch: String,
+}
+
+impl Machine {
+    /// This machine.
+    pub fn current() -> Machine {
+        Machine {
+            hostname: hostname(),
+            cpu: cpu_model(),
+            logical_cpus: logical_cpus(),
+            os: std::env::consts::OS.to_string(),
+            arch: std::env::consts::ARCH.to_string(),
+        }
+    }
 }

@@ -68,11 +68,6 @@ impl<'a> Reference<'a> {
         }
     }
 
-    /// The acceleration structure in use.
-    pub fn accel(&self) -> &Accel {
-        &self.accel
-    }
-
     /// Renders the image on the current rayon pool; `on_row` is called after each row.
     pub fn render(&self, on_row: &(dyn Fn() + Sync)) -> (Film, RayCounts) {
         let (w, h) = (self.settings.width as usize, self.settings.height as usize);

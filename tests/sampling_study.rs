@@ -295,8 +295,8 @@ fn matching_budget_inverts_the_fits() {
 /// Deterministic for fixed seeds, and it fails if stratification breaks (slope → −1).
 #[test]
 fn the_study_meets_its_floor_and_writes_its_outputs() {
+    use raywave::engine::Engine;
     use raywave::variance::{StudyConfig, run_study};
-    use raywave::wavefront::{DEFAULT_BATCH_SIZE, Wavefront};
     let scene = Scene::builtin_default();
     let base = RenderSettings {
         width: 48,
@@ -312,10 +312,7 @@ fn the_study_meets_its_floor_and_writes_its_outputs() {
         heatmap_n: 16,
         ..StudyConfig::standard(base)
     };
-    let render = |scene: &Scene, s: &RenderSettings| {
-        let (film, stats) = Wavefront::new(scene, s, DEFAULT_BATCH_SIZE).render(&|| {});
-        (film, stats.counts)
-    };
+    let render = |scene: &Scene, s: &RenderSettings| Engine::Wavefront.image(scene, s);
     let result = run_study(
         &scene,
         b"test",

@@ -11,13 +11,13 @@
 pub mod compare;
 pub mod record;
 
+use crate::engine::{Engine, Prepared, thread_pool};
 use crate::film::Film;
-use crate::reference::Reference;
-use crate::scene::{BUILTIN_CORNELL_BOX, Scene};
+use crate::options::ImageOptions;
+use crate::scene::{Scene, SceneFile, load_scene};
 use crate::settings::{RenderSettings, ShadowMode};
-use crate::wavefront::{DEFAULT_BATCH_SIZE, Wavefront};
+use crate::wavefront::DEFAULT_BATCH_SIZE;
 use anyhow::{Context, Result, bail};
-use clap::Args;
 use record::{
     BenchRecord, EngineRecord, KindRates, Machine, Measurement, SceneId, Setup, StageFigure,
 };
@@ -31,59 +31,29 @@ pub const EXIT_REGRESSION: u8 = 3;
 /// Default `--threshold`, in percent: see docs/BENCHMARKING.md for the noise it is chosen from.
 pub const DEFAULT_THRESHOLD_PCT: f64 = 40.0;
 
-/// Flags of `raywave bench`.
-#[derive(Args, Debug, Clone)]
-pub struct BenchArgs {
-    /// Scene file (.obj); without one, the built-in lab Cornell box with mirror spheres.
+/// What `raywave bench` is asked to do (its flags, as plain values).
+#[derive(Clone, Debug)]
+pub struct BenchOptions {
+    /// Scene file; `None` for the built-in lab Cornell box with mirror spheres.
     pub scene: Option<PathBuf>,
-    /// The lab's `-input FILE` (same as the positional SCENE).
-    #[arg(long = "input", hide = true, conflicts_with = "scene")]
-    pub input: Option<PathBuf>,
-    /// Size, bounces, shadows and sampling, as for `raywave render`.
-    #[command(flatten)]
-    pub image: crate::cli::ImageArgs,
-    /// Worker threads [default: all cores].
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    /// Size, bounces, shadows and sampling, defaulted as for `raywave render`.
+    pub image: ImageOptions,
+    /// Worker threads (`None`: all cores).
     pub threads: Option<u32>,
     /// Timed runs per engine (medians are reported).
-    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
     pub runs: u32,
     /// Save the record as DIR/NAME.json.
-    #[arg(long, value_name = "NAME")]
     pub save: Option<String>,
-    /// Compare with the record DIR/NAME.json; exit 3 if a headline figure regressed.
-    #[arg(long, value_name = "NAME")]
+    /// Compare with the record DIR/NAME.json.
     pub compare: Option<String>,
     /// Directory of saved records.
-    #[arg(long, default_value = ".raywave-bench")]
     pub dir: PathBuf,
-    /// Regression threshold in percent: a headline figure that falls by more fails --compare.
-    #[arg(long, value_name = "PCT", default_value_t = DEFAULT_THRESHOLD_PCT,
-          value_parser = parse_threshold)]
+    /// Regression threshold in percent.
     pub threshold: f64,
-    /// Also write the record as JSON to FILE (`-` for stdout).
-    #[arg(long, value_name = "FILE")]
+    /// Also write the record as JSON to this file (`-` for stdout).
     pub json: Option<PathBuf>,
-    /// Print only the comparison (or nothing but errors without --compare).
-    #[arg(short, long)]
+    /// Print only the comparison (or nothing but errors without `compare`).
     pub quiet: bool,
-}
-
-fn parse_threshold(s: &str) -> Result<f64, String> {
-    match s.parse::<f64>() {
-        Ok(x) if x.is_finite() && (0.0..1000.0).contains(&x) => Ok(x),
-        _ => Err(format!(
-            "expected a percentage between 0 and 1000, found `{s}`"
-        )),
-    }
-}
-
-impl BenchArgs {
-    /// The render settings, defaulted like `raywave render`'s (the same `ImageArgs`), with or
-    /// without a scene file.
-    pub fn settings(&self, scene_background: Option<[f32; 3]>) -> RenderSettings {
-        self.image.resolve(scene_background).settings
-    }
 }
 
 /// What `run` found: `Some(comparison)` with `--compare`.
@@ -105,7 +75,7 @@ impl Outcome {
 }
 
 /// Runs the bench as the flags say, printing the tables; errors name the file or flag.
-pub fn run(args: &BenchArgs) -> Result<Outcome> {
+pub fn run(args: &BenchOptions) -> Result<Outcome> {
     // Everything that can fail cheaply happens before the timed part.
     let save_path = args
         .save
@@ -115,31 +85,20 @@ pub fn run(args: &BenchArgs) -> Result<Outcome> {
     if let Some(p) = args.json.as_ref().filter(|p| p.as_os_str() != "-") {
         crate::film::check_output_dir(p)?;
     }
-    let (scene, text) = match args.scene.as_ref().or(args.input.as_ref()) {
-        Some(path) => {
-            let scene = Scene::load_with(path, &args.image.parse_options())?;
-            let text =
-                std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?;
-            (scene, text)
-        }
-        None => (
-            Scene::builtin_default(),
-            BUILTIN_CORNELL_BOX.as_bytes().to_vec(),
-        ),
-    };
+    let SceneFile { scene, bytes } =
+        load_scene(args.scene.as_deref(), &args.image.parse_options())?;
     for w in &scene.warnings {
         eprintln!("{w}");
     }
-    let settings = args.settings(scene.background.map(|c| c.to_array()));
-    let mut builder = rayon::ThreadPoolBuilder::new();
-    if let Some(n) = args.threads {
-        builder = builder.num_threads(n as usize);
-    }
-    let pool = builder.build().context("cannot start the worker threads")?;
+    let settings = args
+        .image
+        .resolve(scene.background.map(|c| c.to_array()))
+        .settings;
+    let pool = thread_pool(args.threads)?;
     let setup = Setup {
         scene: SceneId {
             source: scene.source.clone(),
-            text_hash: record::text_hash(&text),
+            text_hash: record::text_hash(&bytes),
             triangles: scene.triangles.len(),
             spheres: scene.spheres.len(),
             lights: scene.lights.len(),
@@ -229,10 +188,7 @@ pub fn run(args: &BenchArgs) -> Result<Outcome> {
 
 /// Writes to stdout; a closed pipe (`raywave bench | head`) is an error, not a panic.
 fn emit(text: &str) -> Result<()> {
-    let mut out = std::io::stdout().lock();
-    out.write_all(text.as_bytes())
-        .and_then(|()| out.flush())
-        .context("cannot write to stdout")
+    crate::terminal::write_stdout(text).context("cannot write to stdout")
 }
 
 fn short(commit: &str) -> &str {
@@ -241,52 +197,38 @@ fn short(commit: &str) -> &str {
 
 /// One untimed render per engine, then `runs` interleaved timed renders of each.
 fn measure(scene: &Scene, settings: &RenderSettings, runs: u32) -> Vec<EngineRecord> {
-    let reference = Reference::new(scene, settings);
-    let wavefront = Wavefront::new(scene, settings, DEFAULT_BATCH_SIZE);
-    let time_reference = || {
+    let engines = [Engine::Reference, Engine::Wavefront]
+        .map(|engine| engine.prepare(scene, settings, DEFAULT_BATCH_SIZE));
+    let time = |engine: &Prepared| {
         let start = Instant::now();
-        let (film, counts) = reference.render(&|| {});
+        let (film, stats) = engine.render(&|| {});
         let seconds = start.elapsed().as_secs_f64();
         drop::<Film>(film);
-        Measurement {
-            seconds,
-            rays: counts,
-            rays_per_second: KindRates::new(&counts, seconds),
-            stages: Vec::new(),
-        }
-    };
-    let time_wavefront = || {
-        let start = Instant::now();
-        let (film, stats) = wavefront.render(&|| {});
-        let seconds = start.elapsed().as_secs_f64();
-        drop::<Film>(film);
+        let stages = match engine.engine() {
+            Engine::Wavefront => stats.stage_rows().iter().map(StageFigure::from).collect(),
+            Engine::Reference => Vec::new(),
+        };
         Measurement {
             seconds,
             rays: stats.counts,
             rays_per_second: KindRates::new(&stats.counts, seconds),
-            stages: stats
-                .stage_rows()
-                .into_iter()
-                .map(|r| StageFigure {
-                    stage: r.stage.to_string(),
-                    rays: r.rays,
-                    thread_seconds: r.thread_seconds,
-                    rays_per_thread_second: r.rays_per_thread_second,
-                })
-                .collect(),
+            stages,
         }
     };
-    time_reference();
-    time_wavefront();
-    let (mut r, mut w) = (Vec::new(), Vec::new());
-    for _ in 0..runs {
-        r.push(time_reference());
-        w.push(time_wavefront());
+    for engine in &engines {
+        time(engine);
     }
-    [("reference", r), ("wavefront", w)]
-        .into_iter()
+    let mut measured = [Vec::new(), Vec::new()];
+    for _ in 0..runs {
+        for (engine, runs) in engines.iter().zip(&mut measured) {
+            runs.push(time(engine));
+        }
+    }
+    engines
+        .iter()
+        .zip(measured)
         .map(|(engine, runs)| EngineRecord {
-            engine: engine.to_string(),
+            engine: engine.engine().name().to_string(),
             median: Measurement::median_of(&runs),
             runs,
         })

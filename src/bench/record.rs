@@ -1,8 +1,10 @@
 //! A bench record: what was measured (medians and every run) and under which conditions
 //! (machine, build, scene, settings), as it is saved to `.raywave-bench/NAME.json`.
 
+pub use crate::machine::Machine;
 use crate::settings::RenderSettings;
 use crate::stats::RayCounts;
+use crate::wavefront::stats::StageRow;
 use anyhow::{Context, Result, bail};
 use serde::{Deserialize, Serialize};
 use std::io::Write;
@@ -34,21 +36,6 @@ pub struct BenchRecord {
     pub runs: u32,
     /// One entry per engine: reference, then wavefront.
     pub engines: Vec<EngineRecord>,
-}
-
-/// The machine.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Machine {
-    /// Host name.
-    pub hostname: String,
-    /// CPU model from /proc/cpuinfo.
-    pub cpu: String,
-    /// Logical CPUs available.
-    pub logical_cpus: usize,
-    /// `std::env::consts::OS`.
-    pub os: String,
-    /// `std::env::consts::ARCH`.
-    pub arch: String,
 }
 
 /// Scene, settings and threads: the work and the resources it was given.
@@ -151,6 +138,17 @@ pub struct StageFigure {
     pub thread_seconds: f64,
     /// rays / thread_seconds: the stage's headline figure.
     pub rays_per_thread_second: f64,
+}
+
+impl From<&StageRow> for StageFigure {
+    fn from(row: &StageRow) -> StageFigure {
+        StageFigure {
+            stage: row.stage.to_string(),
+            rays: row.rays,
+            thread_seconds: row.thread_seconds,
+            rays_per_thread_second: row.rays_per_thread_second,
+        }
+    }
 }
 
 /// The median of `xs` (mean of the middle two for an even count); 0 for none.

@@ -230,20 +230,20 @@ impl Scene {
 
     /// Reads and parses a scene file; errors name the file and line.
     pub fn load_with(path: &Path, options: &ParseOptions) -> Result<Scene, SceneError> {
-        let file = path.display().to_string();
-        let bytes = std::fs::read(path).map_err(|source| SceneError::Io {
-            path: file.clone(),
-            source,
-        })?;
-        let text = String::from_utf8(bytes).map_err(|e| {
-            let valid = &e.as_bytes()[..e.utf8_error().valid_up_to()];
+        Ok(load_scene(Some(path), options)?.scene)
+    }
+
+    /// Parses a scene file's bytes; `file` names it in errors.
+    fn from_bytes(bytes: &[u8], file: &str, options: &ParseOptions) -> Result<Scene, SceneError> {
+        let text = std::str::from_utf8(bytes).map_err(|e| {
+            let valid = &bytes[..e.valid_up_to()];
             ParseError {
                 line: 1 + valid.iter().filter(|&&b| b == b'\n').count(),
                 message: "expected UTF-8 text, found a byte that is not UTF-8".into(),
-                file: file.clone(),
+                file: file.to_string(),
             }
         })?;
-        Ok(parse_scene_str_with(&text, &file, options)?)
+        Ok(parse_scene_str_with(text, file, options)?)
     }
 
     /// The built-in default: the lab's Cornell box with three mirror spheres.
@@ -272,6 +272,34 @@ impl Scene {
     }
 }
 
+/// A scene and the bytes it was parsed from (what caches and bench records key on).
+#[derive(Clone, Debug)]
+pub struct SceneFile {
+    /// The parsed scene, its warnings included.
+    pub scene: Scene,
+    /// The file's bytes, or [`BUILTIN_CORNELL_BOX`]'s.
+    pub bytes: Vec<u8>,
+}
+
+/// Reads the scene file once (the built-in scene without a path) and parses it; errors name
+/// the file and line. The scene's warnings are kept in `Scene::warnings` for the caller to
+/// print.
+pub fn load_scene(path: Option<&Path>, options: &ParseOptions) -> Result<SceneFile, SceneError> {
+    let Some(path) = path else {
+        return Ok(SceneFile {
+            scene: Scene::builtin_default(),
+            bytes: BUILTIN_CORNELL_BOX.as_bytes().to_vec(),
+        });
+    };
+    let file = path.display().to_string();
+    let bytes = std::fs::read(path).map_err(|source| SceneError::Io {
+        path: file.clone(),
+        source,
+    })?;
+    let scene = Scene::from_bytes(&bytes, &file, options)?;
+    Ok(SceneFile { scene, bytes })
+}
+
 /// The lab's `cornell_box_reflective_spheres.obj`, compiled in, with the background of the lab's
 /// run line for it (`-background_color 0.2 0.1 0.6`), so that `raywave` with no arguments
 /// renders what the lab's third run line rendered.
@@ -279,3 +307,37 @@ pub const BUILTIN_CORNELL_BOX: &str = concat!(
     include_str!("../../scenes/cornell_box_reflective_spheres.obj"),
     "\n# The lab's run line for this scene passes -background_color 0.2 0.1 0.6\nbackground_color 0.2 0.1 0.6\n"
 );
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn load_scene_returns_the_bytes_it_parsed() {
+        let builtin = load_scene(None, &ParseOptions::default()).unwrap();
+        assert_eq!(builtin.bytes, BUILTIN_CORNELL_BOX.as_bytes());
+        assert_eq!(builtin.scene.triangles, Scene::builtin_default().triangles);
+
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("box.obj");
+        std::fs::write(&path, BUILTIN_CORNELL_BOX).unwrap();
+        let file = load_scene(Some(&path), &ParseOptions::default()).unwrap();
+        assert_eq!(file.bytes, BUILTIN_CORNELL_BOX.as_bytes());
+        assert_eq!(file.scene.triangles, builtin.scene.triangles);
+        assert_eq!(file.scene.source, path.display().to_string());
+    }
+
+    #[test]
+    fn load_scene_names_the_file_it_cannot_read_or_decode() {
+        let dir = tempfile::tempdir().unwrap();
+        let missing = dir.path().join("missing.obj");
+        let e = load_scene(Some(&missing), &ParseOptions::default()).unwrap_err();
+        assert!(e.to_string().contains("missing.obj"), "{e}");
+
+        let binary = dir.path().join("binary.obj");
+        std::fs::write(&binary, b"v 0 0 0\n\xff\n").unwrap();
+        let e = load_scene(Some(&binary), &ParseOptions::default()).unwrap_err();
+        assert!(e.to_string().contains("binary.obj"), "{e}");
+        assert!(e.to_string().contains("UTF-8"), "{e}");
+    }
+}

@@ -1,69 +1,51 @@
-//! `raywave variance`: the command-line face of the study (flags, progress, outputs).
+//! `raywave variance`: the study as a command (options, progress, outputs); the flags are the
+//! binary's.
 
-use super::{Region, RenderFn, StudyConfig, run_study};
+use super::{Region, StudyConfig, run_study};
+use crate::engine::Engine;
 use crate::sampling::LightSampler;
-use crate::scene::{BUILTIN_CORNELL_BOX, Scene};
-use crate::settings::RenderSettings;
+use crate::scene::{ParseOptions, Scene, SceneFile, load_scene};
+use crate::settings::{LightModel, RenderSettings};
+use crate::terminal::{print, progress_bar};
 use anyhow::{Context, Result, bail};
-use clap::Args;
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use std::io::Write;
 use std::path::PathBuf;
 
-/// Flags of `raywave variance`.
-#[derive(Args, Debug, Clone)]
-pub struct VarianceArgs {
-    /// Scene file; without one, the built-in lab Cornell box with mirror spheres.
+/// What `raywave variance` is asked to do (its flags, as plain values).
+#[derive(Clone, Debug)]
+pub struct VarianceOptions {
+    /// Scene file; `None` for the built-in lab Cornell box with mirror spheres.
     pub scene: Option<PathBuf>,
-    /// Light-sample budgets N, comma-separated.
-    #[arg(long, value_delimiter = ',', default_values_t = [1u32, 4, 16, 64, 256], value_parser = clap::value_parser!(u32).range(1..=65536))]
+    /// Light-sample budgets N.
     pub budgets: Vec<u32>,
-    /// Samplers to compare, comma-separated.
-    #[arg(long, value_enum, value_delimiter = ',', default_values_t = LightSampler::ALL)]
+    /// Samplers to compare.
     pub samplers: Vec<LightSampler>,
-    /// Seeds (independent renders) per sampler and budget; at least 2, for the variance.
-    #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(2..=1024))]
+    /// Seeds (independent renders) per sampler and budget.
     pub seeds: u32,
-    /// Image size.
-    #[arg(long, num_args = 2, value_names = ["W", "H"], default_values_t = [128u32, 128], value_parser = clap::value_parser!(u32).range(1..=4096))]
-    pub size: Vec<u32>,
+    /// Image width and height.
+    pub size: [u32; 2],
     /// Mirror bounces.
-    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(0..=64))]
     pub bounces: u32,
     /// Stratified points per light in each half of the converged reference.
-    #[arg(long, default_value_t = 4096, value_parser = clap::value_parser!(u32).range(1..=65536))]
     pub reference_samples: u32,
     /// Points per light per hit for the penumbra mask.
-    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=65536))]
     pub mask_samples: u32,
-    /// The budget whose per-pixel error maps are drawn (must be one of --budgets).
-    #[arg(long, default_value_t = 16)]
+    /// The budget whose per-pixel error maps are drawn (one of `budgets`).
     pub heatmap_n: u32,
-    /// Directory for table.txt, results.csv, results.json, mse.png and the heat maps.
-    #[arg(long, default_value = "variance-report")]
+    /// Directory for the tables, plots and heat maps.
     pub out: PathBuf,
-    /// Directory caching converged references (keyed by scene bytes and settings).
-    #[arg(long, default_value = ".raywave-cache")]
+    /// Directory caching converged references.
     pub cache: PathBuf,
     /// Always render the converged reference, ignoring and not writing the cache.
-    #[arg(long)]
     pub no_cache: bool,
-    /// How a light's colour reaches a point: lab (no fall-off) or rpi (divided by π·d², as
-    /// RPI's framework does).
-    #[arg(long, value_enum, default_value = "lab")]
-    pub light_model: crate::settings::LightModel,
-    /// The engine that renders the images (both draw the same samples).
-    #[arg(long, value_enum, default_value = "wavefront")]
-    pub engine: crate::cli::Engine,
-    /// Worker threads [default: all cores].
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
-    pub threads: Option<u32>,
+    /// How a light's colour reaches a point.
+    pub light_model: LightModel,
+    /// The engine that renders the images.
+    pub engine: Engine,
     /// No progress bar.
-    #[arg(short, long)]
     pub quiet: bool,
 }
 
-impl VarianceArgs {
+impl VarianceOptions {
     /// Checks the flags against each other; errors name the flag.
     pub fn validate(&self) -> Result<()> {
         // Every seed's image is kept until its statistics are taken.
@@ -85,7 +67,7 @@ impl VarianceArgs {
             );
         }
         if !self.budgets.contains(&self.heatmap_n) {
-            return Err(crate::cli::UsageError(format!(
+            return Err(crate::error::UsageError(format!(
                 "--heatmap-n {} is not one of --budgets {:?}: expected one of the budgets",
                 self.heatmap_n, self.budgets
             ))
@@ -101,16 +83,13 @@ impl VarianceArgs {
 /// The largest total size of the K images a study holds at once.
 pub const MAX_STUDY_BYTES: u64 = 4 << 30;
 
-/// Runs the study with `render` (the engine), writes the outputs, then prints the table.
-pub fn run(args: &VarianceArgs, engine: &str, render: &RenderFn) -> Result<()> {
+/// Runs the study on the current rayon pool, writes the outputs, then prints the table.
+pub fn run(args: &VarianceOptions) -> Result<()> {
     args.validate()?;
-    let (scene, scene_bytes) = match &args.scene {
-        Some(path) => (Scene::load(path)?, std::fs::read(path)?),
-        None => (
-            Scene::builtin_default(),
-            BUILTIN_CORNELL_BOX.as_bytes().to_vec(),
-        ),
-    };
+    let SceneFile {
+        scene,
+        bytes: scene_bytes,
+    } = load_scene(args.scene.as_deref(), &ParseOptions::default())?;
     for w in &scene.warnings {
         eprintln!("{w}");
     }
@@ -166,26 +145,18 @@ pub fn run(args: &VarianceArgs, engine: &str, render: &RenderFn) -> Result<()> {
         ..StudyConfig::standard(base)
     };
     let steps = 2 + (config.samplers.len() * config.budgets.len()) as u64 * config.seeds as u64;
-    let bar = if args.quiet {
-        ProgressBar::hidden()
-    } else {
-        let bar = ProgressBar::with_draw_target(Some(steps), ProgressDrawTarget::stderr());
-        bar.set_style(
-            ProgressStyle::with_template(
-                "{spinner} variance [{bar:30}] {pos}/{len} {msg} ({elapsed}, eta {eta})",
-            )
-            .expect("valid template")
-            .progress_chars("=> "),
-        );
-        bar.set_message("converged reference");
-        bar
-    };
+    let bar = progress_bar(
+        steps,
+        "{spinner} variance [{bar:30}] {pos}/{len} {msg} ({elapsed}, eta {eta})",
+        args.quiet,
+    );
+    bar.set_message("converged reference");
     let result = run_study(
         &scene,
         &scene_bytes,
         &config,
-        engine,
-        render,
+        args.engine.name(),
+        &|scene: &Scene, settings: &RenderSettings| args.engine.image(scene, settings),
         cache,
         &|label| {
             bar.set_message(label.to_string());
@@ -206,10 +177,8 @@ pub fn run(args: &VarianceArgs, engine: &str, render: &RenderFn) -> Result<()> {
             );
         }
     }
-    let mut out = std::io::stdout().lock();
-    writeln!(
-        out,
-        "{}\nconverged reference: {}\nwrote   {}",
+    print(&format!(
+        "{}\nconverged reference: {}\nwrote   {}\n",
         result.table(),
         if result.reference_cached {
             "from the cache"
@@ -221,7 +190,5 @@ pub fn run(args: &VarianceArgs, engine: &str, render: &RenderFn) -> Result<()> {
             .map(|p| p.display().to_string())
             .collect::<Vec<_>>()
             .join(", ")
-    )
-    .context("cannot write to standard output")?;
-    Ok(())
+    ))
 }

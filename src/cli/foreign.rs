@@ -1,0 +1,448 @@
+//! The lab's and RPI's spellings (`-size 200 200 -input f.obj -soft_shadow ...`) translated
+//! into raywave's flags from one table, `FOREIGN_FLAGS`, so that their run lines work verbatim
+//! and clap validates every spelling the same way.
+
+use super::values::DefaultsArg;
+use raywave::error::UsageError;
+use raywave::options::Defaults;
+use std::ffi::OsString;
+
+/// What one value of a lab or RPI flag must look like.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Value {
+    /// A whole number, 0 or more.
+    Count,
+    /// A finite number.
+    Number,
+    /// Any text (a file name).
+    Text,
+}
+
+/// What a lab or RPI flag does in raywave.
+#[derive(Clone, Copy, Debug)]
+enum Meaning {
+    /// This raywave flag, followed by the values as given.
+    Flag(&'static str),
+    /// These raywave arguments (the flag takes no values).
+    Tokens(&'static [&'static str]),
+    /// `-num_shadow_samples N`: `--shadow-samples N`, except that 0, both programs' default,
+    /// is no count: the lab then shades hard shadows (or soft ones with raywave's count), RPI
+    /// casts no shadow rays at all (`--shadows off`).
+    ShadowSamples,
+    /// Accepted and checked, then ignored with a note on stderr giving this reason.
+    NoEffect(&'static str),
+}
+
+/// Which dashes a flag is spelled with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Dashes {
+    /// `-name` only: the lab's ArgParser, or RPI's older single-dash one.
+    One,
+    /// `-name` and RPI 2023's `--name`.
+    Both,
+}
+
+/// One flag of the lab's or RPI's ArgParser.
+struct ForeignFlag {
+    /// The name without its dashes.
+    name: &'static str,
+    /// How it is spelled.
+    dashes: Dashes,
+    /// The values that follow it.
+    values: &'static [Value],
+    /// What raywave does with it.
+    meaning: Meaning,
+}
+
+const fn flag(
+    name: &'static str,
+    dashes: Dashes,
+    values: &'static [Value],
+    meaning: Meaning,
+) -> ForeignFlag {
+    ForeignFlag {
+        name,
+        dashes,
+        values,
+        meaning,
+    }
+}
+
+const RADIOSITY: &str = "raywave has no radiosity solver";
+const PHOTONS: &str = "raywave has no photon mapping; indirect light stays the ambient term";
+const SPHERES: &str = "raywave intersects spheres exactly; RPI cuts them into patches only for radiosity and its OpenGL view";
+const GLOSSY: &str =
+    "raywave traces no glossy reflection rays; glossiness only widens the highlight";
+
+use Dashes::{Both, One};
+use Meaning::{Flag, NoEffect, ShadowSamples, Tokens};
+use Value::{Count, Number, Text};
+
+/// Every flag of the lab's ArgParser and RPI's (single-dash, and the 2023 double-dash forms),
+/// with raywave's meaning: one place to read and extend. Sources: the lab's `argparser.h`
+/// (`-input`, `-size`, `-sphere_rasterization`, `-num_bounces`, `-num_shadow_samples`,
+/// `-num_glossy_samples`, `-num_form_factor_samples`, `-background_color`, `-soft_shadow`),
+/// RPI's `argparser.h` (adds `-i`, `-cylinder_ring_rasterization`, `-num_antialias_samples`,
+/// `-ambient_light` and the photon-mapping flags) and RPI's 2023 `argparser.cpp` (the same with
+/// two dashes, without `-i`). `-output` is raywave's own single-dash spelling of `-o`, kept for
+/// lab-style lines.
+#[rustfmt::skip]
+const FOREIGN_FLAGS: &[ForeignFlag] = &[
+    flag("input",                       Both, &[Text],                   Flag("--input")),
+    flag("i",                           One,  &[Text],                   Flag("--input")),
+    flag("output",                      One,  &[Text],                   Flag("--output")),
+    flag("size",                        Both, &[Count, Count],           Flag("--size")),
+    flag("num_bounces",                 Both, &[Count],                  Flag("--bounces")),
+    flag("num_shadow_samples",          Both, &[Count],                  ShadowSamples),
+    flag("soft_shadow",                 One,  &[],                       Tokens(&["--shadows", "soft"])),
+    flag("background_color",            One,  &[Number, Number, Number], Flag("--background")),
+    flag("num_antialias_samples",       Both, &[Count],                  Flag("--aa")),
+    flag("ambient_light",               Both, &[Number, Number, Number], Flag("--ambient")),
+    flag("cylinder_ring_rasterization", Both, &[Count],                  Flag("--ring-segments")),
+    flag("sphere_rasterization",        Both, &[Count, Count],           NoEffect(SPHERES)),
+    flag("num_glossy_samples",          Both, &[Count],                  NoEffect(GLOSSY)),
+    flag("num_form_factor_samples",     Both, &[Count],                  NoEffect(RADIOSITY)),
+    flag("num_photons_to_shoot",        Both, &[Count],                  NoEffect(PHOTONS)),
+    flag("num_photons_to_collect",      Both, &[Count],                  NoEffect(PHOTONS)),
+    flag("gather_indirect",             Both, &[],                       NoEffect(PHOTONS)),
+];
+
+/// Spellings in the table that are also raywave's own: they do not choose whose defaults apply.
+const RAYWAVE_SPELLINGS: &[&str] = &["-output", "--input", "--size"];
+
+/// raywave flags a lab or RPI flag can stand for, with the setting they name in messages.
+const TARGETS: &[(&str, &str)] = &[
+    ("--input", "the scene"),
+    ("--output", "the output file"),
+    ("-o", "the output file"),
+    ("--size", "the size"),
+    ("--bounces", "the bounces"),
+    ("--shadows", "the shadow mode"),
+    ("--shadow-samples", "the shadow samples"),
+    ("--background", "the background"),
+    ("--aa", "the antialiasing samples"),
+    ("--ambient", "the ambient light"),
+    ("--ring-segments", "the ring segments"),
+];
+
+/// The subcommands that take the image flags, and so the lab's and RPI's spellings.
+const IMAGE_COMMANDS: &[&str] = &["render", "bench"];
+
+const SUBCOMMANDS: &[&str] = &[
+    "render",
+    "info",
+    "meshgen",
+    "variance",
+    "bench",
+    "help",
+    "-h",
+    "--help",
+    "-V",
+    "--version",
+];
+
+/// argv rewritten for clap, and the notes to print on stderr.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Normalized {
+    /// The arguments clap reads.
+    pub args: Vec<OsString>,
+    /// One line each for flags accepted without effect (printed with a `note:` prefix).
+    pub notes: Vec<String>,
+}
+
+/// The table entry for an argument, and whose spelling it is (`None`: raywave's own).
+fn foreign(arg: &str) -> Option<(&'static ForeignFlag, Option<Defaults>)> {
+    let (name, double) = match arg.strip_prefix("--") {
+        Some(name) => (name, true),
+        None => (arg.strip_prefix('-')?, false),
+    };
+    let flag = FOREIGN_FLAGS
+        .iter()
+        .find(|f| f.name == name && (!double || f.dashes == Both))?;
+    let dialect = if RAYWAVE_SPELLINGS.contains(&arg) {
+        None
+    } else if double {
+        Some(Defaults::Rpi)
+    } else {
+        Some(Defaults::Lab)
+    };
+    Some((flag, dialect))
+}
+
+/// Reads the values of `spelling` from `rest`, checking each one.
+fn take_values<'a>(
+    spelling: &str,
+    kinds: &[Value],
+    rest: &mut impl Iterator<Item = &'a OsString>,
+) -> Result<Vec<String>, UsageError> {
+    let what = match (kinds.first(), kinds.len()) {
+        (Some(Value::Count), 1) => "a whole number".to_string(),
+        (Some(Value::Count), n) => format!("{n} whole numbers"),
+        (Some(Value::Number), n) => format!("{n} numbers"),
+        _ => "a file name".to_string(),
+    };
+    let mut values = Vec::with_capacity(kinds.len());
+    for kind in kinds {
+        let found = rest.next().map(|v| v.to_string_lossy().into_owned());
+        let ok = match (&found, kind) {
+            (None, _) => false,
+            (Some(v), Value::Count) => v.parse::<u32>().is_ok(),
+            (Some(v), Value::Number) => v.parse::<f32>().is_ok_and(f32::is_finite),
+            (Some(_), Value::Text) => true,
+        };
+        if !ok {
+            let found = found.map_or("the end of the command line".to_string(), |v| {
+                format!("`{v}`")
+            });
+            return Err(UsageError(format!(
+                "{spelling}: expected {what}, found {found}"
+            )));
+        }
+        values.push(found.unwrap_or_default());
+    }
+    Ok(values)
+}
+
+/// Rewrites argv so clap can read it. A command line without a subcommand (`raywave`,
+/// `raywave scene.obj`, `raywave -size ...`) becomes `raywave render ...`. For `render` and
+/// `bench`, the lab's and RPI's spellings become raywave's flags (see `FOREIGN_FLAGS`), and
+/// they choose whose defaults fill the rest:
+///
+/// - the lab's single-dash spellings (also RPI's older single-dash ones): `--defaults lab`;
+/// - RPI 2023's double-dash spellings (`--num_bounces`, ...; `--input` and `--size` are
+///   raywave's too and choose nothing): `--defaults rpi`;
+/// - an explicit `--defaults` wins over both;
+/// - raywave's own flags mix freely with either: each still sets its setting, and the chosen
+///   defaults fill only what no flag sets;
+/// - the lab's and RPI 2023's spellings on one line, or one setting given twice under two
+///   spellings (`-num_bounces 0 --bounces 3`), are usage errors.
+pub fn normalize_args(args: impl IntoIterator<Item = OsString>) -> Result<Normalized, UsageError> {
+    let mut args: Vec<OsString> = args.into_iter().collect();
+    let program = if args.is_empty() {
+        OsString::from("raywave")
+    } else {
+        args.remove(0)
+    };
+    let first = args.first().and_then(|a| a.to_str()).unwrap_or("");
+    let (command, rest) = if SUBCOMMANDS.contains(&first) {
+        (first.to_string(), args[1..].to_vec())
+    } else {
+        ("render".to_string(), args)
+    };
+    let mut out = vec![program, OsString::from(&command)];
+    if !IMAGE_COMMANDS.contains(&command.as_str()) {
+        out.extend(rest);
+        return Ok(Normalized {
+            args: out,
+            notes: Vec::new(),
+        });
+    }
+
+    // Whose defaults: an explicit --defaults, else the spellings used.
+    let explicit = rest.iter().enumerate().find_map(|(i, a)| {
+        let value = match a.to_str()?.strip_prefix("--defaults") {
+            Some("") => rest.get(i + 1)?.to_str()?,
+            Some(v) => v.strip_prefix('=')?,
+            None => return None,
+        };
+        <DefaultsArg as clap::ValueEnum>::from_str(value, false)
+            .ok()
+            .map(Defaults::from)
+    });
+    let mut lab_spelling = None;
+    let mut rpi_spelling = None;
+    for arg in rest.iter().filter_map(|a| a.to_str()) {
+        match foreign(arg) {
+            Some((_, Some(Defaults::Lab))) => lab_spelling = lab_spelling.or(Some(arg)),
+            Some((_, Some(Defaults::Rpi))) => rpi_spelling = rpi_spelling.or(Some(arg)),
+            _ => {}
+        }
+    }
+    let detected = match (lab_spelling, rpi_spelling) {
+        (Some(lab), Some(rpi)) => {
+            return Err(UsageError(format!(
+                "`{lab}` is the lab's spelling and `{rpi}` RPI 2023's: expected one program's flags on a command line"
+            )));
+        }
+        (Some(_), None) => Some(Defaults::Lab),
+        (None, Some(_)) => Some(Defaults::Rpi),
+        (None, None) => None,
+    };
+    let dialect = explicit.or(detected).unwrap_or(Defaults::Raywave);
+    if explicit.is_none()
+        && let Some(d) = detected
+    {
+        out.extend(["--defaults", d.name()].map(OsString::from));
+    }
+
+    let mut notes = Vec::new();
+    // The setting each raywave flag sets, and the spelling that set it first.
+    let mut set_by: Vec<(&str, String)> = Vec::new();
+    let mut claim = |target: &str, spelling: &str| -> Result<(), UsageError> {
+        let Some(&(target, what)) = TARGETS.iter().find(|(t, _)| *t == target) else {
+            return Ok(());
+        };
+        let target = if target == "-o" { "--output" } else { target };
+        if let Some((_, first)) = set_by.iter().find(|(t, _)| *t == target) {
+            return Err(UsageError(format!(
+                "`{first}` and `{spelling}` both set {what}: expected it once"
+            )));
+        }
+        set_by.push((target, spelling.to_string()));
+        Ok(())
+    };
+    let mut rest = rest.iter();
+    while let Some(arg) = rest.next() {
+        let Some(text) = arg.to_str() else {
+            out.push(arg.clone());
+            continue;
+        };
+        let Some((flag, _)) = foreign(text) else {
+            claim(text, text)?;
+            if text.len() > 2
+                && text.starts_with('-')
+                && !text.starts_with("--")
+                && text[1..].starts_with(|c: char| c.is_ascii_alphabetic())
+            {
+                return Err(UsageError(format!(
+                    "unknown flag `{text}`: expected one of raywave's flags (--help lists them), or one of the lab's or RPI's: {}",
+                    FOREIGN_FLAGS
+                        .iter()
+                        .map(|f| format!("-{}", f.name))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )));
+            }
+            out.push(arg.clone());
+            continue;
+        };
+        let values = take_values(text, flag.values, &mut rest)?;
+        match flag.meaning {
+            Meaning::Flag(target) => {
+                claim(target, text)?;
+                out.push(target.into());
+                out.extend(values.into_iter().map(OsString::from));
+            }
+            Meaning::Tokens(args) => {
+                claim(args[0], text)?;
+                out.extend(args.iter().map(OsString::from));
+            }
+            Meaning::ShadowSamples => match (values[0].as_str(), dialect) {
+                ("0", Defaults::Rpi) => {
+                    claim("--shadows", text)?;
+                    out.extend(["--shadows", "off"].map(OsString::from));
+                }
+                ("0", _) => {}
+                (n, _) => {
+                    claim("--shadow-samples", text)?;
+                    out.extend(["--shadow-samples", n].map(OsString::from));
+                }
+            },
+            Meaning::NoEffect(why) => {
+                let given = std::iter::once(text.to_string())
+                    .chain(values)
+                    .collect::<Vec<_>>()
+                    .join(" ");
+                notes.push(format!("{given}: accepted, no effect in raywave ({why})"));
+            }
+        }
+    }
+    Ok(Normalized { args: out, notes })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn norm(line: &str) -> Result<Normalized, UsageError> {
+        normalize_args(
+            std::iter::once("raywave".into()).chain(line.split_whitespace().map(OsString::from)),
+        )
+    }
+
+    fn args(line: &str) -> String {
+        norm(line)
+            .unwrap()
+            .args
+            .into_iter()
+            .map(|s| s.into_string().unwrap())
+            .collect::<Vec<_>>()
+            .join(" ")
+    }
+
+    #[test]
+    fn lab_run_line_is_translated_with_the_lab_defaults() {
+        assert_eq!(
+            args("-size 200 200 -input a.obj -soft_shadow -num_bounces 5"),
+            "raywave render --defaults lab --size 200 200 --input a.obj --shadows soft --bounces 5"
+        );
+    }
+
+    #[test]
+    fn rpi_2023_line_is_translated_with_rpi_defaults() {
+        assert_eq!(
+            args("--input a.obj --size 300 300 --num_bounces 2 --num_shadow_samples 0"),
+            "raywave render --defaults rpi --input a.obj --size 300 300 --bounces 2 --shadows off"
+        );
+        // --input and --size alone are raywave's spellings too: raywave's defaults.
+        assert_eq!(
+            args("--input a.obj --size 3 3"),
+            "raywave render --input a.obj --size 3 3"
+        );
+    }
+
+    #[test]
+    fn shadow_sample_count_zero_is_no_count_for_the_lab() {
+        assert_eq!(
+            args("-num_shadow_samples 0"),
+            "raywave render --defaults lab"
+        );
+    }
+
+    #[test]
+    fn explicit_defaults_win() {
+        assert_eq!(
+            args("--defaults raywave -num_bounces 1"),
+            "raywave render --defaults raywave --bounces 1"
+        );
+        assert_eq!(
+            args("--num_bounces 1 --defaults=lab"),
+            "raywave render --bounces 1 --defaults=lab"
+        );
+    }
+
+    #[test]
+    fn no_effect_flags_give_notes() {
+        let n = norm("-sphere_rasterization 16 12 --light-model rpi").unwrap();
+        assert_eq!(n.notes.len(), 1);
+        assert!(n.notes[0].starts_with("-sphere_rasterization 16 12: accepted, no effect"));
+    }
+
+    #[test]
+    fn bad_values_mixed_dialects_and_duplicates_are_usage_errors() {
+        for line in [
+            "-size 200",
+            "-size 200 x",
+            "-num_bounces -1",
+            "-ambient_light 1 nan 1",
+            "-num_bounces 1 --num_shadow_samples 2",
+            "-num_bounces 1 --bounces 2",
+            "-soft_shadow --shadows hard",
+            "-frobnicate",
+            "-output a.png -o b.png",
+            "-input a.obj -i b.obj",
+        ] {
+            assert!(norm(line).is_err(), "{line}");
+        }
+    }
+
+    #[test]
+    fn no_arguments_means_render() {
+        assert_eq!(args(""), "raywave render");
+        assert_eq!(args("info"), "raywave info");
+        assert_eq!(
+            args("scene.obj -o x.png"),
+            "raywave render scene.obj -o x.png"
+        );
+    }
+}

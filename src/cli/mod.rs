@@ -1,0 +1,52 @@
+//! The command line, which belongs to the binary: clap's types, one file per command, each
+//! turning its flags into the library's plain options (`ImageOptions`, `BenchOptions`,
+//! `VarianceOptions`) and running the command; `main` owns the exit code.
+//!
+//! ```text
+//! foreign.rs   the lab's and RPI's spellings -> raywave's flags (FOREIGN_FLAGS)
+//! values.rs    clap spellings of the library's enums (engine, shadows, sampler, ...)
+//! image.rs     the image flags render and bench share -> raywave::options::ImageOptions
+//! render.rs    raywave render: summary, --stats, --stats-json, --debug-pixel
+//! bench.rs     raywave bench -> raywave::bench::BenchOptions
+//! variance.rs  raywave variance -> raywave::variance::command::VarianceOptions
+//! meshgen.rs, info.rs
+//! ```
+
+pub mod bench;
+pub mod foreign;
+pub mod image;
+pub mod info;
+pub mod meshgen;
+pub mod render;
+pub mod values;
+pub mod variance;
+
+use clap::{Parser, Subcommand};
+
+/// raywave: a SIMD wavefront ray tracer for the lab's Cornell-box scenes.
+#[derive(Parser, Debug)]
+#[command(name = "raywave", version, about, long_about = None)]
+pub struct Cli {
+    /// What to do (default: render).
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// The subcommands.
+#[derive(Subcommand, Debug)]
+// Parsed once per run: the size of the `Render` variant does not matter.
+#[allow(clippy::large_enum_variant)]
+pub enum Command {
+    /// Render a scene to an image (the default command; the lab's flags work too).
+    Render(render::RenderArgs),
+    /// Print the build's SIMD path, thread count and version.
+    Info,
+    /// Write a generated mesh scene: the lab's Cornell box with its three mirror spheres
+    /// tessellated (for the BVH benchmarks: about 12k or 1M triangles).
+    Meshgen(meshgen::MeshgenArgs),
+    /// Compare light samplers: MSE, bias, variance and slopes against a converged reference.
+    Variance(variance::VarianceArgs),
+    /// Time both engines on a scene (rays/s per kind and stage); save and compare records
+    /// (exit 3 when a figure regresses past --threshold).
+    Bench(bench::BenchArgs),
+}

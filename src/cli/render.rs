@@ -1,0 +1,408 @@
+//! `raywave render`: checks what can fail cheaply, renders with the chosen engine, writes the
+//! image (and the linear floats, and the `--stats-json` record), then prints the summary.
+
+use super::image::ImageArgs;
+use super::values::{EngineArg, ToneMapArg};
+use anyhow::Result;
+use clap::Args;
+use raywave::bench::record::StageFigure;
+use raywave::camera::CameraRays;
+use raywave::debug_view::RayRecorder;
+use raywave::engine::{Engine, thread_pool};
+use raywave::error::UsageError;
+use raywave::film::{OutputFormat, check_hdr_path, check_output_dir, output_format};
+use raywave::machine::Machine;
+use raywave::options::{BackgroundSource, Effective};
+use raywave::reference::Reference;
+use raywave::report::{DefaultsUsed, KindFigures, RenderRecord, SceneFigures};
+use raywave::scene::{Scene, load_scene};
+use raywave::settings::{LightModel, ShadowMode};
+use raywave::stats::RayCounts;
+use raywave::terminal::{print, progress_bar};
+use raywave::wavefront::stats::RenderStats;
+use std::fmt::Write as _;
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// `raywave render` flags.
+#[derive(Args, Debug, Clone)]
+pub struct RenderArgs {
+    /// Scene file (.obj); without one, the built-in lab Cornell box with mirror spheres.
+    pub scene: Option<PathBuf>,
+    /// The lab's `-input FILE` (same as the positional SCENE).
+    #[arg(long = "input", hide = true, conflicts_with = "scene")]
+    pub input: Option<PathBuf>,
+    /// Output: an 8-bit image (.png or .ppm), or only the linear floats (.pfm or .exr);
+    /// written whole or not at all.
+    #[arg(short, long, default_value = "render.png")]
+    pub output: PathBuf,
+    /// Size, bounces, shadows, lighting and sampling (shared with `raywave bench`).
+    #[command(flatten)]
+    pub image: ImageArgs,
+    /// Seed of every random number.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u32,
+    /// Worker threads [default: all cores]; 1 runs serially.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub threads: Option<u32>,
+    /// Also write linear floats to this file (.pfm or .exr).
+    #[arg(long)]
+    pub hdr: Option<PathBuf>,
+    /// Tone mapping of the 8-bit image: clamp (the lab's look) or exp (1 − e^(−3x)).
+    #[arg(long, value_enum, default_value = "clamp")]
+    pub tonemap: ToneMapArg,
+    /// Let faces be hit from behind too.
+    #[arg(long)]
+    pub two_sided: bool,
+    /// Print the rays traced for pixel X Y (from the top-left) and draw them over the image.
+    #[arg(long, num_args = 2, value_names = ["X", "Y"])]
+    pub debug_pixel: Option<Vec<u32>>,
+    /// No progress bar and no summary.
+    #[arg(short, long)]
+    pub quiet: bool,
+    /// Which engine renders the image.
+    #[arg(long, value_enum, default_value = "wavefront")]
+    pub engine: EngineArg,
+    /// Camera samples per wavefront tile: the unit of work and of memory.
+    #[arg(long, default_value_t = raywave::wavefront::DEFAULT_BATCH_SIZE as u32,
+          value_parser = clap::value_parser!(u32).range(1..=1 << 20))]
+    pub batch_size: u32,
+    /// Print rays and rays/s per kind, and per stage for the wavefront engine.
+    #[arg(long)]
+    pub stats: bool,
+    /// Write the same figures as JSON, with the machine, SIMD path and thread count.
+    #[arg(long, value_name = "FILE")]
+    pub stats_json: Option<PathBuf>,
+}
+
+impl RenderArgs {
+    /// The scene path, from the positional argument or the lab's `-input`.
+    pub fn scene_path(&self) -> Option<&PathBuf> {
+        self.scene.as_ref().or(self.input.as_ref())
+    }
+
+    /// Turns the flags into settings; `scene_background` is the file's `background_color`.
+    pub fn settings(&self, scene_background: Option<[f32; 3]>) -> Effective {
+        let mut effective = self.image.options().resolve(scene_background);
+        effective.settings.seed = self.seed;
+        effective.settings.two_sided = self.two_sided;
+        effective
+    }
+}
+
+/// Renders as the flags say.
+pub fn run(args: &RenderArgs) -> Result<()> {
+    // Check everything that can fail cheaply before the long part.
+    let format = output_format(&args.output).map_err(|e| UsageError::from_error(&e))?;
+    check_output_dir(&args.output)?;
+    if let Some(hdr) = &args.hdr {
+        check_hdr_path(hdr).map_err(|e| UsageError::from_error(&e))?;
+        check_output_dir(hdr)?;
+    }
+    let scene = load_scene(
+        args.scene_path().map(PathBuf::as_path),
+        &args.image.options().parse_options(),
+    )?
+    .scene;
+    for w in &scene.warnings {
+        eprintln!("{w}");
+    }
+    let effective = args.settings(scene.background.map(|c| c.to_array()));
+    let settings = effective.settings.clone();
+    if let Some(px) = &args.debug_pixel
+        && (px[0] >= settings.width || px[1] >= settings.height)
+    {
+        return Err(UsageError(format!(
+            "--debug-pixel {} {} is outside the {}×{} image",
+            px[0], px[1], settings.width, settings.height
+        ))
+        .into());
+    }
+    if let Some(path) = &args.stats_json {
+        check_output_dir(path)?;
+    }
+    let pool = thread_pool(args.threads)?;
+    let threads = pool.current_num_threads();
+    let engine_choice = Engine::from(args.engine);
+
+    // The reference's set-up (its BVH for meshes) is timed with its render; the wavefront
+    // engine's BVH build is reported on its own.
+    let setup_start = Instant::now();
+    let engine = engine_choice.prepare(&scene, &settings, args.batch_size as usize);
+    let (units, unit) = engine.work_units(&settings);
+    let progress = progress_bar(
+        units,
+        &format!(
+            "{{spinner}} rendering [{{bar:40}}] {{pos}}/{{len}} {unit}, {{elapsed}} (eta {{eta}})"
+        ),
+        args.quiet,
+    );
+    let start = match engine_choice {
+        Engine::Reference => setup_start,
+        Engine::Wavefront => Instant::now(),
+    };
+    let (film, stats) = pool.install(|| engine.render(&|| progress.inc(1)));
+    let seconds = start.elapsed().as_secs_f64();
+    progress.finish_and_clear();
+    let report = Report {
+        counts: stats.counts,
+        seconds,
+        stages: engine.bvh_build_seconds().map(|bvh| (stats, bvh)),
+    };
+
+    let mut img = match format {
+        OutputFormat::Ldr(_) => Some(film.to_rgb8(args.tonemap.into())),
+        OutputFormat::Linear => None,
+    };
+    if let Some(px) = &args.debug_pixel {
+        let mut recorder = RayRecorder {
+            miss_length: 10.0,
+            ..Default::default()
+        };
+        let pixel = px[1] * settings.width + px[0];
+        // The debug view follows the reference's recursion (both engines trace the same rays).
+        let reference = Reference::new(&scene, &settings);
+        let colour = reference.pixel(pixel, &mut RayCounts::default(), &mut recorder);
+        print(&format!(
+            "rays traced for pixel ({}, {}), colour {:.5}:\n{}",
+            px[0],
+            px[1],
+            colour,
+            recorder.report(&scene)
+        ))?;
+        match &mut img {
+            Some(img) => {
+                let camera = CameraRays::new(&scene.camera, settings.width, settings.height);
+                recorder.draw(img, &camera);
+            }
+            None => eprintln!(
+                "note: the rays are drawn only over an 8-bit image; {} holds the linear image alone",
+                args.output.display()
+            ),
+        }
+    }
+    match &img {
+        Some(img) => raywave::film::write_rgb8(img, &args.output)?,
+        None => film.write_hdr(&args.output)?,
+    }
+    if let Some(hdr) = &args.hdr {
+        film.write_hdr(hdr)?;
+    }
+    let run = RunInfo {
+        engine: engine_choice,
+        threads,
+        batch_size: args.batch_size,
+    };
+    if let Some(path) = &args.stats_json {
+        record(&scene, &effective, &run, &report).write(path)?;
+    }
+    if !args.quiet {
+        let extra = args
+            .hdr
+            .as_ref()
+            .map(|h| format!(" and {}", h.display()))
+            .unwrap_or_default();
+        print(&format!(
+            "{}wrote   {}{extra}\n",
+            summary(&scene, &effective, &run, &report),
+            args.output.display()
+        ))?;
+    }
+    if args.stats {
+        print(&stats_table(&report))?;
+    }
+    Ok(())
+}
+
+/// The summary printed after a render: engine, scene, settings, rays and time.
+fn summary(scene: &Scene, effective: &Effective, run: &RunInfo, report: &Report) -> String {
+    let mut out = String::new();
+    let s = &effective.settings;
+    let shadows = match s.shadows {
+        ShadowMode::Off => "off (every light visible)".to_string(),
+        ShadowMode::Hard => "hard (light centroids)".to_string(),
+        ShadowMode::Soft => format!(
+            "soft, {} {} points per light",
+            s.shadow_samples,
+            s.sampler.name()
+        ),
+    };
+    let _ = writeln!(
+        out,
+        "raywave {} · engine {} · simd {} · {} thread(s)",
+        env!("CARGO_PKG_VERSION"),
+        run.engine.name(),
+        raywave::simd_path(),
+        run.threads
+    );
+    let rings = match scene.ring_count {
+        0 => String::new(),
+        n => format!("; {n} ring(s) cut into faces"),
+    };
+    let _ = writeln!(
+        out,
+        "scene   {}: {} faces ({} triangles{rings}), {} spheres, {} light(s), {} camera",
+        scene.source,
+        scene.face_count,
+        scene.triangles.len(),
+        scene.spheres.len(),
+        scene.lights.len(),
+        if scene.camera_from_file {
+            "file"
+        } else {
+            "lab default"
+        }
+    );
+    let _ = writeln!(
+        out,
+        "render  {}×{}, {} bounces, shadows {shadows}, {} aa sample(s), seed {}, {} faces",
+        s.width,
+        s.height,
+        s.bounces,
+        s.aa_samples,
+        s.seed,
+        if s.two_sided {
+            "two-sided"
+        } else {
+            "one-sided"
+        }
+    );
+    let model = match s.light_model {
+        LightModel::Lab => "lab (no fall-off)",
+        LightModel::Rpi => "rpi (divided by π·d²)",
+    };
+    let background = match effective.background {
+        BackgroundSource::Flag => "flag",
+        BackgroundSource::Scene => "scene",
+        BackgroundSource::Defaults => "default",
+    };
+    let [r, g, b] = s.background;
+    let [ar, ag, ab] = s.ambient;
+    let _ = writeln!(
+        out,
+        "light   model {model}, ambient {ar} {ag} {ab}, background {r} {g} {b} ({background})"
+    );
+    let defaulted = if effective.defaulted.is_empty() {
+        "none needed: flags set every setting".to_string()
+    } else {
+        format!(
+            "{} (--defaults {}) for {}",
+            effective.defaults.owner(),
+            effective.defaults.name(),
+            effective.defaulted.join(", ")
+        )
+    };
+    let _ = writeln!(out, "default {defaulted}");
+    let counts = &report.counts;
+    let _ = writeln!(
+        out,
+        "rays    {} total: {} camera, {} shadow, {} reflection",
+        counts.total(),
+        counts.camera,
+        counts.shadow,
+        counts.reflection
+    );
+    let _ = writeln!(
+        out,
+        "time    {:.3} s, {:.2} Mrays/s",
+        report.seconds,
+        report.kinds().total.rays_per_second / 1e6
+    );
+    out
+}
+
+/// How the render ran, for the summary and the JSON.
+struct RunInfo {
+    engine: Engine,
+    threads: usize,
+    batch_size: u32,
+}
+
+/// What a render measured.
+struct Report {
+    counts: RayCounts,
+    seconds: f64,
+    /// Wavefront only: per-stage figures, and the BVH build time if a BVH was used.
+    stages: Option<(RenderStats, Option<f64>)>,
+}
+
+impl Report {
+    /// Rays and rays per wall-clock second by kind, as the JSON gives them.
+    fn kinds(&self) -> KindFigures {
+        KindFigures::new(&self.counts, self.seconds)
+    }
+}
+
+/// The `--stats` tables: rays by kind, then (wavefront) the BVH build and each stage.
+fn stats_table(report: &Report) -> String {
+    let mut out = String::new();
+    let _ = writeln!(out, "{:<12} {:>14} {:>14}", "kind", "rays", "Mrays/s");
+    for (kind, figure) in report.kinds().rows() {
+        let rays = figure.rays;
+        let _ = writeln!(
+            out,
+            "{kind:<12} {rays:>14} {:>14.2}",
+            figure.rays_per_second / 1e6
+        );
+    }
+    if let Some((_, Some(build))) = &report.stages {
+        let _ = writeln!(out, "bvh build {build:.3} s");
+    }
+    if let Some((stats, _)) = &report.stages {
+        let _ = writeln!(
+            out,
+            "{:<12} {:>14} {:>14} {:>20}",
+            "stage", "rays", "thread-s", "Mrays/thread-s"
+        );
+        for row in stats.stage_rows() {
+            let _ = writeln!(
+                out,
+                "{:<12} {:>14} {:>14.3} {:>20.2}",
+                row.stage,
+                row.rays,
+                row.thread_seconds,
+                row.rays_per_thread_second / 1e6
+            );
+        }
+    }
+    out
+}
+
+/// The `--stats-json` record of a render.
+fn record(scene: &Scene, effective: &Effective, run: &RunInfo, report: &Report) -> RenderRecord {
+    let (stages, bvh) = match &report.stages {
+        Some((stats, bvh)) => (
+            Some(stats.stage_rows().iter().map(StageFigure::from).collect()),
+            Some(*bvh),
+        ),
+        None => (None, None),
+    };
+    RenderRecord {
+        raywave: env!("CARGO_PKG_VERSION"),
+        // The record has never named the host.
+        machine: Machine {
+            hostname: String::new(),
+            ..Machine::current()
+        },
+        simd: raywave::simd_path(),
+        threads: run.threads,
+        engine: run.engine,
+        batch_size: run.batch_size,
+        scene: SceneFigures {
+            source: scene.source.clone(),
+            triangles: scene.triangles.len(),
+            spheres: scene.spheres.len(),
+            lights: scene.lights.len(),
+            bvh: bvh.map(|b| b.is_some()),
+            bvh_build_seconds: bvh.flatten(),
+        },
+        settings: effective.settings.clone(),
+        defaults: DefaultsUsed {
+            from: effective.defaults.name(),
+            settings: effective.defaulted.clone(),
+        },
+        seconds: report.seconds,
+        rays: report.kinds(),
+        stages,
+    }
+}

@@ -1,0 +1,122 @@
+//! The command line's spellings of the library's choices. Each enum mirrors one of the
+//! library's, variant for variant and with the same docs (clap prints them as the possible
+//! values), so that the library's types need no clap; `From` maps each to its twin, and a
+//! variant added to the library fails to compile here until it has a spelling.
+
+use raywave::engine::Engine;
+use raywave::film::ToneMap;
+use raywave::options::Defaults;
+use raywave::sampling::LightSampler;
+use raywave::settings::{LightModel, ShadowMode};
+
+/// Declares a clap value enum and its conversion into the library's enum of the same variants.
+macro_rules! mirror {
+    ($(#[$doc:meta])* $name:ident => $lib:ident { $($(#[$vdoc:meta])* $variant:ident,)+ }) => {
+        $(#[$doc])*
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+        pub enum $name {
+            $($(#[$vdoc])* $variant,)+
+        }
+
+        impl From<$name> for $lib {
+            fn from(value: $name) -> $lib {
+                match value {
+                    $($name::$variant => $lib::$variant,)+
+                }
+            }
+        }
+    };
+}
+
+mirror! {
+    /// The renderers.
+    EngineArg => Engine {
+        /// Structure-of-arrays batches through 8-wide SIMD stages (the default).
+        Wavefront,
+        /// The scalar recursive renderer, one ray at a time: the whole-image twin.
+        Reference,
+    }
+}
+
+mirror! {
+    /// How linear values become 8-bit pixels.
+    ToneMapArg => ToneMap {
+        /// The lab's look: clamp to [0, 1], no gamma.
+        Clamp,
+        /// The lab's key 'h': 1 − exp(−3x).
+        Exp,
+    }
+}
+
+mirror! {
+    /// How shadows are computed.
+    ShadowArg => ShadowMode {
+        /// The lab's starting point: every light counts as visible (no shadow rays).
+        Off,
+        /// One shadow ray per light, to its centroid.
+        Hard,
+        /// `shadow_samples` shadow rays per light, to points chosen by `sampler`.
+        Soft,
+    }
+}
+
+mirror! {
+    /// How a light's colour reaches a shaded point.
+    LightModelArg => LightModel {
+        /// The lab's: Lc = 0.2·ke·area, with no fall-off with distance.
+        Lab,
+        /// RPI's framework (`RayTracer::TraceRay`): Lc = ke·area / (π·d²), with no 0.2 factor, d
+        /// the distance to the light point (docs/SHADING.md).
+        Rpi,
+    }
+}
+
+mirror! {
+    /// How points are chosen on an area light.
+    SamplerArg => LightSampler {
+        /// N independent uniform points on the light.
+        Random,
+        /// Jittered: the light's (u, v) square split into N strata (nx × ny, see `strata_grid`),
+        /// one uniform point in each.
+        Stratified,
+        /// Owen-scrambled Sobol points (Burley 2020), scrambled independently for every
+        /// (pixel, sample, bounce, light): low discrepancy for any N, best at powers of two.
+        Sobol,
+        /// The lab's own strategy: the centre of the light's (u, v) square (its centroid, for a
+        /// parallelogram) when N = 1, independent random points otherwise.
+        Lab,
+    }
+}
+
+impl SamplerArg {
+    /// Every sampler, in the order reports list them (`LightSampler::ALL`).
+    pub const ALL: [SamplerArg; 4] = [
+        SamplerArg::Random,
+        SamplerArg::Stratified,
+        SamplerArg::Sobol,
+        SamplerArg::Lab,
+    ];
+}
+
+mirror! {
+    /// Whose defaults fill the settings that no flag sets.
+    DefaultsArg => Defaults {
+        /// raywave's own, the lab's third run line: 512×512, 5 bounces, soft shadows (16 points).
+        Raywave,
+        /// The lab's ArgParser: 100×100, 0 bounces, hard shadows, white background.
+        Lab,
+        /// RPI's 2023 ArgParser: 500×500, 0 bounces, no shadow test, ambient 0.1, RPI's light model.
+        Rpi,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sampler_spellings_list_every_sampler_in_the_library_order() {
+        let ours: Vec<LightSampler> = SamplerArg::ALL.into_iter().map(Into::into).collect();
+        assert_eq!(ours, LightSampler::ALL);
+    }
+}

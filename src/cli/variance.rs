@@ -1,0 +1,91 @@
+//! `raywave variance` flags, turned into `raywave::variance::command::VarianceOptions`.
+
+use super::values::{EngineArg, LightModelArg, SamplerArg};
+use anyhow::Result;
+use clap::Args;
+use raywave::engine::thread_pool;
+use raywave::variance::command::VarianceOptions;
+use std::path::PathBuf;
+
+/// Flags of `raywave variance`.
+#[derive(Args, Debug, Clone)]
+pub struct VarianceArgs {
+    /// Scene file; without one, the built-in lab Cornell box with mirror spheres.
+    pub scene: Option<PathBuf>,
+    /// Light-sample budgets N, comma-separated.
+    #[arg(long, value_delimiter = ',', default_values_t = [1u32, 4, 16, 64, 256], value_parser = clap::value_parser!(u32).range(1..=65536))]
+    pub budgets: Vec<u32>,
+    /// Samplers to compare, comma-separated.
+    #[arg(long, value_enum, value_delimiter = ',', default_values_t = SamplerArg::ALL)]
+    pub samplers: Vec<SamplerArg>,
+    /// Seeds (independent renders) per sampler and budget; at least 2, for the variance.
+    #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(2..=1024))]
+    pub seeds: u32,
+    /// Image size.
+    #[arg(long, num_args = 2, value_names = ["W", "H"], default_values_t = [128u32, 128], value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pub size: Vec<u32>,
+    /// Mirror bounces.
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(0..=64))]
+    pub bounces: u32,
+    /// Stratified points per light in each half of the converged reference.
+    #[arg(long, default_value_t = 4096, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    pub reference_samples: u32,
+    /// Points per light per hit for the penumbra mask.
+    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    pub mask_samples: u32,
+    /// The budget whose per-pixel error maps are drawn (must be one of --budgets).
+    #[arg(long, default_value_t = 16)]
+    pub heatmap_n: u32,
+    /// Directory for table.txt, results.csv, results.json, mse.png and the heat maps.
+    #[arg(long, default_value = "variance-report")]
+    pub out: PathBuf,
+    /// Directory caching converged references (keyed by scene bytes and settings).
+    #[arg(long, default_value = ".raywave-cache")]
+    pub cache: PathBuf,
+    /// Always render the converged reference, ignoring and not writing the cache.
+    #[arg(long)]
+    pub no_cache: bool,
+    /// How a light's colour reaches a point: lab (no fall-off) or rpi (divided by π·d², as
+    /// RPI's framework does).
+    #[arg(long, value_enum, default_value = "lab")]
+    pub light_model: LightModelArg,
+    /// The engine that renders the images (both draw the same samples).
+    #[arg(long, value_enum, default_value = "wavefront")]
+    pub engine: EngineArg,
+    /// Worker threads [default: all cores].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub threads: Option<u32>,
+    /// No progress bar.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+impl VarianceArgs {
+    /// The flags as the library's options.
+    pub fn options(&self) -> VarianceOptions {
+        VarianceOptions {
+            scene: self.scene.clone(),
+            budgets: self.budgets.clone(),
+            samplers: self.samplers.iter().map(|&s| s.into()).collect(),
+            seeds: self.seeds,
+            size: [self.size[0], self.size[1]],
+            bounces: self.bounces,
+            reference_samples: self.reference_samples,
+            mask_samples: self.mask_samples,
+            heatmap_n: self.heatmap_n,
+            out: self.out.clone(),
+            cache: self.cache.clone(),
+            no_cache: self.no_cache,
+            light_model: self.light_model.into(),
+            engine: self.engine.into(),
+            quiet: self.quiet,
+        }
+    }
+}
+
+/// Runs the study on `--threads` worker threads.
+pub fn run(args: &VarianceArgs) -> Result<()> {
+    let pool = thread_pool(args.threads)?;
+    let options = args.options();
+    pool.install(|| raywave::variance::command::run(&options))
+}
