@@ -3,11 +3,12 @@
 //! `scenes` (bare and bundled scenes, the bias tests' lights and settings), `analytic` (the
 //! closed-form penumbra scene), `strategies`
 //! (proptest inputs), `random` (seeded inputs from `rand`), `bin` (running the binary in a
-//! scratch directory).
+//! scratch directory), `hostile` (the hostile-input catalogue's harness).
 #![allow(dead_code, unused_imports)]
 
 pub mod analytic;
 pub mod bin;
+pub mod hostile;
 pub mod random;
 pub mod rays;
 pub mod scenes;
