@@ -5,7 +5,7 @@
 //! - the **wavefront** engine ([`wavefront`]) moves rays through stages in structure-of-arrays
 //!   batches, 8 lanes at a time: generate → intersect → shadow → film → reflect, tiles spread
 //!   over cores with rayon, meshes through its own 8-wide BVH;
-//! - the **reference** ([`reference`]) is the lab's recursive renderer, one scalar ray at a
+//! - the **reference** ([`reference`](mod@reference)) is the lab's recursive renderer, one scalar ray at a
 //!   time, written to be obviously right: the twin every fast path is checked and timed
 //!   against.
 //!
@@ -14,7 +14,7 @@
 //! and light points go, as pure functions of (pixel, sample, bounce, light, dimension, seed)),
 //! [`geometry`] (scalar intersection kernels), [`spawn`] (where secondary rays start),
 //! [`shading`] (the lab's Shade) and [`film`] (the linear image and its files). Around them:
-//! [`variance`] (the light-sampling study), [`bench`] (both engines timed side by side) and
+//! [`variance`] (the light-sampling study), [`bench`](mod@bench) (both engines timed side by side) and
 //! [`peer`] (the same mesh rays through obvhs and Embree).
 //!
 //! A tiny render of a scene given as text, by both engines:
