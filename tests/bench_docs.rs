@@ -206,12 +206,19 @@ fn check_cargo(words: &[&str]) -> Result<(), String> {
     Ok(())
 }
 
-/// The command with QUICK's values for its subcommand.
+/// The command with QUICK's values for its subcommand. A `bench --against OTHER` runs
+/// against this build itself (an A/A comparison), in its fewest rounds and without `--runs`
+/// (which the A/B mode does not take).
 fn shorten(words: &[&str]) -> Vec<String> {
     let sub = words.get(1).copied().unwrap_or("");
     let mut out: Vec<String> = words.iter().map(|w| w.to_string()).collect();
+    if let Some(i) = out.iter().position(|w| w == "--against") {
+        out[i + 1] = env!("CARGO_BIN_EXE_raywave").to_string();
+        out.extend(["--rounds", "6", "--warmup", "0"].map(String::from));
+    }
+    let ab = out.iter().any(|w| w == "--against");
     for (s, flag, values) in QUICK {
-        if s != sub {
+        if s != sub || (ab && flag == "--runs") {
             continue;
         }
         if let Some(i) = out.iter().position(|w| w == flag) {
@@ -335,8 +342,9 @@ fn raywave_commands_run_in_page_order() {
         let code = out.status.code();
         // A comparison of sub-millisecond renders may call noise a regression (exit 3); it must
         // still have compared.
-        let compared =
-            words.contains(&"--compare") && code == Some(3) && stdout.contains("verdict:");
+        let compared = (words.contains(&"--compare") && stdout.contains("verdict:")
+            || words.contains(&"--against") && stdout.contains("95% interval"))
+            && code == Some(3);
         assert!(
             code == Some(0) || compared,
             "`{command}` (run as `{}`) exited {code:?}:\n{stdout}\n{stderr}",

@@ -8,6 +8,7 @@
 //! medians per figure; print; write --save / --json; compare -> table, verdict (exit 3)
 //! ```
 
+pub mod ab;
 pub mod compare;
 pub mod record;
 

@@ -1,9 +1,11 @@
 //! `raywave bench` flags, turned into `raywave::bench::BenchOptions`.
 
 use super::image::ImageArgs;
+use super::values::EngineArg;
 use anyhow::Result;
 use clap::Args;
-use raywave::bench::{BenchOptions, DEFAULT_THRESHOLD_PCT};
+use raywave::bench::ab::{self, AbOptions, MIN_ROUNDS};
+use raywave::bench::{BenchOptions, DEFAULT_THRESHOLD_PCT, EXIT_REGRESSION};
 use std::path::PathBuf;
 
 /// Flags of `raywave bench`.
@@ -32,10 +34,27 @@ pub struct BenchArgs {
     /// Directory of saved records.
     #[arg(long, default_value = ".raywave-bench")]
     pub dir: PathBuf,
-    /// Regression threshold in percent: a headline figure that falls by more fails --compare.
-    #[arg(long, value_name = "PCT", default_value_t = DEFAULT_THRESHOLD_PCT,
-          value_parser = parse_threshold)]
-    pub threshold: f64,
+    /// Regression threshold in percent: a headline figure that falls by more fails --compare;
+    /// with --against, a ratio whose whole 95% interval lies above 1 + PCT% fails [default: 40;
+    /// 5 with --against].
+    #[arg(long, value_name = "PCT", value_parser = parse_threshold)]
+    pub threshold: Option<f64>,
+    /// Time this build against another raywave binary on the same flags: the two alternate,
+    /// round after round, and each engine's time ratio (this / OTHER) gets a median and a 95%
+    /// interval from the paired rounds; exit 3 when the whole interval lies above the threshold.
+    #[arg(long, value_name = "OTHER", conflicts_with_all = ["save", "compare", "json", "runs"])]
+    pub against: Option<PathBuf>,
+    /// Timed rounds with --against (each runs both builds once).
+    #[arg(long, default_value_t = 20, requires = "against",
+          value_parser = clap::value_parser!(u32).range(i64::from(MIN_ROUNDS)..=10_000))]
+    pub rounds: u32,
+    /// Untimed rounds before the timed ones with --against.
+    #[arg(long, default_value_t = 1, requires = "against",
+          value_parser = clap::value_parser!(u32).range(0..=1000))]
+    pub warmup: u32,
+    /// Which engine --against times [default: both].
+    #[arg(long, value_enum, requires = "against")]
+    pub engine: Option<EngineArg>,
     /// Also write the record as JSON to FILE (`-` for stdout).
     #[arg(long, value_name = "FILE")]
     pub json: Option<PathBuf>,
@@ -64,15 +83,53 @@ impl BenchArgs {
             save: self.save.clone(),
             compare: self.compare.clone(),
             dir: self.dir.clone(),
-            threshold: self.threshold,
+            threshold: self.threshold.unwrap_or(DEFAULT_THRESHOLD_PCT),
             json: self.json.clone(),
             quiet: self.quiet,
         }
     }
 }
 
+/// The threshold of `--against` when none is given, in percent.
+const AB_THRESHOLD_PCT: f64 = 5.0;
+
 /// Runs the bench; the exit code is 3 (`raywave::bench::EXIT_REGRESSION`) when `--compare`
-/// finds a regression, else 0.
+/// or `--against` finds a regression, else 0.
 pub fn run(args: &BenchArgs) -> Result<u8> {
-    Ok(raywave::bench::run(&args.options())?.exit_code())
+    let Some(other) = &args.against else {
+        return Ok(raywave::bench::run(&args.options())?.exit_code());
+    };
+    let options = AbOptions {
+        other: other.clone(),
+        scene: args.scene.clone().or_else(|| args.input.clone()),
+        render_flags: args.image.flags(),
+        engines: match args.engine {
+            Some(e) => vec![e.into()],
+            None => vec![
+                raywave::engine::Engine::Wavefront,
+                raywave::engine::Engine::Reference,
+            ],
+        },
+        threads: args.threads,
+        rounds: args.rounds,
+        warmup: args.warmup,
+        threshold_pct: args.threshold.unwrap_or(AB_THRESHOLD_PCT),
+        quiet: args.quiet,
+    };
+    let bar = raywave::terminal::progress_bar(
+        0,
+        "{elapsed_precise} [{bar:40}] {pos}/{len} runs, both builds alternating",
+        args.quiet,
+    );
+    let results = ab::run(&options, &|done, total| {
+        bar.set_length(total);
+        bar.set_position(done);
+    })?;
+    bar.finish_and_clear();
+    raywave::terminal::print(&ab::report(&options, &results))?;
+    Ok(if ab::regressed(&options, &results) {
+        EXIT_REGRESSION
+    } else {
+        0
+    })
 }

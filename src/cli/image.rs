@@ -68,6 +68,57 @@ impl ImageArgs {
     }
 }
 
+impl ImageArgs {
+    /// The flags as given, spelled for another build's `raywave render` (`bench --against`):
+    /// only what was set, so each build fills the rest with its own defaults, as a user running
+    /// both with the same command line would see.
+    pub fn flags(&self) -> Vec<String> {
+        fn name(v: impl clap::ValueEnum) -> String {
+            v.to_possible_value()
+                .expect("no skipped variants")
+                .get_name()
+                .to_string()
+        }
+        let mut out = Vec::new();
+        let mut push = |flag: &str, values: Vec<String>| {
+            out.push(flag.to_string());
+            out.extend(values);
+        };
+        if let Some(s) = &self.size {
+            push("--size", s.iter().map(u32::to_string).collect());
+        }
+        if let Some(b) = self.bounces {
+            push("--bounces", vec![b.to_string()]);
+        }
+        if let Some(s) = self.shadows {
+            push("--shadows", vec![name(s)]);
+        }
+        if let Some(n) = self.shadow_samples {
+            push("--shadow-samples", vec![n.to_string()]);
+        }
+        push("--sampler", vec![name(self.sampler)]);
+        if let Some(n) = self.aa {
+            push("--aa", vec![n.to_string()]);
+        }
+        if let Some(c) = &self.background {
+            push("--background", c.iter().map(f32::to_string).collect());
+        }
+        if let Some(c) = &self.ambient {
+            push("--ambient", c.iter().map(f32::to_string).collect());
+        }
+        if let Some(m) = self.light_model {
+            push("--light-model", vec![name(m)]);
+        }
+        if let Some(n) = self.ring_segments {
+            push("--ring-segments", vec![n.to_string()]);
+        }
+        if let Some(d) = self.defaults {
+            push("--defaults", vec![name(d)]);
+        }
+        out
+    }
+}
+
 fn parse_colour_component(s: &str) -> Result<f32, String> {
     match s.parse::<f32>() {
         Ok(x) if x.is_finite() && x >= 0.0 => Ok(x),
