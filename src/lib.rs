@@ -70,6 +70,7 @@ pub mod scene;
 pub mod settings;
 pub mod shading;
 pub mod spawn;
+pub mod statistics;
 pub mod stats;
 pub mod terminal;
 pub mod variance;

@@ -20,19 +20,20 @@
 //!     undecided otherwise (the interval straddles a boundary: more rounds narrow it)
 //! ```
 //!
-//! The interval is distribution-free: for n paired ratios sorted, the median lies between the
-//! k-th and the (n − k + 1)-th with probability ≥ 95%, k the largest with
-//! P(Binomial(n, ½) < k) ≤ 2.5%. It needs n ≥ 6.
+//! The interval is distribution-free (`statistics::median_interval_rank`): for n paired ratios
+//! sorted, the median lies between the k-th and the (n − k + 1)-th with probability ≥ 95%, k the
+//! largest with P(Binomial(n, ½) < k) ≤ 2.5%. It needs n ≥ 6.
 
 use crate::engine::Engine;
 use crate::error::UsageError;
+use crate::statistics::{MIN_FOR_INTERVAL, median, median_with_interval};
 use anyhow::{Context, Result, bail};
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-/// The fewest rounds that give a 95% interval of the median (k ≥ 1 needs n ≥ 6).
-pub const MIN_ROUNDS: u32 = 6;
+/// The fewest rounds that give a 95% interval of the median.
+pub const MIN_ROUNDS: u32 = MIN_FOR_INTERVAL as u32;
 
 /// What an A/B run is asked to do.
 #[derive(Clone, Debug)]
@@ -113,41 +114,9 @@ impl EngineAb {
     }
 }
 
-/// The 1-based rank k of the lower end of a 95% interval of the median of n values: the
-/// largest k with P(Binomial(n, ½) < k) ≤ 0.025; `None` below [`MIN_ROUNDS`].
-pub fn median_interval_rank(n: usize) -> Option<usize> {
-    // P(X ≤ j) for X ~ Binomial(n, ½), accumulated in f64 (exact enough for n in the
-    // thousands: the terms are ratios of binomial coefficients times 2^-n).
-    let mut k = 0;
-    let mut term = 0.5f64.powi(n as i32); // P(X = 0)
-    let mut below = 0.0; // P(X < j)
-    for j in 0..=n {
-        if below + term > 0.025 {
-            break;
-        }
-        below += term;
-        k = j + 1;
-        term *= (n - j) as f64 / (j + 1) as f64;
-    }
-    (k >= 1).then_some(k)
-}
-
 /// Median, 95% interval and verdict of per-round ratios.
 pub fn summarize(ratios: &[f64], threshold_pct: f64) -> RatioSummary {
-    let mut sorted = ratios.to_vec();
-    sorted.sort_by(f64::total_cmp);
-    let n = sorted.len();
-    let median = if n == 0 {
-        f64::NAN
-    } else if n % 2 == 1 {
-        sorted[n / 2]
-    } else {
-        0.5 * (sorted[n / 2 - 1] + sorted[n / 2])
-    };
-    let (low, high) = match median_interval_rank(n) {
-        Some(k) => (sorted[k - 1], sorted[n - k]),
-        None => (f64::NEG_INFINITY, f64::INFINITY),
-    };
+    let (median, low, high) = median_with_interval(ratios);
     let slow = 1.0 + threshold_pct / 100.0;
     let verdict = if low > slow {
         Verdict::Slower
@@ -366,10 +335,6 @@ pub fn report(options: &AbOptions, results: &[EngineAb]) -> String {
     out
 }
 
-fn median(xs: &[f64]) -> f64 {
-    super::record::median(xs)
-}
-
 /// True when some engine's verdict is a regression.
 pub fn regressed(options: &AbOptions, results: &[EngineAb]) -> bool {
     results
@@ -380,32 +345,6 @@ pub fn regressed(options: &AbOptions, results: &[EngineAb]) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// Exact P(Binomial(n, ½) < k), by summing coefficients in integers.
-    fn below(n: usize, k: usize) -> f64 {
-        let mut c = 1u128;
-        let mut sum = 0u128;
-        for j in 0..k {
-            sum += c;
-            c = c * (n - j) as u128 / (j + 1) as u128;
-        }
-        sum as f64 / 2f64.powi(n as i32)
-    }
-
-    #[test]
-    fn the_interval_rank_is_the_largest_with_at_most_2_5_percent_below() {
-        assert_eq!(median_interval_rank(5), None);
-        // Tables of the sign test: n = 6 → 1, 10 → 2, 20 → 6, 30 → 10.
-        assert_eq!(median_interval_rank(6), Some(1));
-        assert_eq!(median_interval_rank(10), Some(2));
-        assert_eq!(median_interval_rank(20), Some(6));
-        assert_eq!(median_interval_rank(30), Some(10));
-        for n in 6..100 {
-            let k = median_interval_rank(n).unwrap();
-            assert!(below(n, k) <= 0.025, "n = {n}, k = {k}");
-            assert!(below(n, k + 1) > 0.025, "n = {n}, k + 1 = {}", k + 1);
-        }
-    }
 
     #[test]
     fn verdicts_follow_the_whole_interval() {

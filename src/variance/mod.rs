@@ -303,7 +303,7 @@ pub fn run_study(
                 films.push(film);
                 progress(&format!("{} N={n} seed {}", sampler.name(), k + 1));
             }
-            let seconds = median(&mut times);
+            let seconds = crate::statistics::median(&times);
             let rays = rays / config.seeds.max(1) as u64;
             let images: Vec<&[Vec3]> = films.iter().map(|f| f.pixels.as_slice()).collect();
             for (region, mask) in Region::ALL.iter().zip(&masks) {
@@ -367,19 +367,6 @@ pub fn run_study(
         slopes,
         heatmaps,
     })
-}
-
-fn median(values: &mut [f64]) -> f64 {
-    if values.is_empty() {
-        return 0.0;
-    }
-    values.sort_by(f64::total_cmp);
-    let m = values.len() / 2;
-    if values.len() % 2 == 1 {
-        values[m]
-    } else {
-        0.5 * (values[m - 1] + values[m])
-    }
 }
 
 impl StudyResult {

@@ -1,0 +1,104 @@
+//! Summaries of repeated measurements: the median, and a distribution-free interval for it.
+//! One place for them, so that `raywave bench`, its A/B mode and the variance study's timings
+//! summarise alike.
+
+/// The median of `xs` (the mean of the middle two for an even count), NaN values ignored;
+/// 0 when nothing is left.
+pub fn median(xs: &[f64]) -> f64 {
+    let mut v: Vec<f64> = xs.iter().copied().filter(|x| !x.is_nan()).collect();
+    if v.is_empty() {
+        return 0.0;
+    }
+    v.sort_by(f64::total_cmp);
+    let m = v.len() / 2;
+    if v.len() % 2 == 1 {
+        v[m]
+    } else {
+        (v[m - 1] + v[m]) / 2.0
+    }
+}
+
+/// The fewest values that give a 95% interval of the median (see [`median_interval_rank`]).
+pub const MIN_FOR_INTERVAL: usize = 6;
+
+/// The 1-based rank k of the lower end of a 95% interval of the median of n values: for n
+/// values sorted, the median lies between the k-th and the (n − k + 1)-th with probability at
+/// least 95%, k the largest with P(Binomial(n, ½) < k) ≤ 2.5% (the sign test's interval; it
+/// assumes nothing of the distribution). `None` below [`MIN_FOR_INTERVAL`].
+pub fn median_interval_rank(n: usize) -> Option<usize> {
+    // P(X ≤ j) for X ~ Binomial(n, ½), accumulated in f64 (exact enough for n in the
+    // thousands: the terms are ratios of binomial coefficients times 2^-n).
+    let mut k = 0;
+    let mut term = 0.5f64.powi(n as i32); // P(X = j), from j = 0
+    let mut below = 0.0; // P(X < j)
+    for j in 0..=n {
+        if below + term > 0.025 {
+            break;
+        }
+        below += term;
+        k = j + 1;
+        term *= (n - j) as f64 / (j + 1) as f64;
+    }
+    (k >= 1).then_some(k)
+}
+
+/// The median of `xs` and its 95% interval ([`median_interval_rank`]); the interval is
+/// (−∞, ∞) with fewer than [`MIN_FOR_INTERVAL`] values. NaN values are ignored.
+pub fn median_with_interval(xs: &[f64]) -> (f64, f64, f64) {
+    let mut v: Vec<f64> = xs.iter().copied().filter(|x| !x.is_nan()).collect();
+    v.sort_by(f64::total_cmp);
+    let (low, high) = match median_interval_rank(v.len()) {
+        Some(k) => (v[k - 1], v[v.len() - k]),
+        None => (f64::NEG_INFINITY, f64::INFINITY),
+    };
+    (median(&v), low, high)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn medians() {
+        assert_eq!(median(&[]), 0.0);
+        assert_eq!(median(&[3.0]), 3.0);
+        assert_eq!(median(&[5.0, 1.0, 3.0]), 3.0);
+        assert_eq!(median(&[4.0, 1.0, 3.0, 2.0]), 2.5);
+        assert_eq!(median(&[f64::NAN, 4.0, 1.0, 3.0]), 3.0);
+    }
+
+    /// Exact P(Binomial(n, ½) < k), by summing coefficients in integers.
+    fn below(n: usize, k: usize) -> f64 {
+        let mut c = 1u128;
+        let mut sum = 0u128;
+        for j in 0..k {
+            sum += c;
+            c = c * (n - j) as u128 / (j + 1) as u128;
+        }
+        sum as f64 / 2f64.powi(n as i32)
+    }
+
+    #[test]
+    fn the_interval_rank_is_the_largest_with_at_most_2_5_percent_below() {
+        assert_eq!(median_interval_rank(5), None);
+        // Tables of the sign test: n = 6 → 1, 10 → 2, 20 → 6, 30 → 10.
+        assert_eq!(median_interval_rank(6), Some(1));
+        assert_eq!(median_interval_rank(10), Some(2));
+        assert_eq!(median_interval_rank(20), Some(6));
+        assert_eq!(median_interval_rank(30), Some(10));
+        for n in MIN_FOR_INTERVAL..100 {
+            let k = median_interval_rank(n).unwrap();
+            assert!(below(n, k) <= 0.025, "n = {n}, k = {k}");
+            assert!(below(n, k + 1) > 0.025, "n = {n}, k + 1 = {}", k + 1);
+        }
+    }
+
+    #[test]
+    fn the_interval_holds_the_median() {
+        let xs: Vec<f64> = (0..20).map(|i| (i * 7 % 20) as f64).collect();
+        let (m, lo, hi) = median_with_interval(&xs);
+        assert_eq!((m, lo, hi), (9.5, 5.0, 14.0));
+        let (_, lo, hi) = median_with_interval(&[1.0; 5]);
+        assert!(lo.is_infinite() && hi.is_infinite());
+    }
+}
