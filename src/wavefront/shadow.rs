@@ -21,7 +21,8 @@
 
 use super::batch::{HitBatch, RayBatch, ShadowQueue};
 use super::context::{Context, MaterialTerms};
-use super::simd::{self, LANES, LightBlock, RayColumns};
+use super::lanes::LANES;
+use super::simd::{self, LightBlock, RayColumns};
 use crate::geometry::casters;
 use crate::sampling::{SampleKey, mix32, square_sample};
 use crate::scene::NO_HIT;

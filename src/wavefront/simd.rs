@@ -20,14 +20,14 @@
 
 use super::batch::ShadowBlock;
 use super::context::MaterialTerms;
+use super::lanes::{
+    LANE_INDEX, LANES, MASK_BOOLS, f32_from_bits, f32x8, live_lanes, load, signed, u32x8, unsigned,
+};
+use crate::geometry::Ray;
 use crate::geometry::{EDGE_EPSILON, MISS_MARGIN, T_MIN};
 use crate::scene::{NO_HIT, Sphere, Triangle};
 use crate::spawn::{LightEnd, SurfaceHit};
 use glam::Vec3;
-use wide::{f32x8, i32x8, u32x8};
-
-/// The SIMD width.
-pub const LANES: usize = 8;
 
 /// Ray columns of a batch, borrowed: origin, direction and tmax.
 #[derive(Clone, Copy)]
@@ -49,6 +49,15 @@ impl RayColumns<'_> {
     pub fn is_empty(&self) -> bool {
         self.tmax.is_empty()
     }
+    /// Ray `i`.
+    #[inline(always)]
+    pub fn ray(&self, i: usize) -> Ray {
+        let (o, d) = (self.origin, self.direction);
+        Ray {
+            origin: Vec3::new(o[0][i], o[1][i], o[2][i]),
+            direction: Vec3::new(d[0][i], d[1][i], d[2][i]),
+        }
+    }
 }
 
 /// Eight rays in registers.
@@ -60,19 +69,6 @@ pub struct Rays8 {
     dx: f32x8,
     dy: f32x8,
     dz: f32x8,
-}
-
-#[inline(always)]
-fn load(col: &[f32], i: usize, pad: f32) -> f32x8 {
-    match col.get(i..i + LANES) {
-        Some(s) => f32x8::new(s.try_into().expect("8 lanes")),
-        None => {
-            let mut a = [pad; LANES];
-            let rest = &col[i.min(col.len())..];
-            a[..rest.len()].copy_from_slice(rest);
-            f32x8::new(a)
-        }
-    }
 }
 
 impl Rays8 {
@@ -89,33 +85,6 @@ impl Rays8 {
         }
     }
 }
-
-/// The live lanes of the chunk starting at `i` of a batch of `len`.
-#[inline(always)]
-fn live_lanes(i: usize, len: usize) -> u32 {
-    let n = (len - i).min(LANES);
-    (1u32 << n) - 1
-}
-
-/// Lane k of an 8-lane bitmask as a bool, for all 256 masks: a chunk's results are stored with
-/// one 8-byte copy instead of a loop over lanes (that loop was 6% of the lab benchmark's
-/// instructions).
-const MASK_BOOLS: [[bool; LANES]; 256] = {
-    let mut table = [[false; LANES]; 256];
-    let mut mask = 0;
-    while mask < 256 {
-        let mut lane = 0;
-        while lane < LANES {
-            table[mask][lane] = mask & (1 << lane) != 0;
-            lane += 1;
-        }
-        mask += 1;
-    }
-    table
-};
-
-/// The lane indices 0..8 as floats, to build "lane < count" masks.
-const LANE_INDEX: [f32; LANES] = [0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0];
 
 /// Möller–Trumbore's operands on 8 lanes, as columns: ray origin o and direction d, triangle
 /// corner v0 and edges e1, e2. [`triangle8`] splats the triangle (8 rays, one triangle), the
@@ -432,7 +401,7 @@ fn mix32x8(mut x: u32x8) -> u32x8 {
 fn uniform8(prefix: u32, dims: u32x8) -> f32x8 {
     let h = mix32x8(u32x8::splat(prefix) ^ dims) >> 8;
     // h < 2^24, so the signed conversion is exact.
-    f32x8::from_i32x8(wide::bytemuck::cast::<u32x8, i32x8>(h)) * f32x8::splat(1.0 / 16_777_216.0)
+    f32x8::from_i32x8(signed(h)) * f32x8::splat(1.0 / 16_777_216.0)
 }
 
 /// How a block's (u, v) are drawn: the samplers with an 8-wide twin.
@@ -560,7 +529,7 @@ fn reverse_bits8(mut x: u32x8) -> u32x8 {
 #[inline(always)]
 fn u32_to_f32_norm8(n: u32x8) -> f32x8 {
     let bits = (n >> 9) | u32x8::splat(0x3f80_0000);
-    wide::bytemuck::cast::<u32x8, f32x8>(bits) - f32x8::ONE
+    f32_from_bits(bits) - f32x8::ONE
 }
 
 /// Dimensions 0 and 1 of Owen-scrambled Sobol points `j`: lane k equals
@@ -574,8 +543,7 @@ fn sobol8(j: u32x8, scramble: u32) -> (f32x8, f32x8) {
     let (mut s0, mut s1) = (u32x8::ZERO, u32x8::ZERO);
     for (k, (&v0, &v1)) in vectors[0].iter().zip(&vectors[1]).enumerate() {
         // All ones where bit 31 − k of the index is set.
-        let bit = wide::bytemuck::cast::<u32x8, i32x8>(index << k as u32) >> 31;
-        let bit = wide::bytemuck::cast::<i32x8, u32x8>(bit);
+        let bit = unsigned(signed(index << k as u32) >> 31);
         s0 ^= bit & u32x8::splat(v0);
         s1 ^= bit & u32x8::splat(v1);
     }
@@ -722,7 +690,6 @@ pub fn shade8(
 /// Lane-level entry points for tests: 8 rays given as arrays, the kernels' answers as arrays.
 pub mod lanes {
     use super::*;
-    use crate::geometry::Ray;
 
     fn rays8(rays: &[Ray; LANES]) -> Rays8 {
         let col = |f: fn(&Ray) -> f32| f32x8::new(std::array::from_fn(|k| f(&rays[k])));
