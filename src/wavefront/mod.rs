@@ -26,6 +26,7 @@ pub mod generate;
 pub mod intersect;
 pub mod lanes;
 pub mod reflect;
+pub mod shade;
 pub mod shadow;
 pub mod simd;
 pub mod stats;
