@@ -3,8 +3,9 @@
 //! tables, the view of a vector as its 8 lanes, the bit casts between lane types, and the
 //! iterator over a bitmask's set lanes.
 //!
-//! Only this module and the kernels (`simd/`, `shade.rs`, `bvh/`) name `wide` types, and only
-//! this module names `bytemuck`; `tests/layering.rs` checks it.
+//! This is the only file of the crate that names the `wide` crate or `bytemuck`: the kernels
+//! (`simd/`, `shade.rs`, `bvh/`) take the lane types from here, and `tests/layering.rs` checks
+//! that nothing else reaches for them.
 
 pub(crate) use wide::{f32x8, i32x8, u32x8};
 
