@@ -179,11 +179,6 @@ impl<'a> Context<'a> {
         }
     }
 
-    /// True for stratified light sampling.
-    pub fn stratified(&self) -> bool {
-        self.settings.sampler == LightSampler::Stratified
-    }
-
     /// The hit on primitive `prim` at `p0` (origin + t·direction), put back on its surface,
     /// and its material index: `spawn::surface_hit` from this context's tables.
     #[inline]
