@@ -50,6 +50,7 @@ impl MaterialTerms {
 /// e·r ≤ 0 (with a positive exponent), since the reference then adds `±0.0`, which changes
 /// nothing. Tested bit-equal.
 #[inline]
+#[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(x > 0.0)` is on purpose: true for NaN
 pub fn shade_terms(
     m: &MaterialTerms,
     n: Vec3,

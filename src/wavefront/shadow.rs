@@ -16,9 +16,6 @@
 //! at a time, every sampler with an 8-wide twin (`simd::light_points8`); hard shadows and
 //! other light shapes call the scalar sampling code one point at a time.
 
-// `!(x > 0.0)` is on purpose: it is true for NaN, like the reference's tests.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
-
 use super::batch::{HitBatch, RayBatch, ShadowQueue};
 use super::context::Context;
 use super::lanes::LANES;
