@@ -194,13 +194,9 @@ fn shade(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch, queue: &ShadowQueu
             // Distances are kept only under a light model with fall-off (`ShadowQueue::dist`).
             let falloffs: Option<[f32; LANES]> = (!queue.dist.is_empty())
                 .then(|| std::array::from_fn(|k| falloff(model, queue.dist[q + k])));
-            let at = HitLight {
-                material: m,
-                normal: hits.normal(i),
-                to_eye: -rays.direction(i),
-                light_color: ctx.lights[queue.light[q] as usize].color,
-                weight,
-            };
+            // In the order the kernel's operands were always evaluated: the hit, the rays, the
+            // light (`shade8`'s instruction count moves with it).
+            let (normal, to_eye) = (hits.normal(i), -rays.direction(i));
             let lanes = ShadowLanes {
                 l: [
                     &queue.direction_x[q..end],
@@ -210,6 +206,13 @@ fn shade(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch, queue: &ShadowQueu
                 n_dot_l: &queue.n_dot_l[q..end],
                 blocked: &queue.blocked[q..end],
                 falloff: falloffs.as_ref(),
+            };
+            let at = HitLight {
+                material: m,
+                normal,
+                to_eye,
+                light_color: ctx.lights[queue.light[q] as usize].color,
+                weight,
             };
             let c = shade8(&at, &lanes);
             // In lane order, like the reference's loop; lanes that add nothing hold −0.0.

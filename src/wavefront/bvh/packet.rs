@@ -193,6 +193,7 @@ struct Alone<'b> {
 }
 
 impl<'b> Walk<'b> {
+    /// Stacks deep enough for any walk of `bvh`, allocated once per batch.
     pub(super) fn new(bvh: &'b MeshBvh, two_sided: bool) -> Walk<'b> {
         Walk {
             stack: vec![(0, f32x8::ZERO); bvh.depth * (WIDTH - 1) + 1],

@@ -32,6 +32,7 @@ pub(super) struct RayLanes {
 }
 
 impl RayLanes {
+    /// `ray` splatted, with its guarded 1/d, origin · (1/d) and near bounds.
     #[inline(always)]
     pub(super) fn new(ray: &Ray) -> RayLanes {
         // The three axes at once in one SSE register: one division, no branches. Lane by
@@ -78,6 +79,7 @@ impl RayLanes {
 pub(super) struct Stack(Vec<(u32, f32)>);
 
 impl Stack {
+    /// A stack deep enough for any walk of `bvh`.
     pub(super) fn new(bvh: &MeshBvh) -> Stack {
         Stack(vec![(0, 0.0); bvh.depth * (WIDTH - 1) + 1])
     }
