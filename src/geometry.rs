@@ -137,6 +137,17 @@ pub fn intersect_sphere(sphere: &Sphere, ray: &Ray, tmax: f32) -> f32 {
     }
 }
 
+/// The order every closest-hit query over a BVH minimises: hit (t, prim) beats the best so far
+/// when it is closer, or as close with a lower primitive id, so that of two hits at the same t
+/// (a shared edge, a corner where two walls meet) the lowest id wins, as in a loop over the
+/// primitives in index order, whatever order a tree visits them in. A miss (t = ∞) never wins,
+/// not even against an infinite best. Used by `Accel::closest` and by both walks of the
+/// wavefront engine's mesh BVH (one ray, and lane by lane in packets).
+#[inline(always)]
+pub fn closer(t: f32, prim: u32, best_t: f32, best_prim: u32) -> bool {
+    t < best_t || (t == best_t && t < f32::INFINITY && prim < best_prim)
+}
+
 /// How the reference finds hits: every primitive in turn, or a BVH over the triangles.
 pub struct Accel {
     bvh: Option<CwBvh>,
@@ -192,10 +203,9 @@ impl Accel {
                 }
             }
             Some(bvh) => {
-                // Ties (the same t on a shared edge, or where two walls meet) go to the lowest
-                // triangle id, as in the loop above, whatever order the CWBVH visits them in:
-                // obvhs keeps only strictly closer hits, so the pair (t, id) is tracked here.
-                // The wavefront engine's own BVH breaks ties the same way.
+                // Ties go to the lowest triangle id, as in the loop above (`closer`), whatever
+                // order the CWBVH visits them in: obvhs keeps only strictly closer hits, so the
+                // pair (t, id) is tracked here.
                 // The tree works in coordinates scaled by `self.scale`, and so do the
                 // distances it is given back: a power of two, so both ways are exact.
                 let scale = self.scale;
@@ -210,8 +220,7 @@ impl Accel {
                     };
                     let t =
                         intersect_triangle(&scene.triangles[prim as usize], ray, limit, two_sided);
-                    // A miss is t = ∞, which ties an infinite best.t: it must not count.
-                    if t < best.t || (t == best.t && t < f32::INFINITY && prim < best.prim) {
+                    if closer(t, prim, best.t, best.prim) {
                         best = Hit { t, prim };
                     }
                     t * scale

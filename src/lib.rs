@@ -76,7 +76,8 @@ pub mod terminal;
 pub mod variance;
 pub mod wavefront;
 
-/// Which SIMD instructions this build uses for `wide::f32x8`, decided at compile time.
+/// Which SIMD instructions this build uses for the lane type `f32x8` (from the `wide` crate),
+/// decided at compile time.
 pub fn simd_path() -> &'static str {
     if cfg!(all(target_feature = "avx2", target_feature = "fma")) {
         "avx2+fma (f32x8 in one 256-bit register)"

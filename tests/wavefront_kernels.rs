@@ -16,8 +16,8 @@ use raywave::sampling::{LightSampler, SampleKey, square_sample, strata_grid, uni
 use raywave::scene::{Light, LightShape, Material, NO_HIT, Scene, Sphere};
 use raywave::shading::shade;
 use raywave::spawn::{SurfaceHit, light_end, shadow_ray};
-use raywave::wavefront::context::MaterialTerms;
-use raywave::wavefront::shadow::{key_prefix, shade_terms};
+use raywave::wavefront::shade::{HitLight, MaterialTerms, ShadowLanes, shade_terms, shade8};
+use raywave::wavefront::shadow::key_prefix;
 use raywave::wavefront::simd::{self, BlockSampler, LightBlock, RayColumns, lanes};
 
 const NAN: f32 = f32::NAN;
@@ -344,8 +344,10 @@ proptest! {
         let lab = falloffs.iter().all(|&f| f == 1.0);
         // Dead lanes carry n·l = 0.
         let ndl: Vec<f32> = (0..8).map(|k| if dead_bits & (1 << k) != 0 { 0.0 } else { ndl[k] }).collect();
-        let got = simd::shade8(&terms, n, e, [&lx, &ly, &lz], &ndl, &blocked, lc.abs(),
-            (!lab).then_some(&falloff), weight);
+        let got = shade8(
+            &HitLight { material: &terms, normal: n, to_eye: e, light_color: lc.abs(), weight },
+            &ShadowLanes { l: [&lx, &ly, &lz], n_dot_l: &ndl, blocked: &blocked,
+                falloff: (!lab).then_some(&falloff) });
         for k in 0..8 {
             if !(ndl[k] > 0.0) || blocked[k] {
                 // Adds nothing: exactly −0.0, the identity of addition.

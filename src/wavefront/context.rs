@@ -2,13 +2,13 @@
 //! once (material and light terms, the strata grid, the acceleration choice).
 
 use super::bvh::MeshBvh;
+use super::shade::MaterialTerms;
 use super::simd::BlockSampler;
 use crate::camera::CameraRays;
 use crate::geometry::shadow_casters;
 use crate::sampling::{LightSampler, SOBOL_SEED_DIM, SampleKey, hash, strata_grid};
-use crate::scene::{LightShape, Material, Scene, Triangle};
+use crate::scene::{LightShape, Scene, Triangle};
 use crate::settings::{RenderSettings, ShadowMode};
-use crate::shading::AMBIENT;
 use crate::spawn::{
     SurfaceHit, light_offset, sphere_hit, triangle_hit, triangle_offset, triangle_plane,
 };
@@ -19,40 +19,6 @@ use std::time::Duration;
 /// below it, the 8-wide kernels test every primitive. It equals the reference's `BVH_MIN_TRIANGLES`, so both
 /// engines find hits the same way; see docs/PERFORMANCE.md for the measurements behind it.
 pub const BVH_MIN_TRIANGLES: usize = crate::geometry::BVH_MIN_TRIANGLES;
-
-/// A material's terms of the lab's Shade, computed once with the reference's operations.
-#[derive(Clone, Copy, Debug)]
-pub struct MaterialTerms {
-    /// kd.
-    pub diffuse: Vec3,
-    /// kr.
-    pub reflective: Vec3,
-    /// ambient ⊙ kd: what every hit gets.
-    pub ambient: Vec3,
-    /// AMBIENT · ke: Shade's first term.
-    pub ambient_emitted: Vec3,
-    /// 0.8 · kr: the specular colour.
-    pub specular: Vec3,
-    /// 5 / (g + 0.01).
-    pub shininess: f32,
-    /// kr ≠ 0: spawns mirror rays and has a highlight.
-    pub is_reflective: bool,
-}
-
-impl MaterialTerms {
-    /// The terms of `m` under the ambient light `ambient`.
-    pub fn new(m: &Material, ambient: Vec3) -> MaterialTerms {
-        MaterialTerms {
-            diffuse: m.diffuse,
-            reflective: m.reflective,
-            ambient: ambient * m.diffuse,
-            ambient_emitted: AMBIENT * m.emitted,
-            specular: 0.8 * m.reflective,
-            shininess: m.shininess(),
-            is_reflective: m.is_reflective(),
-        }
-    }
-}
 
 /// A light's terms, with the parallelogram (all the lab's lights) kept apart for the SIMD path.
 #[derive(Clone, Debug)]
@@ -211,11 +177,6 @@ impl<'a> Context<'a> {
             },
             LightSampler::Random | LightSampler::Lab => BlockSampler::Random,
         }
-    }
-
-    /// True for stratified light sampling.
-    pub fn stratified(&self) -> bool {
-        self.settings.sampler == LightSampler::Stratified
     }
 
     /// The hit on primitive `prim` at `p0` (origin + t·direction), put back on its surface,

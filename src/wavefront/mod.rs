@@ -24,7 +24,9 @@ pub mod context;
 pub mod film;
 pub mod generate;
 pub mod intersect;
+pub mod lanes;
 pub mod reflect;
+pub mod shade;
 pub mod shadow;
 pub mod simd;
 pub mod stats;
@@ -88,7 +90,7 @@ impl<'a> Wavefront<'a> {
         let batch_size = batch_size.max(1);
         Wavefront {
             tile_pixels: (batch_size / settings.aa_samples.max(1) as usize).max(1),
-            queue_capacity: batch_size.max(simd::LANES),
+            queue_capacity: batch_size.max(lanes::LANES),
             ctx,
             pool: Mutex::new(Vec::new()),
         }

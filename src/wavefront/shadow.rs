@@ -16,18 +16,16 @@
 //! at a time, every sampler with an 8-wide twin (`simd::light_points8`); hard shadows and
 //! other light shapes call the scalar sampling code one point at a time.
 
-// `!(x > 0.0)` is on purpose: it is true for NaN, like the reference's tests.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
-
 use super::batch::{HitBatch, RayBatch, ShadowQueue};
-use super::context::{Context, MaterialTerms};
-use super::simd::{self, LANES, LightBlock, RayColumns};
+use super::context::Context;
+use super::lanes::LANES;
+use super::shade::{HitLight, ShadowLanes, shade_terms, shade8};
+use super::simd::{self, LightBlock, RayColumns};
 use crate::geometry::casters;
 use crate::sampling::{SampleKey, mix32, square_sample};
 use crate::scene::NO_HIT;
 use crate::settings::LightModel;
 use crate::spawn::{falloff, light_end, shadow_ray};
-use glam::Vec3;
 
 /// The hash state of a SampleKey before its dimension is mixed in: `sampling::hash(key, dim)`
 /// is `mix32(key_prefix(key) ^ dim)`, so a (hit, light) stream is hashed once, not once per
@@ -196,21 +194,27 @@ fn shade(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch, queue: &ShadowQueu
             // Distances are kept only under a light model with fall-off (`ShadowQueue::dist`).
             let falloffs: Option<[f32; LANES]> = (!queue.dist.is_empty())
                 .then(|| std::array::from_fn(|k| falloff(model, queue.dist[q + k])));
-            let c = simd::shade8(
-                m,
-                hits.normal(i),
-                -rays.direction(i),
-                [
+            // In the order the kernel's operands were always evaluated: the hit, the rays, the
+            // light (`shade8`'s instruction count moves with it).
+            let (normal, to_eye) = (hits.normal(i), -rays.direction(i));
+            let lanes = ShadowLanes {
+                l: [
                     &queue.direction_x[q..end],
                     &queue.direction_y[q..end],
                     &queue.direction_z[q..end],
                 ],
-                &queue.n_dot_l[q..end],
-                &queue.blocked[q..end],
-                ctx.lights[queue.light[q] as usize].color,
-                falloffs.as_ref(),
+                n_dot_l: &queue.n_dot_l[q..end],
+                blocked: &queue.blocked[q..end],
+                falloff: falloffs.as_ref(),
+            };
+            let at = HitLight {
+                material: m,
+                normal,
+                to_eye,
+                light_color: ctx.lights[queue.light[q] as usize].color,
                 weight,
-            );
+            };
+            let c = shade8(&at, &lanes);
             // In lane order, like the reference's loop; lanes that add nothing hold −0.0.
             let (mut r, mut g, mut b) = (hits.direct_r[i], hits.direct_g[i], hits.direct_b[i]);
             for ((cr, cg), cb) in c[0].iter().zip(&c[1]).zip(&c[2]) {
@@ -235,32 +239,4 @@ fn shade(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch, queue: &ShadowQueu
         }
         q += 1;
     }
-}
-
-/// The lab's Shade, twin of `shading::shade` with the same operations in the same order, minus
-/// the work whose result is exactly zero: no highlight (and no `powf`) when kr = 0 or when
-/// e·r ≤ 0 (with a positive exponent), since the reference then adds `±0.0`, which changes
-/// nothing. Tested bit-equal.
-#[inline]
-pub fn shade_terms(
-    m: &MaterialTerms,
-    n: Vec3,
-    e: Vec3,
-    l: Vec3,
-    n_dot_l: f32,
-    light_color: Vec3,
-) -> Vec3 {
-    let c = m.ambient_emitted + light_color * m.diffuse * n_dot_l;
-    // With a positive exponent, base^s is finite, so kr = 0 makes the highlight ±0 ...
-    let positive = m.shininess > 0.0;
-    if positive && !m.is_reflective {
-        return c;
-    }
-    let r = (2.0 * n_dot_l * n - l).normalize();
-    let base = e.dot(r).max(0.0);
-    // ... and so does base = 0 (0^s = 0).
-    if positive && !(base > 0.0) {
-        return c;
-    }
-    c + light_color * m.specular * (base.powf(m.shininess) * n_dot_l)
 }

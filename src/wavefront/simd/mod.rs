@@ -1,0 +1,123 @@
+//! The 8-wide kernels of the stages, by idea: ray–primitive tests (`geometry.rs`) and light
+//! sampling with shadow-ray spawning (`light.rs`); the shading kernel sits with its scalar twin
+//! in `wavefront/shade.rs`, and the mesh BVH's node and leaf tests in `wavefront/bvh/`. Lanes,
+//! loads and masks come from `wavefront/lanes.rs`.
+//!
+//! Every kernel is a lane-by-lane copy of a scalar twin, with the same operations in the
+//! same order, so that with IEEE arithmetic (no FMA contraction: Rust never fuses `a * b + c`,
+//! and neither does `wide`) each lane gives the same bits as the twin:
+//!
+//! | kernel               | scalar twin                                              |
+//! |----------------------|----------------------------------------------------------|
+//! | [`moller_trumbore8`] | `geometry::intersect_triangle` (8 rays × 1 triangle in [`triangle8`], 1 ray × 8 triangles in `bvh/`) |
+//! | [`sphere8`]          | `geometry::intersect_sphere`                             |
+//! | [`closest_hits`]     | `Accel::closest` without a BVH                           |
+//! | [`occluded`]         | `Accel::occluded` without a BVH                          |
+//! | [`light_points8`]    | `sampling::square_sample` then `Light::point`            |
+//! | [`shadow_rays8`]     | the start of `Reference::direct` (l, dist, n·l)          |
+//! | `shade::shade8`      | `shade::shade_terms`, twin of `shading::shade`           |
+//!
+//! Branches become masks: a lane that misses gets `f32::INFINITY`, exactly like the twins'
+//! sentinel. Batches whose length is not a multiple of 8 are padded with lanes that cannot hit
+//! (tmax = 0, NaN directions), and the padding is never stored back.
+
+mod geometry;
+mod light;
+
+pub(crate) use geometry::{TriangleLanes, moller_trumbore8, moller_trumbore8_blocks};
+pub use geometry::{closest_hits, occluded, sphere8, triangle8};
+pub use light::{BlockSampler, LightBlock, light_points8, shadow_rays8};
+
+use super::lanes::{LANES, f32x8, load};
+use crate::geometry::Ray;
+use crate::scene::{Sphere, Triangle};
+use glam::Vec3;
+
+/// Ray columns of a batch, borrowed: origin, direction and tmax.
+#[derive(Clone, Copy)]
+pub struct RayColumns<'a> {
+    /// origin x, y, z.
+    pub origin: [&'a [f32]; 3],
+    /// direction x, y, z.
+    pub direction: [&'a [f32]; 3],
+    /// End of the interval (T_MIN, tmax).
+    pub tmax: &'a [f32],
+}
+
+impl RayColumns<'_> {
+    /// Number of rays.
+    pub fn len(&self) -> usize {
+        self.tmax.len()
+    }
+    /// True without rays.
+    pub fn is_empty(&self) -> bool {
+        self.tmax.is_empty()
+    }
+    /// Ray `i`.
+    #[inline(always)]
+    pub fn ray(&self, i: usize) -> Ray {
+        let (o, d) = (self.origin, self.direction);
+        Ray {
+            origin: Vec3::new(o[0][i], o[1][i], o[2][i]),
+            direction: Vec3::new(d[0][i], d[1][i], d[2][i]),
+        }
+    }
+}
+
+/// Eight rays in registers.
+#[derive(Clone, Copy)]
+pub struct Rays8 {
+    ox: f32x8,
+    oy: f32x8,
+    oz: f32x8,
+    dx: f32x8,
+    dy: f32x8,
+    dz: f32x8,
+}
+
+impl Rays8 {
+    /// Loads rays `i..i + 8` (padding past the end with NaN directions).
+    #[inline(always)]
+    fn load(r: &RayColumns, i: usize) -> Rays8 {
+        Rays8 {
+            ox: load(r.origin[0], i, 0.0),
+            oy: load(r.origin[1], i, 0.0),
+            oz: load(r.origin[2], i, 0.0),
+            dx: load(r.direction[0], i, f32::NAN),
+            dy: load(r.direction[1], i, f32::NAN),
+            dz: load(r.direction[2], i, f32::NAN),
+        }
+    }
+}
+
+/// Lane-level entry points for tests: 8 rays given as arrays, the kernels' answers as arrays.
+pub mod lanes {
+    use super::*;
+
+    fn rays8(rays: &[Ray; LANES]) -> Rays8 {
+        let col = |f: fn(&Ray) -> f32| f32x8::new(std::array::from_fn(|k| f(&rays[k])));
+        Rays8 {
+            ox: col(|r| r.origin.x),
+            oy: col(|r| r.origin.y),
+            oz: col(|r| r.origin.z),
+            dx: col(|r| r.direction.x),
+            dy: col(|r| r.direction.y),
+            dz: col(|r| r.direction.z),
+        }
+    }
+
+    /// [`triangle8`] on arrays.
+    pub fn triangle(
+        tri: &Triangle,
+        rays: &[Ray; LANES],
+        tmax: [f32; LANES],
+        two_sided: bool,
+    ) -> [f32; LANES] {
+        triangle8(tri, &rays8(rays), f32x8::new(tmax), two_sided).to_array()
+    }
+
+    /// [`sphere8`] on arrays.
+    pub fn sphere(s: &Sphere, rays: &[Ray; LANES], tmax: [f32; LANES]) -> [f32; LANES] {
+        sphere8(s, &rays8(rays), f32x8::new(tmax)).to_array()
+    }
+}
