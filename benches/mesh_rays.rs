@@ -106,7 +106,7 @@ fn report(s: &Setup, ctx: &Context) {
          {blocks} triangle blocks, depth {})",
         s.label,
         s.obvhs.build_time.as_secs_f64(),
-        ctx.bvh_build_time.as_secs_f64(),
+        bvh.build_time.as_secs_f64(),
         bvh.depth
     );
     #[cfg(feature = "embree")]

@@ -1,4 +1,4 @@
-//! The mesh BVH's leaf kernels (`wavefront::bvh::lanes`) against the scalar
+//! The mesh BVH's leaf kernels (`wavefront::bvh::arrays`) against the scalar
 //! `intersect_triangle`, lane by lane and bit for bit: on an edge-case table of rays and
 //! triangles for every leaf length up to the lane width, and on random input.
 
@@ -10,7 +10,7 @@ use glam::Vec3;
 use proptest::prelude::*;
 use raywave::geometry::{Ray, intersect_triangle};
 use raywave::scene::Triangle;
-use raywave::wavefront::bvh::lanes;
+use raywave::wavefront::bvh::arrays;
 
 const NAN: f32 = f32::NAN;
 const INF: f32 = f32::INFINITY;
@@ -44,7 +44,7 @@ fn edge_triangles() -> Vec<Triangle> {
 
 /// Lane k of the leaf kernels equals the scalar kernel for `tris[k]`; lanes past the end miss.
 fn check_leaf(tris: &[Triangle], r: &Ray, tmax: f32, two_sided: bool) {
-    let got = lanes::triangles(tris, r, tmax, two_sided);
+    let got = arrays::triangles(tris, r, tmax, two_sided);
     let mut any = false;
     for (k, got) in got.iter().enumerate() {
         let want = tris
@@ -58,7 +58,7 @@ fn check_leaf(tris: &[Triangle], r: &Ray, tmax: f32, two_sided: bool) {
         );
     }
     assert_eq!(
-        lanes::blocks(tris, r, tmax, two_sided),
+        arrays::blocks(tris, r, tmax, two_sided),
         any,
         "{r:?} tmax {tmax}"
     );

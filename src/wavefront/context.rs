@@ -13,7 +13,6 @@ use crate::spawn::{
     SurfaceHit, light_offset, sphere_hit, triangle_hit, triangle_offset, triangle_plane,
 };
 use glam::Vec3;
-use std::time::Duration;
 
 /// At or above this many triangles, rays go through the engine's 8-wide BVH (`bvh::MeshBvh`);
 /// below it, the 8-wide kernels test every primitive. It equals the reference's `BVH_MIN_TRIANGLES`, so both
@@ -57,8 +56,6 @@ pub struct Context<'a> {
     pub camera: CameraRays,
     /// The 8-wide mesh BVH when the scene has at least `BVH_MIN_TRIANGLES` triangles.
     pub accel: Option<MeshBvh>,
-    /// BVH build time (zero without one).
-    pub bvh_build_time: Duration,
     /// Without a BVH, the triangles that can block a shadow ray when faces are one-sided
     /// (`geometry::shadow_casters`, the reference's list).
     pub shadow_casters: Vec<Triangle>,
@@ -82,7 +79,6 @@ impl<'a> Context<'a> {
     /// Derives the tables and builds the BVH if the scene needs one.
     pub fn new(scene: &'a Scene, settings: &'a RenderSettings) -> Self {
         let accel = (scene.triangles.len() >= BVH_MIN_TRIANGLES).then(|| MeshBvh::new(scene));
-        let bvh_build_time = accel.as_ref().map_or(Duration::ZERO, |a| a.build_time);
         let ambient = Vec3::from_array(settings.ambient);
         let materials = scene
             .materials
@@ -121,7 +117,6 @@ impl<'a> Context<'a> {
                 Vec::new()
             },
             accel,
-            bvh_build_time,
             triangle_shading: scene
                 .triangles
                 .iter()

@@ -264,7 +264,7 @@ fn cut<'a>(rays: &RayColumns<'a>) -> RayColumns<'a> {
 }
 
 /// Lane-level entry points for tests: one ray against up to 8 triangles, as in a leaf.
-pub mod lanes {
+pub mod arrays {
     use super::*;
 
     fn block(tris: &[Triangle]) -> Block {

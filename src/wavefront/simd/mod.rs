@@ -91,7 +91,7 @@ impl Rays8 {
 }
 
 /// Lane-level entry points for tests: 8 rays given as arrays, the kernels' answers as arrays.
-pub mod lanes {
+pub mod arrays {
     use super::*;
 
     fn rays8(rays: &[Ray; LANES]) -> Rays8 {
