@@ -216,17 +216,24 @@ impl Measurement {
     }
 }
 
-/// Where `--save NAME` / `--compare NAME` keep a record.
+/// Where `--save NAME` / `--compare NAME` keep a record. A name is plain: ASCII letters,
+/// digits, `-`, `_`, `.` and `+`, not starting with `.` or `-`, at most 100 characters; any
+/// other name (a path, `..`, a control character) is a usage error (exit 2).
 pub fn record_path(dir: &Path, name: &str) -> Result<std::path::PathBuf> {
-    if name.is_empty()
-        || name.starts_with('.')
-        || name.contains(['/', '\\'])
-        || name.chars().any(char::is_control)
-    {
-        bail!(
-            "bench record name `{name}` is not usable: expected a plain name like `before` \
-             (no path separators, not starting with '.'); use --dir to choose the directory"
-        );
+    let plain = !name.is_empty()
+        && name.len() <= 100
+        && !name.starts_with(['.', '-'])
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.' | '+'));
+    if !plain {
+        return Err(crate::error::UsageError(format!(
+            "bench record name `{}` is not usable: expected a plain name like `before` \
+             (letters, digits, - _ . +; no path separators, not starting with '.' or '-'); \
+             use --dir to choose the directory",
+            name.escape_debug()
+        ))
+        .into());
     }
     Ok(dir.join(format!("{name}.json")))
 }
@@ -360,9 +367,10 @@ mod tests {
             record_path(dir, "before").unwrap(),
             Path::new("d/before.json")
         );
-        for bad in ["", "../x", "a/b", ".hidden"] {
-            let e = record_path(dir, bad).unwrap_err().to_string();
-            assert!(e.contains("not usable"), "{e}");
+        for bad in ["", "../x", "a/b", ".hidden", "-x", "a\\b", "a\nb", "é"] {
+            let e = record_path(dir, bad).unwrap_err();
+            assert!(e.downcast_ref::<crate::error::UsageError>().is_some());
+            assert!(e.to_string().contains("not usable"), "{e}");
         }
     }
 
