@@ -498,6 +498,39 @@ fn records_that_do_not_parse_name_the_file_and_what_was_expected() {
             "bench record format 99, expected 1",
         ),
         Case {
+            name: "a record that is a FIFO (must not hang)",
+            setup: |d| {
+                std::fs::create_dir(d.join(".raywave-bench")).unwrap();
+                setup::fifo(d, ".raywave-bench/good.json");
+            },
+            args: bench(&["--compare", "good"]),
+            stdin: None,
+            exit: 1,
+            stderr: &[".raywave-bench/good.json: expected a bench record (a regular JSON file)"],
+            outputs: &[],
+        },
+        Case {
+            name: "a record that is a link to /dev/zero (must not read forever)",
+            setup: |d| {
+                std::fs::create_dir(d.join(".raywave-bench")).unwrap();
+                setup::symlink(d, ".raywave-bench/good.json", "/dev/zero");
+            },
+            args: bench(&["--compare", "good"]),
+            stdin: None,
+            exit: 1,
+            stderr: &["expected a bench record (a regular JSON file)"],
+            outputs: &[],
+        },
+        Case {
+            name: "a record that is a directory",
+            setup: |d| std::fs::create_dir_all(d.join(".raywave-bench/good.json")).unwrap(),
+            args: bench(&["--compare", "good"]),
+            stdin: None,
+            exit: 1,
+            stderr: &["found a directory or device"],
+            outputs: &[],
+        },
+        Case {
             name: "--compare a record that does not exist",
             setup: setup::nothing,
             args: bench(&["--compare", "missing"]),

@@ -238,8 +238,29 @@ pub fn record_path(dir: &Path, name: &str) -> Result<std::path::PathBuf> {
     Ok(dir.join(format!("{name}.json")))
 }
 
+/// The largest record file `load` reads (a record of 1000 runs is about 1 MiB).
+pub const MAX_RECORD_BYTES: u64 = 64 << 20;
+
 /// Reads a saved record; a missing file says how to make one.
 pub fn load(path: &Path, name: &str) -> Result<BenchRecord> {
+    // Only a regular file of a plausible size is read: a FIFO would hang the bench and a link
+    // to /dev/zero would read until memory runs out.
+    if let Ok(meta) = std::fs::metadata(path) {
+        if !meta.is_file() {
+            bail!(
+                "{}: expected a bench record (a regular JSON file), found a directory or device",
+                path.display()
+            );
+        }
+        if meta.len() > MAX_RECORD_BYTES {
+            bail!(
+                "{}: {} bytes, expected a bench record of at most {} MiB",
+                path.display(),
+                meta.len(),
+                MAX_RECORD_BYTES >> 20
+            );
+        }
+    }
     let text = match std::fs::read_to_string(path) {
         Ok(t) => t,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => bail!(
