@@ -328,6 +328,20 @@ mod tests {
     }
 
     #[test]
+    fn the_key_follows_the_scene_bytes_and_every_setting() {
+        let s = RenderSettings::preview();
+        let k = key(b"v 0 0 0\n", std::slice::from_ref(&s));
+        assert_eq!(k, key(b"v 0 0 0\n", std::slice::from_ref(&s)));
+        assert_ne!(k, key(b"v 0 0 1\n", std::slice::from_ref(&s)));
+        let other = RenderSettings {
+            seed: s.seed + 1,
+            ..s.clone()
+        };
+        assert_ne!(k, key(b"v 0 0 0\n", &[other]));
+        assert_ne!(k, key(b"v 0 0 0\n", &[s.clone(), s]));
+    }
+
+    #[test]
     fn round_trip_and_checks() {
         let dir = tempfile::tempdir().unwrap();
         let cache = Cache::new(dir.path(), 1);
