@@ -2,10 +2,13 @@
 //! and per stage (medians), and keeps and compares records for regression checks.
 //!
 //! ```text
-//! load --compare's record; refuse if its setup (scene, settings, threads) differs
+//! load --compare's record; refuse if its setup (scene, settings, threads) differs or if it
+//!   lacks an engine or stage, or a headline figure is not a positive rate (no verdict that
+//!   cannot fail)
 //! warm-up: one untimed render per engine
 //! for run in 1..=runs: reference, then wavefront (interleaved, so both see the same load)
-//! medians per figure; print; write --save / --json; compare -> table, verdict (exit 3)
+//! medians per figure; compare -> verdict; print; write --save (never over the record it
+//!   regressed against) / --json; table, verdict (exit 3)
 //! ```
 
 pub mod compare;
