@@ -137,7 +137,7 @@ fn prune_cache(before: std::time::SystemTime) {
             .metadata()
             .and_then(|m| m.modified())
             .is_ok_and(|t| t < before);
-        if old && path.extension().is_some_and(|e| e == "pfm") {
+        if old && path.extension().is_some_and(|e| e == "rwref" || e == "pfm") {
             let _ = std::fs::remove_file(path);
         }
     }
@@ -174,7 +174,9 @@ fn measure(scene: &Scene, config: &StudyConfig) -> (usize, Vec<Measured>) {
         raywave::scene::BUILTIN_CORNELL_BOX.as_bytes(),
         config,
         &render,
-        cache_dir().as_deref(),
+        cache_dir()
+            .map(|d| raywave::variance::Cache::new(&d, raywave::variance::cache::DEFAULT_LIMIT_MIB))
+            .as_ref(),
     )
     .expect("the converged reference");
     if !reference.cached {

@@ -91,7 +91,10 @@ impl Film {
         }
         let (width, height) = (dims[0], dims[1]);
         let floats = &bytes[at..];
-        if floats.len() != width as usize * height as usize * 12 {
+        // A zero dimension would make the row split below panic ("chunk size must be
+        // non-zero"); an empty image is not a PFM this program writes.
+        let expected = (width as u64) * (height as u64) * 12;
+        if width == 0 || height == 0 || floats.len() as u64 != expected {
             return Err(bad());
         }
         let mut pixels: Vec<Vec3> = floats

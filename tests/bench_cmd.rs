@@ -148,7 +148,8 @@ fn a_missing_record_names_the_file_and_how_to_create_it() {
         "{stderr}"
     );
     assert!(stderr.contains("raywave bench --save nope"), "{stderr}");
+    // A name that is not plain is a usage error.
     let out = raywave(dir.path(), &["--save", "../x"]);
-    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(out.status.code(), Some(2));
     assert!(text(&out).1.contains("not usable"));
 }

@@ -156,3 +156,17 @@ fn output_checks() {
     assert!(e.contains("d.png") && e.contains("directory"), "{e}");
     assert!(check_output_dir(&dir.path().join("new.png")).is_ok());
 }
+
+#[test]
+fn a_pfm_with_a_zero_dimension_is_an_error_not_a_panic() {
+    let dir = tempfile::tempdir().unwrap();
+    for header in ["PF\n0 4\n-1.0\n", "PF\n4 0\n-1.0\n", "PF\n0 0\n-1.0\n"] {
+        let path = dir.path().join("zero.pfm");
+        std::fs::write(&path, header).unwrap();
+        let e = format!("{:#}", Film::read_pfm(&path).unwrap_err());
+        assert!(
+            e.contains("not a little-endian colour PFM"),
+            "{header:?}: {e}"
+        );
+    }
+}

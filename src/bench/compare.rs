@@ -153,22 +153,117 @@ pub fn change_pct(before: f64, after: f64) -> f64 {
     }
 }
 
-/// Compares `after` against `before`; `Err` lists the setup differences when they cannot be
-/// compared.
+/// Why two records cannot be compared: each line names what is missing or wrong.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Refusal {
+    /// The setups differ (`path: before -> after` lines): the figures describe other work.
+    Setup(Vec<String>),
+    /// The saved record lacks figures this run has, or holds figures that are not positive
+    /// finite rates: a verdict on them could not fail.
+    Incomparable(Vec<String>),
+}
+
+impl Refusal {
+    /// The lines, whichever the kind.
+    pub fn lines(&self) -> &[String] {
+        match self {
+            Refusal::Setup(l) | Refusal::Incomparable(l) => l,
+        }
+    }
+}
+
+/// A headline rate that a verdict can rest on: finite and above zero.
+fn usable(rate: f64) -> bool {
+    rate.is_finite() && rate > 0.0
+}
+
+/// What in `record` keeps it from being compared with a run of `engines`: an engine it lacks,
+/// a headline figure (an engine's total, a stage that handled rays) that is not a positive
+/// finite rate. Empty when it can be compared. Checked before anything is timed.
+pub fn record_problems(record: &BenchRecord, engines: &[&str]) -> Vec<String> {
+    let mut out = Vec::new();
+    if record.engines.is_empty() {
+        out.push("it holds no engines".to_string());
+    }
+    let names: Vec<&str> = record.engines.iter().map(|e| e.engine.as_str()).collect();
+    for engine in engines {
+        if !names.contains(engine) {
+            out.push(format!(
+                "it has no figures for engine {engine} (it holds {})",
+                if names.is_empty() {
+                    "none".to_string()
+                } else {
+                    names.join(", ")
+                }
+            ));
+        }
+    }
+    for e in &record.engines {
+        let total = e.median.rays_per_second.total;
+        if !usable(total) {
+            out.push(format!(
+                "engine {}: total rate {total}, expected a positive number of rays per second",
+                e.engine
+            ));
+        }
+        for st in e.median.stages.iter().filter(|st| st.rays > 0) {
+            if !usable(st.rays_per_thread_second) {
+                out.push(format!(
+                    "engine {} stage {}: rate {}, expected a positive number of rays per \
+                     thread-second",
+                    e.engine, st.stage, st.rays_per_thread_second
+                ));
+            }
+        }
+    }
+    out
+}
+
+/// Compares `after` against `before`. Refused when the setups differ, and when any headline
+/// figure of `after` has nothing valid to compare with in `before` (a verdict that cannot
+/// fail is not given).
 pub fn compare(
     before: &BenchRecord,
     after: &BenchRecord,
     threshold_pct: f64,
-) -> Result<Comparison, Vec<String>> {
+) -> Result<Comparison, Refusal> {
     let differences = setup_differences(&before.setup, &after.setup);
     if !differences.is_empty() {
-        return Err(differences);
+        return Err(Refusal::Setup(differences));
+    }
+    let engines: Vec<&str> = after.engines.iter().map(|e| e.engine.as_str()).collect();
+    let mut problems = record_problems(before, &engines);
+    if after.engines.is_empty() {
+        problems.push("this run measured no engine".to_string());
+    }
+    for a in &after.engines {
+        let Some(b) = before.engines.iter().find(|b| b.engine == a.engine) else {
+            continue;
+        };
+        for st in a.median.stages.iter().filter(|st| st.rays > 0) {
+            match b.median.stages.iter().find(|sb| sb.stage == st.stage) {
+                None => problems.push(format!(
+                    "engine {} has no figure for stage {}",
+                    a.engine, st.stage
+                )),
+                // A stage idle in the record but not now: its zero rate cannot be compared.
+                Some(sb) if sb.rays == 0 && !usable(sb.rays_per_thread_second) => {
+                    problems.push(format!(
+                        "engine {} stage {}: no rays in the record, {} now",
+                        a.engine, st.stage, st.rays
+                    ))
+                }
+                Some(_) => {}
+            }
+        }
+    }
+    if !problems.is_empty() {
+        return Err(Refusal::Incomparable(problems));
     }
     let mut rows = Vec::new();
     let mut notes = Vec::new();
     for a in &after.engines {
         let Some(b) = before.engines.iter().find(|b| b.engine == a.engine) else {
-            notes.push(format!("engine {} is not in the saved record", a.engine));
             continue;
         };
         engine_rows(&a.engine, &b.median, &a.median, threshold_pct, &mut rows);
@@ -213,7 +308,9 @@ fn engine_rows(
             after,
             change_pct: change,
             headline,
-            regressed: headline && before > 0.0 && change < -threshold,
+            // A headline figure of this run that is not a positive finite rate (with a
+            // positive one in the record) fails too: it is no evidence of speed.
+            regressed: headline && usable(before) && (!usable(after) || change < -threshold),
         });
     };
     for ((name, before), (_, after)) in b
@@ -224,13 +321,16 @@ fn engine_rows(
     {
         push("kind", name, *before, after, *name == "total");
     }
+    // A stage that handled no rays in either record (no shadow rays with shadows off) has no
+    // rate to compare; it is shown and does not gate.
     for sa in &a.stages {
+        let idle = sa.rays == 0;
         let before = b
             .stages
             .iter()
             .find(|sb| sb.stage == sa.stage)
             .map_or(0.0, |sb| sb.rays_per_thread_second);
-        push("stage", &sa.stage, before, sa.rays_per_thread_second, true);
+        push("stage", &sa.stage, before, sa.rays_per_thread_second, !idle);
     }
 }
 
@@ -352,12 +452,54 @@ mod tests {
     }
 
     #[test]
-    fn zero_before_never_regresses() {
+    fn records_with_nothing_valid_to_compare_are_refused() {
+        let refused = |before: &BenchRecord| match compare(before, &record(1.0, 1.0), 10.0) {
+            Err(Refusal::Incomparable(lines)) => lines.join("; "),
+            other => panic!("{other:?}"),
+        };
+        for bad in [0.0, -5.0, f64::NAN, f64::INFINITY] {
+            let mut before = record(1.0, 1.0);
+            before.engines[0].median.stages[0].rays_per_thread_second = bad;
+            assert!(refused(&before).contains("stage generate: rate"), "{bad}");
+            let mut before = record(1.0, 1.0);
+            before.engines[0].median.rays_per_second.total = bad;
+            assert!(refused(&before).contains("total rate"), "{bad}");
+        }
         let mut before = record(1.0, 1.0);
-        before.engines[0].median.stages[0].rays_per_thread_second = 0.0;
-        let c = compare(&before, &record(1.0, 1.0), 10.0).unwrap();
-        assert!(!c.regressed());
+        before.engines.clear();
+        assert!(refused(&before).contains("no engines"));
+        before = record(1.0, 1.0);
+        before.engines[0].engine = "other".into();
+        assert!(refused(&before).contains("no figures for engine wavefront (it holds other)"));
+        before = record(1.0, 1.0);
+        before.engines[0].median.stages.pop();
+        assert!(refused(&before).contains("no figure for stage shadow"));
         assert_eq!(change_pct(0.0, 5.0), 0.0);
+    }
+
+    #[test]
+    fn a_rate_of_this_run_that_is_not_positive_regresses() {
+        let mut after = record(1.0, 1.0);
+        after.engines[0].median.rays_per_second.total = f64::NAN;
+        assert!(
+            compare(&record(1.0, 1.0), &after, 10.0)
+                .unwrap()
+                .regressed()
+        );
+    }
+
+    #[test]
+    fn idle_stages_do_not_gate() {
+        let mut before = record(1.0, 1.0);
+        let mut after = record(1.0, 1.0);
+        for r in [&mut before, &mut after] {
+            let st = &mut r.engines[0].median.stages[1];
+            st.rays = 0;
+            st.rays_per_thread_second = 0.0;
+        }
+        let c = compare(&before, &after, 10.0).unwrap();
+        assert!(!c.regressed());
+        assert!(!c.rows.iter().any(|r| r.name == "shadow" && r.headline));
     }
 
     #[test]
@@ -368,7 +510,7 @@ mod tests {
         after.setup.scene.source = "renamed.obj".into();
         let e = compare(&record(1.0, 1.0), &after, 10.0).unwrap_err();
         assert_eq!(
-            e,
+            e.lines(),
             [
                 "settings.bounces: 2 in the record, 3 now",
                 "threads: 2 in the record, 1 now"
@@ -377,7 +519,10 @@ mod tests {
         let mut edited = record(1.0, 1.0);
         edited.setup.scene.text_hash = "01".into();
         assert_eq!(
-            compare(&record(1.0, 1.0), &edited, 10.0).unwrap_err().len(),
+            compare(&record(1.0, 1.0), &edited, 10.0)
+                .unwrap_err()
+                .lines()
+                .len(),
             1
         );
     }

@@ -2,10 +2,13 @@
 //! and per stage (medians), and keeps and compares records for regression checks.
 //!
 //! ```text
-//! load --compare's record; refuse if its setup (scene, settings, threads) differs
+//! load --compare's record; refuse if its setup (scene, settings, threads) differs or if it
+//!   lacks an engine or stage, or a headline figure is not a positive rate (no verdict that
+//!   cannot fail)
 //! warm-up: one untimed render per engine
 //! for run in 1..=runs: reference, then wavefront (interleaved, so both see the same load)
-//! medians per figure; print; write --save / --json; compare -> table, verdict (exit 3)
+//! medians per figure; compare -> verdict; print; write --save (never over the record it
+//!   regressed against) / --json; table, verdict (exit 3)
 //! ```
 
 pub mod ab;
@@ -122,7 +125,11 @@ pub fn run(args: &BenchOptions) -> Result<Outcome> {
                     differences.join("\n  ")
                 );
             }
-            Some(before)
+            let problems = compare::record_problems(&before, &ENGINES.map(|e| e.name()));
+            if !problems.is_empty() {
+                bail!(incomparable(&path, &problems));
+            }
+            Some((path, before))
         }
         None => None,
     };
@@ -147,13 +154,37 @@ pub fn run(args: &BenchOptions) -> Result<Outcome> {
         runs: args.runs,
         engines,
     };
+    // The verdict is reached before anything is written, so that a run that cannot be
+    // compared, or that regressed, does not replace the record it was compared with.
+    let comparison = match &baseline {
+        Some((path, before)) => Some(compare::compare(before, &record, args.threshold).map_err(
+            |r| match r {
+                compare::Refusal::Setup(d) => anyhow::anyhow!(
+                    "cannot compare with {}: setups differ: {}",
+                    path.display(),
+                    d.join("; ")
+                ),
+                compare::Refusal::Incomparable(p) => anyhow::anyhow!(incomparable(path, &p)),
+            },
+        )?),
+        None => None,
+    };
     if !args.quiet {
         emit(&report(&record))?;
     }
+    let regressed = comparison.as_ref().is_some_and(|c| c.regressed());
     if let Some(path) = &save_path {
-        record::save(path, &record)?;
-        if !args.quiet {
-            emit(&format!("saved   {}\n", path.display()))?;
+        if regressed && args.save == args.compare {
+            eprintln!(
+                "warning: not saved: this run regressed against {}, which is kept as it was; \
+                 save under another name to keep this run",
+                path.display()
+            );
+        } else {
+            record::save(path, &record)?;
+            if !args.quiet {
+                emit(&format!("saved   {}\n", path.display()))?;
+            }
         }
     }
     match &args.json {
@@ -166,25 +197,32 @@ pub fn run(args: &BenchOptions) -> Result<Outcome> {
         })?,
         None => {}
     }
-    let comparison = match &baseline {
-        Some(before) => {
-            let c = compare::compare(before, &record, args.threshold)
-                .map_err(|d| anyhow::anyhow!("setups differ: {}", d.join("; ")))?;
-            if !args.quiet {
-                emit("\n")?;
-            }
-            emit(&format!(
-                "compared with {} ({}, commit {}):\n{}",
-                args.compare.as_deref().unwrap_or_default(),
-                before.timestamp,
-                short(&before.git_commit),
-                c.table()
-            ))?;
-            Some(c)
+    if let (Some(c), Some((_, before))) = (&comparison, &baseline) {
+        if !args.quiet {
+            emit("\n")?;
         }
-        None => None,
-    };
+        emit(&format!(
+            "compared with {} ({}, commit {}):\n{}",
+            args.compare.as_deref().unwrap_or_default(),
+            before.timestamp,
+            short(&before.git_commit),
+            c.table()
+        ))?;
+    }
     Ok(Outcome { record, comparison })
+}
+
+/// The engines `raywave bench` measures, in record order.
+const ENGINES: [Engine; 2] = [Engine::Reference, Engine::Wavefront];
+
+/// The error for a record that holds nothing this run can be compared with.
+fn incomparable(path: &std::path::Path, problems: &[String]) -> String {
+    format!(
+        "cannot compare with {}: expected figures for every engine and stage this run \
+         measures, each a positive rate, but:\n  {}\nsave a new record with --save",
+        path.display(),
+        problems.join("\n  ")
+    )
 }
 
 /// Writes to stdout; a closed pipe (`raywave bench | head`) is an error, not a panic.
@@ -198,8 +236,7 @@ fn short(commit: &str) -> &str {
 
 /// One untimed render per engine, then `runs` interleaved timed renders of each.
 fn measure(scene: &Scene, settings: &RenderSettings, runs: u32) -> Vec<EngineRecord> {
-    let engines = [Engine::Reference, Engine::Wavefront]
-        .map(|engine| engine.prepare(scene, settings, DEFAULT_BATCH_SIZE));
+    let engines = ENGINES.map(|engine| engine.prepare(scene, settings, DEFAULT_BATCH_SIZE));
     let time = |engine: &Prepared| {
         let start = Instant::now();
         let (film, stats) = engine.render(&|| {});

@@ -203,23 +203,51 @@ impl Measurement {
     }
 }
 
-/// Where `--save NAME` / `--compare NAME` keep a record.
+/// Where `--save NAME` / `--compare NAME` keep a record. A name is plain: ASCII letters,
+/// digits, `-`, `_`, `.` and `+`, not starting with `.` or `-`, at most 100 characters; any
+/// other name (a path, `..`, a control character) is a usage error (exit 2).
 pub fn record_path(dir: &Path, name: &str) -> Result<std::path::PathBuf> {
-    if name.is_empty()
-        || name.starts_with('.')
-        || name.contains(['/', '\\'])
-        || name.chars().any(char::is_control)
-    {
-        bail!(
-            "bench record name `{name}` is not usable: expected a plain name like `before` \
-             (no path separators, not starting with '.'); use --dir to choose the directory"
-        );
+    let plain = !name.is_empty()
+        && name.len() <= 100
+        && !name.starts_with(['.', '-'])
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.' | '+'));
+    if !plain {
+        return Err(crate::error::UsageError(format!(
+            "bench record name `{}` is not usable: expected a plain name like `before` \
+             (letters, digits, - _ . +; no path separators, not starting with '.' or '-'); \
+             use --dir to choose the directory",
+            name.escape_debug()
+        ))
+        .into());
     }
     Ok(dir.join(format!("{name}.json")))
 }
 
+/// The largest record file `load` reads (a record of 1000 runs is about 1 MiB).
+pub const MAX_RECORD_BYTES: u64 = 64 << 20;
+
 /// Reads a saved record; a missing file says how to make one.
 pub fn load(path: &Path, name: &str) -> Result<BenchRecord> {
+    // Only a regular file of a plausible size is read: a FIFO would hang the bench and a link
+    // to /dev/zero would read until memory runs out.
+    if let Ok(meta) = std::fs::metadata(path) {
+        if !meta.is_file() {
+            bail!(
+                "{}: expected a bench record (a regular JSON file), found a directory or device",
+                path.display()
+            );
+        }
+        if meta.len() > MAX_RECORD_BYTES {
+            bail!(
+                "{}: {} bytes, expected a bench record of at most {} MiB",
+                path.display(),
+                meta.len(),
+                MAX_RECORD_BYTES >> 20
+            );
+        }
+    }
     let text = match std::fs::read_to_string(path) {
         Ok(t) => t,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => bail!(
@@ -339,9 +367,10 @@ mod tests {
             record_path(dir, "before").unwrap(),
             Path::new("d/before.json")
         );
-        for bad in ["", "../x", "a/b", ".hidden"] {
-            let e = record_path(dir, bad).unwrap_err().to_string();
-            assert!(e.contains("not usable"), "{e}");
+        for bad in ["", "../x", "a/b", ".hidden", "-x", "a\\b", "a\nb", "é"] {
+            let e = record_path(dir, bad).unwrap_err();
+            assert!(e.downcast_ref::<crate::error::UsageError>().is_some());
+            assert!(e.to_string().contains("not usable"), "{e}");
         }
     }
 

@@ -39,12 +39,23 @@ pub struct VarianceArgs {
     /// Directory for table.txt, results.csv, results.json, mse.png and the heat maps.
     #[arg(long, default_value = "variance-report")]
     pub out: PathBuf,
-    /// Directory caching converged references (keyed by scene bytes and settings).
+    /// Directory caching converged references (keyed by the scene bytes parsed, the settings
+    /// and the executable; every entry is checked when read and rendered again if it fails).
     #[arg(long, default_value = ".raywave-cache")]
     pub cache: PathBuf,
     /// Always render the converged reference, ignoring and not writing the cache.
-    #[arg(long)]
+    #[arg(long, conflicts_with_all = ["cache", "cache_limit", "clean_cache"])]
     pub no_cache: bool,
+    /// Bound on the cache's total size in MiB; the least recently used entries are removed
+    /// above it.
+    #[arg(long, value_name = "MIB",
+          default_value_t = raywave::variance::cache::DEFAULT_LIMIT_MIB,
+          value_parser = clap::value_parser!(u64).range(1..=1 << 30))]
+    pub cache_limit: u64,
+    /// Remove every converged reference from the --cache directory (other files are left
+    /// alone) and exit, without running a study.
+    #[arg(long, conflicts_with = "scene")]
+    pub clean_cache: bool,
     /// How a light's colour reaches a point: lab (no fall-off) or rpi (divided by π·d², as
     /// RPI's framework does).
     #[arg(long, value_enum, default_value = "lab")]
@@ -76,6 +87,8 @@ impl VarianceArgs {
             out: self.out.clone(),
             cache: self.cache.clone(),
             no_cache: self.no_cache,
+            cache_limit_mib: self.cache_limit,
+            clean_cache: self.clean_cache,
             light_model: self.light_model.into(),
             engine: self.engine.into(),
             quiet: self.quiet,

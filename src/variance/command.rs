@@ -1,8 +1,9 @@
 //! `raywave variance`: the study as a command (options, progress, outputs); the flags are the
 //! binary's.
 
-use super::{Region, StudyConfig, run_study};
+use super::{Cache, Region, StudyConfig, cache, run_study};
 use crate::engine::Engine;
+use crate::error::UsageError;
 use crate::sampling::LightSampler;
 use crate::scene::{ParseOptions, Scene, SceneFile, load_scene};
 use crate::settings::{LightModel, RenderSettings};
@@ -37,6 +38,10 @@ pub struct VarianceOptions {
     pub cache: PathBuf,
     /// Always render the converged reference, ignoring and not writing the cache.
     pub no_cache: bool,
+    /// Bound on the cache's total size, in MiB: the least recently used entries go first.
+    pub cache_limit_mib: u64,
+    /// Remove the cache's entries and stop, without running a study.
+    pub clean_cache: bool,
     /// How a light's colour reaches a point.
     pub light_model: LightModel,
     /// The engine that renders the images.
@@ -51,14 +56,15 @@ impl VarianceOptions {
         // Every seed's image is kept until its statistics are taken.
         let bytes = self.seeds as u64 * self.size[0] as u64 * self.size[1] as u64 * 12;
         if bytes > MAX_STUDY_BYTES {
-            bail!(
+            return Err(UsageError(format!(
                 "--seeds {} at --size {} {} would hold {:.1} GiB of images at once: expected at most {} GiB; use fewer seeds or a smaller size",
                 self.seeds,
                 self.size[0],
                 self.size[1],
                 bytes as f64 / (1u64 << 30) as f64,
                 MAX_STUDY_BYTES >> 30
-            );
+            ))
+            .into());
         }
         if self.out.exists() && !self.out.is_dir() {
             bail!(
@@ -67,14 +73,18 @@ impl VarianceOptions {
             );
         }
         if !self.budgets.contains(&self.heatmap_n) {
-            return Err(crate::error::UsageError(format!(
+            return Err(UsageError(format!(
                 "--heatmap-n {} is not one of --budgets {:?}: expected one of the budgets",
                 self.heatmap_n, self.budgets
             ))
             .into());
         }
         if self.samplers.is_empty() {
-            bail!("--samplers is empty: expected at least one of random, stratified, sobol, lab");
+            return Err(UsageError(
+                "--samplers is empty: expected at least one of random, stratified, sobol, lab"
+                    .into(),
+            )
+            .into());
         }
         Ok(())
     }
@@ -85,6 +95,15 @@ pub const MAX_STUDY_BYTES: u64 = 4 << 30;
 
 /// Runs the study on the current rayon pool, writes the outputs, then prints the table.
 pub fn run(args: &VarianceOptions) -> Result<()> {
+    if args.clean_cache {
+        let (files, bytes) = cache::clean(&args.cache)?;
+        return print(&format!(
+            "removed {files} cache entr{} ({:.1} MiB) from {}\n",
+            if files == 1 { "y" } else { "ies" },
+            bytes as f64 / (1u64 << 20) as f64,
+            args.cache.display()
+        ));
+    }
     args.validate()?;
     let SceneFile {
         scene,
@@ -102,13 +121,13 @@ pub fn run(args: &VarianceOptions) -> Result<()> {
     // Fail on an unusable output directory now, not after minutes of rendering.
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create the output directory {}", args.out.display()))?;
-    let mut cache = (!args.no_cache).then_some(args.cache.as_path());
-    if let Some(dir) = cache
-        && let Err(e) = std::fs::create_dir_all(dir)
+    let mut cache = (!args.no_cache).then(|| Cache::new(&args.cache, args.cache_limit_mib));
+    if let Some(c) = &cache
+        && let Err(e) = std::fs::create_dir_all(&c.dir)
     {
         eprintln!(
             "warning: cannot use the cache directory {} ({e}): the converged reference will not be cached",
-            dir.display()
+            c.dir.display()
         );
         cache = None;
     }
@@ -157,7 +176,7 @@ pub fn run(args: &VarianceOptions) -> Result<()> {
         &config,
         args.engine.name(),
         &|scene: &Scene, settings: &RenderSettings| args.engine.image(scene, settings),
-        cache,
+        cache.as_ref(),
         &|label| {
             bar.set_message(label.to_string());
             bar.inc(1);

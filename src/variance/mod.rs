@@ -11,6 +11,7 @@
 //! slope of log MSE against log N                                        per sampler and region
 //! ```
 
+pub mod cache;
 pub mod command;
 pub mod mask;
 pub mod plot;
@@ -21,13 +22,14 @@ use crate::sampling::LightSampler;
 use crate::scene::Scene;
 use crate::settings::{RenderSettings, ShadowMode};
 use crate::stats::RayCounts;
-use anyhow::{Context, Result};
+use anyhow::{Context, Result, bail};
 use glam::Vec3;
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+pub use cache::Cache;
 pub use mask::{Regions, penumbra_mask};
 pub use stats::{ErrorStats, LogLogFit, error_stats, loglog_fit};
 
@@ -95,46 +97,57 @@ pub struct Converged {
     pub cached: bool,
 }
 
-/// Renders (or reads from `cache_dir`) the converged reference. `scene_id` must change when
-/// the scene does (the CLI passes the file's bytes).
+/// Renders (or reads from `cache`) the converged reference. `scene_id` must change when the
+/// scene does (the CLI passes the bytes it parsed). An entry that fails its checks is reported
+/// in one warning line and rendered again; a reference with values that are not finite is an
+/// error, not a table of NaN.
 pub fn converged_reference(
     scene: &Scene,
     scene_id: &[u8],
     config: &StudyConfig,
     render: &RenderFn,
-    cache_dir: Option<&Path>,
+    cache: Option<&Cache>,
 ) -> Result<Converged> {
     let halves = [0xa11c_e000u32, 0xb0b0_0001];
     let settings: Vec<RenderSettings> = halves
         .iter()
         .map(|&seed| config.run_settings(LightSampler::Stratified, config.reference_samples, seed))
         .collect();
-    let key = cache_key(scene_id, &settings);
-    let paths =
-        cache_dir.map(|dir| [0, 1].map(|h| dir.join(format!("reference-{key:016x}-{h}.pfm"))));
-    let mut films = None;
-    let mut cached = false;
-    if let Some(paths) = &paths
-        && let (Ok(a), Ok(b)) = (Film::read_pfm(&paths[0]), Film::read_pfm(&paths[1]))
-        && a.width == config.base.width
-        && a.height == config.base.height
-    {
-        films = Some([a, b]);
-        cached = true;
-    }
-    let [a, b] = match films {
-        Some(f) => f,
-        None => {
-            let a = render(scene, &settings[0]).0;
-            let b = render(scene, &settings[1]).0;
-            if let (Some(paths), Some(dir)) = (&paths, cache_dir) {
-                std::fs::create_dir_all(dir).with_context(|| {
-                    format!("cannot create the cache directory {}", dir.display())
-                })?;
-                a.write_hdr(&paths[0])?;
-                b.write_hdr(&paths[1])?;
+    let key = cache::key(scene_id, &settings);
+    let (width, height) = (config.base.width, config.base.height);
+    let lookup = cache.map_or(cache::Lookup::Miss, |c| c.read(key, width, height));
+    let cached = matches!(lookup, cache::Lookup::Hit(_));
+    let [a, b] = match lookup {
+        cache::Lookup::Hit(films) => films,
+        miss => {
+            if let (cache::Lookup::Invalid(what), Some(c)) = (&miss, cache) {
+                eprintln!(
+                    "warning: ignoring the cache entry {}: {what}; rendering the reference again",
+                    c.entry_path(key).display()
+                );
             }
-            [a, b]
+            let films = [render(scene, &settings[0]).0, render(scene, &settings[1]).0];
+            let bad = films
+                .iter()
+                .flat_map(|f| &f.pixels)
+                .filter(|c| !c.is_finite())
+                .count();
+            if bad > 0 {
+                bail!(
+                    "{}: the converged reference has {bad} pixels that are not finite: expected \
+                     finite light everywhere, so there is nothing to measure the errors against",
+                    scene.source
+                );
+            }
+            if let Some(c) = cache
+                && let Err(e) = c.write(key, &films)
+            {
+                eprintln!(
+                    "warning: cannot cache the reference in {}: {e:#}",
+                    c.entry_path(key).display()
+                );
+            }
+            films
         }
     };
     let film = Film {
@@ -158,22 +171,6 @@ pub fn converged_reference(
         noise,
         cached,
     })
-}
-
-/// FNV-1a over the scene bytes, the settings and the running executable's own bytes, so a
-/// change of scene, settings or renderer code makes a new cache entry (hashing the executable
-/// takes a few milliseconds; where it cannot be read, the version stands in for it).
-fn cache_key(scene_id: &[u8], settings: &[RenderSettings]) -> u64 {
-    let mut h = 0xcbf2_9ce4_8422_2325u64;
-    let json = serde_json::to_vec(settings).unwrap_or_default();
-    let code = std::env::current_exe()
-        .and_then(std::fs::read)
-        .unwrap_or_else(|_| env!("CARGO_PKG_VERSION").as_bytes().to_vec());
-    for &byte in scene_id.iter().chain(&json).chain(&code) {
-        h ^= byte as u64;
-        h = h.wrapping_mul(0x0000_0100_0000_01b3);
-    }
-    h
 }
 
 /// The three regions a study reports.
@@ -265,10 +262,10 @@ pub fn run_study(
     config: &StudyConfig,
     engine: &str,
     render: &RenderFn,
-    cache_dir: Option<&Path>,
+    cache: Option<&Cache>,
     progress: &dyn Fn(&str),
 ) -> Result<StudyResult> {
-    let reference = converged_reference(scene, scene_id, config, render, cache_dir)?;
+    let reference = converged_reference(scene, scene_id, config, render, cache)?;
     progress("converged reference");
     let regions = penumbra_mask(scene, &config.base, config.mask_samples);
     progress("penumbra mask");
