@@ -473,7 +473,7 @@ impl Parser<'_> {
             .iter()
             .zip(corners.iter().cycle().skip(1))
             .fold(0.0f32, |m, (a, b)| m.max((*b - *a).length_squared()));
-        if !(area > 1e-10 * longest_squared) || !normal.normalize().is_finite() {
+        if area <= 1e-10 * longest_squared || !normal.normalize().is_finite() {
             return Err(self.error(
                 line,
                 format!(
