@@ -663,6 +663,25 @@ fn repeated_and_meaningless_flags() {
             &["a.pfm"],
         ),
         case(
+            "--batch-size with the reference engine",
+            setup::nothing,
+            &[
+                "--engine",
+                "reference",
+                "--batch-size",
+                "64",
+                "--size",
+                "8",
+                "8",
+                "-q",
+                "-o",
+                "a.png",
+            ],
+            0,
+            &["warning: --batch-size has no effect with --engine reference"],
+            ok_outputs,
+        ),
+        case(
             "bench --shadows off --shadow-samples 4",
             setup::nothing,
             &[
