@@ -117,7 +117,24 @@ impl Prepared<'_> {
     }
 
     /// Renders the image on the current rayon pool, calling `progress` after each work unit.
+    ///
+    /// Every pixel comes out finite: a scene's numbers are bounded by the parser, but a mirror
+    /// that reflects more than it receives, over many bounces, or a bright light next to a
+    /// surface can still overflow f32; such pixels are clamped (see [`clamp_to_finite`]) with
+    /// one warning on stderr.
     pub fn render(&self, progress: &(dyn Fn() + Sync)) -> (Film, RenderStats) {
+        let (mut film, stats) = self.render_raw(progress);
+        let clamped = clamp_to_finite(&mut film);
+        if clamped > 0 {
+            eprintln!(
+                "warning: {clamped} pixel(s) overflowed f32 and were clamped to finite values \
+                 (the scene's colours or mirrors amplify light past 3.4e38)"
+            );
+        }
+        (film, stats)
+    }
+
+    fn render_raw(&self, progress: &(dyn Fn() + Sync)) -> (Film, RenderStats) {
         match self {
             Prepared::Wavefront(w) => w.render(progress),
             Prepared::Reference(r) => {
@@ -132,6 +149,25 @@ impl Prepared<'_> {
             }
         }
     }
+}
+
+/// Makes every channel of every pixel finite: +inf becomes `f32::MAX`, NaN (infinity times
+/// zero) becomes 0. Returns how many pixels changed; finite images are left untouched.
+pub fn clamp_to_finite(film: &mut Film) -> usize {
+    let mut changed = 0;
+    for p in &mut film.pixels {
+        if !p.is_finite() {
+            changed += 1;
+            *p = glam::Vec3::from_array(p.to_array().map(|c| {
+                if c.is_nan() {
+                    0.0
+                } else {
+                    c.clamp(-f32::MAX, f32::MAX)
+                }
+            }));
+        }
+    }
+    changed
 }
 
 /// The worker threads the engines render on: `threads`, or rayon's default (all cores).

@@ -63,6 +63,7 @@ pub mod machine;
 pub mod meshgen;
 pub mod options;
 pub mod peer;
+pub mod quote;
 pub mod reference;
 pub mod report;
 pub mod sampling;

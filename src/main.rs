@@ -17,10 +17,23 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    let cli = Cli::parse_from(normalized.args);
+    let cli = match Cli::try_parse_from(&normalized.args) {
+        Ok(cli) => cli,
+        // --help and --version.
+        Err(e) if !e.use_stderr() => e.exit(),
+        // Usage errors name the flags as typed (`-num_bounces`, not `--bounces`).
+        Err(e) => {
+            eprint!("{}", normalized.respell(&e.to_string()));
+            return ExitCode::from(e.exit_code().clamp(0, 255) as u8);
+        }
+    };
     // Lab and RPI flags accepted without effect: one line each, like the scene's warnings.
     for note in &normalized.notes {
         eprintln!("note: {note}");
+    }
+    // Flags the other flags make meaningless: accepted, with one line each.
+    for warning in cli::combos::meaningless(&cli.command, &|flag| normalized.typed(flag)) {
+        eprintln!("warning: {warning}");
     }
     let result = match cli.command {
         Command::Render(args) => cli::render::run(&args),

@@ -148,6 +148,35 @@ pub struct Normalized {
     pub args: Vec<OsString>,
     /// One line each for flags accepted without effect (printed with a `note:` prefix).
     pub notes: Vec<String>,
+    /// (raywave flag, the lab's or RPI's spelling the user typed for it), so that messages
+    /// name flags as typed.
+    pub spellings: Vec<(&'static str, String)>,
+}
+
+impl Normalized {
+    /// How the user spelled raywave's `flag` (the flag itself when typed as raywave's).
+    pub fn typed(&self, flag: &str) -> String {
+        self.spellings
+            .iter()
+            .find(|(target, _)| *target == flag)
+            .map_or_else(|| flag.to_string(), |(_, typed)| typed.clone())
+    }
+
+    /// A message of clap's about raywave's flags, with each flag named as the user typed it
+    /// (`'--bounces <BOUNCES>'` becomes `'-num_bounces <BOUNCES>'`) and control characters
+    /// from the command line escaped.
+    pub fn respell(&self, message: &str) -> String {
+        let mut out = message.to_string();
+        for (target, typed) in &self.spellings {
+            for end in [' ', '\''] {
+                out = out.replace(&format!("'{target}{end}"), &format!("'{typed}{end}"));
+            }
+        }
+        out.split('\n')
+            .map(raywave::quote::escape)
+            .collect::<Vec<_>>()
+            .join("\n")
+    }
 }
 
 /// The table entry for an argument, and whose spelling it is (`None`: raywave's own).
@@ -235,6 +264,7 @@ pub fn normalize_args(args: impl IntoIterator<Item = OsString>) -> Result<Normal
         return Ok(Normalized {
             args: out,
             notes: Vec::new(),
+            spellings: Vec::new(),
         });
     }
 
@@ -276,6 +306,7 @@ pub fn normalize_args(args: impl IntoIterator<Item = OsString>) -> Result<Normal
     }
 
     let mut notes = Vec::new();
+    let mut spellings: Vec<(&'static str, String)> = Vec::new();
     // The setting each raywave flag sets, and the spelling that set it first.
     let mut set_by: Vec<(&str, String)> = Vec::new();
     let mut claim = |target: &str, spelling: &str| -> Result<(), UsageError> {
@@ -320,21 +351,27 @@ pub fn normalize_args(args: impl IntoIterator<Item = OsString>) -> Result<Normal
         match flag.meaning {
             Meaning::Flag(target) => {
                 claim(target, text)?;
+                if target != text {
+                    spellings.push((target, text.to_string()));
+                }
                 out.push(target.into());
                 out.extend(values.into_iter().map(OsString::from));
             }
             Meaning::Tokens(args) => {
                 claim(args[0], text)?;
+                spellings.push((args[0], text.to_string()));
                 out.extend(args.iter().map(OsString::from));
             }
             Meaning::ShadowSamples => match (values[0].as_str(), dialect) {
                 ("0", Defaults::Rpi) => {
                     claim("--shadows", text)?;
+                    spellings.push(("--shadows", text.to_string()));
                     out.extend(["--shadows", "off"].map(OsString::from));
                 }
                 ("0", _) => {}
                 (n, _) => {
                     claim("--shadow-samples", text)?;
+                    spellings.push(("--shadow-samples", text.to_string()));
                     out.extend(["--shadow-samples", n].map(OsString::from));
                 }
             },
@@ -347,7 +384,11 @@ pub fn normalize_args(args: impl IntoIterator<Item = OsString>) -> Result<Normal
             }
         }
     }
-    Ok(Normalized { args: out, notes })
+    Ok(Normalized {
+        args: out,
+        notes,
+        spellings,
+    })
 }
 
 #[cfg(test)]
@@ -434,6 +475,18 @@ mod tests {
         ] {
             assert!(norm(line).is_err(), "{line}");
         }
+    }
+
+    #[test]
+    fn clap_messages_name_flags_as_typed_and_escape_controls() {
+        let n = norm("-num_bounces 99 -soft_shadow").unwrap();
+        assert_eq!(
+            n.respell("error: invalid value '99' for '--bounces <BOUNCES>': 99 is not in 0..=64"),
+            "error: invalid value '99' for '-num_bounces <BOUNCES>': 99 is not in 0..=64"
+        );
+        assert_eq!(n.typed("--shadows"), "-soft_shadow");
+        assert_eq!(n.typed("--aa"), "--aa");
+        assert_eq!(n.respell("a \u{1b}[2J\nb"), "a \\x1b[2J\nb");
     }
 
     #[test]

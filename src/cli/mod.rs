@@ -3,6 +3,7 @@
 //! `VarianceOptions`) and running the command; `main` owns the exit code.
 //!
 //! ```text
+//! combos.rs    warnings for flags that other flags make meaningless
 //! foreign.rs   the lab's and RPI's spellings -> raywave's flags (FOREIGN_FLAGS)
 //! values.rs    clap spellings of the library's enums (engine, shadows, sampler, ...)
 //! image.rs     the image flags render and bench share -> raywave::options::ImageOptions
@@ -13,6 +14,7 @@
 //! ```
 
 pub mod bench;
+pub mod combos;
 pub mod foreign;
 pub mod image;
 pub mod info;

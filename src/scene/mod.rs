@@ -6,11 +6,13 @@
 //! `u32::MAX`, never an `Option`, so the same sentinel works in SIMD columns.
 
 mod parse;
+mod read;
 
 pub use parse::{
     ParseError, ParseOptions, RPI_RING_SEGMENTS, SceneError, Warning, parse_scene_str,
     parse_scene_str_with,
 };
+pub use read::{MAX_SCENE_BYTES, STDIN_NAME, read_capped, read_scene_bytes};
 
 use glam::Vec3;
 use std::path::Path;
@@ -281,8 +283,9 @@ pub struct SceneFile {
     pub bytes: Vec<u8>,
 }
 
-/// Reads the scene file once (the built-in scene without a path) and parses it; errors name
-/// the file and line. The scene's warnings are kept in `Scene::warnings` for the caller to
+/// Reads the scene file once (the built-in scene without a path; `-` is standard input) and
+/// parses it; errors name the file and line. Directories, devices and sockets are refused, and
+/// no more than [`MAX_SCENE_BYTES`] is read (see [`read_scene_bytes`]). The scene's warnings are kept in `Scene::warnings` for the caller to
 /// print.
 pub fn load_scene(path: Option<&Path>, options: &ParseOptions) -> Result<SceneFile, SceneError> {
     let Some(path) = path else {
@@ -291,11 +294,7 @@ pub fn load_scene(path: Option<&Path>, options: &ParseOptions) -> Result<SceneFi
             bytes: BUILTIN_CORNELL_BOX.as_bytes().to_vec(),
         });
     };
-    let file = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|source| SceneError::Io {
-        path: file.clone(),
-        source,
-    })?;
+    let (bytes, file) = read_scene_bytes(path)?;
     let scene = Scene::from_bytes(&bytes, &file, options)?;
     Ok(SceneFile { scene, bytes })
 }

@@ -10,6 +10,7 @@
 //! quads) come in as [`ParseOptions`], since the file is read before the render settings exist.
 
 use super::{Camera, Light, LightShape, Material, Scene, Sphere, Triangle};
+use crate::quote::quote;
 use glam::Vec3;
 use std::fmt;
 
@@ -36,6 +37,15 @@ pub enum SceneError {
         /// The OS error.
         #[source]
         source: std::io::Error,
+    },
+    /// The input is not something raywave reads as a scene (a directory, a device, a socket),
+    /// or is larger than the limit.
+    #[error("{path}: {message}")]
+    Input {
+        /// The path as given (escaped).
+        path: String,
+        /// What was expected and what was found.
+        message: String,
     },
     /// The file was read but is not a valid scene.
     #[error(transparent)]
@@ -193,7 +203,9 @@ fn number(file: &str, line: usize, what: &str, token: Option<&str>) -> Result<f3
     };
     let token =
         token.ok_or_else(|| error(format!("expected {what}, found the end of the line")))?;
-    match token.parse::<f32>() {
+    let parsed = token.parse::<f32>();
+    let token = quote(token);
+    match parsed {
         Ok(x) if x.is_finite() && x.abs() <= MAX_NUMBER => Ok(x),
         Ok(x) if x.is_finite() => Err(error(format!(
             "expected {what} of magnitude at most 1e9, found `{token}`"
@@ -245,7 +257,10 @@ impl Parser<'_> {
             None => Ok(()),
             Some(extra) => Err(self.error(
                 line,
-                format!("expected {count} value(s) after `{keyword}`, found extra `{extra}`"),
+                format!(
+                    "expected {count} value(s) after `{keyword}`, found extra `{}`",
+                    quote(extra)
+                ),
             )),
         }
     }
@@ -338,7 +353,8 @@ impl Parser<'_> {
                     self.error(
                         line,
                         format!(
-                            "expected a material index (0, 1, 2, ...) after `m`, found `{token}`"
+                            "expected a material index (0, 1, 2, ...) after `m`, found `{}`",
+                            quote(token)
                         ),
                     )
                 })?;
@@ -376,7 +392,7 @@ impl Parser<'_> {
                 self.current_material(line, keyword)?.glossiness = g;
             }
             "texture_file" => {
-                let name = args.first().copied().unwrap_or("");
+                let name = quote(args.first().copied().unwrap_or(""));
                 self.current_material(line, keyword)?.diffuse = Vec3::splat(0.5);
                 self.warn(line, format!("textures are not supported: `{name}` replaced by a neutral grey diffuse 0.5"));
             }
@@ -398,7 +414,10 @@ impl Parser<'_> {
                 self.camera_line(&rest, line)?;
             }
             "vt" | "vn" | "vp" | "g" | "o" | "usemtl" | "mtllib" => {}
-            other => self.warn(line, format!("unknown keyword `{other}`: line skipped")),
+            other => self.warn(
+                line,
+                format!("unknown keyword `{}`: line skipped", quote(other)),
+            ),
         }
         Ok(())
     }
@@ -420,7 +439,8 @@ impl Parser<'_> {
                 self.error(
                     line,
                     format!(
-                        "expected a vertex index (1-based, or negative relative), found `{token}`"
+                        "expected a vertex index (1-based, or negative relative), found `{}`",
+                        quote(token)
                     ),
                 )
             })?;
@@ -445,12 +465,15 @@ impl Parser<'_> {
         corners: Vec<Vec3>,
         material: u32,
     ) -> Result<(), ParseError> {
-        let area = newell_normal(&corners).length() * 0.5;
-        let scale = corners
+        // Relative to the face's own size, so that a scene scaled by 1e-6 or 1e6 keeps its faces:
+        // degenerate means thinner than 1e-10 of its longest edge, or too small for a normal.
+        let normal = newell_normal(&corners);
+        let area = normal.length() * 0.5;
+        let longest_squared = corners
             .iter()
-            .fold(0.0f32, |m, c| m.max(c.abs().max_element()))
-            .max(1.0);
-        if area <= 1e-10 * scale * scale {
+            .zip(corners.iter().cycle().skip(1))
+            .fold(0.0f32, |m, (a, b)| m.max((*b - *a).length_squared()));
+        if area <= 1e-10 * longest_squared || !normal.normalize().is_finite() {
             return Err(self.error(
                 line,
                 format!(
@@ -550,7 +573,10 @@ impl Parser<'_> {
             if closed {
                 return Err(self.error(
                     line,
-                    format!("expected the end of the line after `}}`, found `{token}`"),
+                    format!(
+                        "expected the end of the line after `}}`, found `{}`",
+                        quote(token)
+                    ),
                 ));
             }
             let block = self.camera_block.as_mut().expect("in a camera block");
@@ -618,7 +644,7 @@ impl Parser<'_> {
                 other => {
                     return Err(self.error(
                         line,
-                        format!("expected camera_position, point_of_interest, up or angle in the camera block, found `{other}`"),
+                        format!("expected camera_position, point_of_interest, up or angle in the camera block, found `{}`", quote(other)),
                     ));
                 }
             }

@@ -252,3 +252,53 @@ pub mod setup {
         std::os::unix::fs::symlink(target, dir.join(name)).unwrap();
     }
 }
+
+/// More setup helpers: streams and big files.
+pub mod setup_streams {
+    use std::io::Write;
+    use std::path::Path;
+
+    /// A FIFO `dir/name` and a thread that writes `bytes` into it once a reader opens it (the
+    /// thread waits forever, harmlessly, if none does).
+    pub fn fifo_feeding(dir: &Path, name: &str, bytes: &'static [u8]) {
+        super::setup::fifo(dir, name);
+        let path = dir.join(name);
+        std::thread::spawn(move || {
+            if let Ok(mut f) = std::fs::OpenOptions::new().write(true).open(path) {
+                let _ = f.write_all(bytes);
+            }
+        });
+    }
+
+    /// A sparse file `dir/name` of `len` bytes (zeros, no disk blocks).
+    pub fn sparse(dir: &Path, name: &str, len: u64) {
+        std::fs::File::create(dir.join(name))
+            .unwrap()
+            .set_len(len)
+            .unwrap();
+    }
+
+    /// `dir/name`: the bundled scene `scene` with every vertex and sphere scaled by `s`.
+    pub fn scaled(dir: &Path, name: &str, scene: &str, s: f64) {
+        let text = std::fs::read_to_string(super::super::bin::scenes().join(scene)).unwrap();
+        let mut out = String::new();
+        for line in text.lines() {
+            let t: Vec<&str> = line.split_whitespace().collect();
+            let scale = |xs: &[&str]| {
+                xs.iter()
+                    .map(|x| format!("{:e}", x.parse::<f64>().unwrap() * s))
+                    .collect::<Vec<_>>()
+                    .join(" ")
+            };
+            match t.first() {
+                Some(&"v") => out.push_str(&format!("v {}\n", scale(&t[1..4]))),
+                Some(&"s") if t.len() == 5 => out.push_str(&format!("s {}\n", scale(&t[1..5]))),
+                _ => {
+                    out.push_str(line);
+                    out.push('\n');
+                }
+            }
+        }
+        std::fs::write(dir.join(name), out).unwrap();
+    }
+}
