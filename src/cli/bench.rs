@@ -3,7 +3,9 @@
 use super::image::ImageArgs;
 use anyhow::Result;
 use clap::Args;
+use raywave::bench::record::record_path;
 use raywave::bench::{BenchOptions, DEFAULT_THRESHOLD_PCT};
+use raywave::output::OutputPlan;
 use std::path::PathBuf;
 
 /// Flags of `raywave bench`.
@@ -71,8 +73,28 @@ impl BenchArgs {
     }
 }
 
+/// The scene and the `--compare` record (inputs), the `--save` record and `--json` (outputs).
+/// Names `record_path` refuses are left to the bench, which reports them.
+fn output_plan(args: &BenchArgs) -> OutputPlan {
+    let mut plan = OutputPlan::new();
+    if let Some(scene) = args.scene.as_ref().or(args.input.as_ref()) {
+        plan = plan.input("SCENE", scene);
+    }
+    if let Some(Ok(path)) = args.compare.as_ref().map(|n| record_path(&args.dir, n)) {
+        plan = plan.input("--compare", &path);
+    }
+    if let Some(Ok(path)) = args.save.as_ref().map(|n| record_path(&args.dir, n)) {
+        plan = plan.output_in_new_dir("--save", &path);
+    }
+    if let Some(json) = &args.json {
+        plan = plan.output("--json", json);
+    }
+    plan
+}
+
 /// Runs the bench; the exit code is 3 (`raywave::bench::EXIT_REGRESSION`) when `--compare`
 /// finds a regression, else 0.
 pub fn run(args: &BenchArgs) -> Result<u8> {
+    output_plan(args).check()?;
     Ok(raywave::bench::run(&args.options())?.exit_code())
 }
