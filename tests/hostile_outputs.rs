@@ -356,6 +356,17 @@ fn render_special_files_and_directories() {
             ["x.png"]
         ),
         render!(
+            "--stats-json into a FIFO with a reader",
+            |d| {
+                setup::cornell_box(d);
+                out::fifo_with_reader(d, "stats")
+            },
+            ["-o", "x.png", "--stats-json", "stats"],
+            0,
+            [],
+            ["x.png"]
+        ),
+        render!(
             "-o - writes PNG to stdout",
             setup::cornell_box,
             ["-o", "-"],
@@ -658,6 +669,61 @@ fn bench_variance_and_meshgen_outputs() {
             stdin: None,
             exit: 1,
             stderr: &["f is not a directory"],
+            outputs: &[],
+        },
+        Case {
+            name: "bench --json is a symlink to the scene",
+            setup: |d| {
+                setup::cornell_box(d);
+                setup::symlink(d, "b.json", "cornell_box.obj")
+            },
+            args: &[
+                "bench",
+                "cornell_box.obj",
+                "--size",
+                "8",
+                "8",
+                "--runs",
+                "1",
+                "-q",
+                "--json",
+                "b.json",
+            ],
+            stdin: None,
+            exit: 2,
+            stderr: &["--json b.json is the same file as the input SCENE"],
+            outputs: &[],
+        },
+        Case {
+            name: "variance would draw a heat map over the scene",
+            setup: |d| {
+                setup::cornell_box(d);
+                std::fs::rename(d.join("cornell_box.obj"), d.join("heat_random_N16.png")).unwrap()
+            },
+            args: &[
+                "variance",
+                "heat_random_N16.png",
+                "--size",
+                "8",
+                "8",
+                "--samplers",
+                "random",
+                "--out",
+                ".",
+                "-q",
+            ],
+            stdin: None,
+            exit: 2,
+            stderr: &["is the same file as the input SCENE heat_random_N16.png"],
+            outputs: &[],
+        },
+        Case {
+            name: "meshgen -o a symlink to /dev/null",
+            setup: |d| setup::symlink(d, "m.obj", "/dev/null"),
+            args: &["meshgen", "--triangles", "36", "-o", "m.obj"],
+            stdin: None,
+            exit: 0,
+            stderr: &[],
             outputs: &[],
         },
         Case {

@@ -107,6 +107,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     let plan = output_plan(args);
     plan.check()?;
+    plan.refuse_binary_on_terminal(&["-o", "--hdr"])?;
     // Text meant for the terminal goes to stderr when an image or record goes to stdout.
     let say = |text: &str| -> Result<()> {
         if plan.uses_stdout() {

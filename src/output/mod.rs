@@ -61,6 +61,14 @@ impl Identity {
         }
     }
 
+    /// True for `/dev/null` under any name (also standard output sent there).
+    fn is_null(&self) -> bool {
+        let null = std::fs::metadata("/dev/null")
+            .ok()
+            .map(|m| (m.dev(), m.ino()));
+        self.canonical == Path::new("/dev/null") || (self.dev_ino.is_some() && self.dev_ino == null)
+    }
+
     fn same(&self, other: &Identity) -> bool {
         self.canonical == other.canonical
             || matches!((self.dev_ino, other.dev_ino), (Some(a), Some(b)) if a == b)
@@ -158,6 +166,25 @@ impl OutputPlan {
             .any(|o| is_stdio(&o.path) || is_dev_stdout(&o.path))
     }
 
+    /// Refuses binary output (`flag -`) to standard output when that is a terminal: the
+    /// bytes would only garble it.
+    pub fn refuse_binary_on_terminal(&self, flags: &[&str]) -> Result<()> {
+        use std::io::IsTerminal;
+        if let Some(o) = self
+            .outputs
+            .iter()
+            .find(|o| is_stdio(&o.path) && flags.contains(&o.flag.as_str()))
+            && std::io::stdout().is_terminal()
+        {
+            return Err(UsageError(format!(
+                "{} would write an image to the terminal: expected standard output redirected to a file or a pipe",
+                o.describe()
+            ))
+            .into());
+        }
+        Ok(())
+    }
+
     /// Refuses an output that is an input or another output (a [`UsageError`]), then an
     /// output whose directory is missing, not a directory or not writable, or an output that
     /// is a directory (a plain error: the flags are valid, the file system is not ready).
@@ -185,7 +212,7 @@ impl OutputPlan {
             }
             for (other, other_id) in &outputs[..i] {
                 // Any number of outputs may be thrown away.
-                if id.same(other_id) && id.canonical != Path::new("/dev/null") {
+                if id.same(other_id) && !id.is_null() {
                     return Err(UsageError(format!(
                         "{} and {} are the same file: expected a different file for each output",
                         other.describe(),
