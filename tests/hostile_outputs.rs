@@ -367,6 +367,22 @@ fn render_special_files_and_directories() {
             ["x.png"]
         ),
         render!(
+            "-o /dev/stdout is standard output, not a path to rename over",
+            setup::cornell_box,
+            ["-o", "/dev/stdout"],
+            0,
+            [],
+            []
+        ),
+        render!(
+            "-o /dev/stdout and --stats-json - collide",
+            setup::cornell_box,
+            ["-o", "/dev/stdout", "--stats-json", "-"],
+            2,
+            ["are the same file"],
+            []
+        ),
+        render!(
             "-o - writes PNG to stdout",
             setup::cornell_box,
             ["-o", "-"],

@@ -41,22 +41,22 @@ struct Identity {
 
 impl Identity {
     fn of(path: &Path) -> Identity {
-        if is_stdio(path) {
+        if is_stdio(path) || is_dev_stdout(path) {
             let dev_ino = stdout_dev_ino();
             return Identity {
                 dev_ino,
                 canonical: PathBuf::from("<stdout>"),
             };
         }
-        let resolved = write::resolve_symlinks(path);
-        match std::fs::metadata(&resolved) {
+        match std::fs::metadata(path) {
             Ok(meta) => Identity {
                 dev_ino: Some((meta.dev(), meta.ino())),
-                canonical: std::fs::canonicalize(&resolved).unwrap_or(resolved),
+                canonical: std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf()),
             },
+            // A new file, or one a dangling symlink would create.
             Err(_) => Identity {
                 dev_ino: None,
-                canonical: canonical_new(&resolved),
+                canonical: canonical_new(&write::resolve_symlinks(path)),
             },
         }
     }
@@ -170,11 +170,9 @@ impl OutputPlan {
     /// bytes would only garble it.
     pub fn refuse_binary_on_terminal(&self, flags: &[&str]) -> Result<()> {
         use std::io::IsTerminal;
-        if let Some(o) = self
-            .outputs
-            .iter()
-            .find(|o| is_stdio(&o.path) && flags.contains(&o.flag.as_str()))
-            && std::io::stdout().is_terminal()
+        if let Some(o) = self.outputs.iter().find(|o| {
+            (is_stdio(&o.path) || is_dev_stdout(&o.path)) && flags.contains(&o.flag.as_str())
+        }) && std::io::stdout().is_terminal()
         {
             return Err(UsageError(format!(
                 "{} would write an image to the terminal: expected standard output redirected to a file or a pipe",
@@ -230,7 +228,7 @@ impl OutputPlan {
 }
 
 /// `/dev/stdout`, `/dev/fd/1`, `/proc/self/fd/1`: standard output under another name.
-fn is_dev_stdout(path: &Path) -> bool {
+pub(crate) fn is_dev_stdout(path: &Path) -> bool {
     ["/dev/stdout", "/dev/fd/1", "/proc/self/fd/1"]
         .iter()
         .any(|p| path == Path::new(p))

@@ -45,14 +45,16 @@ impl Target {
 }
 
 /// Classifies `path`, following symlinks (also dangling ones, to the file they would create).
+/// `/dev/stdout` and its aliases are standard output itself, so that its offset is shared and
+/// a pipe behind it (`/proc/self/fd/1 -> pipe:[N]`) is written, not looked up as a path.
 pub fn target(path: &Path) -> Target {
-    if super::is_stdio(path) {
+    if super::is_stdio(path) || super::is_dev_stdout(path) {
         return Target::Stdout;
     }
-    let real = resolve_symlinks(path);
-    match std::fs::metadata(&real) {
-        Ok(m) if !m.is_file() && !m.is_dir() => Target::Special(real),
-        _ => Target::Regular(real),
+    // The kernel follows the links (also /proc's magic ones) to what is really there.
+    match std::fs::metadata(path) {
+        Ok(m) if !m.is_file() && !m.is_dir() => Target::Special(path.to_path_buf()),
+        _ => Target::Regular(resolve_symlinks(path)),
     }
 }
 
@@ -101,11 +103,11 @@ pub fn write_output(
                 .context("cannot write to standard output")?;
             write_direct(&mut File::from(fd), "standard output", fill)
         }
-        Target::Special(real) => {
+        Target::Special(special) => {
             // No truncation: a device or FIFO has no contents to replace.
             let mut file = std::fs::OpenOptions::new()
                 .write(true)
-                .open(&real)
+                .open(&special)
                 .with_context(|| format!("cannot open {} for writing", path.display()))?;
             write_direct(&mut file, &path.display().to_string(), fill)
         }
