@@ -104,15 +104,46 @@ pub fn write_output(
             write_direct(&mut File::from(fd), "standard output", fill)
         }
         Target::Special(special) => {
-            // No truncation: a device or FIFO has no contents to replace.
-            let mut file = std::fs::OpenOptions::new()
-                .write(true)
-                .open(&special)
+            let mut file = open_special(&special)
                 .with_context(|| format!("cannot open {} for writing", path.display()))?;
             write_direct(&mut file, &path.display().to_string(), fill)
         }
         Target::Regular(real) => write_atomically(path, &real, fill),
     }
+}
+
+/// Opens a device or FIFO for writing, without truncation (there are no contents to replace).
+/// A FIFO without a reader blocks, as for any writer; a note on stderr says what it waits for.
+fn open_special(path: &Path) -> std::io::Result<File> {
+    use std::os::unix::fs::OpenOptionsExt;
+    let is_fifo = std::fs::metadata(path).is_ok_and(|m| m.file_type().is_fifo());
+    if is_fifo {
+        // O_NONBLOCK fails with ENXIO exactly when no process has the FIFO open for reading.
+        let probe = std::fs::OpenOptions::new()
+            .write(true)
+            .custom_flags(libc::O_NONBLOCK)
+            .open(path);
+        match probe {
+            // Kept, not reopened: closing a writer could hand the reader an early EOF.
+            Ok(file) => {
+                use std::os::fd::AsRawFd;
+                let fd = file.as_raw_fd();
+                // SAFETY: fcntl on a file descriptor this function owns.
+                let flags = unsafe { libc::fcntl(fd, libc::F_GETFL) };
+                // SAFETY: as above; clears O_NONBLOCK so that writes wait for the reader.
+                let set = unsafe { libc::fcntl(fd, libc::F_SETFL, flags & !libc::O_NONBLOCK) };
+                if flags < 0 || set < 0 {
+                    return Err(std::io::Error::last_os_error());
+                }
+                return Ok(file);
+            }
+            Err(e) if e.raw_os_error() == Some(libc::ENXIO) => {
+                eprintln!("note: waiting for a reader on the FIFO {}", path.display())
+            }
+            Err(_) => {}
+        }
+    }
+    std::fs::OpenOptions::new().write(true).open(path)
 }
 
 fn write_direct(
