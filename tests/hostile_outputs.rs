@@ -324,6 +324,18 @@ fn render_special_files_and_directories() {
             ["made.png"]
         ),
         render!(
+            "a symlink loop is refused before rendering",
+            |d| {
+                setup::cornell_box(d);
+                setup::symlink(d, "a.png", "b.png");
+                setup::symlink(d, "b.png", "a.png")
+            },
+            ["-o", "a.png"],
+            1,
+            ["cannot write a.png", "loop"],
+            []
+        ),
+        render!(
             "a FIFO with a reader gets the PNG",
             |d| {
                 setup::cornell_box(d);

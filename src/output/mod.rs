@@ -241,6 +241,14 @@ fn check_writable(out: &Named) -> Result<()> {
     match target(path) {
         Target::Stdout | Target::Special(_) => return Ok(()),
         Target::Regular(real) => {
+            if let Err(e) = std::fs::metadata(path)
+                && e.raw_os_error() == Some(libc::ELOOP)
+            {
+                bail!(
+                    "cannot write {}: its symlinks form a loop, expected a file or a symlink to one",
+                    path.display()
+                );
+            }
             if real.is_dir() {
                 bail!(
                     "cannot write {}: it is a directory, expected a file",
