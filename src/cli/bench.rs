@@ -6,6 +6,7 @@ use clap::Args;
 use raywave::bench::record::record_path;
 use raywave::bench::{BenchOptions, DEFAULT_THRESHOLD_PCT};
 use raywave::output::OutputPlan;
+use raywave::output::memory::{self, RenderFootprint};
 use std::path::PathBuf;
 
 /// Flags of `raywave bench`.
@@ -96,5 +97,22 @@ fn output_plan(args: &BenchArgs) -> OutputPlan {
 /// finds a regression, else 0.
 pub fn run(args: &BenchArgs) -> Result<u8> {
     output_plan(args).check()?;
+    // Each timed run holds one film; refuse a size the machine cannot hold before any timing.
+    let settings = args.image.options().resolve(None).settings;
+    let threads = args.threads.map_or_else(
+        || std::thread::available_parallelism().map_or(1, |n| n.get() as u64),
+        u64::from,
+    );
+    memory::check(
+        &RenderFootprint {
+            pixels: settings.width as u64 * settings.height as u64,
+            primitives: 0,
+            threads,
+            batch_size: raywave::wavefront::DEFAULT_BATCH_SIZE as u64,
+            rgb8: false,
+            exr_in_memory: false,
+        },
+        None,
+    )?;
     Ok(raywave::bench::run(&args.options())?.exit_code())
 }
