@@ -15,17 +15,26 @@ fn start(dir: &Path, size: &str, slow: bool) -> Child {
     std::fs::write(dir.join("out.png"), OLD).unwrap();
     std::fs::write(dir.join("out.exr"), OLD).unwrap();
     Command::new(env!("CARGO_BIN_EXE_raywave"))
-        .args([
-            "render",
-            "--size",
-            size,
-            size,
-            "--shadows",
-            "off",
-            "--bounces",
-            "0",
-            "-q",
-        ])
+        .args(["render", "--size", size, size, "-q"])
+        .args(if slow {
+            [
+                "--shadows",
+                "soft",
+                "--shadow-samples",
+                "64",
+                "--bounces",
+                "5",
+            ]
+        } else {
+            [
+                "--shadows",
+                "off",
+                "--shadow-samples",
+                "1",
+                "--bounces",
+                "0",
+            ]
+        })
         .args(["--threads", "2", "-o", "out.png", "--hdr", "out.exr"])
         .current_dir(dir)
         .stdout(Stdio::null())
