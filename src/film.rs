@@ -1,7 +1,8 @@
 //! The image being rendered (linear RGB floats) and how it is written.
 //!
 //! Every file is written whole or not at all: the bytes go to a temporary file in the same
-//! directory, which is renamed over the target only once it is complete.
+//! directory, which is renamed over the target only once it is complete (devices, FIFOs and
+//! standard output are written directly: `output::write`).
 
 use anyhow::{Context, Result, bail};
 use glam::Vec3;
@@ -118,7 +119,8 @@ impl Film {
         })
     }
 
-    /// Writes linear floats: `.pfm` (portable float map) or `.exr`.
+    /// Writes linear floats: `.pfm` (portable float map) or `.exr`; PFM to standard output
+    /// (`-`), a device or a FIFO whose name has neither extension.
     pub fn write_hdr(&self, path: &Path) -> Result<()> {
         match hdr_extension(path)? {
             HdrFormat::Pfm => write_atomically(path, |w| {
@@ -134,16 +136,33 @@ impl Film {
                 Ok(())
             }),
             HdrFormat::Exr => {
-                let data: Vec<f32> = self.pixels.iter().flat_map(|c| c.to_array()).collect();
-                let img = image::Rgb32FImage::from_raw(self.width, self.height, data)
-                    .context("image buffer size")?;
-                write_atomically(path, |w| {
-                    image::DynamicImage::ImageRgb32F(img.clone())
-                        .write_to(w, image::ImageFormat::OpenExr)
-                        .map_err(anyhow::Error::from)
-                })
+                if crate::output::target(path).is_stream() {
+                    // EXR seeks back to its offset table: a pipe needs the file in memory.
+                    let mut bytes = std::io::Cursor::new(Vec::new());
+                    self.write_exr(&mut bytes)?;
+                    write_atomically(path, |w| Ok(w.write_all(bytes.get_ref())?))
+                } else {
+                    write_atomically(path, |w| self.write_exr(w))
+                }
             }
         }
+    }
+
+    /// Encodes EXR block by block from the film itself: no copy of the image. (The `image`
+    /// crate's encoder reads from its own buffer, which cost two full copies here.)
+    fn write_exr(&self, w: &mut (impl Write + std::io::Seek)) -> Result<()> {
+        use exr::prelude::{Image, SpecificChannels, Vec2, WritableImage};
+        let (width, height) = (self.width as usize, self.height as usize);
+        Image::from_channels(
+            (width, height),
+            SpecificChannels::rgb(|pixel: Vec2<usize>| {
+                let c = self.pixels[pixel.flat_index_for_size(Vec2(width, height))];
+                (c.x, c.y, c.z)
+            }),
+        )
+        .write()
+        .to_buffered(w)
+        .map_err(|e| anyhow::anyhow!("{e}"))
     }
 }
 
@@ -162,6 +181,7 @@ pub fn ldr_format(path: &Path) -> Result<LdrFormat> {
     match extension(path).as_deref() {
         Some("png") => Ok(LdrFormat::Png),
         Some("ppm") => Ok(LdrFormat::Ppm),
+        _ if is_stream_or_device(path) => Ok(LdrFormat::Png),
         _ => bail!(
             "cannot write {}: expected an output file ending in .png or .ppm (use --hdr for .pfm or .exr)",
             path.display()
@@ -184,6 +204,7 @@ pub fn output_format(path: &Path) -> Result<OutputFormat> {
         Some("png") => Ok(OutputFormat::Ldr(LdrFormat::Png)),
         Some("ppm") => Ok(OutputFormat::Ldr(LdrFormat::Ppm)),
         Some("pfm" | "exr") => Ok(OutputFormat::Linear),
+        _ if is_stream_or_device(path) => Ok(OutputFormat::Ldr(LdrFormat::Png)),
         _ => bail!(
             "cannot write {}: expected an output file ending in .png or .ppm (8-bit), or .pfm or .exr (linear floats only)",
             path.display()
@@ -222,11 +243,21 @@ fn hdr_extension(path: &Path) -> Result<HdrFormat> {
     match extension(path).as_deref() {
         Some("pfm") => Ok(HdrFormat::Pfm),
         Some("exr") => Ok(HdrFormat::Exr),
+        _ if is_stream_or_device(path) => Ok(HdrFormat::Pfm),
         _ => bail!(
             "cannot write {}: expected an --hdr file ending in .pfm or .exr",
             path.display()
         ),
     }
+}
+
+/// Standard output (`-`), or an existing device or FIFO: a name without an extension to go by,
+/// so PNG (8-bit) or PFM (floats), the formats that stream, are written.
+fn is_stream_or_device(path: &Path) -> bool {
+    !matches!(
+        crate::output::target(path),
+        crate::output::Target::Regular(_)
+    )
 }
 
 fn extension(path: &Path) -> Option<String> {
@@ -260,35 +291,12 @@ fn parent_dir(path: &Path) -> &Path {
     }
 }
 
-/// Writes through `fill` into a temporary file beside `path`, then renames it into place.
+/// Writes through `fill` into a temporary file beside `path` (beside the file a symlink points
+/// to), then renames it into place; standard output (`-`), devices and FIFOs are written
+/// directly (see `output::write`).
 pub fn write_atomically(
     path: &Path,
     fill: impl FnOnce(&mut BufWriter<&mut std::fs::File>) -> Result<()>,
 ) -> Result<()> {
-    let dir = parent_dir(path);
-    let mut tmp = tempfile::Builder::new()
-        .prefix(".raywave-")
-        .tempfile_in(dir)
-        .with_context(|| format!("cannot create a temporary file in {}", dir.display()))?;
-    {
-        let mut w = BufWriter::new(tmp.as_file_mut());
-        fill(&mut w).with_context(|| format!("cannot write {}", path.display()))?;
-        w.flush()
-            .with_context(|| format!("cannot write {}", path.display()))?;
-    }
-    // Temporary files are created private (0600); an image is not a secret. Keep the mode of
-    // the file being replaced, or use the usual 0644 for a new one.
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        let mode = std::fs::metadata(path)
-            .map(|m| m.permissions().mode())
-            .unwrap_or(0o644);
-        tmp.as_file()
-            .set_permissions(std::fs::Permissions::from_mode(mode))
-            .with_context(|| format!("cannot set the permissions of {}", path.display()))?;
-    }
-    tmp.persist(path)
-        .with_context(|| format!("cannot move the finished image to {}", path.display()))?;
-    Ok(())
+    crate::output::write_output(path, fill)
 }

@@ -62,6 +62,7 @@ pub mod geometry;
 pub mod machine;
 pub mod meshgen;
 pub mod options;
+pub mod output;
 pub mod peer;
 pub mod quote;
 pub mod reference;

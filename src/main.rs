@@ -1,6 +1,6 @@
 //! The `raywave` command. `main` owns the exit code: 0 on success, 2 for a usage error (clap),
 //! 3 when `raywave bench --compare` finds a regression, 1 for anything else, printed once with
-//! its cause chain. The command line itself is in `cli/`, one file per command.
+//! its cause chain; 130 after SIGINT and 143 after SIGTERM (`output::write`). The command line itself is in `cli/`, one file per command.
 
 mod cli;
 
@@ -27,6 +27,11 @@ fn main() -> ExitCode {
             return ExitCode::from(e.exit_code().clamp(0, 255) as u8);
         }
     };
+    // SIGINT/SIGTERM: remove unfinished temporary files, exit 130/143.
+    if let Err(e) = raywave::output::install_signal_cleanup() {
+        eprintln!("error: {e:#}");
+        return ExitCode::from(1);
+    }
     // Lab and RPI flags accepted without effect: one line each, like the scene's warnings.
     for note in &normalized.notes {
         eprintln!("note: {note}");

@@ -5,7 +5,10 @@ use super::values::EngineArg;
 use anyhow::Result;
 use clap::Args;
 use raywave::bench::ab::{self, AbOptions, MIN_ROUNDS};
+use raywave::bench::record::record_path;
 use raywave::bench::{BenchOptions, DEFAULT_THRESHOLD_PCT, EXIT_REGRESSION};
+use raywave::output::OutputPlan;
+use raywave::output::memory::{self, RenderFootprint};
 use std::path::PathBuf;
 
 /// Flags of `raywave bench`.
@@ -93,9 +96,46 @@ impl BenchArgs {
 /// The threshold of `--against` when none is given, in percent.
 const AB_THRESHOLD_PCT: f64 = 5.0;
 
+/// The scene and the `--compare` record (inputs), the `--save` record and `--json` (outputs).
+/// Names `record_path` refuses are left to the bench, which reports them.
+fn output_plan(args: &BenchArgs) -> OutputPlan {
+    let mut plan = OutputPlan::new();
+    if let Some(scene) = args.scene.as_ref().or(args.input.as_ref()) {
+        plan = plan.input("SCENE", scene);
+    }
+    if let Some(Ok(path)) = args.compare.as_ref().map(|n| record_path(&args.dir, n)) {
+        plan = plan.input("--compare", &path);
+    }
+    if let Some(Ok(path)) = args.save.as_ref().map(|n| record_path(&args.dir, n)) {
+        plan = plan.output_in_new_dir("--save", &path);
+    }
+    if let Some(json) = &args.json {
+        plan = plan.output("--json", json);
+    }
+    plan
+}
+
 /// Runs the bench; the exit code is 3 (`raywave::bench::EXIT_REGRESSION`) when `--compare`
 /// or `--against` finds a regression, else 0.
 pub fn run(args: &BenchArgs) -> Result<u8> {
+    output_plan(args).check()?;
+    // Each timed run holds one film; refuse a size the machine cannot hold before any timing.
+    let settings = args.image.options().resolve(None).settings;
+    let threads = args.threads.map_or_else(
+        || std::thread::available_parallelism().map_or(1, |n| n.get() as u64),
+        u64::from,
+    );
+    memory::check(
+        &RenderFootprint {
+            pixels: settings.width as u64 * settings.height as u64,
+            primitives: 0,
+            threads,
+            batch_size: raywave::wavefront::DEFAULT_BATCH_SIZE as u64,
+            rgb8: false,
+            exr_in_memory: false,
+        },
+        None,
+    )?;
     let Some(other) = &args.against else {
         return Ok(raywave::bench::run(&args.options())?.exit_code());
     };

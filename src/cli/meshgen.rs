@@ -2,8 +2,8 @@
 
 use anyhow::Result;
 use clap::Args;
-use raywave::film::check_output_dir;
 use raywave::meshgen::{bands_for, cornell_box_mesh_spheres, triangle_count};
+use raywave::output::OutputPlan;
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -14,20 +14,27 @@ pub struct MeshgenArgs {
     #[arg(long, default_value_t = 12_000,
           value_parser = clap::value_parser!(u64).range(36..=50_000_000))]
     pub triangles: u64,
-    /// Output scene file (.obj).
+    /// Output scene file (.obj; `-` for standard output).
     #[arg(short, long)]
     pub output: PathBuf,
 }
 
 /// Writes the scene, whole or not at all, and says so.
 pub fn run(args: &MeshgenArgs) -> Result<()> {
-    check_output_dir(&args.output)?;
+    let plan = OutputPlan::new().output("-o", &args.output);
+    plan.check()?;
     let bands = bands_for(args.triangles as usize);
     let text = cornell_box_mesh_spheres(bands);
     raywave::film::write_atomically(&args.output, |w| Ok(w.write_all(text.as_bytes())?))?;
-    raywave::terminal::print(&format!(
+    let text = format!(
         "wrote   {}: {} triangles ({bands} latitude bands per sphere)\n",
         args.output.display(),
         triangle_count(bands)
-    ))
+    );
+    if plan.uses_stdout() {
+        eprint!("{text}");
+        Ok(())
+    } else {
+        raywave::terminal::print(&text)
+    }
 }

@@ -10,9 +10,11 @@ use raywave::camera::CameraRays;
 use raywave::debug_view::RayRecorder;
 use raywave::engine::{Engine, thread_pool};
 use raywave::error::UsageError;
-use raywave::film::{OutputFormat, check_hdr_path, check_output_dir, output_format};
+use raywave::film::{OutputFormat, check_hdr_path, output_format};
 use raywave::machine::Machine;
 use raywave::options::{BackgroundSource, Effective};
+use raywave::output::OutputPlan;
+use raywave::output::memory::{self, RenderFootprint};
 use raywave::reference::Reference;
 use raywave::report::{DefaultsUsed, KindFigures, RenderRecord, SceneFigures};
 use raywave::scene::{Scene, load_scene};
@@ -33,7 +35,8 @@ pub struct RenderArgs {
     #[arg(long = "input", hide = true, conflicts_with = "scene")]
     pub input: Option<PathBuf>,
     /// Output: an 8-bit image (.png or .ppm), or only the linear floats (.pfm or .exr);
-    /// written whole or not at all.
+    /// written whole or not at all. `-` writes PNG to standard output; a device or FIFO
+    /// without an extension (/dev/null) gets PNG too.
     #[arg(short, long, default_value = "render.png")]
     pub output: PathBuf,
     /// Size, bounces, shadows, lighting and sampling (shared with `raywave bench`).
@@ -45,7 +48,7 @@ pub struct RenderArgs {
     /// Worker threads [default: all cores]; 1 runs serially.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
     pub threads: Option<u32>,
-    /// Also write linear floats to this file (.pfm or .exr).
+    /// Also write linear floats to this file (.pfm or .exr; `-` or a device: PFM).
     #[arg(long)]
     pub hdr: Option<PathBuf>,
     /// Tone mapping of the 8-bit image: clamp (the lab's look) or exp (1 − e^(−3x)).
@@ -70,9 +73,14 @@ pub struct RenderArgs {
     /// Print rays and rays/s per kind, and per stage for the wavefront engine.
     #[arg(long)]
     pub stats: bool,
-    /// Write the same figures as JSON, with the machine, SIMD path and thread count.
+    /// Write the same figures as JSON, with the machine, SIMD path and thread count (`-`:
+    /// standard output).
     #[arg(long, value_name = "FILE")]
     pub stats_json: Option<PathBuf>,
+    /// Refuse to start a render whose estimated peak memory exceeds SIZE (e.g. 512M, 2G);
+    /// renders are also refused when they exceed the memory available.
+    #[arg(long, value_name = "SIZE", value_parser = raywave::output::memory::parse_size)]
+    pub max_memory: Option<u64>,
 }
 
 impl RenderArgs {
@@ -94,11 +102,21 @@ impl RenderArgs {
 pub fn run(args: &RenderArgs) -> Result<()> {
     // Check everything that can fail cheaply before the long part.
     let format = output_format(&args.output).map_err(|e| UsageError::from_error(&e))?;
-    check_output_dir(&args.output)?;
     if let Some(hdr) = &args.hdr {
         check_hdr_path(hdr).map_err(|e| UsageError::from_error(&e))?;
-        check_output_dir(hdr)?;
     }
+    let plan = output_plan(args);
+    plan.check()?;
+    plan.refuse_binary_on_terminal(&["-o", "--hdr"])?;
+    // Text meant for the terminal goes to stderr when an image or record goes to stdout.
+    let say = |text: &str| -> Result<()> {
+        if plan.uses_stdout() {
+            eprint!("{text}");
+            Ok(())
+        } else {
+            print(text)
+        }
+    };
     let scene = load_scene(
         args.scene_path().map(PathBuf::as_path),
         &args.image.options().parse_options(),
@@ -118,12 +136,25 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         ))
         .into());
     }
-    if let Some(path) = &args.stats_json {
-        check_output_dir(path)?;
-    }
     let pool = thread_pool(args.threads)?;
     let threads = pool.current_num_threads();
     let engine_choice = Engine::from(args.engine);
+    let exr_to_stream = |p: &PathBuf| {
+        p.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"))
+            && raywave::output::target(p).is_stream()
+    };
+    memory::check(
+        &RenderFootprint {
+            pixels: settings.width as u64 * settings.height as u64,
+            primitives: (scene.triangles.len() + scene.spheres.len()) as u64,
+            threads: threads as u64,
+            batch_size: args.batch_size as u64,
+            rgb8: matches!(format, OutputFormat::Ldr(_)),
+            exr_in_memory: exr_to_stream(&args.output)
+                || args.hdr.as_ref().is_some_and(exr_to_stream),
+        },
+        args.max_memory,
+    )?;
 
     // The reference's set-up (its BVH for meshes) is timed with its render; the wavefront
     // engine's BVH build is reported on its own.
@@ -163,7 +194,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         // The debug view follows the reference's recursion (both engines trace the same rays).
         let reference = Reference::new(&scene, &settings);
         let colour = reference.pixel(pixel, &mut RayCounts::default(), &mut recorder);
-        print(&format!(
+        say(&format!(
             "rays traced for pixel ({}, {}), colour {:.5}:\n{}",
             px[0],
             px[1],
@@ -202,16 +233,35 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             .as_ref()
             .map(|h| format!(" and {}", h.display()))
             .unwrap_or_default();
-        print(&format!(
+        say(&format!(
             "{}wrote   {}{extra}\n",
             summary(&scene, &effective, &run, &report),
             args.output.display()
         ))?;
     }
     if args.stats {
-        print(&stats_table(&report))?;
+        say(&stats_table(&report))?;
     }
     Ok(())
+}
+
+/// The scene (an input) and every output of a render, for the checks before any work.
+fn output_plan(args: &RenderArgs) -> OutputPlan {
+    let mut plan = OutputPlan::new();
+    if let Some(scene) = &args.scene {
+        plan = plan.input("SCENE", scene);
+    }
+    if let Some(input) = &args.input {
+        plan = plan.input("-input", input);
+    }
+    plan = plan.output("-o", &args.output);
+    if let Some(hdr) = &args.hdr {
+        plan = plan.output("--hdr", hdr);
+    }
+    if let Some(json) = &args.stats_json {
+        plan = plan.output("--stats-json", json);
+    }
+    plan
 }
 
 /// The summary printed after a render: engine, scene, settings, rays and time.

@@ -4,6 +4,7 @@ use super::values::{EngineArg, LightModelArg, SamplerArg};
 use anyhow::Result;
 use clap::Args;
 use raywave::engine::thread_pool;
+use raywave::output::OutputPlan;
 use raywave::variance::command::VarianceOptions;
 use std::path::PathBuf;
 
@@ -96,9 +97,30 @@ impl VarianceArgs {
     }
 }
 
+/// The scene (an input) and the files the study writes into `--out` (outputs).
+fn output_plan(options: &VarianceOptions) -> OutputPlan {
+    let mut plan = OutputPlan::new();
+    if let Some(scene) = &options.scene {
+        plan = plan.input("SCENE", scene);
+    }
+    let mut names: Vec<String> = ["table.txt", "results.csv", "results.json", "mse.png"]
+        .map(String::from)
+        .to_vec();
+    for s in &options.samplers {
+        names.push(format!("heat_{}_N{}.png", s.name(), options.heatmap_n));
+    }
+    for name in names {
+        plan = plan.output_in_new_dir("--out", &options.out.join(name));
+    }
+    plan
+}
+
 /// Runs the study on `--threads` worker threads.
 pub fn run(args: &VarianceArgs) -> Result<()> {
-    let pool = thread_pool(args.threads)?;
     let options = args.options();
+    // The flags' own errors first, with their own messages; then the outputs.
+    options.validate()?;
+    output_plan(&options).check()?;
+    let pool = thread_pool(args.threads)?;
     pool.install(|| raywave::variance::command::run(&options))
 }

@@ -302,3 +302,30 @@ pub mod setup_streams {
         std::fs::write(dir.join(name), out).unwrap();
     }
 }
+
+/// More setup helpers for the output cases (tests/hostile_outputs.rs).
+pub mod setup_outputs {
+    use std::path::Path;
+
+    /// A directory `dir/name`.
+    pub fn dir(dir: &Path, name: &str) {
+        std::fs::create_dir_all(dir.join(name)).unwrap();
+    }
+
+    /// A hard link `dir/name` to `dir/target`.
+    pub fn hard_link(dir: &Path, name: &str, target: &str) {
+        std::fs::hard_link(dir.join(target), dir.join(name)).unwrap();
+    }
+
+    /// A FIFO at `dir/name` with a thread that reads it to the end, as a consumer would.
+    pub fn fifo_with_reader(dir: &Path, name: &str) {
+        super::setup::fifo(dir, name);
+        let path = dir.join(name);
+        std::thread::spawn(move || {
+            // Opening blocks until raywave opens the other end.
+            if let Ok(mut f) = std::fs::File::open(&path) {
+                let _ = std::io::copy(&mut f, &mut std::io::sink());
+            }
+        });
+    }
+}

@@ -1,0 +1,292 @@
+//! Where a command's outputs go, checked all at once before any work: no output may be an
+//! input or another output, and every output's directory must be usable.
+//!
+//! ```text
+//! OutputPlan::new().input("SCENE", scene).output("-o", out).output("--hdr", hdr).check()?
+//!   identity of each path: stdout (`-`), or (dev, inode) + canonical path if it exists,
+//!                          else canonical parent + name (symlinks followed first)
+//!   same identity twice  -> UsageError naming both flags and paths (exit 2)
+//!   unusable directory   -> error naming the file and the directory (exit 1)
+//! ```
+//!
+//! `write.rs` writes the files (atomically for regular files, directly for devices, FIFOs and
+//! stdout) and removes temporary files on SIGINT/SIGTERM; `memory.rs` estimates a render's peak.
+
+pub mod memory;
+pub mod write;
+
+pub use write::{Target, install_signal_cleanup, target, write_output};
+
+use crate::error::UsageError;
+use anyhow::{Result, bail};
+use std::os::unix::fs::MetadataExt;
+use std::path::{Path, PathBuf};
+
+/// The path that means standard output (and standard input for a scene).
+pub const STDIO: &str = "-";
+
+/// True when `path` is `-`.
+pub fn is_stdio(path: &Path) -> bool {
+    path.as_os_str() == STDIO
+}
+
+/// What a path names, for telling whether two paths are the same file.
+#[derive(Clone, Debug, PartialEq, Eq)]
+struct Identity {
+    /// Device and inode of an existing file (hard links share them).
+    dev_ino: Option<(u64, u64)>,
+    /// The canonical path, or the canonical parent joined with the name for a new file.
+    canonical: PathBuf,
+}
+
+impl Identity {
+    fn of(path: &Path) -> Identity {
+        if is_stdio(path) || is_dev_stdout(path) {
+            let dev_ino = stdout_dev_ino();
+            return Identity {
+                dev_ino,
+                canonical: PathBuf::from("<stdout>"),
+            };
+        }
+        match std::fs::metadata(path) {
+            Ok(meta) => Identity {
+                dev_ino: Some((meta.dev(), meta.ino())),
+                canonical: std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf()),
+            },
+            // A new file, or one a dangling symlink would create.
+            Err(_) => Identity {
+                dev_ino: None,
+                canonical: canonical_new(&write::resolve_symlinks(path)),
+            },
+        }
+    }
+
+    /// True for `/dev/null` under any name (also standard output sent there).
+    fn is_null(&self) -> bool {
+        let null = std::fs::metadata("/dev/null")
+            .ok()
+            .map(|m| (m.dev(), m.ino()));
+        self.canonical == Path::new("/dev/null") || (self.dev_ino.is_some() && self.dev_ino == null)
+    }
+
+    fn same(&self, other: &Identity) -> bool {
+        self.canonical == other.canonical
+            || matches!((self.dev_ino, other.dev_ino), (Some(a), Some(b)) if a == b)
+    }
+}
+
+/// Device and inode of whatever standard output is (a file, a pipe, a terminal).
+fn stdout_dev_ino() -> Option<(u64, u64)> {
+    std::fs::metadata("/proc/self/fd/1")
+        .ok()
+        .map(|m| (m.dev(), m.ino()))
+}
+
+/// The canonical form of a path that does not exist yet: its parent canonicalised (when it
+/// exists), joined with the name; else the path made absolute.
+fn canonical_new(path: &Path) -> PathBuf {
+    let parent = write::parent_dir(path);
+    let name = path.file_name().map(PathBuf::from).unwrap_or_default();
+    match std::fs::canonicalize(parent) {
+        Ok(p) => p.join(name),
+        Err(_) => std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf()),
+    }
+}
+
+/// One path as the user gave it, with the flag that gave it.
+#[derive(Clone, Debug)]
+struct Named {
+    flag: String,
+    path: PathBuf,
+    /// The command creates the directory itself (bench's `--dir`, variance's `--out`).
+    creates_dir: bool,
+}
+
+impl Named {
+    fn describe(&self) -> String {
+        if is_stdio(&self.path) {
+            format!("{} - (standard output)", self.flag)
+        } else {
+            format!("{} {}", self.flag, self.path.display())
+        }
+    }
+}
+
+/// A command's inputs and outputs, checked together by [`OutputPlan::check`].
+#[derive(Clone, Debug, Default)]
+pub struct OutputPlan {
+    inputs: Vec<Named>,
+    outputs: Vec<Named>,
+}
+
+impl OutputPlan {
+    /// No inputs, no outputs.
+    pub fn new() -> OutputPlan {
+        OutputPlan::default()
+    }
+
+    /// An input file, named as the user gave it (`flag` is e.g. `SCENE` or `--compare`).
+    /// Standard input (`-`) is not a file and is skipped.
+    pub fn input(mut self, flag: &str, path: &Path) -> OutputPlan {
+        if !is_stdio(path) {
+            self.inputs.push(Named {
+                flag: flag.to_string(),
+                path: path.to_path_buf(),
+                creates_dir: false,
+            });
+        }
+        self
+    }
+
+    /// An output file whose directory must already exist.
+    pub fn output(mut self, flag: &str, path: &Path) -> OutputPlan {
+        self.outputs.push(Named {
+            flag: flag.to_string(),
+            path: path.to_path_buf(),
+            creates_dir: false,
+        });
+        self
+    }
+
+    /// An output file in a directory the command creates if it is missing.
+    pub fn output_in_new_dir(mut self, flag: &str, path: &Path) -> OutputPlan {
+        self.outputs.push(Named {
+            flag: flag.to_string(),
+            path: path.to_path_buf(),
+            creates_dir: true,
+        });
+        self
+    }
+
+    /// True when some output is standard output (text meant for the terminal must then go to
+    /// standard error).
+    pub fn uses_stdout(&self) -> bool {
+        self.outputs
+            .iter()
+            .any(|o| is_stdio(&o.path) || is_dev_stdout(&o.path))
+    }
+
+    /// Refuses binary output (`flag -`) to standard output when that is a terminal: the
+    /// bytes would only garble it.
+    pub fn refuse_binary_on_terminal(&self, flags: &[&str]) -> Result<()> {
+        use std::io::IsTerminal;
+        if let Some(o) = self.outputs.iter().find(|o| {
+            (is_stdio(&o.path) || is_dev_stdout(&o.path)) && flags.contains(&o.flag.as_str())
+        }) && std::io::stdout().is_terminal()
+        {
+            return Err(UsageError(format!(
+                "{} would write an image to the terminal: expected standard output redirected to a file or a pipe",
+                o.describe()
+            ))
+            .into());
+        }
+        Ok(())
+    }
+
+    /// Refuses an output that is an input or another output (a [`UsageError`]), then an
+    /// output whose directory is missing, not a directory or not writable, or an output that
+    /// is a directory (a plain error: the flags are valid, the file system is not ready).
+    pub fn check(&self) -> Result<()> {
+        let inputs: Vec<(&Named, Identity)> = self
+            .inputs
+            .iter()
+            .map(|n| (n, Identity::of(&n.path)))
+            .collect();
+        let outputs: Vec<(&Named, Identity)> = self
+            .outputs
+            .iter()
+            .map(|n| (n, Identity::of(&n.path)))
+            .collect();
+        for (i, (out, id)) in outputs.iter().enumerate() {
+            for (input, input_id) in &inputs {
+                if id.same(input_id) {
+                    return Err(UsageError(format!(
+                        "{} is the same file as the input {}: expected an output that is not an input (it would be overwritten)",
+                        out.describe(),
+                        input.describe()
+                    ))
+                    .into());
+                }
+            }
+            for (other, other_id) in &outputs[..i] {
+                // Any number of outputs may be thrown away.
+                if id.same(other_id) && !id.is_null() {
+                    return Err(UsageError(format!(
+                        "{} and {} are the same file: expected a different file for each output",
+                        other.describe(),
+                        out.describe()
+                    ))
+                    .into());
+                }
+            }
+        }
+        for out in &self.outputs {
+            check_writable(out)?;
+        }
+        Ok(())
+    }
+}
+
+/// `/dev/stdout`, `/dev/fd/1`, `/proc/self/fd/1`: standard output under another name.
+pub(crate) fn is_dev_stdout(path: &Path) -> bool {
+    ["/dev/stdout", "/dev/fd/1", "/proc/self/fd/1"]
+        .iter()
+        .any(|p| path == Path::new(p))
+}
+
+/// Checks that the output can be written: not a directory, in a directory that exists (or
+/// that the command creates) and that this process may write in.
+fn check_writable(out: &Named) -> Result<()> {
+    let path = &out.path;
+    match target(path) {
+        Target::Stdout | Target::Special(_) => return Ok(()),
+        Target::Regular(real) => {
+            if let Err(e) = std::fs::metadata(path)
+                && e.raw_os_error() == Some(libc::ELOOP)
+            {
+                bail!(
+                    "cannot write {}: its symlinks form a loop, expected a file or a symlink to one",
+                    path.display()
+                );
+            }
+            if real.is_dir() {
+                bail!(
+                    "cannot write {}: it is a directory, expected a file",
+                    path.display()
+                );
+            }
+            let mut dir = write::parent_dir(&real).to_path_buf();
+            if out.creates_dir {
+                // The nearest existing ancestor is where the new directories will be made.
+                while !dir.exists() {
+                    match dir.parent() {
+                        Some(p) if !p.as_os_str().is_empty() => dir = p.to_path_buf(),
+                        _ => dir = PathBuf::from("."),
+                    }
+                }
+            }
+            if !dir.exists() {
+                bail!(
+                    "cannot write {}: directory {} does not exist",
+                    path.display(),
+                    dir.display()
+                );
+            }
+            if !dir.is_dir() {
+                bail!(
+                    "cannot write {}: {} is not a directory",
+                    path.display(),
+                    dir.display()
+                );
+            }
+            if !write::may_write_in(&dir) {
+                bail!(
+                    "cannot write {}: no permission to create files in {}",
+                    path.display(),
+                    dir.display()
+                );
+            }
+        }
+    }
+    Ok(())
+}

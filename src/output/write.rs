@@ -1,0 +1,233 @@
+//! Writing one output file, whole or not at all.
+//!
+//! - A regular file (or a new one, or a symlink to either) is written to a temporary file
+//!   beside the real target, then renamed over it: the symlink stays a symlink.
+//! - Standard output (`-`), devices (`/dev/null`, `/dev/full`) and FIFOs are written directly:
+//!   renaming over them would replace a device node or a pipe with a plain file. Write errors
+//!   (ENOSPC on `/dev/full`, a closed pipe) are reported with the file's name.
+//! - Temporary files are registered while they exist; on SIGINT or SIGTERM the handler from
+//!   [`install_signal_cleanup`] removes them and exits 130 or 143, so no temporary file survives
+//!   an interruption and the old output stays as it was.
+
+use anyhow::{Context, Result};
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::os::unix::fs::FileTypeExt;
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+
+/// Temporary files that exist now, removed by the signal handler.
+static TEMPORARIES: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+/// What writing to a path means.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Target {
+    /// `-`: this process's standard output.
+    Stdout,
+    /// An existing device, FIFO or socket (symlinks followed): written directly.
+    Special(PathBuf),
+    /// A regular file, existing or not (symlinks followed): the path to rename over.
+    Regular(PathBuf),
+}
+
+impl Target {
+    /// True for targets that cannot seek (stdout, FIFOs): formats that seek back (EXR) must
+    /// be encoded in memory first.
+    pub fn is_stream(&self) -> bool {
+        match self {
+            Target::Stdout => true,
+            Target::Special(p) => std::fs::metadata(p)
+                .map(|m| m.file_type().is_fifo() || m.file_type().is_socket())
+                .unwrap_or(true),
+            Target::Regular(_) => false,
+        }
+    }
+}
+
+/// Classifies `path`, following symlinks (also dangling ones, to the file they would create).
+/// `/dev/stdout` and its aliases are standard output itself, so that its offset is shared and
+/// a pipe behind it (`/proc/self/fd/1 -> pipe:[N]`) is written, not looked up as a path.
+pub fn target(path: &Path) -> Target {
+    if super::is_stdio(path) || super::is_dev_stdout(path) {
+        return Target::Stdout;
+    }
+    // The kernel follows the links (also /proc's magic ones) to what is really there.
+    match std::fs::metadata(path) {
+        Ok(m) if !m.is_file() && !m.is_dir() => Target::Special(path.to_path_buf()),
+        _ => Target::Regular(resolve_symlinks(path)),
+    }
+}
+
+/// Follows a chain of symlinks (at most 40, like the kernel) to the path it ends at, whether
+/// or not that exists.
+pub(crate) fn resolve_symlinks(path: &Path) -> PathBuf {
+    let mut at = path.to_path_buf();
+    for _ in 0..40 {
+        match std::fs::read_link(&at) {
+            Ok(next) => at = parent_dir(&at).join(next),
+            Err(_) => break,
+        }
+    }
+    at
+}
+
+/// The directory a path's file is in (`.` for a bare name).
+pub(crate) fn parent_dir(path: &Path) -> &Path {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    }
+}
+
+/// True when this process may create files in `dir` (`access(2)` with W_OK and X_OK).
+pub(crate) fn may_write_in(dir: &Path) -> bool {
+    use std::os::unix::ffi::OsStrExt;
+    let Ok(c) = std::ffi::CString::new(dir.as_os_str().as_bytes()) else {
+        return false;
+    };
+    // SAFETY: a valid NUL-terminated path; access reads it and keeps nothing.
+    unsafe { libc::access(c.as_ptr(), libc::W_OK | libc::X_OK) == 0 }
+}
+
+/// Writes through `fill`: atomically to a regular target, directly to anything else.
+pub fn write_output(
+    path: &Path,
+    fill: impl FnOnce(&mut BufWriter<&mut File>) -> Result<()>,
+) -> Result<()> {
+    match target(path) {
+        Target::Stdout => {
+            use std::os::fd::AsFd;
+            let fd = std::io::stdout()
+                .as_fd()
+                .try_clone_to_owned()
+                .context("cannot write to standard output")?;
+            write_direct(&mut File::from(fd), "standard output", fill)
+        }
+        Target::Special(special) => {
+            let mut file = open_special(&special)
+                .with_context(|| format!("cannot open {} for writing", path.display()))?;
+            write_direct(&mut file, &path.display().to_string(), fill)
+        }
+        Target::Regular(real) => write_atomically(path, &real, fill),
+    }
+}
+
+/// Opens a device or FIFO for writing, without truncation (there are no contents to replace).
+/// A FIFO without a reader blocks, as for any writer; a note on stderr says what it waits for.
+fn open_special(path: &Path) -> std::io::Result<File> {
+    use std::os::unix::fs::OpenOptionsExt;
+    let is_fifo = std::fs::metadata(path).is_ok_and(|m| m.file_type().is_fifo());
+    if is_fifo {
+        // O_NONBLOCK fails with ENXIO exactly when no process has the FIFO open for reading.
+        let probe = std::fs::OpenOptions::new()
+            .write(true)
+            .custom_flags(libc::O_NONBLOCK)
+            .open(path);
+        match probe {
+            // Kept, not reopened: closing a writer could hand the reader an early EOF.
+            Ok(file) => {
+                use std::os::fd::AsRawFd;
+                let fd = file.as_raw_fd();
+                // SAFETY: fcntl on a file descriptor this function owns.
+                let flags = unsafe { libc::fcntl(fd, libc::F_GETFL) };
+                // SAFETY: as above; clears O_NONBLOCK so that writes wait for the reader.
+                let set = unsafe { libc::fcntl(fd, libc::F_SETFL, flags & !libc::O_NONBLOCK) };
+                if flags < 0 || set < 0 {
+                    return Err(std::io::Error::last_os_error());
+                }
+                return Ok(file);
+            }
+            Err(e) if e.raw_os_error() == Some(libc::ENXIO) => {
+                eprintln!("note: waiting for a reader on the FIFO {}", path.display())
+            }
+            Err(_) => {}
+        }
+    }
+    std::fs::OpenOptions::new().write(true).open(path)
+}
+
+fn write_direct(
+    file: &mut File,
+    name: &str,
+    fill: impl FnOnce(&mut BufWriter<&mut File>) -> Result<()>,
+) -> Result<()> {
+    let mut w = BufWriter::new(file);
+    fill(&mut w).with_context(|| format!("cannot write {name}"))?;
+    w.flush().with_context(|| format!("cannot write {name}"))?;
+    Ok(())
+}
+
+/// Writes into a temporary file beside `real` (the symlink-free target of `path`), then
+/// renames it over `real`.
+fn write_atomically(
+    path: &Path,
+    real: &Path,
+    fill: impl FnOnce(&mut BufWriter<&mut File>) -> Result<()>,
+) -> Result<()> {
+    let dir = parent_dir(real);
+    // Created and registered under the lock, so that the signal handler sees every
+    // temporary file that exists.
+    let mut tmp = {
+        let mut temps = TEMPORARIES.lock().unwrap_or_else(|e| e.into_inner());
+        let tmp = tempfile::Builder::new()
+            .prefix(".raywave-")
+            .tempfile_in(dir)
+            .with_context(|| format!("cannot create a temporary file in {}", dir.display()))?;
+        temps.push(tmp.path().to_path_buf());
+        tmp
+    };
+    let tmp_path = tmp.path().to_path_buf();
+    let result = (|| -> Result<()> {
+        {
+            let mut w = BufWriter::new(tmp.as_file_mut());
+            fill(&mut w).with_context(|| format!("cannot write {}", path.display()))?;
+            w.flush()
+                .with_context(|| format!("cannot write {}", path.display()))?;
+        }
+        // Temporary files are created private (0600); an image is not a secret. Keep the mode
+        // of the file being replaced, or use the usual 0644 for a new one.
+        use std::os::unix::fs::PermissionsExt;
+        let mode = std::fs::metadata(real)
+            .map(|m| m.permissions().mode())
+            .unwrap_or(0o644);
+        tmp.as_file()
+            .set_permissions(std::fs::Permissions::from_mode(mode))
+            .with_context(|| format!("cannot set the permissions of {}", path.display()))?;
+        Ok(())
+    })();
+    let mut temps = TEMPORARIES.lock().unwrap_or_else(|e| e.into_inner());
+    temps.retain(|p| p != &tmp_path);
+    result?;
+    // Renamed under the lock: a signal now waits for the rename, and finds nothing to remove.
+    tmp.persist(real)
+        .with_context(|| format!("cannot move the finished file to {}", path.display()))?;
+    Ok(())
+}
+
+/// Installs the SIGINT/SIGTERM handler: it removes every registered temporary file and exits
+/// with 130 (SIGINT) or 143 (SIGTERM), the shell's 128 + signal number.
+pub fn install_signal_cleanup() -> Result<()> {
+    use signal_hook::consts::{SIGINT, SIGTERM};
+    let mut signals = signal_hook::iterator::Signals::new([SIGINT, SIGTERM])
+        .context("cannot install the signal handler")?;
+    std::thread::Builder::new()
+        .name("signals".into())
+        .spawn(move || {
+            if let Some(signal) = signals.forever().next() {
+                let temps = TEMPORARIES.lock().unwrap_or_else(|e| e.into_inner());
+                for p in temps.iter() {
+                    let _ = std::fs::remove_file(p);
+                }
+                let name = if signal == SIGINT { "SIGINT" } else { "SIGTERM" };
+                eprintln!(
+                    "\nerror: stopped by {name}; {} unfinished temporary file(s) removed, the file being written left as it was",
+                    temps.len()
+                );
+                // _exit: no destructors, no flushing of locks another thread may hold.
+                // SAFETY: _exit ends the process; nothing runs after it.
+                unsafe { libc::_exit(128 + signal) };
+            }
+        })
+        .context("cannot start the signal thread")?;
+    Ok(())
+}
