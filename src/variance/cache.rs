@@ -154,6 +154,16 @@ impl Cache {
                 self.limit_bytes >> 20
             );
         }
+        // Only a regular file of ours is replaced: anything else in an entry's place (a FIFO, a
+        // device, a directory, a symlink) is left alone, and written through by nobody.
+        if let Ok(meta) = std::fs::symlink_metadata(&path)
+            && !meta.is_file()
+        {
+            bail!(
+                "{} is not a regular file: left alone, not cached",
+                path.display()
+            );
+        }
         std::fs::create_dir_all(&self.dir)
             .with_context(|| format!("cannot create {}", self.dir.display()))?;
         let floats = || {
