@@ -41,6 +41,11 @@ impl Film {
         }
     }
 
+    /// How many pixels have a channel that is not finite.
+    pub fn non_finite_pixels(&self) -> usize {
+        self.pixels.iter().filter(|c| !c.is_finite()).count()
+    }
+
     /// 8-bit RGB after tone mapping.
     pub fn to_rgb8(&self, tone: ToneMap) -> image::RgbImage {
         let mut img = image::RgbImage::new(self.width, self.height);

@@ -55,8 +55,12 @@ fn bench_variance_and_meshgen_outputs() {
             outputs: &[],
         },
         Case {
-            name: "bench --save would overwrite the --compare record",
-            setup: setup::cornell_box,
+            name: "bench --json would overwrite the --compare record",
+            setup: |d| {
+                setup::cornell_box(d);
+                std::fs::create_dir(d.join(".raywave-bench")).unwrap();
+                setup::file(d, ".raywave-bench/b.json", b"{}");
+            },
             args: &[
                 "bench",
                 "cornell_box.obj",
@@ -66,10 +70,10 @@ fn bench_variance_and_meshgen_outputs() {
                 "--runs",
                 "1",
                 "-q",
-                "--save",
-                "b",
                 "--compare",
                 "b",
+                "--json",
+                ".raywave-bench/b.json",
             ],
             stdin: None,
             exit: 2,

@@ -97,13 +97,21 @@ impl BenchArgs {
 const AB_THRESHOLD_PCT: f64 = 5.0;
 
 /// The scene and the `--compare` record (inputs), the `--save` record and `--json` (outputs).
+/// `--save` may name the `--compare` record (see below), no other input.
 /// Names `record_path` refuses are left to the bench, which reports them.
 fn output_plan(args: &BenchArgs) -> OutputPlan {
     let mut plan = OutputPlan::new();
     if let Some(scene) = args.scene.as_ref().or(args.input.as_ref()) {
         plan = plan.input("SCENE", scene);
     }
-    if let Some(Ok(path)) = args.compare.as_ref().map(|n| record_path(&args.dir, n)) {
+    // `--compare X --save X` is the rolling baseline, by design: X is read whole before any
+    // timing, and replaced only when this run did not regress against it.
+    if let Some(Ok(path)) = args
+        .compare
+        .as_ref()
+        .filter(|c| args.save.as_ref() != Some(*c))
+        .map(|n| record_path(&args.dir, n))
+    {
         plan = plan.input("--compare", &path);
     }
     if let Some(Ok(path)) = args.save.as_ref().map(|n| record_path(&args.dir, n)) {

@@ -138,11 +138,7 @@ impl Cache {
         if films[1].width != width || films[1].height != height {
             bail!("the two halves differ in size");
         }
-        let bad = films
-            .iter()
-            .flat_map(|f| &f.pixels)
-            .filter(|c| !c.is_finite())
-            .count();
+        let bad: usize = films.iter().map(Film::non_finite_pixels).sum();
         if bad > 0 {
             bail!("{bad} pixels are not finite: not cached");
         }

@@ -127,11 +127,7 @@ pub fn converged_reference(
                 );
             }
             let films = [render(scene, &settings[0]).0, render(scene, &settings[1]).0];
-            let bad = films
-                .iter()
-                .flat_map(|f| &f.pixels)
-                .filter(|c| !c.is_finite())
-                .count();
+            let bad: usize = films.iter().map(Film::non_finite_pixels).sum();
             if bad > 0 {
                 bail!(
                     "{}: the converged reference has {bad} pixels that are not finite: expected \
