@@ -496,3 +496,55 @@ fn sphere_kernel_matches_an_independent_f64_root() {
         "{hits} {misses} {inside}"
     );
 }
+
+/// The occlusion test `sphere_blocks` answers as `intersect_sphere(..) < tmax` does, and as an
+/// f64 root would, on random segments (roots or tmax within 1e-3 of each other or of 0 are the
+/// ambiguous cases left out: there the product and the quotient may round apart).
+#[test]
+fn sphere_blocks_agrees_with_the_closest_hit_and_an_f64_root() {
+    use raywave::geometry::sphere_blocks;
+    let mut rng = seeded(11);
+    let (mut blocked, mut clear) = (0, 0);
+    for _ in 0..20000 {
+        let f = |v: glam::DVec3| v.as_vec3().as_dvec3();
+        let center = f(vec(&mut rng, 2.0));
+        let radius = (0.1 + rng.random::<f64>() * 1.5) as f32 as f64;
+        let origin = f(vec(&mut rng, 4.0));
+        let d = f((center + vec(&mut rng, 2.0) - origin).normalize());
+        let tmax = (rng.random::<f64>() * 8.0) as f32 as f64;
+        let oc = origin - center;
+        let b = oc.dot(d);
+        let disc = b * b - (oc.length_squared() - radius * radius);
+        let roots = if disc > 0.0 {
+            vec![-b - disc.sqrt(), -b + disc.sqrt()]
+        } else {
+            vec![]
+        };
+        let near = |x: f64, y: f64| (x - y).abs() <= 1e-3;
+        if disc.abs() < 1e-3 || roots.iter().any(|&t| near(t, 0.0) || near(t, tmax)) {
+            continue;
+        }
+        let expected = roots.iter().any(|&t| t > 0.0 && t < tmax);
+        let s = Sphere {
+            center: center.as_vec3(),
+            radius: radius as f32,
+            material: 0,
+        };
+        let r = Ray {
+            origin: origin.as_vec3(),
+            direction: d.as_vec3(),
+        };
+        let got = sphere_blocks(&s, &r, tmax as f32);
+        assert_eq!(got, expected, "{r:?} {s:?} tmax {tmax}: roots {roots:?}");
+        assert_eq!(got, intersect_sphere(&s, &r, tmax as f32) < tmax as f32);
+        if got {
+            blocked += 1;
+        } else {
+            clear += 1;
+        }
+    }
+    assert!(
+        blocked > 2000 && clear > 2000,
+        "{blocked} blocked, {clear} clear"
+    );
+}

@@ -219,7 +219,7 @@ impl MeshBvh {
             *blocked = scene
                 .spheres
                 .iter()
-                .any(|s| intersect_sphere(s, &ray, tmax) < tmax)
+                .any(|s| crate::geometry::sphere_blocks(s, &ray, tmax))
                 || self.occluded_in(&ray, tmax, two_sided, &mut stack);
         }
     }

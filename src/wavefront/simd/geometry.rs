@@ -279,12 +279,14 @@ fn occluded8(
     blocked
 }
 
-/// The lanes `s` blocks: `sphere8(..) < tmax`, but returning early when no lane can hit
-/// (most shadow rays miss most spheres; that skips the square root and both divisions).
+/// The lanes `s` blocks: lane k is `geometry::sphere_blocks(s, ray_k, tmax_k)` (the roots
+/// tested against (0, tmax) by multiplication, no division of c by q), returning early when no
+/// lane can hit (most shadow rays miss most spheres; that skips the square root and the
+/// division).
 ///
 /// The early test is the textbook discriminant b² − a·c, which needs no division, with a margin
 /// that makes it prove the stable discriminant negative too (`geometry::MISS_MARGIN`), so the
-/// lanes it drops are misses for `sphere8` as well and the result is `sphere8`'s bit for bit.
+/// lanes it drops are misses of the full test as well.
 /// (With the margin added as a separate term, this test cost 15% more instructions in the
 /// occlusion loop than folded into c.)
 #[inline(always)]
@@ -302,5 +304,18 @@ fn sphere8_blocks(s: &Sphere, r: &Rays8, tmax: f32x8) -> u32 {
     if (b * b - a * c).simd_lt(f32x8::ZERO).all() {
         return 0;
     }
-    sphere8(s, r, tmax).simd_lt(tmax).to_bitmask()
+    let r2 = f32x8::splat(r2);
+    let k = b * (f32x8::ONE / a);
+    let fx = ocx - k * r.dx;
+    let fy = ocy - k * r.dy;
+    let fz = ocz - k * r.dz;
+    let disc = a * (r2 - (fx * fx + fy * fy + fz * fz));
+    let ok = disc.simd_ge(f32x8::ZERO);
+    let sign = f32x8::splat(-0.0);
+    let signed_root = (disc.sqrt() & !sign) | (b & sign);
+    let q = -(b + signed_root);
+    let c = oc2 - r2;
+    let t1_in_range = q.simd_gt(f32x8::ZERO) & q.simd_lt(tmax * a);
+    let t0_in_range = (c * q).simd_gt(f32x8::ZERO) & c.abs().simd_lt(tmax * q.abs());
+    (ok & (t1_in_range | t0_in_range)).to_bitmask()
 }
