@@ -112,6 +112,14 @@ fn repeated_and_meaningless_flags() {
             &[],
         ),
         case(
+            "variance --size twice (a two-value flag, not a list)",
+            setup::nothing,
+            &["variance", "--size", "4", "4", "--size", "8", "8"],
+            2,
+            &["--size <W> <H>' cannot be used multiple times"],
+            &[],
+        ),
+        case(
             "meshgen -o twice",
             setup::nothing,
             &["meshgen", "-o", "a.obj", "-o", "b.obj"],

@@ -23,7 +23,7 @@ pub struct VarianceArgs {
     #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(2..=1024))]
     pub seeds: u32,
     /// Image size.
-    #[arg(long, num_args = 2, value_names = ["W", "H"], default_values_t = [128u32, 128], value_parser = clap::value_parser!(u32).range(1..=4096))]
+    #[arg(long, num_args = 2, action = clap::ArgAction::Set, value_names = ["W", "H"], default_values_t = [128u32, 128], value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub size: Vec<u32>,
     /// Mirror bounces.
     #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(0..=64))]
