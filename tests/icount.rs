@@ -3,12 +3,15 @@
 //!
 //! ```text
 //! runner (this test, in release builds):
+//!     child = this test built for x86-64-v3 (cargo, in target/icount-x86-64-v3), or this
+//!             binary when it is such a build: valgrind runs that on every x86-64 machine
 //!     valgrind --tool=callgrind --collect-atstart=no --toggle-collect='*icount_region_*'
-//!              --dump-after='*icount_region_*'  <this test binary>  (child mode)
-//!     one dump per region → instructions per region
+//!              --dump-after=...icount_region_NAME  <child>  (child mode)
+//!     one dump per region → instructions per region; the child prints its key
 //!     key = rustc version · target arch · enabled x86 features · valgrind version
 //!     baseline for the key?  compare each region: rise > THRESHOLD fails, fall > THRESHOLD notes
-//!     no baseline?           print the counts and how to record them; pass
+//!     nothing compared (no baseline, no valgrind, a debug build)?  fail when CI is set, else
+//!                            say why and pass
 //! child (RAYWAVE_ICOUNT_CHILD set):
 //!     build each workload's inputs (not counted), run the kernel once to size its buffers
 //!     (not counted), then run it once more inside its #[inline(never)] icount_region_* (counted)
@@ -290,12 +293,14 @@ struct Baselines {
     baselines: BTreeMap<String, BTreeMap<String, u64>>,
 }
 
-/// Runs the child under callgrind and returns (region, instructions) in `REGIONS` order, or
-/// None when valgrind cannot run this build (the reason printed).
-fn measure() -> Option<Vec<(&'static str, u64)>> {
+/// The child's key and its instructions per region, in `REGIONS` order.
+type Measured = (String, Vec<(&'static str, u64)>);
+
+/// Runs `exe` (this test, built for `FIXED_TARGET`) as the child under callgrind and returns
+/// the child's key and (region, instructions) in `REGIONS` order, or the reason it could not.
+fn measure(exe: &Path) -> Result<Measured, String> {
     let dir = tempfile::tempdir().expect("a temporary directory");
     let out_file = dir.path().join("callgrind.out");
-    let exe = std::env::current_exe().expect("the test binary");
     let output = Command::new("valgrind")
         .args([
             "--tool=callgrind",
@@ -307,7 +312,7 @@ fn measure() -> Option<Vec<(&'static str, u64)>> {
             REGIONS.map(|r| format!("--dump-after=icount::icount_region_{r}")),
         )
         .arg(format!("--callgrind-out-file={}", out_file.display()))
-        .arg(&exe)
+        .arg(exe)
         .args([
             "--exact",
             "kernel_instruction_counts",
@@ -321,12 +326,10 @@ fn measure() -> Option<Vec<(&'static str, u64)>> {
     let stderr = String::from_utf8_lossy(&output.stderr);
     if !output.status.success() {
         if stderr.contains("unhandled instruction") || stderr.contains("unrecognised instruction") {
-            eprintln!(
-                "icount: SKIPPED: valgrind cannot run this build (an instruction it does not \
-                 emulate, e.g. AVX-512 from target-cpu=native); build with \
-                 RUSTFLAGS=\"-C target-cpu=x86-64-v3\" to measure here.\n{stderr}"
-            );
-            return None;
+            return Err(format!(
+                "valgrind cannot run {} (an instruction it does not emulate)\n{stderr}",
+                exe.display()
+            ));
         }
         panic!(
             "icount: the workloads failed under valgrind ({}):\n{}\n{stderr}",
@@ -362,7 +365,72 @@ fn measure() -> Option<Vec<(&'static str, u64)>> {
         assert!(total > 0, "icount: region {region} counted no instructions");
         counts.push((*region, total));
     }
-    Some(counts)
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    let key = stdout
+        .lines()
+        // The test harness's "test ... " may precede it on the same line.
+        .find_map(|l| l.find(KEY_LINE).map(|i| &l[i + KEY_LINE.len()..]))
+        .ok_or_else(|| format!("the child printed no `{KEY_LINE}` line:\n{stdout}"))?;
+    Ok((key.to_string(), counts))
+}
+
+/// The CPU the gate measures for, whatever the machine: valgrind runs x86-64-v3 code on every
+/// x86-64 machine it runs on (this machine's native AVX-512 build it cannot), so one baseline
+/// serves them all.
+const FIXED_TARGET: &str = "x86-64-v3";
+/// Where the fixed-target build of this test goes: its own target directory, so that building
+/// it does not wait on the lock of the `cargo test` that runs this.
+const FIXED_TARGET_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/target/icount-x86-64-v3");
+/// The line by which the child tells the runner its key.
+const KEY_LINE: &str = "icount-key: ";
+
+/// This test built for `FIXED_TARGET`: this binary when it is one (a build with exactly that
+/// target's features and no AVX-512), else one built now by cargo (a release build of this test
+/// only, in `FIXED_TARGET_DIR`; a minute or two the first time, then incremental).
+fn fixed_target_child() -> Result<std::path::PathBuf, String> {
+    let is_fixed = cfg!(all(
+        target_feature = "avx2",
+        target_feature = "fma",
+        target_feature = "bmi2"
+    )) && !cfg!(target_feature = "avx512f");
+    if is_fixed && std::env::var_os("RAYWAVE_ICOUNT_REBUILD").is_none() {
+        return std::env::current_exe().map_err(|e| format!("cannot find this test binary: {e}"));
+    }
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let output = Command::new(cargo)
+        .args([
+            "test",
+            "--release",
+            "--test",
+            "icount",
+            "--no-run",
+            "--message-format=json",
+        ])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .env("RUSTFLAGS", format!("-C target-cpu={FIXED_TARGET}"))
+        .env("CARGO_TARGET_DIR", FIXED_TARGET_DIR)
+        .output()
+        .map_err(|e| format!("cannot run cargo to build the {FIXED_TARGET} child: {e}"))?;
+    if !output.status.success() {
+        return Err(format!(
+            "building the {FIXED_TARGET} child failed:\n{}",
+            String::from_utf8_lossy(&output.stderr)
+        ));
+    }
+    String::from_utf8_lossy(&output.stdout)
+        .lines()
+        .filter_map(|l| serde_json::from_str::<serde_json::Value>(l).ok())
+        .filter(|m| m["reason"] == "compiler-artifact" && m["target"]["name"] == "icount")
+        .find_map(|m| m["executable"].as_str().map(std::path::PathBuf::from))
+        .ok_or_else(|| format!("cargo built no icount executable for {FIXED_TARGET}"))
+}
+
+/// A gate that did not compare is a pass on a developer's machine (with the reason printed) and
+/// a failure in CI (`CI` set), where a silent pass would be a false green.
+fn not_gated(why: &str) {
+    let ci = std::env::var_os("CI").is_some_and(|v| !v.is_empty() && v != "false" && v != "0");
+    assert!(!ci, "icount: the gate did not run, and CI is set: {why}");
+    eprintln!("icount: SKIPPED: {why}");
 }
 
 /// A region's count against its baseline.
@@ -398,24 +466,26 @@ fn the_threshold_is_one_percent_either_way() {
 #[test]
 fn kernel_instruction_counts() {
     if std::env::var_os(CHILD).is_some() {
+        println!("{KEY_LINE}{}", key());
         workloads();
         return;
     }
     if cfg!(debug_assertions) {
-        eprintln!(
-            "icount: SKIPPED in a debug build: the baselines are release counts (cargo test --release)"
-        );
-        return;
+        return not_gated("a debug build: the baselines are release counts (cargo test --release)");
     }
     if valgrind_version().is_none() {
-        eprintln!(
-            "icount: SKIPPED: valgrind is not installed (Debian: apt-get install valgrind); the \
-             instruction-count gate did not run"
+        return not_gated(
+            "valgrind is not installed (Debian: apt-get install valgrind; .ci/run installs it)",
         );
-        return;
     }
-    let Some(counts) = measure() else { return };
-    let key = key();
+    let child = match fixed_target_child() {
+        Ok(child) => child,
+        Err(why) => return not_gated(&why),
+    };
+    let (key, counts) = match measure(&child) {
+        Ok(measured) => measured,
+        Err(why) => return not_gated(&why),
+    };
     let mut record: Baselines = std::fs::read_to_string(RECORD)
         .ok()
         .map(|text| serde_json::from_str(&text).unwrap_or_else(|e| panic!("icount: {RECORD}: {e}")))
@@ -464,13 +534,11 @@ fn kernel_instruction_counts() {
         return;
     }
     let Some(baseline) = baseline else {
-        println!(
-            "icount: NO BASELINE for this key in {RECORD}: nothing compared (the gate only \
-             checked that every region runs under callgrind). Keys recorded: {:?}. To record \
-             this machine's: {RECORD_COMMAND}",
+        return not_gated(&format!(
+            "NO BASELINE for this key in {RECORD}: nothing compared (every region ran under \
+             callgrind). Keys recorded: {:?}. To record this one: {RECORD_COMMAND}",
             record.baselines.keys().collect::<Vec<_>>()
-        );
-        return;
+        ));
     };
     let missing: Vec<_> = REGIONS
         .iter()
