@@ -104,29 +104,10 @@ pub fn intersect_triangle(tri: &Triangle, ray: &Ray, tmax: f32, two_sided: bool)
 /// are c/q and q/a with q = −(b + sign(b)·√disc), which never subtracts nearly equal numbers.
 /// Two divisions, as the textbook form has.
 #[inline]
-#[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(x >= 0)` is on purpose: NaN must miss
 pub fn intersect_sphere(sphere: &Sphere, ray: &Ray, tmax: f32) -> f32 {
-    let oc = ray.origin - sphere.center;
-    let a = ray.direction.length_squared();
-    let b = oc.dot(ray.direction);
-    let r2 = sphere.radius * sphere.radius;
-    // Most rays miss most spheres: the textbook discriminant, which needs no division, proves
-    // it with a margin (`MISS_MARGIN`), and the stable one is computed only for the rest.
-    let oc2 = oc.length_squared();
-    // The margin folded into c: c − k·(|oc|² + r²) = (1 − k)·|oc|² − (1 + k)·r².
-    if b * b - a * ((1.0 - MISS_MARGIN) * oc2 - (1.0 + MISS_MARGIN) * r2) < 0.0 {
+    let Some(SphereRoots { inv_a, c, q, .. }) = sphere_roots(sphere, ray) else {
         return f32::INFINITY;
-    }
-    // One division for 1/a, used twice (a multiply is cheaper than a division, and the extra
-    // rounding is an ulp).
-    let inv_a = 1.0 / a;
-    let f = oc - (b * inv_a) * ray.direction;
-    let disc = a * (r2 - f.length_squared());
-    if !(disc >= 0.0) {
-        return f32::INFINITY;
-    }
-    let q = -(b + disc.sqrt().copysign(b));
-    let c = oc2 - r2;
+    };
     let (t0, t1) = (c / q, q * inv_a);
     let (near, far) = if t0 < t1 { (t0, t1) } else { (t1, t0) };
     let t = if near > T_MIN { near } else { far };
@@ -150,27 +131,54 @@ pub fn intersect_sphere(sphere: &Sphere, ray: &Ray, tmax: f32) -> f32 {
 /// (`raywave bench --against`, the lab benchmark, 20 rounds: 0.987× the time of the form with
 /// the division, 95% interval [0.981, 0.992].)
 #[inline]
-#[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(x >= 0)` is on purpose: NaN must miss
 pub fn sphere_blocks(sphere: &Sphere, ray: &Ray, tmax: f32) -> bool {
+    let Some(SphereRoots { a, c, q, .. }) = sphere_roots(sphere, ray) else {
+        return false;
+    };
+    // T_MIN is 0: "> 0" below is "> T_MIN".
+    let t1_in_range = q > 0.0 && q < tmax * a;
+    let t0_in_range = c * q > 0.0 && c.abs() < tmax * q.abs();
+    t1_in_range || t0_in_range
+}
+
+/// What both sphere tests need before they judge the roots t0 = c/q and t1 = q/a.
+struct SphereRoots {
+    a: f32,
+    inv_a: f32,
+    c: f32,
+    q: f32,
+}
+
+/// The shared first half of [`intersect_sphere`] and [`sphere_blocks`]: `None` when the ray's
+/// line misses the sphere. Most rays miss most spheres: the textbook discriminant, which needs
+/// no division, proves it with a margin (`MISS_MARGIN`), and the stable one is computed only
+/// for the rest.
+#[inline(always)]
+#[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(x >= 0)` is on purpose: NaN must miss
+fn sphere_roots(sphere: &Sphere, ray: &Ray) -> Option<SphereRoots> {
     let oc = ray.origin - sphere.center;
     let a = ray.direction.length_squared();
     let b = oc.dot(ray.direction);
     let r2 = sphere.radius * sphere.radius;
     let oc2 = oc.length_squared();
+    // The margin folded into c: c − k·(|oc|² + r²) = (1 − k)·|oc|² − (1 + k)·r².
     if b * b - a * ((1.0 - MISS_MARGIN) * oc2 - (1.0 + MISS_MARGIN) * r2) < 0.0 {
-        return false;
+        return None;
     }
-    let f = oc - (b * (1.0 / a)) * ray.direction;
+    // One division for 1/a, used twice by `intersect_sphere` (a multiply is cheaper than a
+    // division, and the extra rounding is an ulp).
+    let inv_a = 1.0 / a;
+    let f = oc - (b * inv_a) * ray.direction;
     let disc = a * (r2 - f.length_squared());
     if !(disc >= 0.0) {
-        return false;
+        return None;
     }
-    let q = -(b + disc.sqrt().copysign(b));
-    let c = oc2 - r2;
-    // T_MIN is 0: "> 0" below is "> T_MIN".
-    let t1_in_range = q > 0.0 && q < tmax * a;
-    let t0_in_range = c * q > 0.0 && c.abs() < tmax * q.abs();
-    t1_in_range || t0_in_range
+    Some(SphereRoots {
+        a,
+        inv_a,
+        c: oc2 - r2,
+        q: -(b + disc.sqrt().copysign(b)),
+    })
 }
 
 /// The order every closest-hit query over a BVH minimises: hit (t, prim) beats the best so far

@@ -145,25 +145,9 @@ fn triangle8_blocks(tri: &Triangle, r: &Rays8, tmax: f32x8, two_sided: bool) -> 
 /// ```
 #[inline(always)]
 pub fn sphere8(s: &Sphere, r: &Rays8, tmax: f32x8) -> f32x8 {
-    let ocx = r.ox - f32x8::splat(s.center.x);
-    let ocy = r.oy - f32x8::splat(s.center.y);
-    let ocz = r.oz - f32x8::splat(s.center.z);
-    let a = r.dx * r.dx + r.dy * r.dy + r.dz * r.dz;
-    let b = ocx * r.dx + ocy * r.dy + ocz * r.dz;
-    let inv_a = f32x8::ONE / a;
-    let k = b * inv_a;
-    let fx = ocx - k * r.dx;
-    let fy = ocy - k * r.dy;
-    let fz = ocz - k * r.dz;
-    let r2 = f32x8::splat(s.radius * s.radius);
-    let disc = a * (r2 - (fx * fx + fy * fy + fz * fz));
-    let ok = disc.simd_ge(f32x8::ZERO);
-    let root = disc.sqrt();
-    // copysign(√disc, b): the sign bit of b on the magnitude of √disc.
-    let sign = f32x8::splat(-0.0);
-    let signed_root = (root & !sign) | (b & sign);
-    let q = -(b + signed_root);
-    let c = (ocx * ocx + ocy * ocy + ocz * ocz) - r2;
+    let Roots8 {
+        ok, inv_a, c, q, ..
+    } = SphereLanes::new(s, r).roots(r);
     let t0 = c / q;
     let t1 = q * inv_a;
     let first = t0.simd_lt(t1);
@@ -173,6 +157,76 @@ pub fn sphere8(s: &Sphere, r: &Rays8, tmax: f32x8) -> f32x8 {
     let t = near.simd_gt(t_min).select(near, far);
     let hit = ok & t.simd_gt(t_min) & t.simd_lt(tmax);
     hit.select(t, f32x8::splat(f32::INFINITY))
+}
+
+/// One sphere against 8 rays, up to the discriminant: what [`sphere8`] and `sphere8_blocks`
+/// share (lane-wise twin of `geometry::sphere_roots`).
+struct SphereLanes {
+    oc: [f32x8; 3],
+    a: f32x8,
+    b: f32x8,
+    oc2: f32x8,
+    r2: f32,
+}
+
+/// The roots' parts, t0 = c/q and t1 = q·(1/a), and which lanes have them (`ok`).
+struct Roots8 {
+    ok: f32x8,
+    a: f32x8,
+    inv_a: f32x8,
+    c: f32x8,
+    q: f32x8,
+}
+
+impl SphereLanes {
+    #[inline(always)]
+    fn new(s: &Sphere, r: &Rays8) -> SphereLanes {
+        let ocx = r.ox - f32x8::splat(s.center.x);
+        let ocy = r.oy - f32x8::splat(s.center.y);
+        let ocz = r.oz - f32x8::splat(s.center.z);
+        SphereLanes {
+            a: r.dx * r.dx + r.dy * r.dy + r.dz * r.dz,
+            b: ocx * r.dx + ocy * r.dy + ocz * r.dz,
+            oc2: ocx * ocx + ocy * ocy + ocz * ocz,
+            oc: [ocx, ocy, ocz],
+            r2: s.radius * s.radius,
+        }
+    }
+
+    /// True when the textbook discriminant b² − a·c proves every lane a miss, with the margin
+    /// that makes the stable discriminant negative too (`geometry::MISS_MARGIN`), folded into
+    /// c: c − k·(|oc|² + r²) = (1 − k)·|oc|² − (1 + k)·r². NaN compares false: such a lane is
+    /// not proven a miss and goes to the exact test.
+    #[inline(always)]
+    fn all_miss(&self) -> bool {
+        let (a, b) = (self.a, self.b);
+        let c = self.oc2 * f32x8::splat(1.0 - MISS_MARGIN)
+            - f32x8::splat(self.r2 * (1.0 + MISS_MARGIN));
+        (b * b - a * c).simd_lt(f32x8::ZERO).all()
+    }
+
+    /// The stable discriminant a·(r² − |oc − (b/a)·d|²) and q = −(b + sign(b)·√disc).
+    #[inline(always)]
+    fn roots(&self, r: &Rays8) -> Roots8 {
+        let (a, b, [ocx, ocy, ocz]) = (self.a, self.b, self.oc);
+        let inv_a = f32x8::ONE / a;
+        let k = b * inv_a;
+        let fx = ocx - k * r.dx;
+        let fy = ocy - k * r.dy;
+        let fz = ocz - k * r.dz;
+        let r2 = f32x8::splat(self.r2);
+        let disc = a * (r2 - (fx * fx + fy * fy + fz * fz));
+        // copysign(√disc, b): the sign bit of b on the magnitude of √disc.
+        let sign = f32x8::splat(-0.0);
+        let signed_root = (disc.sqrt() & !sign) | (b & sign);
+        Roots8 {
+            ok: disc.simd_ge(f32x8::ZERO),
+            a,
+            inv_a,
+            c: self.oc2 - r2,
+            q: -(b + signed_root),
+        }
+    }
 }
 
 /// Closest hit of every ray against every primitive, in the reference's order (triangles by
@@ -291,30 +345,11 @@ fn occluded8(
 /// occlusion loop than folded into c.)
 #[inline(always)]
 fn sphere8_blocks(s: &Sphere, r: &Rays8, tmax: f32x8) -> u32 {
-    let ocx = r.ox - f32x8::splat(s.center.x);
-    let ocy = r.oy - f32x8::splat(s.center.y);
-    let ocz = r.oz - f32x8::splat(s.center.z);
-    let a = r.dx * r.dx + r.dy * r.dy + r.dz * r.dz;
-    let b = ocx * r.dx + ocy * r.dy + ocz * r.dz;
-    let oc2 = ocx * ocx + ocy * ocy + ocz * ocz;
-    // b² − a·c with the margin folded into c: c − k·(|oc|² + r²) = (1 − k)·|oc|² − (1 + k)·r².
-    let r2 = s.radius * s.radius;
-    let c = oc2 * f32x8::splat(1.0 - MISS_MARGIN) - f32x8::splat(r2 * (1.0 + MISS_MARGIN));
-    // NaN compares false: such a lane is not proven a miss and goes to the exact test.
-    if (b * b - a * c).simd_lt(f32x8::ZERO).all() {
+    let lanes = SphereLanes::new(s, r);
+    if lanes.all_miss() {
         return 0;
     }
-    let r2 = f32x8::splat(r2);
-    let k = b * (f32x8::ONE / a);
-    let fx = ocx - k * r.dx;
-    let fy = ocy - k * r.dy;
-    let fz = ocz - k * r.dz;
-    let disc = a * (r2 - (fx * fx + fy * fy + fz * fz));
-    let ok = disc.simd_ge(f32x8::ZERO);
-    let sign = f32x8::splat(-0.0);
-    let signed_root = (disc.sqrt() & !sign) | (b & sign);
-    let q = -(b + signed_root);
-    let c = oc2 - r2;
+    let Roots8 { ok, a, c, q, .. } = lanes.roots(r);
     let t1_in_range = q.simd_gt(f32x8::ZERO) & q.simd_lt(tmax * a);
     let t0_in_range = (c * q).simd_gt(f32x8::ZERO) & c.abs().simd_lt(tmax * q.abs());
     (ok & (t1_in_range | t0_in_range)).to_bitmask()
