@@ -5,27 +5,7 @@
 
 mod common;
 
-use common::hostile::{Case, check_all, setup};
-use std::path::Path;
-
-fn case(
-    name: &'static str,
-    setup: fn(&Path),
-    args: &'static [&'static str],
-    exit: i32,
-    stderr: &'static [&'static str],
-    outputs: &'static [&'static str],
-) -> Case {
-    Case {
-        name,
-        setup,
-        args,
-        stdin: None,
-        exit,
-        stderr,
-        outputs,
-    }
-}
+use common::hostile::{case, check_all, setup};
 
 #[test]
 fn repeated_and_meaningless_flags() {

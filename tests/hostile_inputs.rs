@@ -8,7 +8,7 @@
 mod common;
 
 use common::hostile::setup_streams::{fifo_feeding, scaled, sparse};
-use common::hostile::{Case, TIMEOUT, check_all, run, setup};
+use common::hostile::{Case, TIMEOUT, case, check_all, run, setup};
 use std::path::Path;
 
 /// The lab's box, fed through FIFOs and standard input.
@@ -16,25 +16,6 @@ const BOX: &[u8] = include_bytes!("../scenes/cornell_box.obj");
 
 const DIR_MSG: &str = "found a directory";
 const DEV_MSG: &str = "found a character device";
-
-fn case(
-    name: &'static str,
-    setup: fn(&Path),
-    args: &'static [&'static str],
-    exit: i32,
-    stderr: &'static [&'static str],
-    outputs: &'static [&'static str],
-) -> Case {
-    Case {
-        name,
-        setup,
-        args,
-        stdin: None,
-        exit,
-        stderr,
-        outputs,
-    }
-}
 
 fn subdir(d: &Path) {
     std::fs::create_dir(d.join("scene.obj")).unwrap();

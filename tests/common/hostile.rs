@@ -205,6 +205,26 @@ pub fn check(case: &Case) -> Result<(), String> {
     }
 }
 
+/// A case with nothing on standard input, the commonest kind.
+pub fn case(
+    name: &'static str,
+    setup: fn(&Path),
+    args: &'static [&'static str],
+    exit: i32,
+    stderr: &'static [&'static str],
+    outputs: &'static [&'static str],
+) -> Case {
+    Case {
+        name,
+        setup,
+        args,
+        stdin: None,
+        exit,
+        stderr,
+        outputs,
+    }
+}
+
 /// Runs every case and fails listing all that went wrong.
 pub fn check_all(cases: &[Case]) {
     let failures: Vec<String> = cases.iter().filter_map(|c| check(c).err()).collect();
