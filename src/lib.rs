@@ -57,6 +57,7 @@ pub mod camera;
 pub mod debug_view;
 pub mod engine;
 pub mod error;
+pub mod false_colour;
 pub mod film;
 pub mod geometry;
 pub mod machine;

@@ -3,11 +3,11 @@
 //! (DejaVu Sans, via the `dejavu` crate), so plots need no system fonts.
 
 use super::{Region, StudyResult};
+use crate::false_colour::{inferno, register_font};
 use crate::film::write_atomically;
 use anyhow::{Context, Result, anyhow};
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
-use std::sync::Once;
 
 const PALETTE: [RGBColor; 4] = [
     RGBColor(31, 119, 180),
@@ -15,18 +15,6 @@ const PALETTE: [RGBColor; 4] = [
     RGBColor(44, 160, 44),
     RGBColor(214, 39, 40),
 ];
-
-fn register_font() {
-    static ONCE: Once = Once::new();
-    ONCE.call_once(|| {
-        // Failure leaves text undrawn but the plot still valid; the font is a fixed asset.
-        let _ = plotters::style::register_font(
-            "sans-serif",
-            FontStyle::Normal,
-            dejavu::sans::regular(),
-        );
-    });
-}
 
 /// Draws `mse.png`: three log-log panels (whole, penumbra, lit).
 pub fn mse_plot(result: &StudyResult, path: &Path) -> Result<()> {
@@ -170,20 +158,4 @@ pub fn heatmaps(result: &StudyResult, dir: &Path) -> Result<Vec<PathBuf>> {
         written.push(path);
     }
     Ok(written)
-}
-
-/// A five-stop approximation of the 'inferno' colour map.
-fn inferno(t: f32) -> [u8; 3] {
-    const STOPS: [[f32; 3]; 5] = [
-        [0.0, 0.0, 4.0],
-        [87.0, 16.0, 110.0],
-        [188.0, 55.0, 84.0],
-        [249.0, 142.0, 9.0],
-        [252.0, 255.0, 164.0],
-    ];
-    let x = t * (STOPS.len() - 1) as f32;
-    let i = (x as usize).min(STOPS.len() - 2);
-    let f = x - i as f32;
-    let c = |k: usize| (STOPS[i][k] * (1.0 - f) + STOPS[i + 1][k] * f) as u8;
-    [c(0), c(1), c(2)]
 }
