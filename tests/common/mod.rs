@@ -8,6 +8,7 @@
 
 pub mod analytic;
 pub mod bin;
+pub mod docs;
 pub mod hostile;
 pub mod random;
 pub mod rays;
