@@ -1,0 +1,27 @@
+//! One pixel's ray tree: every ray its render traces (camera, reflection and shadow rays), where
+//! each goes, what it hits or what blocks it, and the colour each adds to the pixel.
+//!
+//! ```text
+//! trace_pixel(scene, settings, x, y) -> RayTree       tracer.rs: the reference's recursion, recorded
+//! check_pixel(scene, settings, &tree) -> PixelCheck   check.rs: Σ contributions vs both engines
+//! scene_geometry(scene) -> SceneGeometry              scene_view.rs: triangles, spheres, lights
+//! ```
+//!
+//! The types (tree.rs, scene_view.rs) are plain serde values with a JSON Schema
+//! (docs/schema/ray-tree.schema.json, docs/TRACE.md).
+
+pub mod check;
+pub mod scene_view;
+pub mod tracer;
+pub mod tree;
+
+pub use check::{PixelEngine, check_pixel, render_pixel};
+pub use scene_view::{
+    LightView, MaterialView, SceneGeometry, SphereView, TriangleView, scene_bounds,
+    scene_geometry,
+};
+pub use tracer::{TraceError, primitive_ref, trace_pixel, trace_settings};
+pub use tree::{
+    BlockerInfo, CameraInfo, PixelCheck, PixelRef, PrimitiveRef, PrimitiveShape, RayTree,
+    SCHEMA_ID, Segment, SegmentKind, ShadowInfo, SurfaceInfo, TraceSettings,
+};
