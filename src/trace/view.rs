@@ -2,7 +2,7 @@
 //! orbits away from the render's camera.
 //!
 //! ```text
-//! eye = look_at + R(up, orbit) · (from − look_at)     from: --view-from, else the render's eye
+//! eye = look_at + distance · R(up, orbit) · (from − look_at)   from: --view-from, else the render's eye
 //! looks at the render camera's point of interest, with its up axis and field of view
 //! project(p): the inverse of CameraRays' pixel -> ray mapping (continuous pixel coordinates)
 //! ```
@@ -23,6 +23,9 @@ pub struct ViewPlacement {
     /// Degrees about the scene's up axis (through the render camera's point of interest),
     /// counter-clockwise seen from above.
     pub orbit_degrees: f32,
+    /// The eye's distance from the point of interest is multiplied by this (> 0): above 1 the
+    /// debug camera backs away and shows more around the tree.
+    pub distance: f32,
 }
 
 impl ViewPlacement {
@@ -31,6 +34,7 @@ impl ViewPlacement {
         ViewPlacement {
             from: None,
             orbit_degrees: DEFAULT_ORBIT_DEGREES,
+            distance: 1.0,
         }
     }
 
@@ -41,7 +45,8 @@ impl ViewPlacement {
         let up = main.up.normalize();
         let from = self.from.unwrap_or(main.position);
         let offset = from - main.point_of_interest;
-        let rotated = Quat::from_axis_angle(up, self.orbit_degrees.to_radians()) * offset;
+        let rotated =
+            Quat::from_axis_angle(up, self.orbit_degrees.to_radians()) * offset * self.distance;
         let position = main.point_of_interest + rotated;
         let forward = rotated.length();
         let sideways = rotated.cross(up).length();
