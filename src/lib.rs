@@ -76,6 +76,7 @@ pub mod spawn;
 pub mod statistics;
 pub mod stats;
 pub mod terminal;
+pub mod trace;
 pub mod variance;
 pub mod wavefront;
 

@@ -134,6 +134,7 @@ const SUBCOMMANDS: &[&str] = &[
     "meshgen",
     "variance",
     "bench",
+    "trace-pixel",
     "help",
     "-h",
     "--help",

@@ -10,6 +10,7 @@
 //! render.rs    raywave render: summary, --stats, --stats-json, --debug-pixel
 //! bench.rs     raywave bench -> raywave::bench::BenchOptions
 //! variance.rs  raywave variance -> raywave::variance::command::VarianceOptions
+//! trace_pixel.rs  raywave trace-pixel: one pixel's ray tree (JSON, OBJ, PLY, PNG)
 //! meshgen.rs, info.rs
 //! ```
 
@@ -20,6 +21,7 @@ pub mod image;
 pub mod info;
 pub mod meshgen;
 pub mod render;
+pub mod trace_pixel;
 pub mod values;
 pub mod variance;
 
@@ -51,4 +53,7 @@ pub enum Command {
     /// Time both engines on a scene (rays/s per kind and stage); save and compare records
     /// (exit 3 when a figure regresses past --threshold).
     Bench(bench::BenchArgs),
+    /// Trace one pixel as its render does and show its ray tree: a summary, or JSON, OBJ/PLY
+    /// and a PNG from a debug camera (checked against both engines' render of that pixel).
+    TracePixel(trace_pixel::TracePixelArgs),
 }
