@@ -657,6 +657,20 @@ fn bad_input_is_a_usage_error_and_writes_nothing() {
             "same file",
         ),
         (&["trace-pixel", "1", "1", SCENE, "--frobnicate"], ""),
+        // 4096 camera rays × 3 path segments × (1 + 65536 points): refused before tracing.
+        (
+            &[
+                "trace-pixel",
+                "1",
+                "1",
+                SCENE,
+                "--aa",
+                "4096",
+                "--shadow-samples",
+                "65536",
+            ],
+            "segments",
+        ),
         // The debug eye straight above the point of interest: no direction the up axis orients.
         (
             &[
@@ -689,4 +703,68 @@ fn bad_input_is_a_usage_error_and_writes_nothing() {
     let out = raywave(dir.path(), &["trace-pixel", "0", "0", "missing.obj"]);
     assert_eq!(out.status.code(), Some(1));
     assert!(stderr(&out).contains("missing.obj"));
+}
+
+/// The `raywave` commands of the ```sh blocks in docs/TRACE.md and README's debug view (with
+/// `\` continuations joined).
+fn documented_commands() -> Vec<String> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let trace = std::fs::read_to_string(root.join("docs/TRACE.md")).unwrap();
+    let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
+    let start = readme.find("### The debug view").unwrap();
+    let end = start + readme[start..].find("\n## ").unwrap();
+    let mut out = Vec::new();
+    for doc in [trace.as_str(), &readme[start..end]] {
+        let mut in_sh = false;
+        let mut pending = String::new();
+        for line in doc.lines() {
+            match line.trim() {
+                "```sh" => in_sh = true,
+                "```" => in_sh = false,
+                l if in_sh => {
+                    let (body, more) = match l.strip_suffix('\\') {
+                        Some(b) => (b, true),
+                        None => (l, false),
+                    };
+                    pending.push_str(body);
+                    pending.push(' ');
+                    if !more {
+                        out.push(pending.trim().to_string());
+                        pending.clear();
+                    }
+                }
+                _ => {}
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn the_documented_commands_run() {
+    let commands = documented_commands();
+    assert!(commands.len() >= 4, "{commands:?}");
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir(dir.path().join("scenes")).unwrap();
+    std::fs::copy(
+        common::bin::scenes().join(SCENE),
+        dir.path().join("scenes").join(SCENE),
+    )
+    .unwrap();
+    for command in &commands {
+        let words: Vec<&str> = command.split_whitespace().collect();
+        assert_eq!(words[0], "raywave", "{command}");
+        let out = raywave(dir.path(), &words[1..]);
+        assert!(out.status.success(), "{command}: {}", stderr(&out));
+        // Every file the command names is there.
+        for (i, w) in words.iter().enumerate() {
+            if matches!(*w, "--json" | "--obj" | "--ply" | "--png" | "-o") {
+                assert!(
+                    dir.path().join(words[i + 1]).is_file(),
+                    "{command}: {}",
+                    words[i + 1]
+                );
+            }
+        }
+    }
 }
