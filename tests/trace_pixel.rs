@@ -484,6 +484,11 @@ struct TestCamera {
 impl TestCamera {
     fn default_view(size: u32) -> TestCamera {
         let eye = DQuat::from_rotation_y(30f64.to_radians()) * DVec3::from_array(demo::EYE);
+        TestCamera::looking_from(eye, size)
+    }
+
+    /// A camera at `eye` looking at the origin (the file's point of interest), up +y.
+    fn looking_from(eye: DVec3, size: u32) -> TestCamera {
         let forward = (-eye).normalize();
         let right = forward.cross(DVec3::Y).normalize();
         let up = right.cross(forward);
@@ -767,4 +772,110 @@ fn the_documented_commands_run() {
             }
         }
     }
+}
+
+/// Whether the sphere or the slab's top (y = 1.65, seen from above) hides `p` from `eye`, and
+/// how clearly (the smallest distance from the edge of what hides it, or of what it misses).
+fn hidden(eye: DVec3, p: DVec3) -> (bool, f64) {
+    let (c, r) = (DVec3::from_array(demo::SPHERE.0), demo::SPHERE.1);
+    let d = p - eye;
+    // The sphere: the closest approach of eye → p, counted only in front of p.
+    let t = ((c - eye).dot(d) / d.length_squared()).clamp(0.0, 1.0);
+    let gap = (eye + t * d - c).length() - r;
+    let by_sphere = gap < 0.0 && t < 1.0 && (p - c).length() > r + 1e-4;
+    let mut margin = gap.abs();
+    let top = 1.65;
+    let mut by_slab = false;
+    if eye.y > top && p.y < top {
+        let q = eye + (top - eye.y) / (p.y - eye.y) * d;
+        let (x0, x1) = demo::OCCLUDER_X;
+        let (z0, z1) = demo::OCCLUDER_Z;
+        by_slab = q.x > x0 && q.x < x1 && q.z > z0 && q.z < z1;
+        let edge = [q.x - x0, x1 - q.x, q.z - z0, z1 - q.z]
+            .iter()
+            .map(|m| m.abs())
+            .fold(f64::INFINITY, f64::min);
+        margin = margin.min(edge);
+    }
+    (by_sphere || by_slab, margin)
+}
+
+#[test]
+fn rays_are_drawn_solid_where_seen_and_faint_where_hidden() {
+    // From behind and above the mirror sphere: it hides the end of the camera ray and the start
+    // of its shadow rays.
+    let dir = dir_with(&[SCENE]);
+    let size = 200u32;
+    let eye = DVec3::new(0.4, 0.9, -1.9);
+    let out = run(
+        dir.path(),
+        &[
+            "--png",
+            "v.png",
+            "--json",
+            "t.json",
+            "--view-size",
+            "200",
+            "200",
+            "--view-from",
+            "0.4",
+            "0.9",
+            "-1.9",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let tree: RayTree =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("t.json")).unwrap()).unwrap();
+    let img = image::open(dir.path().join("v.png")).unwrap().to_rgb8();
+    let camera = TestCamera::looking_from(eye, size);
+    let colour_of = |s: &raywave::trace::Segment| raywave::trace::palette::Style::of(s).colour();
+    let (mut hidden_points, mut hidden_solid) = (0, 0);
+    let (mut seen_points, mut seen_solid) = (0, 0);
+    for s in &tree.segments {
+        let dashed = s.shadow.as_ref().and_then(|i| i.blocked) == Some(true);
+        for i in 5..=95 {
+            let p = d(s.origin).lerp(d(s.end), i as f64 / 100.0);
+            let Some((x, y)) = camera.project(p) else {
+                continue;
+            };
+            if !(x >= 1.0 && y >= 1.0 && x < size as f64 - 1.0 && y < size as f64 - 1.0) {
+                continue;
+            }
+            let (is_hidden, margin) = hidden(eye, p);
+            if margin < 0.02 {
+                continue;
+            }
+            // Within a pixel: is the segment's full colour there?
+            let solid = (-1i64..=1).any(|dy| {
+                (-1i64..=1).any(|dx| {
+                    let (px, py) = (
+                        (x.floor() as i64 + dx) as u32,
+                        (y.floor() as i64 + dy) as u32,
+                    );
+                    img.get_pixel(px, py).0 == colour_of(s)
+                })
+            });
+            if is_hidden {
+                // Another ray of the same colour may pass in front nearby: count, then bound.
+                hidden_points += 1;
+                hidden_solid += usize::from(solid);
+            } else if !dashed {
+                seen_points += 1;
+                seen_solid += usize::from(solid);
+            }
+        }
+    }
+    assert!(
+        hidden_points > 50,
+        "only {hidden_points} hidden sample points: the view tests nothing"
+    );
+    assert!(seen_points > 50, "only {seen_points} visible sample points");
+    assert!(
+        (hidden_solid as f64) < 0.1 * hidden_points as f64,
+        "{hidden_solid} of {hidden_points} hidden points drawn in full colour"
+    );
+    assert!(
+        (seen_solid as f64) > 0.9 * seen_points as f64,
+        "{seen_solid} of {seen_points} visible points drawn in full colour"
+    );
 }
