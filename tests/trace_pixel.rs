@@ -484,6 +484,11 @@ struct TestCamera {
 impl TestCamera {
     fn default_view(size: u32) -> TestCamera {
         let eye = DQuat::from_rotation_y(30f64.to_radians()) * DVec3::from_array(demo::EYE);
+        TestCamera::looking_from(eye, size)
+    }
+
+    /// A camera at `eye` looking at the origin (the file's point of interest), up +y.
+    fn looking_from(eye: DVec3, size: u32) -> TestCamera {
         let forward = (-eye).normalize();
         let right = forward.cross(DVec3::Y).normalize();
         let up = right.cross(forward);
@@ -657,6 +662,20 @@ fn bad_input_is_a_usage_error_and_writes_nothing() {
             "same file",
         ),
         (&["trace-pixel", "1", "1", SCENE, "--frobnicate"], ""),
+        // 4096 camera rays × 3 path segments × (1 + 65536 points): refused before tracing.
+        (
+            &[
+                "trace-pixel",
+                "1",
+                "1",
+                SCENE,
+                "--aa",
+                "4096",
+                "--shadow-samples",
+                "65536",
+            ],
+            "segments",
+        ),
         // The debug eye straight above the point of interest: no direction the up axis orients.
         (
             &[
@@ -689,4 +708,174 @@ fn bad_input_is_a_usage_error_and_writes_nothing() {
     let out = raywave(dir.path(), &["trace-pixel", "0", "0", "missing.obj"]);
     assert_eq!(out.status.code(), Some(1));
     assert!(stderr(&out).contains("missing.obj"));
+}
+
+/// The `raywave` commands of the ```sh blocks in docs/TRACE.md and README's debug view (with
+/// `\` continuations joined).
+fn documented_commands() -> Vec<String> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let trace = std::fs::read_to_string(root.join("docs/TRACE.md")).unwrap();
+    let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
+    let start = readme.find("### The debug view").unwrap();
+    let end = start + readme[start..].find("\n## ").unwrap();
+    let mut out = Vec::new();
+    for doc in [trace.as_str(), &readme[start..end]] {
+        let mut in_sh = false;
+        let mut pending = String::new();
+        for line in doc.lines() {
+            match line.trim() {
+                "```sh" => in_sh = true,
+                "```" => in_sh = false,
+                l if in_sh => {
+                    let (body, more) = match l.strip_suffix('\\') {
+                        Some(b) => (b, true),
+                        None => (l, false),
+                    };
+                    pending.push_str(body);
+                    pending.push(' ');
+                    if !more {
+                        out.push(pending.trim().to_string());
+                        pending.clear();
+                    }
+                }
+                _ => {}
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn the_documented_commands_run() {
+    let commands = documented_commands();
+    assert!(commands.len() >= 4, "{commands:?}");
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir(dir.path().join("scenes")).unwrap();
+    std::fs::copy(
+        common::bin::scenes().join(SCENE),
+        dir.path().join("scenes").join(SCENE),
+    )
+    .unwrap();
+    for command in &commands {
+        let words: Vec<&str> = command.split_whitespace().collect();
+        assert_eq!(words[0], "raywave", "{command}");
+        let out = raywave(dir.path(), &words[1..]);
+        assert!(out.status.success(), "{command}: {}", stderr(&out));
+        // Every file the command names is there.
+        for (i, w) in words.iter().enumerate() {
+            if matches!(*w, "--json" | "--obj" | "--ply" | "--png" | "-o") {
+                assert!(
+                    dir.path().join(words[i + 1]).is_file(),
+                    "{command}: {}",
+                    words[i + 1]
+                );
+            }
+        }
+    }
+}
+
+/// Whether the sphere or the slab's top (y = 1.65, seen from above) hides `p` from `eye`, and
+/// how clearly (the smallest distance from the edge of what hides it, or of what it misses).
+fn hidden(eye: DVec3, p: DVec3) -> (bool, f64) {
+    let (c, r) = (DVec3::from_array(demo::SPHERE.0), demo::SPHERE.1);
+    let d = p - eye;
+    // The sphere: the closest approach of eye → p, counted only in front of p.
+    let t = ((c - eye).dot(d) / d.length_squared()).clamp(0.0, 1.0);
+    let gap = (eye + t * d - c).length() - r;
+    let by_sphere = gap < 0.0 && t < 1.0 && (p - c).length() > r + 1e-4;
+    let mut margin = gap.abs();
+    let top = 1.65;
+    let mut by_slab = false;
+    if eye.y > top && p.y < top {
+        let q = eye + (top - eye.y) / (p.y - eye.y) * d;
+        let (x0, x1) = demo::OCCLUDER_X;
+        let (z0, z1) = demo::OCCLUDER_Z;
+        by_slab = q.x > x0 && q.x < x1 && q.z > z0 && q.z < z1;
+        let edge = [q.x - x0, x1 - q.x, q.z - z0, z1 - q.z]
+            .iter()
+            .map(|m| m.abs())
+            .fold(f64::INFINITY, f64::min);
+        margin = margin.min(edge);
+    }
+    (by_sphere || by_slab, margin)
+}
+
+#[test]
+fn rays_are_drawn_solid_where_seen_and_faint_where_hidden() {
+    // From behind and above the mirror sphere: it hides the end of the camera ray and the start
+    // of its shadow rays.
+    let dir = dir_with(&[SCENE]);
+    let size = 200u32;
+    let eye = DVec3::new(0.4, 0.9, -1.9);
+    let out = run(
+        dir.path(),
+        &[
+            "--png",
+            "v.png",
+            "--json",
+            "t.json",
+            "--view-size",
+            "200",
+            "200",
+            "--view-from",
+            "0.4",
+            "0.9",
+            "-1.9",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let tree: RayTree =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("t.json")).unwrap()).unwrap();
+    let img = image::open(dir.path().join("v.png")).unwrap().to_rgb8();
+    let camera = TestCamera::looking_from(eye, size);
+    let colour_of = |s: &raywave::trace::Segment| raywave::trace::palette::Style::of(s).colour();
+    let (mut hidden_points, mut hidden_solid) = (0, 0);
+    let (mut seen_points, mut seen_solid) = (0, 0);
+    for s in &tree.segments {
+        let dashed = s.shadow.as_ref().and_then(|i| i.blocked) == Some(true);
+        for i in 5..=95 {
+            let p = d(s.origin).lerp(d(s.end), i as f64 / 100.0);
+            let Some((x, y)) = camera.project(p) else {
+                continue;
+            };
+            if !(x >= 1.0 && y >= 1.0 && x < size as f64 - 1.0 && y < size as f64 - 1.0) {
+                continue;
+            }
+            let (is_hidden, margin) = hidden(eye, p);
+            if margin < 0.02 {
+                continue;
+            }
+            // Within a pixel: is the segment's full colour there?
+            let solid = (-1i64..=1).any(|dy| {
+                (-1i64..=1).any(|dx| {
+                    let (px, py) = (
+                        (x.floor() as i64 + dx) as u32,
+                        (y.floor() as i64 + dy) as u32,
+                    );
+                    img.get_pixel(px, py).0 == colour_of(s)
+                })
+            });
+            if is_hidden {
+                // Another ray of the same colour may pass in front nearby: count, then bound.
+                hidden_points += 1;
+                hidden_solid += usize::from(solid);
+            } else if !dashed {
+                seen_points += 1;
+                seen_solid += usize::from(solid);
+            }
+        }
+    }
+    assert!(
+        hidden_points > 50,
+        "only {hidden_points} hidden sample points: the view tests nothing"
+    );
+    assert!(seen_points > 50, "only {seen_points} visible sample points");
+    assert!(
+        (hidden_solid as f64) < 0.1 * hidden_points as f64,
+        "{hidden_solid} of {hidden_points} hidden points drawn in full colour"
+    );
+    assert!(
+        (seen_solid as f64) > 0.9 * seen_points as f64,
+        "{seen_solid} of {seen_points} visible points drawn in full colour"
+    );
 }

@@ -12,7 +12,7 @@ use raywave::error::UsageError;
 use raywave::film::ldr_format;
 use raywave::output::{OutputPlan, write_output};
 use raywave::scene::load_scene;
-use raywave::terminal::print;
+use raywave::terminal::{print, progress_bar};
 use raywave::trace::draw::{Overlay, depth_buffer};
 use raywave::trace::view::ViewPlacement;
 use raywave::trace::{check_pixel, mesh, obj, ply, scene_bounds, summary, trace_pixel};
@@ -67,7 +67,7 @@ pub struct TracePixelArgs {
     pub view_distance: f32,
     /// Size of the debug camera's image [default: the render's size].
     #[arg(long, num_args = 2, value_names = ["W", "H"],
-          value_parser = clap::value_parser!(u32).range(1..=8192))]
+          value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub view_size: Option<Vec<u32>>,
     /// Draw only the scene and the render camera's marker in the PNG, not the rays.
     #[arg(long)]
@@ -116,8 +116,8 @@ pub fn run(args: &TracePixelArgs) -> Result<()> {
         .settings;
     settings.seed = args.seed;
     settings.two_sided = args.two_sided;
-    let mut tree = trace_pixel(&scene, &settings, args.x, args.y)
-        .map_err(|e| UsageError(format!("X Y: {e}")))?;
+    let mut tree =
+        trace_pixel(&scene, &settings, args.x, args.y).map_err(|e| UsageError(e.to_string()))?;
     let placement = ViewPlacement {
         from: args
             .view_from
@@ -178,16 +178,23 @@ pub fn run(args: &TracePixelArgs) -> Result<()> {
             ..settings.clone()
         };
         let pool = thread_pool(args.threads)?;
+        let engine = Engine::Wavefront.prepare(
+            &view_scene,
+            &view_settings,
+            raywave::wavefront::DEFAULT_BATCH_SIZE,
+        );
+        let (units, unit) = engine.work_units(&view_settings);
+        let progress = progress_bar(
+            units,
+            &format!("{{spinner}} rendering the debug view [{{bar:40}}] {{pos}}/{{len}} {unit}"),
+            false,
+        );
         let (film, depth) = pool.install(|| {
-            let (film, _) = Engine::Wavefront.render(
-                &view_scene,
-                &view_settings,
-                raywave::wavefront::DEFAULT_BATCH_SIZE,
-                &|| {},
-            );
+            let (film, _) = engine.render(&|| progress.inc(1));
             let rays = CameraRays::new(&camera, width, height);
             (film, depth_buffer(&view_scene, &rays, settings.two_sided))
         });
+        progress.finish_and_clear();
         let mut img = film.to_rgb8(args.tonemap.into());
         let (lo, hi) = scene_bounds(&scene);
         Overlay {
