@@ -10,11 +10,13 @@
 //! render.rs    raywave render: summary, --stats, --stats-json, --debug-pixel
 //! bench.rs     raywave bench -> raywave::bench::BenchOptions
 //! variance.rs  raywave variance -> raywave::variance::command::VarianceOptions
+//! diff.rs      raywave diff -> raywave::image_diff
 //! meshgen.rs, info.rs
 //! ```
 
 pub mod bench;
 pub mod combos;
+pub mod diff;
 pub mod foreign;
 pub mod image;
 pub mod info;
@@ -51,4 +53,8 @@ pub enum Command {
     /// Time both engines on a scene (rays/s per kind and stage); save and compare records
     /// (exit 3 when a figure regresses past --threshold).
     Bench(bench::BenchArgs),
+    /// Compare two images (PNG, PPM, PFM, EXR): MSE, relative MSE, largest difference, PSNR
+    /// and FLIP, per channel, over the image or a mask; a false-colour map of the error
+    /// (exit 3 past --fail-above).
+    Diff(diff::DiffArgs),
 }
