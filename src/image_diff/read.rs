@@ -50,9 +50,14 @@ pub fn read_image(path: &Path) -> Result<Image> {
             path.display()
         ),
     };
+    let name = match format {
+        ImageFormat::Png => "PNG",
+        ImageFormat::Pnm => "PPM",
+        _ => "EXR",
+    };
     let decoded = reader
         .decode()
-        .with_context(|| format!("{}: not a readable {format:?} image", path.display()))?;
+        .with_context(|| format!("{}: not a readable {name} image", path.display()))?;
     let encoding = match decoded.color() {
         ColorType::L8 | ColorType::La8 | ColorType::Rgb8 | ColorType::Rgba8 => Encoding::Bits8,
         ColorType::L16 | ColorType::La16 | ColorType::Rgb16 | ColorType::Rgba16 => Encoding::Bits16,
@@ -73,11 +78,7 @@ pub fn read_image(path: &Path) -> Result<Image> {
         height,
         pixels,
         encoding,
-        format: match format {
-            ImageFormat::Png => "PNG",
-            ImageFormat::Pnm => "PPM",
-            _ => "EXR",
-        },
+        format: name,
     })
 }
 
