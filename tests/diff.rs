@@ -131,7 +131,11 @@ fn the_table_says_the_figures_are_exact_and_how_psnr_is_taken() {
     assert!(!text.contains("HDR"), "{text}");
     write_pfm(&dir.path().join("hdr.pfm"), 2, &[[4.0; 3]; 4]);
     let out = raywave(dir.path(), &["diff", "a.pfm", "hdr.pfm"]);
-    assert!(stdout(&out).contains("B reaches 4.0000 > 1 (HDR)"));
+    assert!(
+        stdout(&out).contains("B reaches 4.0000 > 1 (HDR)"),
+        "{}",
+        stdout(&out)
+    );
 }
 
 #[test]

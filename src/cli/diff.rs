@@ -204,15 +204,20 @@ pub fn run(args: &DiffArgs) -> Result<u8> {
             _ => image_diff::pixel_errors(&a, &b, &region, metric),
         };
         let within = match (args.penumbra(), args.mask_file()) {
-            (true, _) => " in the penumbra".to_string(),
-            (_, Some(mask)) => format!(" in {}", file_name(mask)),
+            (true, _) => " in the penumbra (outside: black)".to_string(),
+            (_, Some(mask)) => format!(" in {} (outside: black)", file_name(mask)),
             _ => String::new(),
         };
         let title = format!(
             "{} vs {}: {}{within}",
             file_name(&args.a),
             file_name(&args.b),
-            metric.name(),
+            match metric {
+                Metric::Mse | Metric::Psnr => "squared error",
+                Metric::Relmse => "relative squared error",
+                Metric::Max => "largest |a − b|",
+                Metric::Flip => "FLIP error",
+            },
         );
         let fig = image_diff::figure(&errors, a.width, a.height, metric, &title)?;
         raywave::film::write_rgb8(&fig, out)?;
@@ -241,8 +246,12 @@ pub fn run(args: &DiffArgs) -> Result<u8> {
             (false, Metric::Psnr) => ("pass", "not below"),
             (false, _) => ("pass", "not above"),
         };
+        let shown = match metric {
+            Metric::Psnr => format!("{v:.2} dB"),
+            _ => format!("{v:.4e}"),
+        };
         text.push_str(&format!(
-            "{verdict:<8} {} {v:.6e} is {relation} --fail-above {threshold}\n",
+            "{verdict:<8} {} {shown} is {relation} --fail-above {threshold}\n",
             metric.name()
         ));
     }

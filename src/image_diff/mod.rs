@@ -146,10 +146,11 @@ impl Metric {
     /// True when `value` is worse than `threshold`: above it, or for PSNR below it. A NaN
     /// value fails.
     pub fn fails(self, value: f64, threshold: f64) -> bool {
-        match self {
-            Metric::Psnr => !(value >= threshold),
-            _ => !(value <= threshold),
-        }
+        value.is_nan()
+            || match self {
+                Metric::Psnr => value < threshold,
+                _ => value > threshold,
+            }
     }
 }
 

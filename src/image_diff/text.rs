@@ -74,17 +74,16 @@ pub fn table(c: &Comparison) -> String {
         "exact    computed over all {} pixels compared, not estimated: no sampling error",
         c.pixels_compared
     );
-    let _ = write!(
+    let _ = writeln!(
         out,
         "defined  relMSE = mean (a−b)²/(b+0.01)² (pbrt-v4's MRSE, B the reference); PSNR = 10·log10({PSNR_PEAK}²/MSE)"
     );
     if c.b_max > PSNR_PEAK {
-        let _ = write!(
+        let _ = writeln!(
             out,
-            "; B reaches {:.4} > {PSNR_PEAK} (HDR), so the peak of PSNR does not bound it: prefer MSE and relMSE",
+            "note     B reaches {:.4} > {PSNR_PEAK} (HDR): PSNR's peak of {PSNR_PEAK} does not bound it; prefer MSE and relMSE",
             c.b_max
         );
     }
-    out.push('\n');
     out
 }
