@@ -28,7 +28,7 @@ fn write_png(path: &Path, width: u32, pixels: &[[u8; 3]]) {
     let raw: Vec<u8> = pixels.iter().flatten().copied().collect();
     image::RgbImage::from_raw(width, height, raw)
         .unwrap()
-        .save(path)
+        .save_with_format(path, image::ImageFormat::Png)
         .unwrap();
 }
 
@@ -314,6 +314,36 @@ fn a_mask_file_restricts_every_figure() {
     assert_eq!(out.status.code(), Some(2));
     assert!(
         stderr(&out).contains("--mask big.png is 3×1"),
+        "{}",
+        stderr(&out)
+    );
+}
+
+#[test]
+fn a_mask_file_named_penumbra_is_read_through_its_path() {
+    let dir = pair();
+    let d = dir.path();
+    write_png(
+        &d.join("penumbra"),
+        2,
+        &[[0, 0, 0], [9, 9, 9], [0, 0, 0], [0, 0, 0]],
+    );
+    let j = diff_json(d, &["a.pfm", "b.pfm", "--mask", "./penumbra"], 0);
+    assert_eq!(j["region_pixels"], 1);
+    close(&j["channels"][1]["mse"], 0.0625);
+    // Scene flags without --mask penumbra: a warning naming them; a figure not .png or .ppm:
+    // a usage error naming --out.
+    let out = raywave(d, &["diff", "a.pfm", "b.pfm", "--bounces", "2"]);
+    assert_eq!(out.status.code(), Some(0));
+    assert!(
+        stderr(&out).contains("warning: --bounces has no effect without --mask penumbra"),
+        "{}",
+        stderr(&out)
+    );
+    let out = raywave(d, &["diff", "a.pfm", "b.pfm", "--out", "d.jpg"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        stderr(&out).contains("--out d.jpg: expected"),
         "{}",
         stderr(&out)
     );

@@ -105,7 +105,7 @@ const PENUMBRA: &str = "penumbra";
 
 impl DiffArgs {
     fn penumbra(&self) -> bool {
-        self.mask.as_deref() == Some(Path::new(PENUMBRA))
+        self.mask.as_deref().map(Path::as_os_str) == Some(std::ffi::OsStr::new(PENUMBRA))
     }
 
     fn mask_file(&self) -> Option<&Path> {
@@ -136,17 +136,35 @@ pub fn run(args: &DiffArgs) -> Result<u8> {
         )
         .into());
     }
-    if let Some(out) = &args.out {
-        ldr_format(out).map_err(|e| UsageError::from_error(&e))?;
+    if let Some(out) = &args.out
+        && ldr_format(out).is_err()
+    {
+        return Err(UsageError(format!(
+            "--out {}: expected a figure file ending in .png or .ppm",
+            out.display()
+        ))
+        .into());
     }
-    let scene_flags = args.scene.is_some()
-        || args.bounces.is_some()
-        || args.defaults.is_some()
-        || args.ring_segments.is_some()
-        || args.two_sided;
-    if scene_flags && !args.penumbra() {
+    let scene_flags: Vec<&str> = [
+        ("--scene", args.scene.is_some()),
+        ("--bounces", args.bounces.is_some()),
+        ("--defaults", args.defaults.is_some()),
+        ("--ring-segments", args.ring_segments.is_some()),
+        ("--two-sided", args.two_sided),
+    ]
+    .iter()
+    .filter(|(_, given)| *given)
+    .map(|(flag, _)| *flag)
+    .collect();
+    if !scene_flags.is_empty() && !args.penumbra() {
         eprintln!(
-            "warning: --scene, --bounces, --defaults, --ring-segments and --two-sided have no effect without --mask penumbra"
+            "warning: {} {} no effect without --mask penumbra",
+            scene_flags.join(", "),
+            if scene_flags.len() == 1 {
+                "has"
+            } else {
+                "have"
+            }
         );
     }
     let mut plan = OutputPlan::new().input("A", &args.a).input("B", &args.b);
