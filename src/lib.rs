@@ -60,6 +60,7 @@ pub mod error;
 pub mod false_colour;
 pub mod film;
 pub mod geometry;
+pub mod image_diff;
 pub mod machine;
 pub mod meshgen;
 pub mod options;

@@ -1,5 +1,6 @@
 //! The `raywave` command. `main` owns the exit code: 0 on success, 2 for a usage error (clap),
-//! 3 when `raywave bench --compare` finds a regression, 1 for anything else, printed once with
+//! 3 when `raywave bench --compare` finds a regression or `raywave diff --fail-above` a figure
+//! past its threshold, 1 for anything else, printed once with
 //! its cause chain; 130 after SIGINT and 143 after SIGTERM (`output::write`). The command line itself is in `cli/`, one file per command.
 
 mod cli;
@@ -48,6 +49,11 @@ fn main() -> ExitCode {
         Command::TracePixel(args) => cli::trace_pixel::run(&args),
         // Exit 3 when --compare finds a regression (raywave::bench::EXIT_REGRESSION).
         Command::Bench(args) => match cli::bench::run(&args) {
+            Ok(code) => return ExitCode::from(code),
+            Err(e) => Err(e),
+        },
+        // Exit 3 when the figure is past --fail-above (raywave::image_diff::EXIT_FAILED).
+        Command::Diff(args) => match cli::diff::run(&args) {
             Ok(code) => return ExitCode::from(code),
             Err(e) => Err(e),
         },

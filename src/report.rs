@@ -127,6 +127,22 @@ impl RenderRecord {
             Ok(writeln!(w)?)
         })
     }
+
+    /// [`RenderRecord::write`] with one more top-level entry, `key` (e.g. `mse_reference`,
+    /// the render's error against `render --mse-reference`).
+    pub fn write_with(
+        &self,
+        path: &Path,
+        key: &str,
+        value: serde_json::Value,
+    ) -> anyhow::Result<()> {
+        let mut json = serde_json::to_value(self)?;
+        json[key] = value;
+        crate::film::write_atomically(path, |w| {
+            serde_json::to_writer_pretty(&mut *w, &json)?;
+            Ok(writeln!(w)?)
+        })
+    }
 }
 
 #[cfg(test)]

@@ -11,11 +11,13 @@
 //! bench.rs     raywave bench -> raywave::bench::BenchOptions
 //! variance.rs  raywave variance -> raywave::variance::command::VarianceOptions
 //! trace_pixel.rs  raywave trace-pixel: one pixel's ray tree (JSON, OBJ, PLY, PNG)
+//! diff.rs      raywave diff -> raywave::image_diff
 //! meshgen.rs, info.rs
 //! ```
 
 pub mod bench;
 pub mod combos;
+pub mod diff;
 pub mod foreign;
 pub mod image;
 pub mod info;
@@ -56,4 +58,8 @@ pub enum Command {
     /// Trace one pixel as its render does and show its ray tree: a summary, or JSON, OBJ/PLY
     /// and a PNG from a debug camera (checked against both engines' render of that pixel).
     TracePixel(trace_pixel::TracePixelArgs),
+    /// Compare two images (PNG, PPM, PFM, EXR): MSE, relative MSE, largest difference, PSNR
+    /// and FLIP, per channel, over the image or a mask; a false-colour map of the error
+    /// (exit 3 past --fail-above).
+    Diff(diff::DiffArgs),
 }

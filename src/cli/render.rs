@@ -5,12 +5,15 @@ use super::image::ImageArgs;
 use super::values::{EngineArg, ToneMapArg};
 use anyhow::Result;
 use clap::Args;
+use image::RgbImage;
 use raywave::bench::record::StageFigure;
 use raywave::camera::CameraRays;
 use raywave::debug_view::RayRecorder;
 use raywave::engine::{Engine, thread_pool};
 use raywave::error::UsageError;
+use raywave::film::{Film, ToneMap};
 use raywave::film::{OutputFormat, check_hdr_path, output_format};
+use raywave::image_diff::{self, Encoding, FileInfo, Image, Region, read_image};
 use raywave::machine::Machine;
 use raywave::options::{BackgroundSource, Effective};
 use raywave::output::OutputPlan;
@@ -22,7 +25,7 @@ use raywave::stats::RayCounts;
 use raywave::terminal::{print, progress_bar};
 use raywave::wavefront::stats::RenderStats;
 use std::fmt::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// `raywave render` flags.
@@ -80,6 +83,11 @@ pub struct RenderArgs {
     /// renders are also refused when they exceed the memory available.
     #[arg(long, value_name = "SIZE", value_parser = raywave::output::memory::parse_size)]
     pub max_memory: Option<u64>,
+    /// After rendering, print the image's error against this reference (PNG, PPM, PFM or
+    /// EXR; the figures of `raywave diff`): a float reference is compared with the linear
+    /// image, an 8-bit one with the 8-bit image written.
+    #[arg(long, value_name = "REF")]
+    pub mse_reference: Option<PathBuf>,
 }
 
 impl RenderArgs {
@@ -135,6 +143,25 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         ))
         .into());
     }
+    // The reference is read and its size checked before the long part.
+    let reference = match &args.mse_reference {
+        Some(path) => {
+            let image = read_image(path)?;
+            if (image.width, image.height) != (settings.width, settings.height) {
+                return Err(UsageError(format!(
+                    "--mse-reference {} is {}×{} but the render is {}×{}: expected a reference of the render's size",
+                    path.display(),
+                    image.width,
+                    image.height,
+                    settings.width,
+                    settings.height
+                ))
+                .into());
+            }
+            Some((path, image))
+        }
+        None => None,
+    };
     let pool = thread_pool(args.threads)?;
     let threads = pool.current_num_threads();
     let engine_choice = Engine::from(args.engine);
@@ -218,8 +245,22 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         threads,
         batch_size: args.batch_size,
     };
+    let reference_error = match &reference {
+        Some((path, image)) => Some(reference_error(
+            path,
+            image,
+            &film,
+            img.as_ref(),
+            args.tonemap.into(),
+        )?),
+        None => None,
+    };
     if let Some(path) = &args.stats_json {
-        record(&scene, &effective, &run, &report).write(path)?;
+        let record = record(&scene, &effective, &run, &report);
+        match &reference_error {
+            Some((_, json)) => record.write_with(path, "mse_reference", json.clone())?,
+            None => record.write(path)?,
+        }
     }
     if !args.quiet {
         let extra = args
@@ -236,7 +277,43 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if args.stats {
         say(&stats_table(&report))?;
     }
+    if let Some((text, _)) = &reference_error {
+        say(text)?;
+    }
     Ok(())
+}
+
+/// The render's error against `--mse-reference`, as text and as JSON: the linear image against
+/// a float reference, the 8-bit image written (`rgb8`, else the film tone mapped) against an
+/// 8- or 16-bit one, so that `raywave diff` on the files gives the same figures.
+fn reference_error(
+    path: &Path,
+    reference: &Image,
+    film: &Film,
+    rgb8: Option<&RgbImage>,
+    tone: ToneMap,
+) -> Result<(String, serde_json::Value)> {
+    let (render, compared_as) = if reference.encoding == Encoding::Float {
+        (Image::from_film(film, "render"), "linear floats")
+    } else {
+        let image = match rgb8 {
+            Some(img) => Image::from_rgb8(img, "render"),
+            None => Image::from_rgb8(&film.to_rgb8(tone), "render"),
+        };
+        (image, "the 8-bit image")
+    };
+    let region = Region::whole(render.width, render.height);
+    let comparison = image_diff::compare(&render, reference, &region)?;
+    let info = FileInfo::of(path, reference);
+    let text = format!(
+        "error of the render ({compared_as}) against --mse-reference {}\n{}",
+        info.describe(),
+        image_diff::text::table(&comparison)
+    );
+    let mut json = serde_json::to_value(&comparison)?;
+    json["reference"] = serde_json::to_value(&info)?;
+    json["compared_as"] = compared_as.into();
+    Ok((text, json))
 }
 
 /// The scene (an input) and every output of a render, for the checks before any work.
@@ -254,6 +331,9 @@ fn output_plan(args: &RenderArgs) -> OutputPlan {
     }
     if let Some(json) = &args.stats_json {
         plan = plan.output("--stats-json", json);
+    }
+    if let Some(reference) = &args.mse_reference {
+        plan = plan.input("--mse-reference", reference);
     }
     plan
 }
