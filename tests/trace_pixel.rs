@@ -547,7 +547,9 @@ fn png_differs_from_the_plain_view_exactly_along_the_rays() {
     let plain = image::open(dir.path().join("plain.png")).unwrap().to_rgb8();
     assert_eq!(rays.dimensions(), (size, size));
     let camera = TestCamera::default_view(size);
-    let projected: Vec<((f64, f64), (f64, f64), bool)> = tree
+    // (start, end, dashed) in pixel coordinates.
+    type Projected = ((f64, f64), (f64, f64), bool);
+    let projected: Vec<Projected> = tree
         .segments
         .iter()
         .filter_map(|s| {
