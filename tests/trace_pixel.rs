@@ -664,6 +664,23 @@ fn bad_input_is_a_usage_error_and_writes_nothing() {
             "same file",
         ),
         (&["trace-pixel", "1", "1", SCENE, "--frobnicate"], ""),
+        (
+            &[
+                "trace-pixel",
+                "1",
+                "1",
+                SCENE,
+                "--view-from",
+                "1",
+                "2",
+                "3",
+                "--view-from",
+                "4",
+                "5",
+                "6",
+            ],
+            "cannot be used multiple times",
+        ),
         // 4096 camera rays × 3 path segments × (1 + 65536 points): refused before tracing.
         (
             &[
@@ -706,6 +723,27 @@ fn bad_input_is_a_usage_error_and_writes_nothing() {
         assert!(!stderr(&out).contains("panicked"), "{args:?}");
         assert_eq!(files_in(dir.path()), vec![SCENE.to_string()], "{args:?}");
     }
+    // Debug-camera flags without --png: the run goes ahead, with a warning.
+    let out = raywave(
+        dir.path(),
+        &[
+            "trace-pixel",
+            "1",
+            "1",
+            SCENE,
+            "--size",
+            "8",
+            "8",
+            "--orbit",
+            "10",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("--orbit has no effect without --png"),
+        "{}",
+        stderr(&out)
+    );
     // A scene that does not parse: exit 1, naming the file.
     let out = raywave(dir.path(), &["trace-pixel", "0", "0", "missing.obj"]);
     assert_eq!(out.status.code(), Some(1));

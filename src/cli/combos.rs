@@ -36,6 +36,10 @@ pub fn meaningless(command: &Command, typed: &dyn Fn(&str) -> String) -> Vec<Str
             }
         }
         Command::Bench(args) => image(&args.image, typed, &mut out),
+        Command::TracePixel(args) => {
+            image(&args.image, typed, &mut out);
+            out.extend(super::trace_pixel::meaningless(args));
+        }
         _ => {}
     }
     out
