@@ -99,6 +99,13 @@ fn the_chosen_pixel_has_the_segments_the_settings_give() {
     assert_eq!(count(SegmentKind::Camera), 1);
     assert_eq!(count(SegmentKind::Reflection), 1);
     assert_eq!(count(SegmentKind::Shadow), 2 * 16);
+    let rays = raywave::trace::check_pixel(&scene, &settings, &tree).rays;
+    let expected = raywave::trace::KindCounts {
+        camera: 1,
+        reflection: 1,
+        shadow: 32,
+    };
+    assert_eq!((rays.reference, rays.wavefront), (expected, expected));
 
     let camera = &tree.segments[0];
     assert_eq!(camera.kind, SegmentKind::Camera);
@@ -240,6 +247,11 @@ fn contributions_sum_to_the_pixel_both_engines_render() {
         for pixel in rendered(&scene, settings, PIXEL.0, PIXEL.1) {
             assert_sums_to(&tree, pixel);
         }
+        // Each engine counts, for this pixel, the rays the tree holds.
+        let check = raywave::trace::check_pixel(&scene, settings, &tree);
+        assert_eq!(check.rays.reference, check.rays.tree, "{settings:?}");
+        assert_eq!(check.rays.wavefront, check.rays.tree, "{settings:?}");
+        assert!(check.agrees, "{check:?}");
         if settings.shadows == ShadowMode::Off {
             assert!(
                 tree.segments
