@@ -505,3 +505,29 @@ fn the_documented_commands_run() {
         }
     }
 }
+
+#[test]
+fn a_ray_that_misses_ends_a_scene_diagonal_out_and_adds_the_background() {
+    // Pixel (29, 32): the mirror sends the camera ray out of the open box.
+    let tree = trace_pixel(&scene(), &settings(), 29, 32).unwrap();
+    let reflection = tree
+        .segments
+        .iter()
+        .find(|s| s.kind == SegmentKind::Reflection)
+        .expect("the camera ray hits the mirror");
+    assert!(reflection.hit.is_none(), "{reflection:?}");
+    // The file's bounding box: x -2..3, y -1..3, z -2..3.
+    let diagonal = (5.0f64 * 5.0 + 4.0 * 4.0 + 5.0 * 5.0).sqrt();
+    let drawn = (d(reflection.end) - d(reflection.origin)).length();
+    assert!((drawn - diagonal).abs() < 1e-4, "{drawn} vs {diagonal}");
+    // White background times the mirror's kr, one aa sample.
+    for c in 0..3 {
+        assert!((f64::from(reflection.contribution[c]) - 0.85).abs() < 1e-6);
+        assert!((f64::from(reflection.throughput[c]) - 0.85).abs() < 1e-6);
+    }
+    assert!(
+        tree.segments
+            .iter()
+            .all(|s| s.parent != Some(reflection.id))
+    );
+}
