@@ -54,7 +54,8 @@ pub struct TracePixelArgs {
     pub png: Option<PathBuf>,
     /// Place the debug camera's eye here (before --orbit), looking at the render camera's
     /// point of interest [default: the render camera's eye].
-    #[arg(long, num_args = 3, value_names = ["X", "Y", "Z"], allow_negative_numbers = true,
+    #[arg(long, num_args = 3, action = clap::ArgAction::Set, value_names = ["X", "Y", "Z"],
+          allow_negative_numbers = true,
           value_parser = parse_finite)]
     pub view_from: Option<Vec<f32>>,
     /// Turn the debug camera this many degrees about the scene's up axis, around the point of
@@ -66,7 +67,7 @@ pub struct TracePixelArgs {
     #[arg(long, value_name = "F", default_value_t = 1.0, value_parser = parse_positive)]
     pub view_distance: f32,
     /// Size of the debug camera's image [default: the render's size].
-    #[arg(long, num_args = 2, value_names = ["W", "H"],
+    #[arg(long, num_args = 2, action = clap::ArgAction::Set, value_names = ["W", "H"],
           value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub view_size: Option<Vec<u32>>,
     /// Draw only the scene and the render camera's marker in the PNG, not the rays.
@@ -243,6 +244,29 @@ pub fn run(args: &TracePixelArgs) -> Result<()> {
         ))?;
     }
     Ok(())
+}
+
+/// The debug camera's flags without `--png`: they shape only that image.
+pub fn meaningless(args: &TracePixelArgs) -> Vec<String> {
+    if args.png.is_some() {
+        return Vec::new();
+    }
+    let given = [
+        ("--view-from", args.view_from.is_some()),
+        ("--orbit", args.orbit.is_some()),
+        ("--view-distance", args.view_distance != 1.0),
+        ("--view-size", args.view_size.is_some()),
+        ("--no-rays", args.no_rays),
+        ("--tonemap", args.tonemap != ToneMapArg::Clamp),
+        ("--threads", args.threads.is_some()),
+    ];
+    given
+        .iter()
+        .filter(|(_, set)| *set)
+        .map(|(flag, _)| {
+            format!("{flag} has no effect without --png (it shapes the debug camera's image only)")
+        })
+        .collect()
 }
 
 /// The scene (an input) and the outputs, checked before any work.

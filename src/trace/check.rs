@@ -5,7 +5,7 @@
 //! `render_tile` on a tile of that one pixel (a pixel's value does not depend on the tile it is
 //! in: every lane is bit-equal to the scalar twins and each pixel is summed in sample order).
 
-use super::tree::{PixelCheck, RayTree};
+use super::tree::{KindCounts, PixelCheck, RayCountCheck, RayTree, SegmentKind};
 use crate::reference::Reference;
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
@@ -36,30 +36,68 @@ pub fn render_pixel(
     settings: &RenderSettings,
     index: u32,
 ) -> Vec3 {
+    render_pixel_counted(engine, scene, settings, index).0
+}
+
+/// Pixel `index` as `engine` renders it, and the rays the engine counts for it.
+pub fn render_pixel_counted(
+    engine: PixelEngine,
+    scene: &Scene,
+    settings: &RenderSettings,
+    index: u32,
+) -> (Vec3, RayCounts) {
     match engine {
         PixelEngine::Reference => {
-            Reference::new(scene, settings).pixel(index, &mut RayCounts::default(), &mut ())
+            let mut counts = RayCounts::default();
+            let colour = Reference::new(scene, settings).pixel(index, &mut counts, &mut ());
+            (colour, counts)
         }
         PixelEngine::Wavefront => {
             let batch = settings.aa_samples.max(1) as usize;
             let wavefront = Wavefront::new(scene, settings, batch);
             let mut out = [Vec3::ZERO];
-            wavefront.render_tile(
-                index,
-                &mut out,
-                &mut Workspace::default(),
-                &mut RenderStats::default(),
-            );
-            out[0]
+            let mut stats = RenderStats::default();
+            wavefront.render_tile(index, &mut out, &mut Workspace::default(), &mut stats);
+            (out[0], stats.counts)
         }
+    }
+}
+
+fn kinds(counts: &RayCounts) -> KindCounts {
+    KindCounts {
+        camera: counts.camera,
+        reflection: counts.reflection,
+        shadow: counts.shadow,
+    }
+}
+
+/// The tree's rays by kind, shadow rays counted where the occlusion test ran (as the engines
+/// count them).
+pub fn tree_counts(tree: &RayTree) -> KindCounts {
+    let of = |k: SegmentKind| tree.segments.iter().filter(|s| s.kind == k).count() as u64;
+    KindCounts {
+        camera: of(SegmentKind::Camera),
+        reflection: of(SegmentKind::Reflection),
+        shadow: tree
+            .segments
+            .iter()
+            .filter(|s| s.shadow.as_ref().is_some_and(|i| i.blocked.is_some()))
+            .count() as u64,
     }
 }
 
 /// Renders the tree's pixel with both engines and compares it with the tree's sum.
 pub fn check_pixel(scene: &Scene, settings: &RenderSettings, tree: &RayTree) -> PixelCheck {
     let index = tree.pixel.index;
-    let reference = render_pixel(PixelEngine::Reference, scene, settings, index);
-    let wavefront = render_pixel(PixelEngine::Wavefront, scene, settings, index);
+    let (reference, reference_rays) =
+        render_pixel_counted(PixelEngine::Reference, scene, settings, index);
+    let (wavefront, wavefront_rays) =
+        render_pixel_counted(PixelEngine::Wavefront, scene, settings, index);
+    let rays = RayCountCheck {
+        tree: tree_counts(tree),
+        reference: kinds(&reference_rays),
+        wavefront: kinds(&wavefront_rays),
+    };
     let difference = |p: Vec3| {
         (0..3)
             .map(|c| (tree.sum[c] - f64::from(p[c])).abs())
@@ -75,6 +113,10 @@ pub fn check_pixel(scene: &Scene, settings: &RenderSettings, tree: &RayTree) -> 
         reference_difference: rd,
         wavefront_difference: wd,
         tolerance,
-        agrees: rd <= tolerance && wd <= tolerance,
+        agrees: rd <= tolerance
+            && wd <= tolerance
+            && rays.tree == rays.reference
+            && rays.tree == rays.wavefront,
+        rays,
     }
 }

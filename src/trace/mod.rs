@@ -25,13 +25,14 @@ pub mod tracer;
 pub mod tree;
 pub mod view;
 
-pub use check::{PixelEngine, check_pixel, render_pixel};
+pub use check::{PixelEngine, check_pixel, render_pixel, render_pixel_counted, tree_counts};
 pub use scene_view::{
     LightView, MaterialView, SceneGeometry, SphereView, TriangleView, scene_bounds, scene_geometry,
 };
 pub use summary::summary;
 pub use tracer::{TraceError, primitive_ref, trace_pixel, trace_settings};
 pub use tree::{
-    BlockerInfo, CameraInfo, PixelCheck, PixelRef, PrimitiveRef, PrimitiveShape, RayTree,
-    SCHEMA_ID, Segment, SegmentKind, ShadowInfo, SurfaceInfo, TraceSettings,
+    BlockerInfo, CameraInfo, KindCounts, PixelCheck, PixelRef, PrimitiveRef, PrimitiveShape,
+    RayCountCheck, RayTree, SCHEMA_ID, Segment, SegmentKind, ShadowInfo, SurfaceInfo,
+    TraceSettings,
 };

@@ -137,10 +137,30 @@ pub fn summary(tree: &RayTree) -> String {
             rgb(c.wavefront),
             c.wavefront_difference,
             c.tolerance,
-            if c.agrees {
+            if c.reference_difference <= c.tolerance && c.wavefront_difference <= c.tolerance {
                 "the tree adds up to the rendered pixel"
             } else {
                 "MISMATCH: the tree does not add up to the rendered pixel"
+            }
+        );
+        let k = |n: &super::tree::KindCounts| {
+            format!(
+                "{} camera, {} reflection, {} shadow",
+                n.camera, n.reflection, n.shadow
+            )
+        };
+        let r = &c.rays;
+        let same = r.tree == r.reference && r.tree == r.wavefront;
+        let _ = writeln!(
+            s,
+            "rays    tree {}; reference {}; wavefront {}: {}",
+            k(&r.tree),
+            k(&r.reference),
+            k(&r.wavefront),
+            if same {
+                "the same rays"
+            } else {
+                "MISMATCH: the engines count other rays"
             }
         );
     }

@@ -240,6 +240,33 @@ pub struct PixelCheck {
     /// The largest difference accepted: rounding of the f32 sums the engines do in another
     /// order: 1e-5 × max(1, the pixel's largest channel).
     pub tolerance: f64,
-    /// Both differences within the tolerance.
+    /// Both differences within the tolerance, and the tree's rays counted as each engine
+    /// counts the rays it traces for the pixel.
     pub agrees: bool,
+    /// Rays by kind: the tree's (shadow rays: those tested for occlusion) and each engine's
+    /// own count for the pixel.
+    #[serde(default)]
+    pub rays: RayCountCheck,
+}
+
+/// Rays by kind, as the tree holds them and as each engine counts them for the pixel.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+pub struct RayCountCheck {
+    /// The tree's segments (shadow segments only where the occlusion test ran).
+    pub tree: KindCounts,
+    /// The reference's counters for the pixel.
+    pub reference: KindCounts,
+    /// The wavefront engine's counters for the pixel.
+    pub wavefront: KindCounts,
+}
+
+/// Rays of each kind.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+pub struct KindCounts {
+    /// Camera rays.
+    pub camera: u64,
+    /// Reflection rays.
+    pub reflection: u64,
+    /// Shadow rays tested for occlusion.
+    pub shadow: u64,
 }
