@@ -113,8 +113,8 @@ impl Comparison {
         }
         let _ = writeln!(
             s,
-            "kinds in Mrays/s (wall clock), stages in Mrays/thread-s; * = headline figure, \
-             checked against the threshold of -{:.1}%",
+            "totals in Mrays/s (wall clock), kinds and stages in Mrays/thread-s; \
+             * = headline figure, checked against the threshold of -{:.1}%",
             self.threshold_pct
         );
         for n in &self.notes {
