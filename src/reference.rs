@@ -91,8 +91,9 @@ impl<'a> Reference<'a> {
     /// camera ray and its closest hit, reflection = the mirror ray and its closest hit,
     /// shadow = the whole light loop (spawn, occlusion, Shade). A separate copy of the loop
     /// (the clock is a type parameter), so `render` carries no timer; this one reads the clock
-    /// four times per path segment, which costs time: docs/SCHEMA.md gives the measured
-    /// overhead. Same image, same counts.
+    /// two or three times per path segment (a reading that ends one interval starts the
+    /// next), which costs time: docs/SCHEMA.md gives the measured overhead. Same image, same
+    /// counts.
     pub fn render_timed(&self, on_row: &(dyn Fn() + Sync)) -> (Film, RayCounts, KindTimes) {
         let w = self.settings.width as usize;
         let mut film = Film::new(self.settings.width, self.settings.height);
@@ -182,11 +183,12 @@ impl<'a> Reference<'a> {
             return self.settings.background();
         }
         let surface = surface_hit(self.scene, hit.prim, ray, hit.t, self.settings.two_sided);
-        clock.since(kind, start);
+        // One reading ends this ray's work and starts what follows (the few operations of
+        // the ambient term go with it).
+        let mut start = clock.since(kind, start);
         let material = self.scene.material_of(hit.prim);
         let mut color = Vec3::from_array(self.settings.ambient) * material.diffuse;
         if material.is_reflective() && key.bounce < self.settings.bounces {
-            let start = clock.mark();
             let next = mirror_ray(&surface, ray.direction);
             counts.reflection += 1;
             let bounced = SampleKey {
@@ -194,8 +196,9 @@ impl<'a> Reference<'a> {
                 ..key
             };
             color += material.reflective * self.trace(&next, bounced, counts, log, clock, start);
+            // The mirror ray's path took its own time: the light loop starts now.
+            start = clock.mark();
         }
-        let start = clock.mark();
         let direct = self.direct(&surface, -ray.direction, material, key, counts, log);
         clock.since(RayKind::Shadow, start);
         color + direct

@@ -99,8 +99,9 @@ pub trait KindClock {
     type Mark: Copy;
     /// Now.
     fn mark(&self) -> Self::Mark;
-    /// Adds the time since `since` to `kind`.
-    fn since(&mut self, kind: RayKind, since: Self::Mark);
+    /// Adds the time since `since` to `kind`, and returns now (the start of what follows:
+    /// one clock read ends one interval and begins the next).
+    fn since(&mut self, kind: RayKind, since: Self::Mark) -> Self::Mark;
 }
 
 impl KindClock for () {
@@ -118,7 +119,9 @@ impl KindClock for KindTimes {
         Instant::now()
     }
     #[inline(always)]
-    fn since(&mut self, kind: RayKind, since: Instant) {
-        self.add(kind, since.elapsed());
+    fn since(&mut self, kind: RayKind, since: Instant) -> Instant {
+        let now = Instant::now();
+        self.add(kind, now - since);
+        now
     }
 }
