@@ -47,10 +47,10 @@ pub struct RenderRecord {
     /// `instrumented pass` (the reference: a second render of the frame with timers, so the
     /// timed render had none).
     pub kinds_timed_by: &'static str,
-    /// Wall-clock seconds of the reference's instrumented pass (`None` for the wavefront
+    /// Wall-clock seconds of the reference's instrumented pass (null for the wavefront
     /// engine): beside `seconds`, the timers' cost.
     pub instrumented_seconds: Option<f64>,
-    /// Per stage (`None` for the reference, which has no stages).
+    /// Per stage (null for the reference, which has no stages).
     pub stages: Option<Vec<StageFigure>>,
 }
 
@@ -65,7 +65,7 @@ pub struct SceneFigures {
     pub spheres: usize,
     /// Lights.
     pub lights: usize,
-    /// Whether the wavefront engine built a mesh BVH (`None` for the reference).
+    /// Whether the wavefront engine built a mesh BVH (null for the reference).
     pub bvh: Option<bool>,
     /// How long that took.
     pub bvh_build_seconds: Option<f64>,
@@ -86,9 +86,9 @@ pub struct DefaultsUsed {
 pub struct KindFigure {
     /// Rays cast.
     pub rays: u64,
-    /// Thread-seconds of this kind's work, summed over worker threads (`None`: not measured).
+    /// Thread-seconds of this kind's work, summed over worker threads (null: not measured).
     pub thread_seconds: Option<f64>,
-    /// rays / thread_seconds (`None`: not measured, or no rays).
+    /// rays / thread_seconds (null: not measured, or no rays).
     pub rays_per_thread_second: Option<f64>,
 }
 

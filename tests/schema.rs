@@ -177,7 +177,8 @@ fn bench_json_and_saved_records_validate() {
 #[test]
 fn doctored_records_do_not_validate() {
     let record = stats_json("wavefront");
-    let doctored: [(&str, fn(&mut Value)); 5] = [
+    type Doctor = fn(&mut Value);
+    let doctored: [(&str, Doctor); 5] = [
         ("an older format", |r| r["format"] = json!(1)),
         ("no format", |r| {
             r.as_object_mut().unwrap().remove("format");

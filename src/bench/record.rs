@@ -3,7 +3,7 @@
 
 pub use crate::machine::Machine;
 use crate::settings::RenderSettings;
-use crate::stats::{KindTimes, RayCounts};
+use crate::stats::RayCounts;
 use crate::wavefront::stats::{RenderStats, StageRow};
 use anyhow::{Context, Result, bail};
 use schemars::JsonSchema;
@@ -98,11 +98,11 @@ pub struct Measurement {
 }
 
 /// How fast each kind of ray was handled. A kind's rate is its rays per thread-second of
-/// that kind's own work ([`KindTimes`]: for the wavefront engine from its stage timers), so
-/// it says how fast that work went whatever else the frame did; the total is all rays per
-/// wall-clock second of the frame, the headline figure. A kind is `None` when its time was
-/// not measured (the reference in `raywave bench`, which times it without timers) or it cast
-/// no rays.
+/// that kind's own work ([`crate::stats::KindTimes`]: for the wavefront engine from its stage
+/// timers), so it says how fast that work went whatever else the frame did; the total is all
+/// rays per wall-clock second of the frame, the headline figure. A kind is null (`None`) when
+/// its time was not measured (the reference in `raywave bench`, which times it without
+/// timers) or it cast no rays.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct KindRates {
     /// Camera rays per thread-second of camera work.
@@ -181,14 +181,6 @@ impl KindRates {
 pub fn per_thread_second(rays: u64, time: std::time::Duration) -> Option<f64> {
     let seconds = time.as_secs_f64();
     (rays > 0 && seconds > 0.0).then(|| rays as f64 / seconds)
-}
-
-/// Thread-seconds of each kind's work, `None` where not measured.
-pub fn kind_seconds(times: Option<&KindTimes>) -> [Option<f64>; 3] {
-    match times {
-        Some(t) => [t.camera, t.shadow, t.reflection].map(|d| Some(d.as_secs_f64())),
-        None => [None; 3],
-    }
 }
 
 /// One wavefront stage's figures.
