@@ -435,7 +435,7 @@ fn stats_table(report: &Report) -> String {
             out,
             "{kind:<12} {:>14} {:>14} {:>20}",
             figure.rays,
-            or_dash(figure.thread_seconds, 1.0, 3),
+            or_dash(figure.thread_seconds, 1.0, 4),
             or_dash(figure.rays_per_thread_second, 1e-6, 2)
         );
     }
@@ -483,7 +483,7 @@ fn stats_table(report: &Report) -> String {
         for row in stats.stage_rows() {
             let _ = writeln!(
                 out,
-                "{:<12} {:>14} {:>14.3} {:>20.2}",
+                "{:<12} {:>14} {:>14.4} {:>20.2}",
                 row.stage,
                 row.rays,
                 row.thread_seconds,
