@@ -350,7 +350,13 @@ mod tests {
         Measurement {
             seconds: 1.0 / total_scale,
             rays,
-            rays_per_second: KindRates::new(&rays, 1.0 / total_scale),
+            rays_per_second: KindRates {
+                // Each kind falls with the total: shown, never gating.
+                camera: Some(100.0 * total_scale),
+                shadow: Some(1000.0 * total_scale),
+                reflection: Some(10.0 * total_scale),
+                ..KindRates::new(&rays, 1.0 / total_scale)
+            },
             stages: ["generate", "shadow"]
                 .iter()
                 .map(|s| StageFigure {
