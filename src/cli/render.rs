@@ -9,7 +9,7 @@ use image::RgbImage;
 use raywave::bench::record::StageFigure;
 use raywave::camera::CameraRays;
 use raywave::debug_view::RayRecorder;
-use raywave::engine::{Engine, thread_pool};
+use raywave::engine::{Engine, Prepared, thread_pool};
 use raywave::error::UsageError;
 use raywave::film::{Film, ToneMap};
 use raywave::film::{OutputFormat, check_hdr_path, output_format};
@@ -198,15 +198,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         Engine::Reference => setup_start,
         Engine::Wavefront => Instant::now(),
     };
-    let (film, stats) = pool.install(|| engine.render(&|| progress.inc(1)));
+    let (film, mut stats) = pool.install(|| engine.render(&|| progress.inc(1)));
     let seconds = start.elapsed().as_secs_f64();
     progress.finish_and_clear();
-    let report = Report {
-        counts: stats.counts,
-        seconds,
-        stages: engine.bvh_build_seconds().map(|bvh| (stats, bvh)),
-    };
-
     let mut img = match format {
         OutputFormat::Ldr(_) => Some(film.to_rgb8(args.tonemap.into())),
         OutputFormat::Linear => None,
@@ -240,6 +234,33 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if let Some(hdr) = &args.hdr {
         film.write_hdr(hdr)?;
     }
+    // The reference's render carries no timer; its kinds are timed by a second pass with
+    // timers, only when the figures are asked for (its image is dropped, as are these first:
+    // the memory check counted one film).
+    drop((img, film));
+    let mut instrumented_seconds = None;
+    if let (Prepared::Reference(reference), true) =
+        (&engine, args.stats || args.stats_json.is_some())
+    {
+        let progress = progress_bar(
+            units,
+            "{spinner} timing ray kinds (a second pass, with timers) [{bar:40}] {pos}/{len} rows, {elapsed} (eta {eta})",
+            args.quiet,
+        );
+        let start = Instant::now();
+        let (_, counts, times) = pool.install(|| reference.render_timed(&|| progress.inc(1)));
+        instrumented_seconds = Some(start.elapsed().as_secs_f64());
+        progress.finish_and_clear();
+        debug_assert_eq!(counts, stats.counts);
+        stats.kind_time = Some(times);
+    }
+    let report = Report {
+        stats,
+        seconds,
+        stages: engine.bvh_build_seconds().map(|bvh| (stats, bvh)),
+        instrumented_seconds,
+    };
+
     let run = RunInfo {
         engine: engine_choice,
         threads,
@@ -417,7 +438,7 @@ fn summary(scene: &Scene, effective: &Effective, run: &RunInfo, report: &Report)
         )
     };
     let _ = writeln!(out, "default {defaulted}");
-    let counts = &report.counts;
+    let counts = &report.stats.counts;
     let _ = writeln!(
         out,
         "rays    {} total: {} camera, {} shadow, {} reflection",
@@ -444,30 +465,85 @@ struct RunInfo {
 
 /// What a render measured.
 struct Report {
-    counts: RayCounts,
+    /// Ray counts, and each kind's thread-time when measured.
+    stats: RenderStats,
     seconds: f64,
     /// Wavefront only: per-stage figures, and the BVH build time if a BVH was used.
     stages: Option<(RenderStats, Option<f64>)>,
+    /// Reference only, with --stats or --stats-json: the wall-clock seconds of the second,
+    /// instrumented pass that timed the kinds.
+    instrumented_seconds: Option<f64>,
 }
 
 impl Report {
-    /// Rays and rays per wall-clock second by kind, as the JSON gives them.
+    /// Rays by kind, each kind per thread-second of its work, the total per wall-clock second,
+    /// as the JSON gives them.
     fn kinds(&self) -> KindFigures {
-        KindFigures::new(&self.counts, self.seconds)
+        KindFigures::new(&self.stats, self.seconds)
+    }
+
+    /// How the kinds' thread-time was measured, as the JSON names it.
+    fn kinds_timed_by(&self) -> &'static str {
+        match self.instrumented_seconds {
+            Some(_) => "instrumented pass",
+            None => "stage timers",
+        }
     }
 }
 
-/// The `--stats` tables: rays by kind, then (wavefront) the BVH build and each stage.
+/// The `--stats` tables: rays by kind (each kind over the thread-time of its own work, the
+/// total over the wall clock), then (wavefront) the BVH build and each stage.
 fn stats_table(report: &Report) -> String {
     let mut out = String::new();
-    let _ = writeln!(out, "{:<12} {:>14} {:>14}", "kind", "rays", "Mrays/s");
-    for (kind, figure) in report.kinds().rows() {
-        let rays = figure.rays;
+    let kinds = report.kinds();
+    let _ = writeln!(
+        out,
+        "{:<12} {:>14} {:>14} {:>20}",
+        "kind", "rays", "thread-s", "Mrays/thread-s"
+    );
+    let or_dash = |x: Option<f64>, scale: f64, digits: usize| {
+        x.map_or("-".to_string(), |x| format!("{:.digits$}", x * scale))
+    };
+    for (kind, figure) in kinds.kinds() {
         let _ = writeln!(
             out,
-            "{kind:<12} {rays:>14} {:>14.2}",
-            figure.rays_per_second / 1e6
+            "{kind:<12} {:>14} {:>14} {:>20}",
+            figure.rays,
+            or_dash(figure.thread_seconds, 1.0, 4),
+            or_dash(figure.rays_per_thread_second, 1e-6, 2)
         );
+    }
+    let total = kinds.total;
+    let _ = writeln!(
+        out,
+        "{:<12} {:>14} {:>14} {:>20}",
+        "", "", "wall s", "Mrays/s"
+    );
+    let _ = writeln!(
+        out,
+        "{:<12} {:>14} {:>14.3} {:>20.2}",
+        "total",
+        total.rays,
+        total.seconds,
+        total.rays_per_second / 1e6
+    );
+    match report.instrumented_seconds {
+        Some(pass) => {
+            let _ = writeln!(
+                out,
+                "kinds timed by a second pass with timers: {pass:.3} s against the render's \
+                 {:.3} s ({:+.1}%); the render itself had no timers",
+                report.seconds,
+                (pass / report.seconds.max(1e-9) - 1.0) * 100.0
+            );
+        }
+        None => {
+            let _ = writeln!(
+                out,
+                "kinds timed by the stage timers: camera = generate + intersect of camera rays, \
+                 reflection = reflect + intersect of mirror rays, shadow = shadow; film in none"
+            );
+        }
     }
     if let Some((_, Some(build))) = &report.stages {
         let _ = writeln!(out, "bvh build {build:.3} s");
@@ -481,7 +557,7 @@ fn stats_table(report: &Report) -> String {
         for row in stats.stage_rows() {
             let _ = writeln!(
                 out,
-                "{:<12} {:>14} {:>14.3} {:>20.2}",
+                "{:<12} {:>14} {:>14.4} {:>20.2}",
                 row.stage,
                 row.rays,
                 row.thread_seconds,
@@ -502,6 +578,7 @@ fn record(scene: &Scene, effective: &Effective, run: &RunInfo, report: &Report) 
         None => (None, None),
     };
     RenderRecord {
+        format: raywave::bench::record::FORMAT,
         raywave: env!("CARGO_PKG_VERSION"),
         // The record has never named the host.
         machine: Machine {
@@ -527,6 +604,8 @@ fn record(scene: &Scene, effective: &Effective, run: &RunInfo, report: &Report) 
         },
         seconds: report.seconds,
         rays: report.kinds(),
+        kinds_timed_by: report.kinds_timed_by(),
+        instrumented_seconds: report.instrumented_seconds,
         stages,
     }
 }
