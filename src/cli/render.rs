@@ -21,7 +21,6 @@ use raywave::output::memory::{self, RenderFootprint};
 use raywave::report::{DefaultsUsed, KindFigures, RenderRecord, SceneFigures};
 use raywave::scene::{Scene, load_scene};
 use raywave::settings::{LightModel, ShadowMode};
-use raywave::stats::RayCounts;
 use raywave::terminal::{print, progress_bar};
 use raywave::wavefront::stats::RenderStats;
 use std::fmt::Write as _;
@@ -234,6 +233,16 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if let Some(hdr) = &args.hdr {
         film.write_hdr(hdr)?;
     }
+    let reference_error = match &reference {
+        Some((path, image)) => Some(reference_error(
+            path,
+            image,
+            &film,
+            img.as_ref(),
+            args.tonemap.into(),
+        )?),
+        None => None,
+    };
     // The reference's render carries no timer; its kinds are timed by a second pass with
     // timers, only when the figures are asked for (its image is dropped, as are these first:
     // the memory check counted one film).
@@ -265,16 +274,6 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         engine: engine_choice,
         threads,
         batch_size: args.batch_size,
-    };
-    let reference_error = match &reference {
-        Some((path, image)) => Some(reference_error(
-            path,
-            image,
-            &film,
-            img.as_ref(),
-            args.tonemap.into(),
-        )?),
-        None => None,
     };
     if let Some(path) = &args.stats_json {
         let record = record(&scene, &effective, &run, &report);
