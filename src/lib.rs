@@ -76,6 +76,7 @@ pub mod statistics;
 pub mod stats;
 pub mod terminal;
 pub mod variance;
+pub mod view;
 pub mod wavefront;
 
 /// Which SIMD instructions this build uses for the lane type `f32x8` (from the `wide` crate),

@@ -133,6 +133,7 @@ const SUBCOMMANDS: &[&str] = &[
     "info",
     "meshgen",
     "variance",
+    "view",
     "bench",
     "help",
     "-h",

@@ -10,6 +10,7 @@
 //! render.rs    raywave render: summary, --stats, --stats-json, --debug-pixel
 //! bench.rs     raywave bench -> raywave::bench::BenchOptions
 //! variance.rs  raywave variance -> raywave::variance::command::VarianceOptions
+//! view.rs      raywave view -> raywave::view::ViewOptions (the browser debug window)
 //! meshgen.rs, info.rs
 //! ```
 
@@ -22,6 +23,7 @@ pub mod meshgen;
 pub mod render;
 pub mod values;
 pub mod variance;
+pub mod view;
 
 use clap::{Parser, Subcommand};
 
@@ -51,4 +53,7 @@ pub enum Command {
     /// Time both engines on a scene (rays/s per kind and stage); save and compare records
     /// (exit 3 when a figure regresses past --threshold).
     Bench(bench::BenchArgs),
+    /// The lab's debug window in the browser: the render, coarse to fine, the scene in 3D, a
+    /// pixel's ray tree, two samplers side by side (a local server on 127.0.0.1).
+    View(view::ViewArgs),
 }
