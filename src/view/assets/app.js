@@ -166,14 +166,14 @@ async function start() {
   try {
     app.view = RayView.create($('view3d'));
   } catch (e) { showError(`WebGL: ${e.message}`); }
-  if (app.view) { app.view.setScene(info.scene); app.view.viewFrom(app.sceneCamera, 2.2); }
+  if (app.view) { app.view.setScene(info.scene); app.view.viewFrom(app.sceneCamera, 1.6, 0.5); }
   Compare.init(info.samplers, settingsFromForm);
   $('settings').addEventListener('change', render);
   $('render').addEventListener('click', pick);
   $('use-view').addEventListener('click', () => { if (app.view) { app.camera = app.view.camera(); render(); } });
   $('reset-camera').addEventListener('click', () => {
     app.camera = null;
-    if (app.view) app.view.viewFrom(app.sceneCamera, 2.2);
+    if (app.view) app.view.viewFrom(app.sceneCamera, 1.6, 0.5);
     render();
   });
   render();

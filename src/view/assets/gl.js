@@ -88,8 +88,7 @@ const RayView = (() => {
       return add(state.target, scale([cp * Math.sin(state.yaw), Math.sin(state.pitch), cp * Math.cos(state.yaw)], state.dist));
     }
     function matrix() {
-      const near = Math.max(state.dist - 4 * state.radius, state.dist * 0.01);
-      const proj = perspective(state.fov, canvas.width / canvas.height, near, state.dist + 4 * state.radius);
+      const proj = perspective(state.fov, canvas.width / canvas.height, state.dist * 0.01, 4 * (state.dist + state.radius));
       return mul(proj, lookAt(eye(), state.target, [0, 1, 0]));
     }
     function lineSet(segments) {
@@ -153,14 +152,17 @@ const RayView = (() => {
       draw();
     }
 
-    // Puts the orbit camera behind the render camera (`back` times as far from what it looks
-    // at), with its field of view, so the render camera's frame is in sight.
-    function viewFrom(cam, back) {
+    // Puts the orbit camera `back` times as far from what the render camera looks at, turned by
+    // `turn` radians (half that upwards), with its field of view: the frame is then in sight.
+    function viewFrom(cam, back, turn) {
       const d = sub(cam.position, cam.look_at);
       state.target = cam.look_at.slice();
-      state.dist = (Math.hypot(...d) || 1) * back;
+      state.dist = Math.hypot(...d) || 1;
       state.yaw = Math.atan2(d[0], d[2]);
       state.pitch = Math.asin(Math.max(-1, Math.min(1, d[1] / state.dist)));
+      state.dist *= back;
+      state.yaw += turn;
+      state.pitch = Math.max(-1.5, Math.min(1.5, state.pitch + turn / 2));
       state.fov = Math.max(0.05, Math.min(2.5, cam.fov_degrees * Math.PI / 180));
       draw();
     }
