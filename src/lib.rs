@@ -75,6 +75,7 @@ pub mod spawn;
 pub mod statistics;
 pub mod stats;
 pub mod terminal;
+pub mod trace;
 pub mod variance;
 pub mod view;
 pub mod wavefront;

@@ -50,6 +50,7 @@ fn main() -> ExitCode {
         Command::Meshgen(args) => cli::meshgen::run(&args),
         Command::Variance(args) => cli::variance::run(&args),
         Command::View(args) => cli::view::run(&args),
+        Command::TracePixel(args) => cli::trace_pixel::run(&args),
         // Exit 3 when --compare finds a regression (raywave::bench::EXIT_REGRESSION).
         Command::Bench(args) => match cli::bench::run(&args) {
             Ok(code) => return ExitCode::from(code),

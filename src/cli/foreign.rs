@@ -135,6 +135,7 @@ const SUBCOMMANDS: &[&str] = &[
     "variance",
     "view",
     "bench",
+    "trace-pixel",
     "help",
     "-h",
     "--help",

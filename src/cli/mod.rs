@@ -11,6 +11,7 @@
 //! bench.rs     raywave bench -> raywave::bench::BenchOptions
 //! variance.rs  raywave variance -> raywave::variance::command::VarianceOptions
 //! view.rs      raywave view -> raywave::view::ViewOptions (the browser debug window)
+//! trace_pixel.rs  raywave trace-pixel: one pixel's ray tree (JSON, OBJ, PLY, PNG)
 //! meshgen.rs, info.rs
 //! ```
 
@@ -21,6 +22,7 @@ pub mod image;
 pub mod info;
 pub mod meshgen;
 pub mod render;
+pub mod trace_pixel;
 pub mod values;
 pub mod variance;
 pub mod view;
@@ -56,4 +58,7 @@ pub enum Command {
     /// The lab's debug window in the browser: the render, coarse to fine, the scene in 3D, a
     /// pixel's ray tree, two samplers side by side (a local server on 127.0.0.1).
     View(view::ViewArgs),
+    /// Trace one pixel as its render does and show its ray tree: a summary, or JSON, OBJ/PLY
+    /// and a PNG from a debug camera (checked against both engines' render of that pixel).
+    TracePixel(trace_pixel::TracePixelArgs),
 }
