@@ -45,6 +45,7 @@ pub fn scene_json(scene: &Scene, base: &Resolved) -> Vec<u8> {
         samplers: Vec<&'a str>,
         engines: Vec<&'a str>,
         simd: &'a str,
+        palette: tree::Palette,
     }
     serde_json::to_vec(&Body {
         scene: SceneJson::new(scene),
@@ -52,6 +53,7 @@ pub fn scene_json(scene: &Scene, base: &Resolved) -> Vec<u8> {
         samplers: LightSampler::ALL.iter().map(|s| s.name()).collect(),
         engines: ENGINES.iter().map(|e| e.name()).collect(),
         simd: crate::simd_path(),
+        palette: tree::PALETTE,
     })
     .unwrap_or_default()
 }
@@ -142,15 +144,13 @@ pub fn pixel(state: &State, q: &str) -> Result<Reply, ApiError> {
     let pairs = query(q, &["job", "x", "y"])?;
     let job = job_by_id(state, number(&pairs, "job")?)?;
     let (x, y): (u32, u32) = (number(&pairs, "x")?, number(&pairs, "y")?);
-    let s = &job.resolved.settings;
-    if x >= s.width || y >= s.height {
-        return Err(ApiError::bad(format!(
-            "pixel ({x}, {y}) is outside the {}×{} image: expected 0 ≤ x < {} and 0 ≤ y < {}",
-            s.width, s.height, s.width, s.height
-        )));
-    }
     let scene = super::jobs::with_camera(&state.scene, &job.resolved.camera);
-    Ok(Reply::json(&tree::pixel_tree(&scene, s, x, y)))
+    Ok(Reply::json(&tree::pixel_tree(
+        &scene,
+        &job.resolved.settings,
+        x,
+        y,
+    )?))
 }
 
 /// `POST /api/compare`.

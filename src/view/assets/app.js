@@ -115,26 +115,41 @@ async function render() {
   } catch (e) { showError(e.message); }
 }
 
-// The tree's side panel: one row per segment, and the JSON.
+// What a segment did, in words.
+function outcome(s) {
+  if (s.kind === 'shadow') {
+    const sh = s.shadow || {};
+    if (sh.blocked === null || sh.blocked === undefined) return `light ${sh.light}: not tested (shadows off)`;
+    if (!sh.blocked) return `light ${sh.light}: seen`;
+    const b = sh.blocker;
+    return `light ${sh.light}: blocked` + (b ? ` by ${b.primitive.shape} ${b.primitive.index} at t = ${b.t.toPrecision(4)}` : '');
+  }
+  if (!s.hit) return 'missed: background';
+  const p = s.hit.primitive;
+  return `hit ${p.shape} ${p.index}` + (p.face !== null && p.face !== undefined ? ` (face ${p.face})` : '') + ` at t = ${s.hit.t.toPrecision(4)}`;
+}
+
+// The tree's side panel: one row per segment with what it added to the pixel, and the JSON.
 function showTree(tree) {
   const body = $('segments').querySelector('tbody');
   body.innerHTML = '';
-  tree.segments.forEach((s, i) => {
+  tree.segments.forEach(s => {
     const tr = document.createElement('tr');
-    tr.className = s.kind === 'shadow' && s.blocked ? 'blocked' : s.kind;
-    let outcome;
-    if (s.kind === 'shadow') outcome = s.blocked === null ? 'not tested (shadows off)' : s.blocked ? 'blocked' : 'light seen';
-    else outcome = s.hit ? 'hit' : 'missed';
-    const contribution = s.contribution ? s.contribution.map(v => v.toFixed(4)).join(' ') : '';
-    for (const v of [i, s.kind, s.depth, outcome, contribution]) {
+    tr.className = RayView.style(s);
+    const contribution = s.contribution.map(v => v.toFixed(5)).join(' ');
+    for (const v of [s.id, s.parent === null ? '' : s.parent, s.kind, s.depth, outcome(s), contribution]) {
       const td = document.createElement('td'); td.textContent = v; tr.appendChild(td);
     }
     body.appendChild(tr);
   });
   $('tree-json').textContent = JSON.stringify(tree, null, 1);
-  $('tree-title').textContent = `pixel (${tree.x}, ${tree.y}): ${tree.segments.length} segments`;
+  const sum = tree.sum.map(v => v.toFixed(5)).join(' ');
+  const check = tree.check ? (tree.check.agrees ? ', equal to both engines\' render of it' :
+    `, NOT equal to the engines' render (reference ${tree.check.reference.map(v => v.toFixed(5)).join(' ')}, wavefront ${tree.check.wavefront.map(v => v.toFixed(5)).join(' ')})`) : '';
+  $('tree-title').textContent = `pixel (${tree.pixel.x}, ${tree.pixel.y}): ${tree.segments.length} segments, ` +
+    `contributions sum to ${sum}${check}`;
   const t = $('tree');
-  t.dataset.x = String(tree.x); t.dataset.y = String(tree.y);
+  t.dataset.x = String(tree.pixel.x); t.dataset.y = String(tree.pixel.y);
   t.dataset.segments = String(tree.segments.length);
   if (app.view) app.view.setTree(tree.segments);
 }
@@ -166,7 +181,7 @@ async function start() {
   try {
     app.view = RayView.create($('view3d'));
   } catch (e) { showError(`WebGL: ${e.message}`); }
-  if (app.view) { app.view.setScene(info.scene); app.view.viewFrom(app.sceneCamera, 1.6, 0.5); }
+  if (app.view) { app.view.setPalette(info.palette); app.view.setScene(info.scene); app.view.viewFrom(app.sceneCamera, 1.6, 0.5); }
   Compare.init(info.samplers, settingsFromForm);
   $('settings').addEventListener('change', render);
   $('render').addEventListener('click', pick);

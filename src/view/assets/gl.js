@@ -37,11 +37,20 @@ const RayView = (() => {
   const FS = `precision mediump float; varying vec3 vc; uniform float alpha;
     void main() { gl_FragColor = vec4(vc, alpha); }`;
 
-  // The colours of the kinds of ray, as the lab draws them.
+  // The colours of the rays: raywave::trace::palette's, sent with the scene (the lab's:
+  // camera white, reflection red, shadow green, blocked shadow magenta); these until it comes.
   const COLOURS = {
-    camera: [0.9, 0.9, 0.9], reflection: [1, 0.2, 0.2], shadow: [0.2, 1, 0.2],
-    blocked: [0.16, 0.54, 0.16], frame: [1, 0.84, 0], light: [1, 1, 0.6],
+    camera: [1, 1, 1], reflection: [1, 0.16, 0.16], shadow_visible: [0.16, 0.9, 0.16],
+    shadow_blocked: [0.9, 0, 0.9], shadow_untested: [0.63, 1, 0.63], main_camera: [1, 0.82, 0],
+    light: [1, 1, 0.6],
   };
+
+  // The style of a segment of a raywave::trace RayTree.
+  function style(seg) {
+    if (seg.kind !== 'shadow') return seg.kind;
+    const blocked = seg.shadow ? seg.shadow.blocked : null;
+    return blocked === null ? 'shadow_untested' : blocked ? 'shadow_blocked' : 'shadow_visible';
+  }
 
   function sphereMesh(s, out) {
     const [cx, cy, cz] = s.center, r = s.radius, rings = 16, segs = 24;
@@ -175,29 +184,35 @@ const RayView = (() => {
     function setFrame(frame) {
       const s = [];
       frame.corners.forEach((c, i) => {
-        s.push({ a: frame.eye, b: c, c: COLOURS.frame });
-        s.push({ a: c, b: frame.corners[(i + 1) % 4], c: COLOURS.frame });
+        s.push({ a: frame.eye, b: c, c: COLOURS.main_camera });
+        s.push({ a: c, b: frame.corners[(i + 1) % 4], c: COLOURS.main_camera });
       });
       state.lines.frame = lineSet(s);
       draw();
     }
 
-    // Each segment of the tree as lines; a blocked shadow ray dashed in dark green.
+    // Each segment of the tree as lines; a blocked shadow ray solid up to its blocker and
+    // dashed beyond it.
     function setTree(segments) {
       const s = [];
       for (const seg of segments) {
-        const colour = seg.kind === 'shadow' ? (seg.blocked ? COLOURS.blocked : COLOURS.shadow) : COLOURS[seg.kind];
-        if (seg.kind === 'shadow' && seg.blocked) {
+        const st = style(seg), colour = COLOURS[st] || [1, 1, 1];
+        if (st === 'shadow_blocked') {
+          const blocker = seg.shadow.blocker ? seg.shadow.blocker.point : seg.origin;
+          s.push({ a: seg.origin, b: blocker, c: colour });
           const dashes = 16;
-          for (let k = 0; k < dashes; k += 2) {
-            const at = t => add(seg.from, scale(sub(seg.to, seg.from), t));
-            s.push({ a: at(k / dashes), b: at((k + 1) / dashes), c: colour });
-          }
-        } else s.push({ a: seg.from, b: seg.to, c: colour || [1, 1, 1] });
+          const at = t => add(blocker, scale(sub(seg.end, blocker), t));
+          for (let k = 0; k < dashes; k += 2) s.push({ a: at(k / dashes), b: at((k + 1) / dashes), c: colour });
+        } else s.push({ a: seg.origin, b: seg.end, c: colour });
       }
       state.lines.tree = lineSet(s);
       canvas.dataset.segments = String(segments.length);
       draw();
+    }
+
+    // Takes the server's palette (0-255 per channel).
+    function setPalette(palette) {
+      for (const k of Object.keys(palette)) COLOURS[k] = palette[k].map(v => v / 255);
     }
 
     // Mouse: orbit, pan, zoom.
@@ -226,8 +241,8 @@ const RayView = (() => {
     }, { passive: false });
 
     canvas.dataset.webgl = 'ok';
-    return { setScene, setFrame, setTree, viewFrom, camera, draw };
+    return { setScene, setFrame, setTree, setPalette, viewFrom, camera, draw };
   }
 
-  return { create, COLOURS };
+  return { create, style, COLOURS };
 })();
