@@ -16,6 +16,7 @@
 mod common;
 
 use common::view::ViewServer;
+use fantoccini::actions::{InputSource, MOUSE_BUTTON_LEFT, MouseActions, PointerAction};
 use fantoccini::{Client, ClientBuilder, Locator};
 use std::net::TcpListener;
 use std::path::{Path, PathBuf};
@@ -133,17 +134,33 @@ async fn wait_render(c: &Client, previous: u64) -> u64 {
 }
 
 async fn click_centre_and_count(c: &Client, expected: usize) {
-    // The render is shown 512 pixels wide for a 64-pixel image: its centre is pixel (32, 32).
-    c.find(Locator::Css("#render"))
-        .await
-        .unwrap()
-        .click()
-        .await
-        .unwrap();
+    // The render is shown 512 CSS pixels wide for a 64-pixel image, 8 per pixel: half a pixel
+    // right of and below its centre is the middle of pixel (32, 32).
+    let element = c.find(Locator::Css("#render")).await.unwrap();
+    let click = MouseActions::new("mouse".into())
+        .then(PointerAction::MoveToElement {
+            element,
+            duration: None,
+            x: 4.0,
+            y: 4.0,
+        })
+        .then(PointerAction::Down {
+            button: MOUSE_BUTTON_LEFT,
+        })
+        .then(PointerAction::Up {
+            button: MOUSE_BUTTON_LEFT,
+        });
+    c.perform_actions(click).await.unwrap();
     let n = expected.to_string();
     wait_attr(c, "#tree", "data-segments", |v| v == n).await;
-    assert_eq!(wait_attr(c, "#tree", "data-x", |v| !v.is_empty()).await, "32");
-    assert_eq!(wait_attr(c, "#tree", "data-y", |v| !v.is_empty()).await, "32");
+    assert_eq!(
+        wait_attr(c, "#tree", "data-x", |v| !v.is_empty()).await,
+        "32"
+    );
+    assert_eq!(
+        wait_attr(c, "#tree", "data-y", |v| !v.is_empty()).await,
+        "32"
+    );
     // The 3D view drew them.
     wait_attr(c, "#view3d", "data-segments", |v| v == n).await;
 }

@@ -19,24 +19,41 @@ fn every_endpoint_answers() {
 
     let page = server.get("/");
     assert_eq!(page.status, 200);
-    assert!(page.header("content-type").unwrap().starts_with("text/html"));
+    assert!(
+        page.header("content-type")
+            .unwrap()
+            .starts_with("text/html")
+    );
     assert!(page.text().contains("<title>raywave view</title>"));
     for asset in ["gl.js", "app.js", "compare.js"] {
         let r = server.get(&format!("/assets/{asset}"));
         assert_eq!(r.status, 200, "{asset}");
-        assert!(r.header("content-type").unwrap().starts_with("text/javascript"));
-        assert!(page.text().contains(&format!("/assets/{asset}")), "{asset} is used");
+        assert!(
+            r.header("content-type")
+                .unwrap()
+                .starts_with("text/javascript")
+        );
+        assert!(
+            page.text().contains(&format!("/assets/{asset}")),
+            "{asset} is used"
+        );
     }
     assert_eq!(server.get("/assets/style.css").status, 200);
 
     let scene = server.get("/api/scene").json();
     // 6 quads of the box = 12 triangles, 3 spheres, 1 light with 4 corners.
-    assert_eq!(scene["scene"]["positions"].as_array().unwrap().len(), 12 * 9);
+    assert_eq!(
+        scene["scene"]["positions"].as_array().unwrap().len(),
+        12 * 9
+    );
     assert_eq!(scene["scene"]["spheres"].as_array().unwrap().len(), 3);
     assert_eq!(scene["scene"]["lights"][0].as_array().unwrap().len(), 4);
     assert_eq!(scene["settings"]["width"], 32);
     assert_eq!(scene["settings"]["shadows"], "hard");
-    assert_eq!(scene["palette"]["reflection"], serde_json::json!([255, 40, 40]));
+    assert_eq!(
+        scene["palette"]["reflection"],
+        serde_json::json!([255, 40, 40])
+    );
 
     let (job, status) = server.render("{}", LIMIT);
     // Levels at 1/8, 1/4, 1/2 and 1 of 32×16, coarse to fine.
@@ -85,7 +102,10 @@ fn every_endpoint_answers() {
     assert_eq!(compare["sides"][0]["sampler"], "random");
     assert_eq!(compare["sides"][1]["sampler"], "sobol");
     // The longer side is 16, the aspect ratio the render's (2:1).
-    assert_eq!((compare["width"].clone(), compare["height"].clone()), (16.into(), 8.into()));
+    assert_eq!(
+        (compare["width"].clone(), compare["height"].clone()),
+        (16.into(), 8.into())
+    );
     for url in [
         compare["reference"].as_str().unwrap(),
         compare["sides"][0]["image"].as_str().unwrap(),
@@ -153,8 +173,13 @@ fn bad_requests_get_their_4xx_and_a_message() {
         assert_eq!(r.status, status, "{what}: {}", r.text());
         assert_eq!(r.header("content-type"), Some("application/json"), "{what}");
         let json = r.json();
-        let error = json["error"].as_str().unwrap_or_else(|| panic!("{what}: {json}"));
-        assert!(error.contains(message), "{what}: {error:?} lacks {message:?}");
+        let error = json["error"]
+            .as_str()
+            .unwrap_or_else(|| panic!("{what}: {json}"));
+        assert!(
+            error.contains(message),
+            "{what}: {error:?} lacks {message:?}"
+        );
         if status == 405 {
             assert!(r.header("allow").is_some(), "{what}: no Allow header");
         }
@@ -193,7 +218,10 @@ fn a_busy_port_and_an_oversized_image_are_refused_before_serving() {
     let out = common::bin::raywave(dir.path(), &["view", "--port", &port]);
     assert_eq!(out.status.code(), Some(1));
     let err = common::bin::stderr(&out);
-    assert!(err.contains(&format!("cannot listen on 127.0.0.1:{port}")), "{err}");
+    assert!(
+        err.contains(&format!("cannot listen on 127.0.0.1:{port}")),
+        "{err}"
+    );
 
     let out = common::bin::raywave(dir.path(), &["view", "--size", "4096", "16"]);
     assert_eq!(out.status.code(), Some(2));

@@ -43,10 +43,7 @@ pub struct ViewArgs {
 
 /// Serves the page until Ctrl-C.
 pub fn run(args: &ViewArgs) -> Result<()> {
-    let file = load_scene(
-        args.scene.as_deref(),
-        &args.image.options().parse_options(),
-    )?;
+    let file = load_scene(args.scene.as_deref(), &args.image.options().parse_options())?;
     let scene = file.scene;
     for w in &scene.warnings {
         eprintln!("{w}");

@@ -84,12 +84,8 @@ fn with_frame(status: super::jobs::JobStatus, resolved: &Resolved) -> Reply {
 }
 
 fn job_id(text: &str) -> Result<u64, ApiError> {
-    text.parse().map_err(|_| {
-        ApiError::bad(format!(
-            "expected a job number, found `{}`",
-            quote(text)
-        ))
-    })
+    text.parse()
+        .map_err(|_| ApiError::bad(format!("expected a job number, found `{}`", quote(text))))
 }
 
 fn find_job(state: &State, text: &str) -> Result<Arc<super::jobs::Job>, ApiError> {

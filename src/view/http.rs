@@ -204,8 +204,23 @@ mod tests {
                 .message
                 .contains("whole number")
         );
-        assert!(number::<u32>(&q, "z").unwrap_err().message.contains("missing"));
-        assert!(query("q=1", &["x"]).unwrap_err().message.contains("unknown"));
-        assert!(query("x=1&x=2", &["x"]).unwrap_err().message.contains("twice"));
+        assert!(
+            number::<u32>(&q, "z")
+                .unwrap_err()
+                .message
+                .contains("missing")
+        );
+        assert!(
+            query("q=1", &["x"])
+                .unwrap_err()
+                .message
+                .contains("unknown")
+        );
+        assert!(
+            query("x=1&x=2", &["x"])
+                .unwrap_err()
+                .message
+                .contains("twice")
+        );
     }
 }

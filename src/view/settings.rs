@@ -78,7 +78,11 @@ impl CameraJson {
     /// The camera, or a 400 naming what is wrong with it.
     pub fn to_camera(&self) -> Result<Camera, ApiError> {
         let all = [self.position, self.look_at, self.up];
-        if all.iter().flatten().any(|v| !v.is_finite() || v.abs() > 1e6) {
+        if all
+            .iter()
+            .flatten()
+            .any(|v| !v.is_finite() || v.abs() > 1e6)
+        {
             return Err(ApiError::bad(
                 "camera: expected finite coordinates of magnitude at most 1e6",
             ));
@@ -255,7 +259,10 @@ mod tests {
 
     #[test]
     fn empty_body_keeps_the_base() {
-        let r = ViewSettings::parse(b" \n").unwrap().resolve(&base()).unwrap();
+        let r = ViewSettings::parse(b" \n")
+            .unwrap()
+            .resolve(&base())
+            .unwrap();
         assert_eq!(r, base());
     }
 

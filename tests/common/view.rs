@@ -200,6 +200,7 @@ pub fn png_size(bytes: &[u8]) -> (u32, u32) {
         "not a PNG: {:?}",
         &bytes[..bytes.len().min(16)]
     );
-    let be = |at: usize| u32::from_be_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]]);
+    let be =
+        |at: usize| u32::from_be_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]]);
     (be(16), be(20))
 }

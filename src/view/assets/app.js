@@ -11,6 +11,7 @@ const app = {
   camera: null,      // the render camera sent with the settings (null: the scene's)
   sceneCamera: null, // the scene's own camera
   poll: null,
+  shownLevel: 0,     // the finest level of the job on screen (1-based)
 };
 
 function showError(text) { $('error').textContent = text || ''; }
@@ -68,7 +69,9 @@ function showStats(status) {
 function showLevel(status, k) {
   const img = new Image();
   img.onload = () => {
-    if (!app.job || app.job.job !== status.job) return;
+    // Images may load out of order: never replace a finer level by a coarser one.
+    if (!app.job || app.job.job !== status.job || k + 1 <= app.shownLevel) return;
+    app.shownLevel = k + 1;
     const el = $('render');
     el.src = img.src;
     el.dataset.level = String(k + 1);
@@ -89,7 +92,8 @@ async function pollJob(id) {
     try { status = await api(`/api/render/${id}`); } catch (e) { showError(e.message); clearInterval(app.poll); return; }
     if (!app.job || app.job.job !== id) return;
     app.job = status;
-    while (shown < status.levels.length) showLevel(status, shown++);
+    // Levels that arrived together: only the finest is worth loading.
+    if (shown < status.levels.length) { shown = status.levels.length; showLevel(status, shown - 1); }
     showStats(status);
     const el = $('render');
     el.dataset.levels = String(status.sizes.length);
@@ -106,6 +110,7 @@ async function render() {
   try {
     const status = await api('/api/render', { method: 'POST', body: JSON.stringify(settingsFromForm()) });
     app.job = status;
+    app.shownLevel = 0;
     const el = $('render');
     el.dataset.job = String(status.job);
     el.dataset.level = '0';
@@ -181,14 +186,14 @@ async function start() {
   try {
     app.view = RayView.create($('view3d'));
   } catch (e) { showError(`WebGL: ${e.message}`); }
-  if (app.view) { app.view.setPalette(info.palette); app.view.setScene(info.scene); app.view.viewFrom(app.sceneCamera, 1.6, 0.5); }
+  if (app.view) { app.view.setPalette(info.palette); app.view.setScene(info.scene); app.view.overview(app.sceneCamera); }
   Compare.init(info.samplers, settingsFromForm);
   $('settings').addEventListener('change', render);
   $('render').addEventListener('click', pick);
   $('use-view').addEventListener('click', () => { if (app.view) { app.camera = app.view.camera(); render(); } });
   $('reset-camera').addEventListener('click', () => {
     app.camera = null;
-    if (app.view) app.view.viewFrom(app.sceneCamera, 1.6, 0.5);
+    if (app.view) app.view.overview(app.sceneCamera);
     render();
   });
   render();

@@ -161,18 +161,16 @@ const RayView = (() => {
       draw();
     }
 
-    // Puts the orbit camera `back` times as far from what the render camera looks at, turned by
-    // `turn` radians (half that upwards), with its field of view: the frame is then in sight.
-    function viewFrom(cam, back, turn) {
-      const d = sub(cam.position, cam.look_at);
-      state.target = cam.look_at.slice();
-      state.dist = Math.hypot(...d) || 1;
-      state.yaw = Math.atan2(d[0], d[2]);
-      state.pitch = Math.asin(Math.max(-1, Math.min(1, d[1] / state.dist)));
-      state.dist *= back;
-      state.yaw += turn;
-      state.pitch = Math.max(-1.5, Math.min(1.5, state.pitch + turn / 2));
-      state.fov = Math.max(0.05, Math.min(2.5, cam.fov_degrees * Math.PI / 180));
+    // An overview of the scene and the render camera together: the orbit camera looks at a
+    // point a third of the way from what the render camera looks at towards its eye, from
+    // twice the eye's distance, turned 45° aside and 20° up, with a 40° field of view.
+    function overview(cam) {
+      const d = sub(cam.position, cam.look_at), len = Math.hypot(...d) || 1;
+      state.target = add(cam.look_at, scale(d, 0.35));
+      state.dist = 2 * len;
+      state.yaw = Math.atan2(d[0], d[2]) + 0.8;
+      state.pitch = Math.max(-1.5, Math.min(1.5, Math.asin(Math.max(-1, Math.min(1, d[1] / len))) + 0.35));
+      state.fov = 40 * Math.PI / 180;
       draw();
     }
 
@@ -241,7 +239,7 @@ const RayView = (() => {
     }, { passive: false });
 
     canvas.dataset.webgl = 'ok';
-    return { setScene, setFrame, setTree, setPalette, viewFrom, camera, draw };
+    return { setScene, setFrame, setTree, setPalette, overview, camera, draw };
   }
 
   return { create, style, COLOURS };
