@@ -184,6 +184,20 @@ fn bad_requests_get_their_4xx_and_a_message() {
             assert!(r.header("allow").is_some(), "{what}: no Allow header");
         }
     }
+    // A tree too large to show: 64 aa × 65 depths × (1 + 4096 points) segments at most.
+    let r = server.post(
+        "/api/render",
+        r#"{"width": 2, "height": 2, "aa": 64, "bounces": 64, "shadows": "soft", "shadow_samples": 4096}"#,
+    );
+    let huge = r.json()["job"].as_u64().unwrap();
+    let r = server.get(&format!("/api/pixel?job={huge}&x=0&y=0"));
+    assert_eq!(r.status, 400, "{}", r.text());
+    assert!(
+        r.json()["error"]
+            .as_str()
+            .unwrap()
+            .contains(&format!("{} segments", 64 * 65 * 4097))
+    );
     // Still serving, and the job is unharmed.
     assert_eq!(server.get("/api/scene").status, 200);
     assert_eq!(server.get(&format!("/api/render/{job}/3.png")).status, 200);

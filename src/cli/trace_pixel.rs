@@ -104,10 +104,7 @@ pub fn run(args: &TracePixelArgs) -> Result<()> {
     plan.check()?;
     plan.refuse_binary_on_terminal(&["--png"])?;
 
-    let scene_file = load_scene(
-        args.scene.as_deref(),
-        &args.image.options().parse_options(),
-    )?;
+    let scene_file = load_scene(args.scene.as_deref(), &args.image.options().parse_options())?;
     let scene = scene_file.scene;
     for w in &scene.warnings {
         eprintln!("{w}");

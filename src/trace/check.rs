@@ -10,8 +10,8 @@ use crate::reference::Reference;
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
 use crate::stats::RayCounts;
-use crate::wavefront::{Wavefront, Workspace};
 use crate::wavefront::stats::RenderStats;
+use crate::wavefront::{Wavefront, Workspace};
 use glam::Vec3;
 
 /// The accepted difference between the tree's sum and a rendered pixel, relative to

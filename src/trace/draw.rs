@@ -117,7 +117,10 @@ impl Overlay<'_> {
     ) {
         let cam = &self.camera;
         let near = 1e-4 * self.diagonal.max(f32::MIN_POSITIVE);
-        let (da, db) = ((a - cam.origin).dot(cam.forward), (b - cam.origin).dot(cam.forward));
+        let (da, db) = (
+            (a - cam.origin).dot(cam.forward),
+            (b - cam.origin).dot(cam.forward),
+        );
         if !(da > near || db > near) {
             return;
         }

@@ -124,7 +124,11 @@ fn sphere(name: &str, centre: Vec3, radius: f32, colour: Rgb) -> Group {
         let theta = PI * ring as f32 / SPHERE_RINGS as f32;
         for seg in 0..SPHERE_SEGMENTS {
             let phi = 2.0 * PI * seg as f32 / SPHERE_SEGMENTS as f32;
-            let dir = Vec3::new(theta.sin() * phi.cos(), theta.cos(), -theta.sin() * phi.sin());
+            let dir = Vec3::new(
+                theta.sin() * phi.cos(),
+                theta.cos(),
+                -theta.sin() * phi.sin(),
+            );
             g.vertex(centre + radius * dir, colour);
         }
     }
@@ -138,7 +142,11 @@ fn sphere(name: &str, centre: Vec3, radius: f32, colour: Rgb) -> Group {
             g.triangles.push([a, c, d]);
             g.triangles.push([a, d, b]);
         }
-        g.triangles.push([bottom, at(SPHERE_RINGS - 1, seg + 1), at(SPHERE_RINGS - 1, seg)]);
+        g.triangles.push([
+            bottom,
+            at(SPHERE_RINGS - 1, seg + 1),
+            at(SPHERE_RINGS - 1, seg),
+        ]);
     }
     g
 }

@@ -27,8 +27,7 @@ pub mod view;
 
 pub use check::{PixelEngine, check_pixel, render_pixel};
 pub use scene_view::{
-    LightView, MaterialView, SceneGeometry, SphereView, TriangleView, scene_bounds,
-    scene_geometry,
+    LightView, MaterialView, SceneGeometry, SphereView, TriangleView, scene_bounds, scene_geometry,
 };
 pub use summary::summary;
 pub use tracer::{TraceError, primitive_ref, trace_pixel, trace_settings};

@@ -44,7 +44,10 @@ pub fn summary(tree: &RayTree) -> String {
     let mut s = String::new();
     let st = &tree.settings;
     let shadows = match st.shadows.as_str() {
-        "soft" => format!("soft, {} {} points per light", st.points_per_light, st.sampler),
+        "soft" => format!(
+            "soft, {} {} points per light",
+            st.points_per_light, st.sampler
+        ),
         other => other.to_string(),
     };
     let _ = writeln!(
@@ -102,11 +105,9 @@ pub fn summary(tree: &RayTree) -> String {
             SegmentKind::Shadow => {
                 let Some(info) = &seg.shadow else { continue };
                 let outcome = match (info.blocked, &info.blocker) {
-                    (Some(true), Some(b)) => format!(
-                        "blocked by {} at {}",
-                        primitive(&b.primitive),
-                        v3(b.point)
-                    ),
+                    (Some(true), Some(b)) => {
+                        format!("blocked by {} at {}", primitive(&b.primitive), v3(b.point))
+                    }
                     (Some(true), None) => "blocked".to_string(),
                     (Some(false), _) => format!("visible, adds {adds}"),
                     (None, _) => format!("not tested (shadows off), adds {adds}"),

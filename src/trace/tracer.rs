@@ -17,8 +17,8 @@
 //! (`super::check`).
 
 use super::tree::{
-    BlockerInfo, PixelRef, PrimitiveRef, PrimitiveShape, RayTree, SCHEMA_ID, Segment,
-    SegmentKind, ShadowInfo, SurfaceInfo, TraceSettings,
+    BlockerInfo, PixelRef, PrimitiveRef, PrimitiveShape, RayTree, SCHEMA_ID, Segment, SegmentKind,
+    ShadowInfo, SurfaceInfo, TraceSettings,
 };
 use crate::camera::CameraRays;
 use crate::geometry::{Accel, Ray};
@@ -33,7 +33,9 @@ use glam::Vec3;
 #[derive(Debug, thiserror::Error)]
 pub enum TraceError {
     /// The pixel lies outside the image.
-    #[error("pixel ({x}, {y}) is outside the {width}×{height} image: expected x < {width} and y < {height}")]
+    #[error(
+        "pixel ({x}, {y}) is outside the {width}×{height} image: expected x < {width} and y < {height}"
+    )]
     OutsideImage {
         /// Column asked for.
         x: u32,
@@ -100,11 +102,7 @@ pub fn trace_pixel(
     Ok(RayTree {
         schema: SCHEMA_ID.to_string(),
         scene: scene.source.clone(),
-        pixel: PixelRef {
-            x,
-            y,
-            index: pixel,
-        },
+        pixel: PixelRef { x, y, index: pixel },
         settings: trace_settings(settings),
         camera: super::tree::CameraInfo::of(&scene.camera),
         miss_length,
@@ -260,12 +258,9 @@ impl Tracer<'_> {
                 // the render's own test; this only names the blocker.
                 let blocker = (blocked == Some(true))
                     .then(|| {
-                        let h = self.accel.closest(
-                            scene,
-                            &shadow.ray,
-                            shadow.tmax,
-                            settings.two_sided,
-                        );
+                        let h =
+                            self.accel
+                                .closest(scene, &shadow.ray, shadow.tmax, settings.two_sided);
                         h.is_hit().then(|| BlockerInfo {
                             primitive: primitive_ref(scene, h.prim),
                             t: h.t,

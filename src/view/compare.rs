@@ -183,11 +183,14 @@ pub struct Comparison {
     pub seconds: f64,
 }
 
+/// An image of a comparison and its name in the URL.
+type NamedPng = (String, Arc<Vec<u8>>);
+
 /// Kept comparisons and their images.
 #[derive(Default)]
 pub struct Comparisons {
     next: std::sync::atomic::AtomicU64,
-    kept: Mutex<VecDeque<(u64, Vec<(String, Arc<Vec<u8>>)>)>>,
+    kept: Mutex<VecDeque<(u64, Vec<NamedPng>)>>,
     /// Held while one runs: a second request gets 409 instead of halving the first one's speed.
     pub running: Mutex<()>,
 }
