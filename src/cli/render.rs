@@ -15,7 +15,6 @@ use raywave::machine::Machine;
 use raywave::options::{BackgroundSource, Effective};
 use raywave::output::OutputPlan;
 use raywave::output::memory::{self, RenderFootprint};
-use raywave::reference::Reference;
 use raywave::report::{DefaultsUsed, KindFigures, RenderRecord, SceneFigures};
 use raywave::scene::{Scene, load_scene};
 use raywave::settings::{LightModel, ShadowMode};
@@ -186,25 +185,20 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         OutputFormat::Linear => None,
     };
     if let Some(px) = &args.debug_pixel {
-        let mut recorder = RayRecorder {
-            miss_length: 10.0,
-            ..Default::default()
-        };
-        let pixel = px[1] * settings.width + px[0];
-        // The debug view follows the reference's recursion (both engines trace the same rays).
-        let reference = Reference::new(&scene, &settings);
-        let colour = reference.pixel(pixel, &mut RayCounts::default(), &mut recorder);
+        // The tree both engines trace for the pixel (raywave::trace), checked against both.
+        let mut tree = raywave::trace::trace_pixel(&scene, &settings, px[0], px[1])
+            .map_err(|e| UsageError(format!("--debug-pixel: {e}")))?;
+        tree.check = Some(raywave::trace::check_pixel(&scene, &settings, &tree));
         say(&format!(
-            "rays traced for pixel ({}, {}), colour {:.5}:\n{}",
+            "rays traced for pixel ({}, {}):\n{}",
             px[0],
             px[1],
-            colour,
-            recorder.report(&scene)
+            raywave::trace::summary(&tree)
         ))?;
         match &mut img {
             Some(img) => {
                 let camera = CameraRays::new(&scene.camera, settings.width, settings.height);
-                recorder.draw(img, &camera);
+                RayRecorder::from_tree(&tree).draw(img, &camera);
             }
             None => eprintln!(
                 "note: the rays are drawn only over an 8-bit image; {} holds the linear image alone",

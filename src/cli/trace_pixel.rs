@@ -12,7 +12,7 @@ use raywave::error::UsageError;
 use raywave::film::ldr_format;
 use raywave::output::{OutputPlan, write_output};
 use raywave::scene::load_scene;
-use raywave::terminal::print;
+use raywave::terminal::{print, progress_bar};
 use raywave::trace::draw::{Overlay, depth_buffer};
 use raywave::trace::view::ViewPlacement;
 use raywave::trace::{check_pixel, mesh, obj, ply, scene_bounds, summary, trace_pixel};
@@ -54,7 +54,8 @@ pub struct TracePixelArgs {
     pub png: Option<PathBuf>,
     /// Place the debug camera's eye here (before --orbit), looking at the render camera's
     /// point of interest [default: the render camera's eye].
-    #[arg(long, num_args = 3, value_names = ["X", "Y", "Z"], allow_negative_numbers = true,
+    #[arg(long, num_args = 3, action = clap::ArgAction::Set, value_names = ["X", "Y", "Z"],
+          allow_negative_numbers = true,
           value_parser = parse_finite)]
     pub view_from: Option<Vec<f32>>,
     /// Turn the debug camera this many degrees about the scene's up axis, around the point of
@@ -66,8 +67,8 @@ pub struct TracePixelArgs {
     #[arg(long, value_name = "F", default_value_t = 1.0, value_parser = parse_positive)]
     pub view_distance: f32,
     /// Size of the debug camera's image [default: the render's size].
-    #[arg(long, num_args = 2, value_names = ["W", "H"],
-          value_parser = clap::value_parser!(u32).range(1..=8192))]
+    #[arg(long, num_args = 2, action = clap::ArgAction::Set, value_names = ["W", "H"],
+          value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub view_size: Option<Vec<u32>>,
     /// Draw only the scene and the render camera's marker in the PNG, not the rays.
     #[arg(long)]
@@ -116,8 +117,8 @@ pub fn run(args: &TracePixelArgs) -> Result<()> {
         .settings;
     settings.seed = args.seed;
     settings.two_sided = args.two_sided;
-    let mut tree = trace_pixel(&scene, &settings, args.x, args.y)
-        .map_err(|e| UsageError(format!("X Y: {e}")))?;
+    let mut tree =
+        trace_pixel(&scene, &settings, args.x, args.y).map_err(|e| UsageError(e.to_string()))?;
     let placement = ViewPlacement {
         from: args
             .view_from
@@ -178,16 +179,23 @@ pub fn run(args: &TracePixelArgs) -> Result<()> {
             ..settings.clone()
         };
         let pool = thread_pool(args.threads)?;
+        let engine = Engine::Wavefront.prepare(
+            &view_scene,
+            &view_settings,
+            raywave::wavefront::DEFAULT_BATCH_SIZE,
+        );
+        let (units, unit) = engine.work_units(&view_settings);
+        let progress = progress_bar(
+            units,
+            &format!("{{spinner}} rendering the debug view [{{bar:40}}] {{pos}}/{{len}} {unit}"),
+            false,
+        );
         let (film, depth) = pool.install(|| {
-            let (film, _) = Engine::Wavefront.render(
-                &view_scene,
-                &view_settings,
-                raywave::wavefront::DEFAULT_BATCH_SIZE,
-                &|| {},
-            );
+            let (film, _) = engine.render(&|| progress.inc(1));
             let rays = CameraRays::new(&camera, width, height);
             (film, depth_buffer(&view_scene, &rays, settings.two_sided))
         });
+        progress.finish_and_clear();
         let mut img = film.to_rgb8(args.tonemap.into());
         let (lo, hi) = scene_bounds(&scene);
         Overlay {
@@ -236,6 +244,29 @@ pub fn run(args: &TracePixelArgs) -> Result<()> {
         ))?;
     }
     Ok(())
+}
+
+/// The debug camera's flags without `--png`: they shape only that image.
+pub fn meaningless(args: &TracePixelArgs) -> Vec<String> {
+    if args.png.is_some() {
+        return Vec::new();
+    }
+    let given = [
+        ("--view-from", args.view_from.is_some()),
+        ("--orbit", args.orbit.is_some()),
+        ("--view-distance", args.view_distance != 1.0),
+        ("--view-size", args.view_size.is_some()),
+        ("--no-rays", args.no_rays),
+        ("--tonemap", args.tonemap != ToneMapArg::Clamp),
+        ("--threads", args.threads.is_some()),
+    ];
+    given
+        .iter()
+        .filter(|(_, set)| *set)
+        .map(|(flag, _)| {
+            format!("{flag} has no effect without --png (it shapes the debug camera's image only)")
+        })
+        .collect()
 }
 
 /// The scene (an input) and the outputs, checked before any work.

@@ -86,9 +86,9 @@ impl Overlay<'_> {
                 if stamp[k] != i as u32 + 1 {
                     stamp[k] = i as u32 + 1;
                     let p = img.get_pixel_mut(x, y);
-                    for c in 0..3 {
-                        p.0[c] = (f32::from(p.0[c]) * (1.0 - FAINT_ALPHA)
-                            + f32::from(colour[c]) * FAINT_ALPHA)
+                    for (channel, &c) in p.0.iter_mut().zip(&colour) {
+                        *channel = (f32::from(*channel) * (1.0 - FAINT_ALPHA)
+                            + f32::from(c) * FAINT_ALPHA)
                             .round() as u8;
                     }
                 }

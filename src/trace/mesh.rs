@@ -7,7 +7,7 @@
 //! sphere_K       sphere K as SPHERE_RINGS × SPHERE_SEGMENTS latitude-longitude triangles
 //! rays_camera, rays_reflection, rays_shadow_visible, rays_shadow_blocked,
 //! rays_shadow_untested   one line (2 vertices) per segment of that style (palette.rs)
-//! main_camera    the render camera's marker (view::camera_marker), 10 lines
+//! main_camera    the render camera's marker (view::camera_marker), 9 lines
 //! ```
 //!
 //! Groups with nothing in them are left out.

@@ -46,7 +46,25 @@ pub enum TraceError {
         /// Image height.
         height: u32,
     },
+    /// The tree could hold more segments than [`MAX_SEGMENTS`].
+    #[error("the tree could hold up to {bound} segments ({aa} camera rays × {paths} path segments × (1 + {lights} light(s) × {points} points)): expected at most {max}; use fewer --aa, --shadow-samples or --bounces", max = MAX_SEGMENTS)]
+    TooLarge {
+        /// The bound on the segment count.
+        bound: u64,
+        /// Camera rays per pixel.
+        aa: u32,
+        /// Path segments per camera ray at most (bounces + 1).
+        paths: u64,
+        /// Lights in the scene.
+        lights: usize,
+        /// Points per light.
+        points: u32,
+    },
 }
+
+/// The most segments a tree may hold (about 400 MB of JSON): a bound on the count, from the
+/// settings, is checked before tracing, so a huge request is refused instead of filling memory.
+pub const MAX_SEGMENTS: u64 = 1_000_000;
 
 /// Traces pixel (x, y) (from the top-left) of `scene` rendered with `settings` and records its
 /// ray tree; errors when the pixel is outside the image.
@@ -62,6 +80,21 @@ pub fn trace_pixel(
             y,
             width: settings.width,
             height: settings.height,
+        });
+    }
+    let aa = settings.aa_samples.max(1);
+    let paths = u64::from(settings.bounces) + 1;
+    let points = settings.points_per_light();
+    let bound = u64::from(aa)
+        .saturating_mul(paths)
+        .saturating_mul(1 + scene.lights.len() as u64 * u64::from(points));
+    if bound > MAX_SEGMENTS {
+        return Err(TraceError::TooLarge {
+            bound,
+            aa,
+            paths,
+            lights: scene.lights.len(),
+            points,
         });
     }
     let pixel = y * settings.width + x;

@@ -15,7 +15,7 @@ pub const SCHEMA_ID: &str = "raywave.ray-tree/1";
 /// Every ray the render traces for one pixel, with what each one adds to the pixel's colour.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct RayTree {
-    /// Always [`SCHEMA_ID`]: which layout this is.
+    /// Always `raywave.ray-tree/1` in this version: which layout this is.
     pub schema: String,
     /// Where the scene came from (a path, `<stdin>` or `<built-in ...>`).
     pub scene: String,
@@ -33,8 +33,8 @@ pub struct RayTree {
     pub segments: Vec<Segment>,
     /// The sum of every segment's `contribution` (summed in f64): the pixel's colour.
     pub sum: [f64; 3],
-    /// The sum compared with the pixel as each engine renders it (filled by
-    /// [`crate::trace::check_pixel`]; absent when not checked).
+    /// The sum compared with the pixel as each engine renders it (absent when not checked;
+    /// `raywave trace-pixel` always checks).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub check: Option<PixelCheck>,
 }
@@ -238,7 +238,7 @@ pub struct PixelCheck {
     /// Largest |sum − wavefront| over the channels.
     pub wavefront_difference: f64,
     /// The largest difference accepted: rounding of the f32 sums the engines do in another
-    /// order (`trace::check::TOLERANCE` relative to the pixel's magnitude).
+    /// order: 1e-5 × max(1, the pixel's largest channel).
     pub tolerance: f64,
     /// Both differences within the tolerance.
     pub agrees: bool,

@@ -73,6 +73,7 @@ impl ViewPlacement {
 /// Projects a world point to continuous pixel coordinates (x right, y down; pixel (i, j)
 /// covers [i, i + 1) × [j, j + 1)) and its distance from the eye, or `None` behind the eye.
 /// The inverse of `CameraRays::screen` and `CameraRays::ray`.
+#[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(x > 0)` is on purpose: NaN is not in front
 pub fn project(camera: &CameraRays, p: Vec3) -> Option<(f32, f32, f32)> {
     let d = p - camera.origin;
     let depth = d.dot(camera.forward);
