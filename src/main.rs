@@ -1,7 +1,8 @@
 //! The `raywave` command. `main` owns the exit code: 0 on success, 2 for a usage error (clap),
 //! 3 when `raywave bench --compare` finds a regression, 1 for anything else, printed once with
-//! its cause chain; 130 after SIGINT and 143 after SIGTERM (`output::write`), but 0 when `raywave view` is stopped by
-//! them, its normal end. The command line itself is in `cli/`, one file per command.
+//! its cause chain; 130 after SIGINT and 143 after SIGTERM (`output::write`), but 0 when
+//! `raywave view` is stopped by them, its normal end. The command line itself is in `cli/`, one
+//! file per command.
 
 mod cli;
 

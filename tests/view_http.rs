@@ -122,13 +122,23 @@ fn every_endpoint_answers() {
     }
 }
 
+/// A bad request: method, path, extra headers, body, the status and a part of the message.
+type Case<'a> = (
+    &'a str,
+    String,
+    Vec<(&'a str, &'a str)>,
+    &'a [u8],
+    u16,
+    &'a str,
+);
+
 #[test]
 fn bad_requests_get_their_4xx_and_a_message() {
     let server = ViewServer::start(&["--size", "32", "16", "--bounces", "0"]);
     let (job, _) = server.render("{}", LIMIT);
     let big = vec![b' '; 70_000];
     let pixel = |q: &str| format!("/api/pixel?{q}");
-    let cases: Vec<(&str, String, Vec<(&str, &str)>, &[u8], u16, &str)> = vec![
+    let cases: Vec<Case> = vec![
         ("GET", "/nope".into(), vec![], b"", 404, "no such path"),
         ("GET", "/assets/nope.js".into(), vec![], b"", 404, "no asset"),
         ("DELETE", "/api/scene".into(), vec![], b"", 405, "DELETE is not allowed"),
