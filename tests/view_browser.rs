@@ -236,6 +236,13 @@ async fn drive(c: &Client, url: &str, screenshot: Option<PathBuf>) {
     assert_eq!(sizes, serde_json::json!([16, 16, 16, 16, 16]));
 
     if let Some(path) = screenshot {
+        // The ray tree and the comparison in view.
+        c.execute(
+            "document.getElementById('tree-panel').scrollIntoView();",
+            vec![],
+        )
+        .await
+        .unwrap();
         let png = c.screenshot().await.unwrap();
         std::fs::write(&path, png).unwrap();
         eprintln!("screenshot: {}", path.display());

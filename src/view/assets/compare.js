@@ -28,7 +28,7 @@ const Compare = (() => {
       `its own noise ${sci(result.reference_noise)}`, count));
     result.sides.forEach((s, i) => {
       const name = i === 0 ? 'A' : 'B';
-      out.appendChild(figure(s.image, `${name}: ${s.sampler}, N = ${result.n} (seed 1), ${s.seconds.toFixed(3)} s per render`, count));
+      out.appendChild(figure(s.image, `${name}: ${s.sampler}, N = ${result.n} (seed 1), ${s.seconds.toPrecision(3)} s per render`, count));
       const pen = s.mse_penumbra ? `; penumbra (${result.penumbra_pixels} px) ${est(s.mse_penumbra)}` : '';
       out.appendChild(figure(s.heat, `${name} error: MSE ${est(s.mse)} (mean ± s.e. over ${result.seeds} seeds)${pen}; ` +
         `bias ${sci(s.bias[0])} (bound ${sci(s.bias[1])})`, count));
@@ -36,7 +36,7 @@ const Compare = (() => {
     if (result.heat_scale) {
       const p = document.createElement('p');
       p.className = 'note';
-      p.textContent = `heat maps: per-pixel MSE on one log scale, dark 1e${result.heat_scale[0].toFixed(1)} to bright 1e${result.heat_scale[1].toFixed(1)}; ${result.seconds.toFixed(2)} s in all`;
+      p.textContent = `heat maps: per-pixel MSE on one log scale, dark 1e${result.heat_scale[0].toFixed(1)} to bright 1e${result.heat_scale[1].toFixed(1)}; ${result.seconds.toPrecision(3)} s in all`;
       out.appendChild(p);
     }
   }
