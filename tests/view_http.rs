@@ -176,6 +176,7 @@ fn bad_requests_get_their_4xx_and_a_message() {
         ("GET", "/api/compare/1/nope.png".into(), vec![], b"", 404, "no image"),
         ("GET", "/api/compare/x/a.png".into(), vec![], b"", 400, "expected a comparison number"),
         ("GET", "/api/scene".into(), vec![("Host", "evil.example")], b"", 421, "unexpected Host"),
+        ("POST", "/api/render".into(), vec![("Origin", "http://evil.example")], b"{}", 403, "are refused"),
     ];
     for (method, path, headers, body, status, message) in cases {
         let r = server.request(method, &path, &headers, body);

@@ -96,16 +96,19 @@ fn respond(mut request: tiny_http::Request, state: &State) {
     let method = request.method().as_str().to_string();
     let url = request.url().to_string();
     let declared = request.body_length();
-    let host = request
-        .headers()
-        .iter()
-        .find(|h| h.field.equiv("Host"))
-        .map(|h| h.value.as_str().to_string());
+    let header = |name: &'static str| {
+        request
+            .headers()
+            .iter()
+            .find(|h| h.field.equiv(name))
+            .map(|h| h.value.as_str().to_string())
+    };
+    let (host, origin) = (header("Host"), header("Origin"));
     let reply = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         route(
             &method,
             &url,
-            host.as_deref(),
+            [host.as_deref(), origin.as_deref()],
             declared,
             request.as_reader(),
             state,
@@ -145,12 +148,13 @@ fn respond(mut request: tiny_http::Request, state: &State) {
 fn route(
     method: &str,
     url: &str,
-    host: Option<&str>,
+    [host, origin]: [Option<&str>; 2],
     declared: Option<usize>,
     body: &mut dyn std::io::Read,
     state: &State,
 ) -> Result<Reply, ApiError> {
     check_host(host, state.port)?;
+    check_origin(origin, state.port)?;
     let (path, query) = url.split_once('?').unwrap_or((url, ""));
     let segments: Vec<&str> = path.split('/').skip(1).collect();
     let get = |allow: &'static str| {
@@ -231,6 +235,28 @@ fn check_host(host: Option<&str>, port: u16) -> Result<(), ApiError> {
     }
 }
 
+/// Refuses requests that a page from another origin sent (browsers name the page's origin on
+/// every POST): such a page could otherwise start renders here.
+fn check_origin(origin: Option<&str>, port: u16) -> Result<(), ApiError> {
+    let Some(origin) = origin else {
+        return Ok(());
+    };
+    let ours = ["127.0.0.1", "localhost", "[::1]"]
+        .iter()
+        .any(|h| origin == format!("http://{h}:{port}"));
+    if ours {
+        Ok(())
+    } else {
+        Err(ApiError::status(
+            403,
+            format!(
+                "requests from `{}` are refused: only the page at http://127.0.0.1:{port}/ may call this API",
+                crate::quote::quote(origin)
+            ),
+        ))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -247,5 +273,19 @@ mod tests {
             421
         );
         assert_eq!(check_host(None, 8080).unwrap_err().status, 421);
+        assert!(check_origin(None, 8080).is_ok());
+        assert!(check_origin(Some("http://127.0.0.1:8080"), 8080).is_ok());
+        assert_eq!(
+            check_origin(Some("http://127.0.0.1:9090"), 8080)
+                .unwrap_err()
+                .status,
+            403
+        );
+        assert_eq!(
+            check_origin(Some("https://evil.example"), 8080)
+                .unwrap_err()
+                .status,
+            403
+        );
     }
 }
