@@ -79,6 +79,7 @@ pub mod stats;
 pub mod terminal;
 pub mod trace;
 pub mod variance;
+pub mod view;
 pub mod wavefront;
 
 /// Which SIMD instructions this build uses for the lane type `f32x8` (from the `wide` crate),

@@ -40,6 +40,7 @@ pub fn meaningless(command: &Command, typed: &dyn Fn(&str) -> String) -> Vec<Str
             }
         }
         Command::Bench(args) => image(&args.image, typed, &mut out),
+        Command::View(args) => image(&args.image, typed, &mut out),
         _ => {}
     }
     out

@@ -134,6 +134,7 @@ const SUBCOMMANDS: &[&str] = &[
     "meshgen",
     "variance",
     "diff",
+    "view",
     "bench",
     "trace-pixel",
     "help",

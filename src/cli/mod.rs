@@ -10,6 +10,7 @@
 //! render.rs    raywave render: summary, --stats, --stats-json, --debug-pixel
 //! bench.rs     raywave bench -> raywave::bench::BenchOptions
 //! variance.rs  raywave variance -> raywave::variance::command::VarianceOptions
+//! view.rs      raywave view -> raywave::view::ViewOptions (the browser debug window)
 //! trace_pixel.rs  raywave trace-pixel: one pixel's ray tree (JSON, OBJ, PLY, PNG)
 //! diff.rs      raywave diff -> raywave::image_diff
 //! meshgen.rs, info.rs
@@ -26,6 +27,7 @@ pub mod render;
 pub mod trace_pixel;
 pub mod values;
 pub mod variance;
+pub mod view;
 
 use clap::{Parser, Subcommand};
 
@@ -55,6 +57,9 @@ pub enum Command {
     /// Time both engines on a scene (rays/s per kind and stage); save and compare records
     /// (exit 3 when a figure regresses past --threshold).
     Bench(bench::BenchArgs),
+    /// The lab's debug window in the browser: the render, coarse to fine, the scene in 3D, a
+    /// pixel's ray tree, two samplers side by side (a local server on 127.0.0.1).
+    View(view::ViewArgs),
     /// Trace one pixel as its render does and show its ray tree: a summary, or JSON, OBJ/PLY
     /// and a PNG from a debug camera (checked against both engines' render of that pixel).
     TracePixel(trace_pixel::TracePixelArgs),

@@ -31,7 +31,7 @@ use std::time::Instant;
 
 pub use cache::Cache;
 pub use mask::{Regions, penumbra_mask};
-pub use stats::{ErrorStats, LogLogFit, error_stats, loglog_fit};
+pub use stats::{ErrorStats, LogLogFit, error_stats, loglog_fit, pixel_mse};
 
 /// Renders one image: the engine is the caller's choice (the fastest one, normally).
 pub type RenderFn<'a> = dyn Fn(&Scene, &RenderSettings) -> (Film, RayCounts) + Sync + 'a;
@@ -317,16 +317,7 @@ pub fn run_study(
                 });
             }
             if n == config.heatmap_n {
-                let map = (0..reference.film.pixels.len())
-                    .map(|p| {
-                        let sq: f32 = images
-                            .iter()
-                            .map(|img| (img[p] - reference.film.pixels[p]).length_squared())
-                            .sum();
-                        sq / (3 * images.len()) as f32
-                    })
-                    .collect();
-                heatmaps.push((sampler, map));
+                heatmaps.push((sampler, pixel_mse(&images, &reference.film.pixels)));
             }
         }
     }

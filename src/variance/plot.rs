@@ -3,7 +3,7 @@
 //! (DejaVu Sans, via the `dejavu` crate), so plots need no system fonts.
 
 use super::{Region, StudyResult};
-use crate::false_colour::{inferno, register_font};
+use crate::false_colour::{self, register_font};
 use crate::film::write_atomically;
 use anyhow::{Context, Result, anyhow};
 use plotters::prelude::*;
@@ -115,37 +115,15 @@ pub fn mse_plot(result: &StudyResult, path: &Path) -> Result<()> {
     })
 }
 
-/// Writes `heat_<sampler>_N<n>.png` for every sampler: log10 of per-pixel MSE on one scale
-/// shared by all samplers (dark = low error, bright = high), so the maps compare directly.
+/// Writes `heat_<sampler>_N<n>.png` for every sampler (see [`heat_images`]).
 pub fn heatmaps(result: &StudyResult, dir: &Path) -> Result<Vec<PathBuf>> {
-    let all: Vec<f32> = result
-        .heatmaps
-        .iter()
-        .flat_map(|(_, m)| m.iter().copied().filter(|v| *v > 0.0))
-        .collect();
-    if all.is_empty() {
-        return Ok(Vec::new());
-    }
-    let mut sorted = all.clone();
-    sorted.sort_by(f32::total_cmp);
-    // Scale from the 1st to the 99.9th percentile, so a few outliers do not flatten the map.
-    let lo = sorted[sorted.len() / 100].max(1e-12).log10();
-    let hi = sorted[(sorted.len() * 999 / 1000).min(sorted.len() - 1)]
-        .max(1e-12)
-        .log10()
-        .max(lo + 1e-3);
     let (w, h) = (result.config.base.width, result.config.base.height);
+    let maps: Vec<&[f32]> = result.heatmaps.iter().map(|(_, m)| m.as_slice()).collect();
+    let Some((images, _)) = heat_images(&maps, w, h) else {
+        return Ok(Vec::new());
+    };
     let mut written = Vec::new();
-    for (sampler, map) in &result.heatmaps {
-        let mut img = image::RgbImage::new(w, h);
-        for (px, v) in img.pixels_mut().zip(map) {
-            let t = if *v > 0.0 {
-                ((v.log10() - lo) / (hi - lo)).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            *px = image::Rgb(inferno(t));
-        }
+    for ((sampler, _), img) in result.heatmaps.iter().zip(images) {
         let path = dir.join(format!(
             "heat_{}_N{}.png",
             sampler.name(),
@@ -158,4 +136,17 @@ pub fn heatmaps(result: &StudyResult, dir: &Path) -> Result<Vec<PathBuf>> {
         written.push(path);
     }
     Ok(written)
+}
+
+/// Per-pixel MSE maps (each `w` × `h`) as images on one shared log scale
+/// ([`false_colour::Scale::from_values`]: the 1st to the 99.9th percentile of all maps' positive
+/// values; dark = low error, bright = high), so that the maps compare directly; also returns
+/// that scale as (lo, hi) in log10. `None` when no map has a positive value.
+pub fn heat_images(maps: &[&[f32]], w: u32, h: u32) -> Option<(Vec<image::RgbImage>, [f32; 2])> {
+    let scale = false_colour::Scale::from_values(maps.iter().flat_map(|m| m.iter()), true)?;
+    let images = maps
+        .iter()
+        .map(|map| false_colour::map_image(map, w, h, &scale))
+        .collect();
+    Some((images, [scale.low.log10() as f32, scale.high.log10() as f32]))
 }

@@ -76,6 +76,20 @@ pub fn error_stats(
     }
 }
 
+/// The squared error of each pixel against `reference`, averaged over channels and `images`:
+/// the heat maps' values.
+pub fn pixel_mse(images: &[&[Vec3]], reference: &[Vec3]) -> Vec<f32> {
+    (0..reference.len())
+        .map(|p| {
+            let sq: f32 = images
+                .iter()
+                .map(|img| (img[p] - reference[p]).length_squared())
+                .sum();
+            sq / (3 * images.len().max(1)) as f32
+        })
+        .collect()
+}
+
 /// A least-squares line through (log10 x, log10 y).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct LogLogFit {
