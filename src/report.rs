@@ -46,7 +46,7 @@ pub struct RenderRecord {
     /// How the kinds' thread-seconds were measured: `stage timers` (wavefront),
     /// `instrumented pass` (the reference: a second render of the frame with timers, so the
     /// timed render had none).
-    pub kinds_timed_by: &'static str,
+    pub kinds_timed_by: KindTiming,
     /// Wall-clock seconds of the reference's instrumented pass (null for the wavefront
     /// engine): beside `seconds`, the timers' cost.
     pub instrumented_seconds: Option<f64>,
@@ -79,6 +79,17 @@ pub struct DefaultsUsed {
     /// The settings they filled, as the summary names them.
     #[serde(rename = "for")]
     pub settings: Vec<&'static str>,
+}
+
+/// How a render's kinds were timed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, JsonSchema)]
+pub enum KindTiming {
+    /// The wavefront engine's stage timers, which run in every render.
+    #[serde(rename = "stage timers")]
+    StageTimers,
+    /// The reference's second render of the frame, with timers (the timed render had none).
+    #[serde(rename = "instrumented pass")]
+    InstrumentedPass,
 }
 
 /// One kind's rays, the thread-time of its work, and its rate over that time.
@@ -258,7 +269,7 @@ mod tests {
             },
             seconds: 2.0,
             rays: KindFigures::new(&stats, 2.0),
-            kinds_timed_by: "instrumented pass",
+            kinds_timed_by: KindTiming::InstrumentedPass,
             instrumented_seconds: Some(2.5),
             stages: None,
         };

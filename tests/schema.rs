@@ -178,7 +178,7 @@ fn bench_json_and_saved_records_validate() {
 fn doctored_records_do_not_validate() {
     let record = stats_json("wavefront");
     type Doctor = fn(&mut Value);
-    let doctored: [(&str, Doctor); 5] = [
+    let doctored: [(&str, Doctor); 6] = [
         ("an older format", |r| r["format"] = json!(1)),
         ("no format", |r| {
             r.as_object_mut().unwrap().remove("format");
@@ -190,6 +190,9 @@ fn doctored_records_do_not_validate() {
             r["rays"]["camera"]["rays"] = json!(-1)
         }),
         ("an unknown engine", |r| r["engine"] = json!("gpu")),
+        ("kinds timed some other way", |r| {
+            r["kinds_timed_by"] = json!("guessed")
+        }),
     ];
     for (what, doctor) in doctored {
         let mut r = record.clone();

@@ -18,7 +18,7 @@ use raywave::machine::Machine;
 use raywave::options::{BackgroundSource, Effective};
 use raywave::output::OutputPlan;
 use raywave::output::memory::{self, RenderFootprint};
-use raywave::report::{DefaultsUsed, KindFigures, RenderRecord, SceneFigures};
+use raywave::report::{DefaultsUsed, KindFigures, KindTiming, RenderRecord, SceneFigures};
 use raywave::scene::{Scene, load_scene};
 use raywave::settings::{LightModel, ShadowMode};
 use raywave::terminal::{print, progress_bar};
@@ -482,10 +482,10 @@ impl Report {
     }
 
     /// How the kinds' thread-time was measured, as the JSON names it.
-    fn kinds_timed_by(&self) -> &'static str {
+    fn kinds_timed_by(&self) -> KindTiming {
         match self.instrumented_seconds {
-            Some(_) => "instrumented pass",
-            None => "stage timers",
+            Some(_) => KindTiming::InstrumentedPass,
+            None => KindTiming::StageTimers,
         }
     }
 }
