@@ -4,8 +4,7 @@
 
 mod cli;
 
-use clap::Parser;
-use cli::{Cli, Command};
+use cli::Command;
 use raywave::error::UsageError;
 use std::process::ExitCode;
 
@@ -17,8 +16,8 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    let cli = match Cli::try_parse_from(&normalized.args) {
-        Ok(cli) => cli,
+    let (cli, matches) = match cli::parse(&normalized.args) {
+        Ok(parsed) => parsed,
         // --help and --version.
         Err(e) if !e.use_stderr() => e.exit(),
         // Usage errors name the flags as typed (`-num_bounces`, not `--bounces`).
@@ -46,7 +45,7 @@ fn main() -> ExitCode {
         Command::Meshgen(args) => cli::meshgen::run(&args),
         Command::Variance(args) => cli::variance::run(&args),
         // Exit 3 when --compare finds a regression (raywave::bench::EXIT_REGRESSION).
-        Command::Bench(args) => match cli::bench::run(&args) {
+        Command::Bench(args) => match cli::bench::run(&args, matches.subcommand_matches("bench")) {
             Ok(code) => return ExitCode::from(code),
             Err(e) => Err(e),
         },

@@ -23,7 +23,7 @@ pub mod render;
 pub mod values;
 pub mod variance;
 
-use clap::{Parser, Subcommand};
+use clap::{ArgMatches, CommandFactory, FromArgMatches, Parser, Subcommand};
 
 /// raywave: a SIMD wavefront ray tracer for the lab's Cornell-box scenes.
 #[derive(Parser, Debug)]
@@ -51,4 +51,12 @@ pub enum Command {
     /// Time both engines on a scene (rays/s per kind and stage); save and compare records
     /// (exit 3 when a figure regresses past --threshold).
     Bench(bench::BenchArgs),
+}
+
+/// Parses the command line, keeping clap's matches: `bench --compare` asks them which flags
+/// were given (`ArgMatches::value_source`).
+pub fn parse(args: &[std::ffi::OsString]) -> Result<(Cli, ArgMatches), clap::Error> {
+    let matches = Cli::command().try_get_matches_from(args)?;
+    let cli = Cli::from_arg_matches(&matches)?;
+    Ok((cli, matches))
 }
