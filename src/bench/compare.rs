@@ -17,16 +17,29 @@
 use super::record::{BenchRecord, FigureSummary, Setup};
 use std::fmt::Write;
 
-/// The fields in which two setups differ, as `path: before -> after` lines (empty if none).
+/// The fields in which two setups differ, as `path: X in the record, Y now` lines (empty if
+/// none).
 pub fn setup_differences(before: &Setup, after: &Setup) -> Vec<String> {
-    let a = serde_json::to_value(before).unwrap_or_default();
-    let b = serde_json::to_value(after).unwrap_or_default();
-    let mut out = Vec::new();
-    diff("", &a, &b, &mut out);
-    out
+    setup_differences_as(before, after, "in the record", "now")
 }
 
-fn diff(path: &str, a: &serde_json::Value, b: &serde_json::Value, out: &mut Vec<String>) {
+/// [`setup_differences`] with the two sides named (`in A`, `in B`).
+pub fn setup_differences_as(before: &Setup, after: &Setup, a: &str, b: &str) -> Vec<String> {
+    let va = serde_json::to_value(before).unwrap_or_default();
+    let vb = serde_json::to_value(after).unwrap_or_default();
+    let mut out = Vec::new();
+    diff("", &va, &vb, &mut out);
+    out.into_iter()
+        .map(|(path, x, y)| format!("{path}: {x} {a}, {y} {b}"))
+        .collect()
+}
+
+fn diff(
+    path: &str,
+    a: &serde_json::Value,
+    b: &serde_json::Value,
+    out: &mut Vec<(String, String, String)>,
+) {
     use serde_json::Value::Object;
     // The scene's source is its name only: the text hash and counts decide.
     if path == "scene.source" {
@@ -52,7 +65,7 @@ fn diff(path: &str, a: &serde_json::Value, b: &serde_json::Value, out: &mut Vec<
                 );
             }
         }
-        _ if a != b => out.push(format!("{path}: {a} in the record, {b} now")),
+        _ if a != b => out.push((path.to_string(), a.to_string(), b.to_string())),
         _ => {}
     }
 }

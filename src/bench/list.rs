@@ -26,16 +26,20 @@ pub fn load(dir: &Path, name: &str) -> Result<BenchRecord> {
 pub fn compare_saved(dir: &Path, a: &str, b: &str, threshold_pct: f64) -> Result<(String, bool)> {
     let (ra, rb) = (load(dir, a)?, load(dir, b)?);
     let c = compare(&ra, &rb, threshold_pct).map_err(|r| {
-        let why = match &r {
-            Refusal::Setup(_) => "they were measured with different setups",
-            Refusal::Incomparable(_) => {
-                "expected figures for every engine and stage of B, \
-                                          each a positive rate with a 95% interval, in both"
-            }
+        let (why, lines) = match &r {
+            Refusal::Setup(_) => (
+                "they were measured with different setups",
+                super::compare::setup_differences_as(&ra.setup, &rb.setup, "in A", "in B"),
+            ),
+            Refusal::Incomparable(l) => (
+                "expected figures for every engine and stage of B, each a positive rate with \
+                 a 95% interval, in both",
+                l.clone(),
+            ),
         };
         anyhow::anyhow!(
-            "cannot compare {a} with {b}: {why}:\n  {}",
-            r.lines().join("\n  ")
+            "cannot compare A = {a} with B = {b}: {why}:\n  {}",
+            lines.join("\n  ")
         )
     })?;
     let header = format!(
@@ -93,7 +97,20 @@ pub fn list(dir: &Path) -> Result<(String, Vec<String>)> {
                 .and_then(|e| e.summary.iter().find(|f| f.figure == "total"))
                 .map_or("-".to_string(), |f| format!("{:.2}", f.median / 1e6))
         };
-        let scene = crate::quote::quote(&r.setup.scene.source);
+        let source = crate::quote::escape(&r.setup.scene.source);
+        let scene: String = if source.chars().count() > 28 {
+            let tail: String = source
+                .chars()
+                .rev()
+                .take(27)
+                .collect::<Vec<_>>()
+                .into_iter()
+                .rev()
+                .collect();
+            format!("…{tail}")
+        } else {
+            source
+        };
         out.push_str(&format!(
             "{:<24} {:<20} {:<20} {:<28} {:<24} {:>7} {:>10} {:>10}\n",
             name,
