@@ -99,15 +99,7 @@ pub fn list(dir: &Path) -> Result<(String, Vec<String>)> {
         };
         let source = crate::quote::escape(&r.setup.scene.source);
         let scene: String = if source.chars().count() > 28 {
-            let tail: String = source
-                .chars()
-                .rev()
-                .take(27)
-                .collect::<Vec<_>>()
-                .into_iter()
-                .rev()
-                .collect();
-            format!("…{tail}")
+            format!("{}…", source.chars().take(27).collect::<String>())
         } else {
             source
         };
