@@ -299,3 +299,17 @@ fn bench_list_lists_records_and_skips_bad_ones_with_a_warning() {
         stderr(&out)
     );
 }
+
+#[test]
+fn another_simd_path_is_noted() {
+    let mut after = record(STEADY, STEADY);
+    after["simd"] = json!("sse2");
+    let c = compare(&parse(&record(STEADY, STEADY)), &parse(&after), 40.0).unwrap();
+    assert_eq!(c.notes.len(), 1, "{:?}", c.notes);
+    assert!(
+        c.notes[0].contains("simd avx2+fma") && c.notes[0].contains("simd sse2"),
+        "{:?}",
+        c.notes
+    );
+    assert!(!c.regressed());
+}
