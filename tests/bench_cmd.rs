@@ -368,3 +368,45 @@ fn a_missing_record_names_the_file_and_how_to_create_it() {
     assert_eq!(out.status.code(), Some(2));
     assert!(text(&out).1.contains("not usable"));
 }
+
+#[test]
+fn exports_may_not_overwrite_inputs_or_each_other_and_a_scene_named_list_is_dot_slash_list() {
+    let dir = common::bin::dir_with(&["cornell_box.obj"]);
+    let out = raywave(
+        dir.path(),
+        &["cornell_box.obj", "--export-csv", "cornell_box.obj"],
+    );
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        text(&out)
+            .1
+            .contains("--export-csv cornell_box.obj is the same file as the input SCENE"),
+        "{}",
+        text(&out).1
+    );
+    let out = raywave(
+        dir.path(),
+        &["--export-json", "-", "--export-markdown", "-"],
+    );
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        text(&out)
+            .1
+            .contains("--export-json - (standard output) and --export-markdown - (standard output) are the same file"),
+        "{}",
+        text(&out).1
+    );
+    // `-` alone: the export on stdout, the report on stderr.
+    let out = raywave(dir.path(), &["--export-csv", "-"]);
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stdout.starts_with("point,scene,width"), "{stdout}");
+    assert!(stderr.contains("reference  total"), "{stderr}");
+    // A scene file named like a subcommand.
+    std::fs::copy(dir.path().join("cornell_box.obj"), dir.path().join("list")).unwrap();
+    let out = raywave(dir.path(), &["./list", "--json", "r.json", "-q"]);
+    assert!(out.status.success(), "{}", text(&out).1);
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("r.json")).unwrap()).unwrap();
+    assert_eq!(r["setup"]["scene"]["source"], "./list");
+}
