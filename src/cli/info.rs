@@ -9,7 +9,10 @@ pub fn run() -> Result<()> {
     raywave::terminal::print(&format!(
         "raywave {}\ncommit  {}\nbuild   {} · {}\nrustflags {}\nfeatures {}\nsimd    {}\nthreads {} (rayon default; --threads N to change)\n",
         env!("CARGO_PKG_VERSION"),
-        b.short_commit(),
+        match b.dirty {
+            Some(true) => format!("{} (dirty)", b.commit),
+            _ => b.commit.clone(),
+        },
         b.profile,
         b.target,
         if b.rustflags.is_empty() {
