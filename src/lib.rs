@@ -53,6 +53,7 @@
 #![warn(missing_docs)]
 
 pub mod bench;
+pub mod build_info;
 pub mod camera;
 pub mod debug_view;
 pub mod engine;

@@ -6,8 +6,7 @@
 
 mod cli;
 
-use clap::Parser;
-use cli::{Cli, Command};
+use cli::Command;
 use raywave::error::UsageError;
 use std::process::ExitCode;
 
@@ -19,8 +18,8 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    let cli = match Cli::try_parse_from(&normalized.args) {
-        Ok(cli) => cli,
+    let (cli, matches) = match cli::parse(&normalized.args) {
+        Ok(parsed) => parsed,
         // --help and --version.
         Err(e) if !e.use_stderr() => e.exit(),
         // Usage errors name the flags as typed (`-num_bounces`, not `--bounces`).
@@ -53,7 +52,7 @@ fn main() -> ExitCode {
         Command::View(args) => cli::view::run(&args),
         Command::TracePixel(args) => cli::trace_pixel::run(&args),
         // Exit 3 when --compare finds a regression (raywave::bench::EXIT_REGRESSION).
-        Command::Bench(args) => match cli::bench::run(&args) {
+        Command::Bench(args) => match cli::bench::run(&args, matches.subcommand_matches("bench")) {
             Ok(code) => return ExitCode::from(code),
             Err(e) => Err(e),
         },

@@ -45,7 +45,7 @@ const MANUAL: [(&str, &str); 3] = [
 /// gives is replaced, one it lacks is added. docs/BENCHMARKING.md repeats this table.
 const QUICK: [(&str, &str, &[&str]); 10] = [
     ("bench", "--size", &["24", "24"]),
-    ("bench", "--runs", &["1"]),
+    ("bench", "--runs", &["6"]),
     ("bench", "--shadow-samples", &["4"]),
     ("render", "--size", &["24", "24"]),
     ("render", "--shadow-samples", &["4"]),
@@ -213,6 +213,10 @@ fn check_cargo(words: &[&str]) -> Result<(), String> {
 /// (which the A/B mode does not take).
 fn shorten(words: &[&str]) -> Vec<String> {
     let sub = words.get(1).copied().unwrap_or("");
+    // `bench compare A B` and `bench list` read saved records and take no image flags.
+    if sub == "bench" && matches!(words.get(2).copied(), Some("compare" | "list")) {
+        return words.iter().map(|w| w.to_string()).collect();
+    }
     let mut out: Vec<String> = words.iter().map(|w| w.to_string()).collect();
     if let Some(i) = out.iter().position(|w| w == "--against") {
         out[i + 1] = env!("CARGO_BIN_EXE_raywave").to_string();
@@ -223,12 +227,17 @@ fn shorten(words: &[&str]) -> Vec<String> {
         if s != sub || (ab && flag == "--runs") {
             continue;
         }
-        if let Some(i) = out.iter().position(|w| w == flag) {
-            out.splice(
-                i + 1..i + 1 + values.len(),
-                values.iter().map(|v| v.to_string()),
-            );
-        } else {
+        // Every occurrence is shortened (a sweep repeats `--size`); the k-th size is made
+        // 8k pixels wider, so that the points of a sweep stay distinct.
+        let at: Vec<usize> = (0..out.len()).filter(|&i| out[i] == flag).collect();
+        for (k, &i) in at.iter().enumerate() {
+            let mut values: Vec<String> = values.iter().map(|v| v.to_string()).collect();
+            if flag == "--size" {
+                values[0] = (24 + 8 * k).to_string();
+            }
+            out.splice(i + 1..i + 1 + values.len(), values);
+        }
+        if at.is_empty() {
             out.push(flag.to_string());
             out.extend(values.iter().map(|v| v.to_string()));
         }
@@ -344,7 +353,8 @@ fn raywave_commands_run_in_page_order() {
         let code = out.status.code();
         // A comparison of sub-millisecond renders may call noise a regression (exit 3); it must
         // still have compared.
-        let compared = (words.contains(&"--compare") && stdout.contains("verdict:")
+        let compared = ((words.contains(&"--compare") || words.get(2) == Some(&"compare"))
+            && stdout.contains("verdict:")
             || words.contains(&"--against") && stdout.contains("95% interval"))
             && code == Some(3);
         assert!(

@@ -9,8 +9,8 @@ mod common;
 
 use common::hostile::{Case, TIMEOUT, check_all, run, setup};
 use std::path::Path;
-/// The smallest bench: 8×8, one run.
-const BENCH: &[&str] = &["bench", "--size", "8", "8", "--runs", "1", "-q"];
+/// The smallest bench that can be compared: 8×8, six runs (the fewest with a 95% interval).
+const BENCH: &[&str] = &["bench", "--size", "8", "8", "--runs", "6", "-q"];
 
 fn bench(extra: &[&'static str]) -> &'static [&'static str] {
     Box::leak([BENCH, extra].concat().into_boxed_slice())
@@ -43,11 +43,17 @@ fn refused(name: &'static str, setup: fn(&Path), why: &'static str) -> Case {
     }
 }
 
-/// The median figures of `engine` in a record.
-fn median<'a>(json: &'a mut serde_json::Value, engine: &str) -> &'a mut serde_json::Value {
+/// The headline figure `figure` ("total", "stage generate") of `engine` in a record: its
+/// summary, on which verdicts are decided.
+fn figure<'a>(
+    json: &'a mut serde_json::Value,
+    engine: &str,
+    figure: &str,
+) -> &'a mut serde_json::Value {
     let engines = json["engines"].as_array_mut().unwrap();
     let e = engines.iter_mut().find(|e| e["engine"] == engine).unwrap();
-    &mut e["median"]
+    let summary = e["summary"].as_array_mut().unwrap();
+    summary.iter_mut().find(|f| f["figure"] == figure).unwrap()
 }
 
 #[test]
@@ -71,39 +77,46 @@ fn records_with_nothing_valid_to_compare_are_refused() {
         ),
         refused(
             "a record whose total rate is zero",
-            |d| {
-                doctored_record(d, |j| {
-                    median(j, "reference")["rates"]["total_per_second"] = 0.into()
-                })
-            },
-            "engine reference: total rate 0, expected a positive number",
+            |d| doctored_record(d, |j| figure(j, "reference", "total")["median"] = 0.into()),
+            "engine reference total: rate 0, expected a positive number",
         ),
         refused(
             "a record whose total rate is negative",
             |d| {
                 doctored_record(d, |j| {
-                    median(j, "wavefront")["rates"]["total_per_second"] = (-5.0).into()
+                    figure(j, "wavefront", "total")["median"] = (-5.0).into()
                 })
             },
-            "engine wavefront: total rate -5, expected a positive number",
+            "engine wavefront total: rate -5, expected a positive number",
         ),
         refused(
             "a record whose stage rate is zero",
             |d| {
                 doctored_record(d, |j| {
-                    median(j, "wavefront")["stages"][0]["rays_per_thread_second"] = 0.into()
+                    figure(j, "wavefront", "stage generate")["median"] = 0.into()
                 })
             },
             "stage generate: rate 0",
         ),
         refused(
+            "a record without intervals (fewer than 6 runs)",
+            |d| {
+                doctored_record(d, |j| {
+                    figure(j, "wavefront", "total")["low"] = serde_json::Value::Null
+                })
+            },
+            "engine wavefront total: no 95% interval",
+        ),
+        refused(
             "a record without a stage this run has",
             |d| {
                 doctored_record(d, |j| {
-                    median(j, "wavefront")["stages"]
-                        .as_array_mut()
-                        .unwrap()
-                        .remove(0);
+                    let engines = j["engines"].as_array_mut().unwrap();
+                    let e = engines
+                        .iter_mut()
+                        .find(|e| e["engine"] == "wavefront")
+                        .unwrap();
+                    e["summary"].as_array_mut().unwrap().remove(1);
                 })
             },
             "engine wavefront has no figure for stage generate",
@@ -123,7 +136,7 @@ fn records_that_do_not_parse_name_the_file_and_what_was_expected() {
             "a record with a NaN rate (null in JSON)",
             |d| {
                 doctored_record(d, |j| {
-                    median(j, "wavefront")["rates"]["total_per_second"] = serde_json::Value::Null
+                    figure(j, "wavefront", "total")["median"] = serde_json::Value::Null
                 })
             },
             "not a valid bench record: invalid type: null, expected f64",
@@ -132,7 +145,7 @@ fn records_that_do_not_parse_name_the_file_and_what_was_expected() {
             "a record with a word for a rate",
             |d| {
                 doctored_record(d, |j| {
-                    median(j, "wavefront")["rates"]["total_per_second"] = "fast".into()
+                    figure(j, "wavefront", "total")["median"] = "fast".into()
                 })
             },
             "invalid type: string \"fast\", expected f64",
@@ -208,10 +221,11 @@ fn records_that_do_not_parse_name_the_file_and_what_was_expected() {
 /// `good`, doctored 1000× faster than any run can be, so that comparing with it regresses.
 fn inflated(dir: &Path) {
     doctored_record(dir, |j| {
-        for e in j["engines"].as_array_mut().unwrap() {
-            let m = &mut e["median"];
-            let total = m["rates"]["total_per_second"].as_f64().unwrap();
-            m["rates"]["total_per_second"] = (total * 1000.0).into();
+        for e in ["reference", "wavefront"] {
+            let f = figure(j, e, "total");
+            for k in ["min", "low", "median", "high", "max"] {
+                f[k] = (f[k].as_f64().unwrap() * 1000.0).into();
+            }
         }
     })
 }

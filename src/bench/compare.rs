@@ -1,19 +1,45 @@
-//! Comparing two bench records: refuse different setups, then a before/after table and the
-//! verdict. Pure functions of the two records and the threshold.
+//! Comparing two bench records: refuse different setups, then a before/after table of the
+//! headline figures and the verdict. Pure functions of the two records and the threshold.
+//!
+//! The rule (docs/BENCHMARKING.md, "The verdict"): a headline figure **regressed** when both
+//!
+//! ```text
+//! (after.median − before.median) / before.median < −threshold      the effect is large enough
+//! after.high < before.low                                          and beyond the noise: the
+//!                                                                  95% intervals of the two
+//!                                                                  medians do not overlap
+//! ```
+//!
+//! and is **faster** in the mirror case (+threshold, after.low > before.high). Either alone is
+//! not enough: a large change with overlapping intervals is noise a few runs could produce, a
+//! small change with separate intervals is real but below what the threshold says matters.
 
-use super::record::{BenchRecord, Measurement, Setup};
+use super::record::{BenchRecord, FigureSummary, Setup};
 use std::fmt::Write;
 
-/// The fields in which two setups differ, as `path: before -> after` lines (empty if none).
+/// The fields in which two setups differ, as `path: X in the record, Y now` lines (empty if
+/// none).
 pub fn setup_differences(before: &Setup, after: &Setup) -> Vec<String> {
-    let a = serde_json::to_value(before).unwrap_or_default();
-    let b = serde_json::to_value(after).unwrap_or_default();
-    let mut out = Vec::new();
-    diff("", &a, &b, &mut out);
-    out
+    setup_differences_as(before, after, "in the record", "now")
 }
 
-fn diff(path: &str, a: &serde_json::Value, b: &serde_json::Value, out: &mut Vec<String>) {
+/// [`setup_differences`] with the two sides named (`in A`, `in B`).
+pub fn setup_differences_as(before: &Setup, after: &Setup, a: &str, b: &str) -> Vec<String> {
+    let va = serde_json::to_value(before).unwrap_or_default();
+    let vb = serde_json::to_value(after).unwrap_or_default();
+    let mut out = Vec::new();
+    diff("", &va, &vb, &mut out);
+    out.into_iter()
+        .map(|(path, x, y)| format!("{path}: {x} {a}, {y} {b}"))
+        .collect()
+}
+
+fn diff(
+    path: &str,
+    a: &serde_json::Value,
+    b: &serde_json::Value,
+    out: &mut Vec<(String, String, String)>,
+) {
     use serde_json::Value::Object;
     // The scene's source is its name only: the text hash and counts decide.
     if path == "scene.source" {
@@ -39,36 +65,88 @@ fn diff(path: &str, a: &serde_json::Value, b: &serde_json::Value, out: &mut Vec<
                 );
             }
         }
-        _ if a != b => out.push(format!("{path}: {a} in the record, {b} now")),
+        _ if a != b => out.push((path.to_string(), a.to_string(), b.to_string())),
         _ => {}
     }
 }
 
-/// One line of the before/after table.
+/// What the rule says of one headline figure.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Verdict {
+    /// Fell by more than the threshold, and the intervals do not overlap.
+    Regressed,
+    /// Rose by more than the threshold, and the intervals do not overlap.
+    Faster,
+    /// Changed by more than the threshold, but the intervals overlap: noise could explain it.
+    WithinNoise,
+    /// The intervals do not overlap, but the change is within the threshold.
+    WithinThreshold,
+    /// Within the threshold, intervals overlapping.
+    NoChange,
+}
+
+impl Verdict {
+    /// The word printed in the table.
+    pub fn label(self) -> &'static str {
+        match self {
+            Verdict::Regressed => "REGRESSED",
+            Verdict::Faster => "faster",
+            Verdict::WithinNoise => "noise (intervals overlap)",
+            Verdict::WithinThreshold => "within threshold",
+            Verdict::NoChange => "no change",
+        }
+    }
+}
+
+/// The rule, on the summaries of one figure before and after (rates: higher is better).
+/// A figure without an interval on either side, or whose `after` median is not a positive
+/// finite rate, is decided by [`compare`] before this is called.
+pub fn verdict(before: &FigureSummary, after: &FigureSummary, threshold_pct: f64) -> Verdict {
+    let change = change_pct(before.median, after.median);
+    let (Some(bl), Some(bh), Some(al), Some(ah)) = (before.low, before.high, after.low, after.high)
+    else {
+        return Verdict::WithinNoise;
+    };
+    let apart_below = ah < bl;
+    let apart_above = al > bh;
+    if change < -threshold_pct {
+        if apart_below {
+            Verdict::Regressed
+        } else {
+            Verdict::WithinNoise
+        }
+    } else if change > threshold_pct {
+        if apart_above {
+            Verdict::Faster
+        } else {
+            Verdict::WithinNoise
+        }
+    } else if apart_below || apart_above {
+        Verdict::WithinThreshold
+    } else {
+        Verdict::NoChange
+    }
+}
+
+/// One headline figure of one engine, before and after.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Row {
     /// Engine name.
     pub engine: String,
-    /// "kind" (rays per wall-clock second) or "stage" (rays per thread-second).
-    pub section: &'static str,
-    /// Kind or stage name.
-    pub name: String,
-    /// Rays/s in the saved record.
-    pub before: f64,
-    /// Rays/s now.
-    pub after: f64,
-    /// (after − before) / before, in percent (0 when before is 0).
+    /// Before (the saved record, or A).
+    pub before: FigureSummary,
+    /// After (this run, or B).
+    pub after: FigureSummary,
+    /// (after − before) / before of the medians, in percent.
     pub change_pct: f64,
-    /// A headline figure: each engine's total and each stage; these decide the verdict.
-    pub headline: bool,
-    /// A headline figure that fell by more than the threshold.
-    pub regressed: bool,
+    /// What the rule says.
+    pub verdict: Verdict,
 }
 
 /// The comparison of two records with equal setups.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Comparison {
-    /// Every row, engine by engine: kinds, then stages.
+    /// Every headline figure, engine by engine: total, then stages.
     pub rows: Vec<Row>,
     /// The threshold used, in percent.
     pub threshold_pct: f64,
@@ -76,46 +154,60 @@ pub struct Comparison {
     pub notes: Vec<String>,
 }
 
+/// The figure in the unit the tables print (Mrays/s or Mrays/thread-s).
+fn mega(x: f64) -> f64 {
+    x / 1e6
+}
+
 impl Comparison {
     /// Whether any headline figure regressed.
     pub fn regressed(&self) -> bool {
-        self.rows.iter().any(|r| r.regressed)
+        self.rows.iter().any(|r| r.verdict == Verdict::Regressed)
     }
 
-    /// The before/after table, the notes and the verdict, as printed.
+    /// The before/after table, the rule, the notes and the verdict, as `raywave bench
+    /// --compare` prints them (columns "before" and "after").
     pub fn table(&self) -> String {
+        self.table_with("before", "after")
+    }
+
+    /// The table with the two columns named `a` and `b` (`raywave bench compare A B`).
+    pub fn table_with(&self, a: &str, b: &str) -> String {
         let mut s = String::new();
+        let cell =
+            |f: &FigureSummary| format!("{:.2} {}", mega(f.median), f.interval_text(1e-6, 2));
         let _ = writeln!(
             s,
-            "{:<10} {:<18} {:>12} {:>12} {:>9}",
-            "engine", "figure", "before", "after", "change"
+            "{:<10} {:<17} {:>26} {:>26} {:>8}  verdict",
+            "engine",
+            "figure",
+            format!("{a} [95% interval]"),
+            format!("{b} [95% interval]"),
+            "change"
         );
         for r in &self.rows {
-            let figure = format!(
-                "{} {}",
-                r.name,
-                if r.section == "kind" { "" } else { "(stage)" }
-            );
-            let mark = match (r.headline, r.regressed) {
-                (_, true) => "  REGRESSED",
-                (true, false) => "  *",
-                _ => "",
-            };
             let _ = writeln!(
                 s,
-                "{:<10} {:<18} {:>12.2} {:>12.2} {:>+8.1}%{mark}",
+                "{:<10} {:<17} {:>26} {:>26} {:>+7.1}%  {}",
                 r.engine,
-                figure.trim_end(),
-                r.before / 1e6,
-                r.after / 1e6,
+                r.after.figure,
+                cell(&r.before),
+                cell(&r.after),
                 r.change_pct,
+                r.verdict.label()
             );
         }
         let _ = writeln!(
             s,
-            "totals in Mrays/s (wall clock), kinds and stages in Mrays/thread-s; \
-             * = headline figure, checked against the threshold of -{:.1}%",
-            self.threshold_pct
+            "totals in Mrays/s (wall clock), kinds and stages in Mrays/thread-s; medians of {} and {} run(s)",
+            self.rows.first().map_or(0, |r| r.before.runs),
+            self.rows.first().map_or(0, |r| r.after.runs),
+        );
+        let _ = writeln!(
+            s,
+            "rule: REGRESSED when the median fell by more than {t:.1}% and the 95% intervals do \
+             not overlap ({b}'s high < {a}'s low); faster in the mirror case",
+            t = self.threshold_pct
         );
         for n in &self.notes {
             let _ = writeln!(s, "note: {n}");
@@ -123,13 +215,22 @@ impl Comparison {
         let regressed: Vec<String> = self
             .rows
             .iter()
-            .filter(|r| r.regressed)
-            .map(|r| format!("{} {} {:+.1}%", r.engine, r.name, r.change_pct))
+            .filter(|r| r.verdict == Verdict::Regressed)
+            .map(|r| {
+                format!(
+                    "{} {} {:+.1}% ({} < {})",
+                    r.engine,
+                    r.after.figure,
+                    r.change_pct,
+                    r.after.interval_text(1e-6, 2),
+                    r.before.interval_text(1e-6, 2)
+                )
+            })
             .collect();
         if regressed.is_empty() {
             let _ = writeln!(
                 s,
-                "verdict: no headline figure fell by more than {:.1}%",
+                "verdict: no headline figure regressed (threshold {:.1}%)",
                 self.threshold_pct
             );
         } else {
@@ -158,8 +259,8 @@ pub fn change_pct(before: f64, after: f64) -> f64 {
 pub enum Refusal {
     /// The setups differ (`path: before -> after` lines): the figures describe other work.
     Setup(Vec<String>),
-    /// The saved record lacks figures this run has, or holds figures that are not positive
-    /// finite rates: a verdict on them could not fail.
+    /// A record lacks figures the other has, holds figures that are not positive finite
+    /// rates, or has no intervals (fewer than 6 runs): a verdict on them could not fail.
     Incomparable(Vec<String>),
 }
 
@@ -177,9 +278,10 @@ fn usable(rate: f64) -> bool {
     rate.is_finite() && rate > 0.0
 }
 
-/// What in `record` keeps it from being compared with a run of `engines`: an engine it lacks,
-/// a headline figure (an engine's total, a stage that handled rays) that is not a positive
-/// finite rate. Empty when it can be compared. Checked before anything is timed.
+/// What in `record` keeps it from being compared with a run of `engines`: an engine it lacks
+/// or that has no summary, a headline figure (an engine's total, a stage that handled rays)
+/// whose median is not a positive finite rate or that has no 95% interval (fewer than 6
+/// runs). Empty when it can be compared. Checked before anything is timed.
 pub fn record_problems(record: &BenchRecord, engines: &[&str]) -> Vec<String> {
     let mut out = Vec::new();
     if record.engines.is_empty() {
@@ -198,30 +300,48 @@ pub fn record_problems(record: &BenchRecord, engines: &[&str]) -> Vec<String> {
             ));
         }
     }
-    for e in &record.engines {
-        let total = e.median.rays_per_second.total;
-        if !usable(total) {
-            out.push(format!(
-                "engine {}: total rate {total}, expected a positive number of rays per second",
-                e.engine
-            ));
+    for e in record
+        .engines
+        .iter()
+        .filter(|e| engines.contains(&e.engine.as_str()))
+    {
+        if !e.summary.iter().any(|f| f.figure == "total") {
+            out.push(format!("engine {}: no total figure", e.engine));
         }
-        for st in e.median.stages.iter().filter(|st| st.rays > 0) {
-            if !usable(st.rays_per_thread_second) {
+        for f in &e.summary {
+            if !usable(f.median) {
+                let what = if f.figure == "total" {
+                    "rays per second"
+                } else {
+                    "rays per thread-second"
+                };
                 out.push(format!(
-                    "engine {} stage {}: rate {}, expected a positive number of rays per \
-                     thread-second",
-                    e.engine, st.stage, st.rays_per_thread_second
+                    "engine {} {}: rate {}, expected a positive number of {what}",
+                    e.engine, f.figure, f.median
                 ));
+            }
+            match (f.low, f.high) {
+                (Some(l), Some(h)) if l <= f.median && f.median <= h => {}
+                (Some(l), Some(h)) => out.push(format!(
+                    "engine {} {}: interval [{l}, {h}] does not hold its median {}",
+                    e.engine, f.figure, f.median
+                )),
+                _ => out.push(format!(
+                    "engine {} {}: no 95% interval ({} run(s); at least {} needed)",
+                    e.engine,
+                    f.figure,
+                    f.runs,
+                    crate::statistics::MIN_FOR_INTERVAL
+                )),
             }
         }
     }
     out
 }
 
-/// Compares `after` against `before`. Refused when the setups differ, and when any headline
-/// figure of `after` has nothing valid to compare with in `before` (a verdict that cannot
-/// fail is not given).
+/// Compares `after` against `before` by the rule of [`verdict`]. Refused when the setups
+/// differ, and when any headline figure of `after` has nothing valid to compare with in
+/// `before` (a verdict that cannot fail is not given).
 pub fn compare(
     before: &BenchRecord,
     after: &BenchRecord,
@@ -234,43 +354,60 @@ pub fn compare(
     let engines: Vec<&str> = after.engines.iter().map(|e| e.engine.as_str()).collect();
     let mut problems = record_problems(before, &engines);
     if after.engines.is_empty() {
-        problems.push("this run measured no engine".to_string());
+        problems.push("the newer record measured no engine".to_string());
     }
+    let mut rows = Vec::new();
     for a in &after.engines {
         let Some(b) = before.engines.iter().find(|b| b.engine == a.engine) else {
             continue;
         };
-        for st in a.median.stages.iter().filter(|st| st.rays > 0) {
-            match b.median.stages.iter().find(|sb| sb.stage == st.stage) {
-                None => problems.push(format!(
-                    "engine {} has no figure for stage {}",
-                    a.engine, st.stage
-                )),
-                // A stage idle in the record but not now: its zero rate cannot be compared.
-                Some(sb) if sb.rays == 0 && !usable(sb.rays_per_thread_second) => {
-                    problems.push(format!(
-                        "engine {} stage {}: no rays in the record, {} now",
-                        a.engine, st.stage, st.rays
-                    ))
-                }
-                Some(_) => {}
+        for fa in &a.summary {
+            let Some(fb) = b.summary.iter().find(|fb| fb.figure == fa.figure) else {
+                problems.push(format!(
+                    "engine {} has no figure for {}",
+                    a.engine, fa.figure
+                ));
+                continue;
+            };
+            if fa.low.is_none() || fa.high.is_none() {
+                problems.push(format!(
+                    "engine {} {} of the newer run: no 95% interval ({} run(s); at least {} \
+                     needed)",
+                    a.engine,
+                    fa.figure,
+                    fa.runs,
+                    crate::statistics::MIN_FOR_INTERVAL
+                ));
+                continue;
             }
+            let change_pct = change_pct(fb.median, fa.median);
+            // A figure of the newer run that is not a positive finite rate (with a positive one
+            // before) fails: it is no evidence of speed.
+            let verdict = if usable(fa.median) {
+                verdict(fb, fa, threshold_pct)
+            } else {
+                Verdict::Regressed
+            };
+            rows.push(Row {
+                engine: a.engine.clone(),
+                before: fb.clone(),
+                after: fa.clone(),
+                change_pct,
+                verdict,
+            });
         }
     }
     if !problems.is_empty() {
         return Err(Refusal::Incomparable(problems));
     }
-    let mut rows = Vec::new();
     let mut notes = Vec::new();
     for a in &after.engines {
-        let Some(b) = before.engines.iter().find(|b| b.engine == a.engine) else {
-            continue;
-        };
-        engine_rows(&a.engine, &b.median, &a.median, threshold_pct, &mut rows);
-        if b.median.rays != a.median.rays {
+        if let Some(b) = before.engines.iter().find(|b| b.engine == a.engine)
+            && b.median.rays != a.median.rays
+        {
             notes.push(format!(
-                "{}: ray counts differ ({} rays in the record, {} now): the engines no longer \
-                 do the same work",
+                "{}: ray counts differ ({} rays before, {} after): the engines no longer do \
+                 the same work",
                 a.engine,
                 b.median.rays.total(),
                 a.median.rays.total()
@@ -280,7 +417,7 @@ pub fn compare(
     let (mb, ma) = (&before.machine, &after.machine);
     if (&mb.hostname, &mb.cpu, &before.simd) != (&ma.hostname, &ma.cpu, &after.simd) {
         notes.push(format!(
-            "the record was made on {} ({}, simd {}), this run on {} ({}, simd {})",
+            "the records were made on {} ({}, simd {}) and {} ({}, simd {})",
             mb.hostname, mb.cpu, before.simd, ma.hostname, ma.cpu, after.simd
         ));
     }
@@ -291,255 +428,59 @@ pub fn compare(
     })
 }
 
-fn engine_rows(
-    engine: &str,
-    b: &Measurement,
-    a: &Measurement,
-    threshold: f64,
-    rows: &mut Vec<Row>,
-) {
-    let mut push = |section: &'static str, name: &str, before: f64, after: f64, headline: bool| {
-        let change = change_pct(before, after);
-        rows.push(Row {
-            engine: engine.to_string(),
-            section,
-            name: name.to_string(),
-            before,
-            after,
-            change_pct: change,
-            headline,
-            // A headline figure of this run that is not a positive finite rate (with a
-            // positive one in the record) fails too: it is no evidence of speed.
-            regressed: headline && usable(before) && (!usable(after) || change < -threshold),
-        });
-    };
-    for ((name, before), (_, after)) in b
-        .rays_per_second
-        .rows()
-        .iter()
-        .zip(a.rays_per_second.rows())
-    {
-        push("kind", name, *before, after, *name == "total");
-    }
-    // A stage that handled no rays in either record (no shadow rays with shadows off) has no
-    // rate to compare; it is shown and does not gate.
-    for sa in &a.stages {
-        let idle = sa.rays == 0;
-        let before = b
-            .stages
-            .iter()
-            .find(|sb| sb.stage == sa.stage)
-            .map_or(0.0, |sb| sb.rays_per_thread_second);
-        push("stage", &sa.stage, before, sa.rays_per_thread_second, !idle);
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bench::record::*;
-    use crate::settings::RenderSettings;
-    use crate::stats::RayCounts;
 
-    fn measurement(total_scale: f64, stage_scale: f64) -> Measurement {
-        let rays = RayCounts {
-            camera: 100,
-            shadow: 1000,
-            reflection: 10,
-        };
-        Measurement {
-            seconds: 1.0 / total_scale,
-            rays,
-            rays_per_second: KindRates {
-                // Each kind falls with the total: shown, never gating.
-                camera: Some(100.0 * total_scale),
-                shadow: Some(1000.0 * total_scale),
-                reflection: Some(10.0 * total_scale),
-                ..KindRates::new(&rays, 1.0 / total_scale)
-            },
-            stages: ["generate", "shadow"]
-                .iter()
-                .map(|s| StageFigure {
-                    stage: s.to_string(),
-                    rays: 100,
-                    thread_seconds: 1.0 / stage_scale,
-                    rays_per_thread_second: 100.0 * stage_scale,
-                })
-                .collect(),
-        }
-    }
-
-    fn record(total_scale: f64, stage_scale: f64) -> BenchRecord {
-        let m = measurement(total_scale, stage_scale);
-        BenchRecord {
-            format: FORMAT,
-            raywave: "0".into(),
-            git_commit: "unknown".into(),
-            git_dirty: None,
-            timestamp: rfc3339_utc(0),
-            machine: Machine {
-                hostname: "h".into(),
-                cpu: "c".into(),
-                logical_cpus: 2,
-                os: "linux".into(),
-                arch: "x86_64".into(),
-            },
-            simd: "s".into(),
-            setup: Setup {
-                scene: SceneId {
-                    source: "a.obj".into(),
-                    text_hash: "00".into(),
-                    triangles: 12,
-                    spheres: 3,
-                    lights: 1,
-                },
-                settings: RenderSettings::preview(),
-                threads: 2,
-                batch_size: 4096,
-            },
-            runs: 1,
-            engines: vec![EngineRecord {
-                engine: "wavefront".into(),
-                median: m.clone(),
-                runs: vec![m],
-            }],
+    fn fig(median: f64, low: f64, high: f64) -> FigureSummary {
+        FigureSummary {
+            figure: "total".into(),
+            unit: "rays/s".into(),
+            runs: 10,
+            min: low,
+            median,
+            low: Some(low),
+            high: Some(high),
+            max: high,
+            outliers: vec![],
         }
     }
 
     #[test]
-    fn equal_records_pass() {
-        let c = compare(&record(1.0, 1.0), &record(1.0, 1.0), 10.0).unwrap();
-        assert!(!c.regressed());
-        assert!(c.rows.iter().all(|r| r.change_pct == 0.0));
-        assert!(c.table().contains("verdict: no headline figure fell"));
-    }
-
-    #[test]
-    fn threshold_is_strict_and_one_sided() {
-        // 9% slower total: within a 10% threshold; 11% slower: past it.
-        assert!(
-            !compare(&record(1.0, 1.0), &record(0.91, 1.0), 10.0)
-                .unwrap()
-                .regressed()
-        );
-        let c = compare(&record(1.0, 1.0), &record(0.89, 1.0), 10.0).unwrap();
-        assert!(c.regressed());
-        let bad: Vec<_> = c
-            .rows
-            .iter()
-            .filter(|r| r.regressed)
-            .map(|r| r.name.as_str())
-            .collect();
-        assert_eq!(bad, ["total"], "per-kind rates are shown but do not gate");
-        // Faster is never a regression.
-        assert!(
-            !compare(&record(1.0, 1.0), &record(5.0, 5.0), 1.0)
-                .unwrap()
-                .regressed()
-        );
-    }
-
-    #[test]
-    fn a_stage_alone_regresses() {
-        let c = compare(&record(1.0, 1.0), &record(1.0, 0.5), 10.0).unwrap();
-        let bad: Vec<_> = c
-            .rows
-            .iter()
-            .filter(|r| r.regressed)
-            .map(|r| r.name.as_str())
-            .collect();
-        assert_eq!(bad, ["generate", "shadow"]);
-        let table = c.table();
-        assert!(table.contains("-50.0%  REGRESSED"), "{table}");
-        assert!(
-            table.contains("verdict: REGRESSION past 10.0%: wavefront generate -50.0%"),
-            "{table}"
-        );
-    }
-
-    #[test]
-    fn records_with_nothing_valid_to_compare_are_refused() {
-        let refused = |before: &BenchRecord| match compare(before, &record(1.0, 1.0), 10.0) {
-            Err(Refusal::Incomparable(lines)) => lines.join("; "),
-            other => panic!("{other:?}"),
-        };
-        for bad in [0.0, -5.0, f64::NAN, f64::INFINITY] {
-            let mut before = record(1.0, 1.0);
-            before.engines[0].median.stages[0].rays_per_thread_second = bad;
-            assert!(refused(&before).contains("stage generate: rate"), "{bad}");
-            let mut before = record(1.0, 1.0);
-            before.engines[0].median.rays_per_second.total = bad;
-            assert!(refused(&before).contains("total rate"), "{bad}");
-        }
-        let mut before = record(1.0, 1.0);
-        before.engines.clear();
-        assert!(refused(&before).contains("no engines"));
-        before = record(1.0, 1.0);
-        before.engines[0].engine = "other".into();
-        assert!(refused(&before).contains("no figures for engine wavefront (it holds other)"));
-        before = record(1.0, 1.0);
-        before.engines[0].median.stages.pop();
-        assert!(refused(&before).contains("no figure for stage shadow"));
-        assert_eq!(change_pct(0.0, 5.0), 0.0);
-    }
-
-    #[test]
-    fn a_rate_of_this_run_that_is_not_positive_regresses() {
-        let mut after = record(1.0, 1.0);
-        after.engines[0].median.rays_per_second.total = f64::NAN;
-        assert!(
-            compare(&record(1.0, 1.0), &after, 10.0)
-                .unwrap()
-                .regressed()
-        );
-    }
-
-    #[test]
-    fn idle_stages_do_not_gate() {
-        let mut before = record(1.0, 1.0);
-        let mut after = record(1.0, 1.0);
-        for r in [&mut before, &mut after] {
-            let st = &mut r.engines[0].median.stages[1];
-            st.rays = 0;
-            st.rays_per_thread_second = 0.0;
-        }
-        let c = compare(&before, &after, 10.0).unwrap();
-        assert!(!c.regressed());
-        assert!(!c.rows.iter().any(|r| r.name == "shadow" && r.headline));
-    }
-
-    #[test]
-    fn different_setups_are_refused() {
-        let mut after = record(1.0, 1.0);
-        after.setup.settings.bounces += 1;
-        after.setup.threads = 1;
-        after.setup.scene.source = "renamed.obj".into();
-        let e = compare(&record(1.0, 1.0), &after, 10.0).unwrap_err();
+    fn the_rule_needs_both_effect_and_separation() {
+        let before = fig(100.0, 95.0, 105.0);
+        // -50%, apart: regressed.
         assert_eq!(
-            e.lines(),
-            [
-                "settings.bounces: 2 in the record, 3 now",
-                "threads: 2 in the record, 1 now"
-            ]
+            verdict(&before, &fig(50.0, 45.0, 55.0), 10.0),
+            Verdict::Regressed
         );
-        let mut edited = record(1.0, 1.0);
-        edited.setup.scene.text_hash = "01".into();
+        // -50% but a wide interval reaching the old one: noise.
         assert_eq!(
-            compare(&record(1.0, 1.0), &edited, 10.0)
-                .unwrap_err()
-                .lines()
-                .len(),
-            1
+            verdict(&before, &fig(50.0, 40.0, 96.0), 10.0),
+            Verdict::WithinNoise
         );
-    }
-
-    #[test]
-    fn other_machine_and_counts_are_noted() {
-        let mut after = record(1.0, 1.0);
-        after.machine.hostname = "other".into();
-        after.engines[0].median.rays.shadow += 1;
-        let c = compare(&record(1.0, 1.0), &after, 10.0).unwrap();
-        assert_eq!(c.notes.len(), 2, "{:?}", c.notes);
-        assert!(!c.regressed());
+        // -8%, apart: real but within the threshold.
+        assert_eq!(
+            verdict(&before, &fig(92.0, 91.0, 94.0), 10.0),
+            Verdict::WithinThreshold
+        );
+        // Touching ends overlap.
+        assert_eq!(
+            verdict(&before, &fig(50.0, 45.0, 95.0), 10.0),
+            Verdict::WithinNoise
+        );
+        assert_eq!(
+            verdict(&before, &fig(101.0, 97.0, 104.0), 10.0),
+            Verdict::NoChange
+        );
+        assert_eq!(
+            verdict(&before, &fig(200.0, 190.0, 210.0), 10.0),
+            Verdict::Faster
+        );
+        // Exactly the threshold is not past it.
+        assert_eq!(
+            verdict(&before, &fig(90.0, 85.0, 91.0), 10.0),
+            Verdict::WithinThreshold
+        );
     }
 }

@@ -14,7 +14,9 @@ use std::path::Path;
 /// The layout version of bench records and `--stats-json` files (both carry it as `format`),
 /// bumped when either layout changes; records of another version are refused with a message.
 /// 2: per-kind rates per thread-second of the kind's own work (were: per wall-clock second of
-/// the whole frame), and `--stats-json` carries `format` too. docs/SCHEMA.md has the rule.
+/// the whole frame), and `--stats-json` carries `format` too. Bench records also keep
+/// every run's summary (min, median, 95% interval, max, outliers), the warm-up and the build.
+/// docs/SCHEMA.md has the rule.
 pub const FORMAT: u32 = 2;
 
 /// One `raywave bench` invocation.
@@ -25,10 +27,12 @@ pub struct BenchRecord {
     pub format: u32,
     /// raywave's version.
     pub raywave: String,
-    /// `git rev-parse HEAD` of the source tree, or "unknown".
+    /// `git rev-parse HEAD` of the source tree at build time, or "unknown" (= `build.commit`).
     pub git_commit: String,
-    /// Whether the source tree had uncommitted changes (None when unknown).
+    /// Whether tracked files had uncommitted changes at build time (None when unknown).
     pub git_dirty: Option<bool>,
+    /// The build: commit, profile, target, target features, RUSTFLAGS (`build.rs`).
+    pub build: crate::build_info::BuildInfo,
     /// When the bench ran, UTC, RFC 3339.
     pub timestamp: String,
     /// Where it ran.
@@ -39,7 +43,9 @@ pub struct BenchRecord {
     pub setup: Setup,
     /// Timed runs per engine.
     pub runs: u32,
-    /// One entry per engine: reference, then wavefront.
+    /// Untimed runs per engine before the timed ones.
+    pub warmup: u32,
+    /// One entry per engine measured: reference, then wavefront.
     pub engines: Vec<EngineRecord>,
 }
 
@@ -81,6 +87,96 @@ pub struct EngineRecord {
     pub median: Measurement,
     /// Every timed run, in order.
     pub runs: Vec<Measurement>,
+    /// The headline figures over the runs (total, then each stage that handled rays): min,
+    /// median, its 95% interval, max, outliers. Verdicts are decided on these.
+    pub summary: Vec<FigureSummary>,
+}
+
+/// One headline figure over the timed runs.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct FigureSummary {
+    /// "total" (rays per wall-clock second) or "stage NAME" (rays per thread-second).
+    pub figure: String,
+    /// "rays/s" or "rays/thread-s".
+    pub unit: String,
+    /// How many runs it summarises.
+    pub runs: usize,
+    /// The slowest run.
+    pub min: f64,
+    /// The median run.
+    pub median: f64,
+    /// Lower end of the median's 95% interval (`statistics::median_with_interval`); null
+    /// with fewer than 6 runs.
+    pub low: Option<f64>,
+    /// Upper end of that interval; null with fewer than 6 runs.
+    pub high: Option<f64>,
+    /// The fastest run.
+    pub max: f64,
+    /// Runs (0-based) whose modified Z-score exceeds `statistics::OUTLIER_Z`.
+    pub outliers: Vec<usize>,
+}
+
+impl FigureSummary {
+    /// The summary of `values`, one per run.
+    pub fn of(figure: &str, unit: &str, values: &[f64]) -> FigureSummary {
+        let (median, low, high) = crate::statistics::median_with_interval(values);
+        let finite = |x: f64| x.is_finite().then_some(x);
+        FigureSummary {
+            figure: figure.to_string(),
+            unit: unit.to_string(),
+            runs: values.len(),
+            min: values.iter().copied().fold(f64::INFINITY, f64::min),
+            median,
+            low: finite(low),
+            high: finite(high),
+            max: values.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+            outliers: crate::statistics::outliers(values),
+        }
+    }
+
+    /// (high − low) / median, in percent; None without an interval.
+    pub fn relative_width_pct(&self) -> Option<f64> {
+        match (self.low, self.high) {
+            (Some(l), Some(h)) if self.median > 0.0 => Some((h - l) / self.median * 100.0),
+            _ => None,
+        }
+    }
+
+    /// The interval as `[low, high]` scaled by `scale`, or `[no interval: n < 6]`.
+    pub fn interval_text(&self, scale: f64, decimals: usize) -> String {
+        match (self.low, self.high) {
+            (Some(l), Some(h)) => format!("[{:.d$}, {:.d$}]", l * scale, h * scale, d = decimals),
+            _ => format!(
+                "[none: {} run(s) < {}]",
+                self.runs,
+                crate::statistics::MIN_FOR_INTERVAL
+            ),
+        }
+    }
+}
+
+/// The headline figures of an engine's runs: the total rate, then each stage that handled
+/// rays in the first run (by name), each over every run.
+pub fn summarise(runs: &[Measurement]) -> Vec<FigureSummary> {
+    let mut out = Vec::new();
+    let Some(first) = runs.first() else {
+        return out;
+    };
+    let totals: Vec<f64> = runs.iter().map(|r| r.rays_per_second.total).collect();
+    out.push(FigureSummary::of("total", "rays/s", &totals));
+    for st in first.stages.iter().filter(|st| st.rays > 0) {
+        let values: Vec<f64> = runs
+            .iter()
+            .filter_map(|r| r.stages.iter().find(|s| s.stage == st.stage))
+            .map(|s| s.rays_per_thread_second)
+            .collect();
+        out.push(FigureSummary::of(
+            &format!("stage {}", st.stage),
+            "rays/thread-s",
+            &values,
+        ));
+    }
+    out
 }
 
 /// What one render measured (or the medians of several).
@@ -345,30 +441,6 @@ pub fn text_hash(bytes: &[u8]) -> String {
         h = h.wrapping_mul(0x0000_0100_0000_01b3);
     }
     format!("{h:016x}")
-}
-
-/// `git rev-parse HEAD` and whether the tree is dirty, for the source tree this binary was
-/// built from (its manifest directory), falling back to the current directory.
-pub fn git_commit() -> (String, Option<bool>) {
-    let git = |dir: &Path, args: &[&str]| {
-        std::process::Command::new("git")
-            .arg("-C")
-            .arg(dir)
-            .args(args)
-            .stderr(std::process::Stdio::null())
-            .output()
-            .ok()
-            .filter(|o| o.status.success())
-            .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
-    };
-    for dir in [Path::new(env!("CARGO_MANIFEST_DIR")), Path::new(".")] {
-        if let Some(commit) = git(dir, &["rev-parse", "HEAD"]).filter(|c| !c.is_empty()) {
-            let dirty =
-                git(dir, &["status", "--porcelain", "--untracked-files=no"]).map(|s| !s.is_empty());
-            return (commit, dirty);
-        }
-    }
-    ("unknown".to_string(), None)
 }
 
 /// Seconds since the Unix epoch as RFC 3339 UTC (`2026-11-22T20:13:01Z`).

@@ -1,19 +1,39 @@
-//! `raywave bench` flags, turned into `raywave::bench::BenchOptions`.
+//! `raywave bench` flags, turned into `raywave::bench::BenchOptions`; `raywave bench compare
+//! A B` and `raywave bench list` for saved records.
 
 use super::image::ImageArgs;
-use super::values::EngineArg;
 use anyhow::Result;
-use clap::Args;
+use clap::parser::ValueSource;
+use clap::{ArgAction, ArgMatches, Args, Subcommand, ValueEnum};
 use raywave::bench::ab::{self, AbOptions, MIN_ROUNDS};
 use raywave::bench::record::record_path;
-use raywave::bench::{BenchOptions, DEFAULT_THRESHOLD_PCT, EXIT_REGRESSION};
+use raywave::bench::sweep::{Sweep, record_name};
+use raywave::bench::{
+    BenchOptions, DEFAULT_RUNS, DEFAULT_THRESHOLD_PCT, EXIT_REGRESSION, Hooks, list,
+};
+use raywave::engine::Engine;
+use raywave::error::UsageError;
 use raywave::output::OutputPlan;
 use raywave::output::memory::{self, RenderFootprint};
 use std::path::PathBuf;
 
-/// Flags of `raywave bench`.
+/// Flags of `raywave bench`. A scene file literally named `compare` or `list` is given as
+/// `./compare` or `./list` (the bare words are the subcommands).
 #[derive(Args, Debug, Clone)]
+#[command(
+    args_conflicts_with_subcommands = true,
+    subcommand_negates_reqs = true,
+    mut_arg("size", |a| a.action(ArgAction::Append)
+        .help("Image size in pixels; repeat to sweep sizes (--size 256 256 --size 512 512) \
+               [default: 512 512; the lab's 100 100; RPI's 500 500]")),
+    mut_arg("shadow_samples", |a| a.action(ArgAction::Append).value_delimiter(',')
+        .help("Points per light with soft shadows; a comma-separated list sweeps them \
+               (16,64) [default: 16]")),
+)]
 pub struct BenchArgs {
+    /// Offline commands on saved records.
+    #[command(subcommand)]
+    pub action: Option<BenchAction>,
     /// Scene file (.obj); without one, the built-in lab Cornell box with mirror spheres.
     pub scene: Option<PathBuf>,
     /// The lab's `-input FILE` (same as the positional SCENE).
@@ -22,48 +42,113 @@ pub struct BenchArgs {
     /// Size, bounces, shadows and sampling, as for `raywave render`.
     #[command(flatten)]
     pub image: ImageArgs,
-    /// Worker threads [default: all cores].
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
-    pub threads: Option<u32>,
-    /// Timed runs per engine (medians are reported).
-    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    /// Worker threads; a comma-separated list sweeps them (1,2) [default: all cores].
+    #[arg(long, value_delimiter = ',', value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub threads: Vec<u32>,
+    /// Which engines to time.
+    #[arg(long, value_enum, default_value = "both")]
+    pub engine: BenchEngine,
+    /// Timed runs per engine (at least 6 for a 95% interval of the median).
+    #[arg(long, default_value_t = DEFAULT_RUNS, value_parser = clap::value_parser!(u32).range(1..=1000))]
     pub runs: u32,
-    /// Save the record as DIR/NAME.json.
+    /// Untimed runs per engine (rounds with --against) before the timed ones.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(0..=1000))]
+    pub warmup: u32,
+    /// Save the record as DIR/NAME.json (each point of a sweep as DIR/NAME+POINT.json).
     #[arg(long, value_name = "NAME")]
     pub save: Option<String>,
-    /// Compare with the record DIR/NAME.json; exit 3 if a headline figure regressed.
+    /// Compare with the record DIR/NAME.json, measured with its settings, threads and engines
+    /// unless a flag says otherwise; exit 3 if a headline figure regressed.
     #[arg(long, value_name = "NAME")]
     pub compare: Option<String>,
     /// Directory of saved records.
     #[arg(long, default_value = ".raywave-bench")]
     pub dir: PathBuf,
-    /// Regression threshold in percent: a headline figure that falls by more fails --compare;
-    /// with --against, a ratio whose whole 95% interval lies above 1 + PCT% fails [default: 40;
-    /// 5 with --against].
+    /// Regression threshold in percent: with --compare, a headline figure whose median fell
+    /// by more and whose 95% interval lies wholly below the record's regressed; with
+    /// --against, a ratio whose whole 95% interval lies above 1 + PCT% [default: 40; 5 with
+    /// --against].
     #[arg(long, value_name = "PCT", value_parser = parse_threshold)]
     pub threshold: Option<f64>,
     /// Time this build against another raywave binary on the same flags: the two alternate,
     /// round after round, and each engine's time ratio (this / OTHER) gets a median and a 95%
     /// interval from the paired rounds; exit 3 when the whole interval lies above the threshold.
-    #[arg(long, value_name = "OTHER", conflicts_with_all = ["save", "compare", "json", "runs"])]
+    #[arg(long, value_name = "OTHER", conflicts_with_all = ["save", "compare", "json", "runs",
+          "export_json", "export_csv", "export_markdown"])]
     pub against: Option<PathBuf>,
     /// Timed rounds with --against (each runs both builds once).
     #[arg(long, default_value_t = 20, requires = "against",
           value_parser = clap::value_parser!(u32).range(i64::from(MIN_ROUNDS)..=10_000))]
     pub rounds: u32,
-    /// Untimed rounds before the timed ones with --against.
-    #[arg(long, default_value_t = 1, requires = "against",
-          value_parser = clap::value_parser!(u32).range(0..=1000))]
-    pub warmup: u32,
-    /// Which engine --against times [default: both].
-    #[arg(long, value_enum, requires = "against")]
-    pub engine: Option<EngineArg>,
-    /// Also write the record as JSON to FILE (`-` for stdout).
+    /// Also write the record as JSON to FILE (`-` for stdout); one point only.
     #[arg(long, value_name = "FILE")]
     pub json: Option<PathBuf>,
-    /// Print only the comparison (or nothing but errors without --compare).
+    /// Write every point's record to FILE as a JSON array (`-` for stdout).
+    #[arg(long, value_name = "FILE")]
+    pub export_json: Option<PathBuf>,
+    /// Write every point's headline figures to FILE as CSV (`-` for stdout).
+    #[arg(long, value_name = "FILE")]
+    pub export_csv: Option<PathBuf>,
+    /// Write every point's headline figures to FILE as a Markdown table (`-` for stdout).
+    #[arg(long, value_name = "FILE")]
+    pub export_markdown: Option<PathBuf>,
+    /// Print only the comparison (or nothing but errors without --compare); no progress bar.
     #[arg(short, long)]
     pub quiet: bool,
+}
+
+/// Which engines `raywave bench` times.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum BenchEngine {
+    /// The SIMD wavefront engine only.
+    Wavefront,
+    /// The scalar reference only.
+    Reference,
+    /// Both, alternating.
+    Both,
+}
+
+impl BenchEngine {
+    /// The engines, in record order.
+    pub fn engines(self) -> Vec<Engine> {
+        match self {
+            BenchEngine::Wavefront => vec![Engine::Wavefront],
+            BenchEngine::Reference => vec![Engine::Reference],
+            BenchEngine::Both => vec![Engine::Reference, Engine::Wavefront],
+        }
+    }
+}
+
+/// `raywave bench compare` and `raywave bench list`.
+#[derive(Subcommand, Debug, Clone)]
+pub enum BenchAction {
+    /// Compare two saved records (B against A) by the verdict rule; exit 3 if B regressed.
+    Compare(CompareArgs),
+    /// List the saved records: name, date, commit, scene, settings, threads, total medians.
+    List(ListArgs),
+}
+
+/// Flags of `raywave bench compare`.
+#[derive(Args, Debug, Clone)]
+pub struct CompareArgs {
+    /// The earlier record: a name in --dir, or a path ending in .json.
+    pub a: String,
+    /// The later record, judged against A.
+    pub b: String,
+    /// Directory of saved records.
+    #[arg(long, default_value = ".raywave-bench")]
+    pub dir: PathBuf,
+    /// Regression threshold in percent (the rule of --compare).
+    #[arg(long, value_name = "PCT", value_parser = parse_threshold, default_value_t = DEFAULT_THRESHOLD_PCT)]
+    pub threshold: f64,
+}
+
+/// Flags of `raywave bench list`.
+#[derive(Args, Debug, Clone)]
+pub struct ListArgs {
+    /// Directory of saved records.
+    #[arg(long, default_value = ".raywave-bench")]
+    pub dir: PathBuf,
 }
 
 fn parse_threshold(s: &str) -> Result<f64, String> {
@@ -75,19 +160,72 @@ fn parse_threshold(s: &str) -> Result<f64, String> {
     }
 }
 
+/// The flags whose values `--compare` must not replace with the record's: those given on the
+/// command line.
+const ADOPTABLE: [&str; 12] = [
+    "size",
+    "bounces",
+    "shadows",
+    "shadow_samples",
+    "sampler",
+    "aa",
+    "background",
+    "ambient",
+    "light_model",
+    "defaults",
+    "threads",
+    "engine",
+];
+
 impl BenchArgs {
-    /// The flags as the library's options.
-    pub fn options(&self) -> BenchOptions {
+    /// The swept values: every `--size W H`, every shadow-sample count, every thread count.
+    fn sweep(&self) -> Sweep {
+        let sizes = self
+            .image
+            .size
+            .as_ref()
+            .map(|v| v.chunks_exact(2).map(|c| [c[0], c[1]]).collect())
+            .unwrap_or_default();
+        Sweep {
+            sizes,
+            shadow_samples: Vec::new(),
+            threads: self.threads.clone(),
+        }
+    }
+
+    /// The flags as the library's options; `matches` are bench's own (for the shadow-sample
+    /// list and which flags were given).
+    pub fn options(&self, matches: Option<&ArgMatches>) -> BenchOptions {
+        let mut sweep = self.sweep();
+        let mut explicit = Vec::new();
+        if let Some(m) = matches {
+            sweep.shadow_samples = m
+                .get_many::<u32>("shadow_samples")
+                .map(|v| v.copied().collect())
+                .unwrap_or_default();
+            explicit = ADOPTABLE
+                .iter()
+                .filter(|id| m.value_source(id) == Some(ValueSource::CommandLine))
+                .map(|id| id.to_string())
+                .collect();
+        }
         BenchOptions {
             scene: self.scene.clone().or_else(|| self.input.clone()),
             image: self.image.options(),
-            threads: self.threads,
+            sweep,
+            engines: self.engine.engines(),
             runs: self.runs,
+            warmup: self.warmup,
             save: self.save.clone(),
             compare: self.compare.clone(),
             dir: self.dir.clone(),
             threshold: self.threshold.unwrap_or(DEFAULT_THRESHOLD_PCT),
             json: self.json.clone(),
+            export_json: self.export_json.clone(),
+            export_csv: self.export_csv.clone(),
+            export_markdown: self.export_markdown.clone(),
+            explicit,
+            report_to_stderr: output_plan(self, &[]).uses_stdout(),
             quiet: self.quiet,
         }
     }
@@ -96,10 +234,11 @@ impl BenchArgs {
 /// The threshold of `--against` when none is given, in percent.
 const AB_THRESHOLD_PCT: f64 = 5.0;
 
-/// The scene and the `--compare` record (inputs), the `--save` record and `--json` (outputs).
-/// `--save` may name the `--compare` record (see below), no other input.
-/// Names `record_path` refuses are left to the bench, which reports them.
-fn output_plan(args: &BenchArgs) -> OutputPlan {
+/// The scene and the `--compare` record (inputs), the `--save` records (one per point of
+/// `labels`, or one), `--json` and the exports (outputs). `--save` may name the `--compare`
+/// record (see below), no other input. Names `record_path` refuses are left to the bench,
+/// which reports them.
+fn output_plan(args: &BenchArgs, points: &[raywave::bench::sweep::Point]) -> OutputPlan {
     let mut plan = OutputPlan::new();
     if let Some(scene) = args.scene.as_ref().or(args.input.as_ref()) {
         plan = plan.input("SCENE", scene);
@@ -114,28 +253,63 @@ fn output_plan(args: &BenchArgs) -> OutputPlan {
     {
         plan = plan.input("--compare", &path);
     }
-    if let Some(Ok(path)) = args.save.as_ref().map(|n| record_path(&args.dir, n)) {
-        plan = plan.output_in_new_dir("--save", &path);
+    if let Some(name) = &args.save {
+        for point in points {
+            if let Ok(path) = record_path(&args.dir, &record_name(name, point)) {
+                plan = plan.output_in_new_dir("--save", &path);
+            }
+        }
     }
-    if let Some(json) = &args.json {
-        plan = plan.output("--json", json);
+    for (flag, path) in [
+        ("--json", &args.json),
+        ("--export-json", &args.export_json),
+        ("--export-csv", &args.export_csv),
+        ("--export-markdown", &args.export_markdown),
+    ] {
+        if let Some(p) = path {
+            plan = plan.output(flag, p);
+        }
     }
     plan
 }
 
-/// Runs the bench; the exit code is 3 (`raywave::bench::EXIT_REGRESSION`) when `--compare`
-/// or `--against` finds a regression, else 0.
-pub fn run(args: &BenchArgs) -> Result<u8> {
-    output_plan(args).check()?;
+/// Runs the bench or one of its subcommands; the exit code is 3
+/// (`raywave::bench::EXIT_REGRESSION`) when `--compare`, `--against` or `bench compare` finds
+/// a regression, else 0. `matches` are bench's own.
+pub fn run(args: &BenchArgs, matches: Option<&ArgMatches>) -> Result<u8> {
+    match &args.action {
+        Some(BenchAction::Compare(c)) => {
+            let (table, regressed) = list::compare_saved(&c.dir, &c.a, &c.b, c.threshold)?;
+            raywave::terminal::print(&table)?;
+            return Ok(if regressed { EXIT_REGRESSION } else { 0 });
+        }
+        Some(BenchAction::List(l)) => {
+            let (table, warnings) = list::list(&l.dir)?;
+            for w in warnings {
+                eprintln!("warning: {w}");
+            }
+            raywave::terminal::print(&table)?;
+            return Ok(0);
+        }
+        None => {}
+    }
+    let options = args.options(matches);
+    output_plan(args, &options.sweep.points()).check()?;
     // Each timed run holds one film; refuse a size the machine cannot hold before any timing.
+    let largest = options
+        .sweep
+        .sizes
+        .iter()
+        .map(|[w, h]| u64::from(*w) * u64::from(*h))
+        .max();
     let settings = args.image.options().resolve(None).settings;
-    let threads = args.threads.map_or_else(
+    let threads = options.sweep.threads.iter().max().map_or_else(
         || std::thread::available_parallelism().map_or(1, |n| n.get() as u64),
-        u64::from,
+        |t| u64::from(*t),
     );
     memory::check(
         &RenderFootprint {
-            pixels: settings.width as u64 * settings.height as u64,
+            pixels: largest.unwrap_or(settings.width as u64 * settings.height as u64),
             primitives: 0,
             threads,
             batch_size: raywave::wavefront::DEFAULT_BATCH_SIZE as u64,
@@ -145,20 +319,43 @@ pub fn run(args: &BenchArgs) -> Result<u8> {
         None,
     )?;
     let Some(other) = &args.against else {
-        return Ok(raywave::bench::run(&args.options())?.exit_code());
+        let bar = raywave::terminal::progress_bar(
+            0,
+            "{elapsed_precise} [{bar:40}] {pos}/{len} runs (warm-up included), engines alternating",
+            args.quiet,
+        );
+        let progress = |done: u64, total: u64| {
+            bar.set_length(total);
+            bar.set_position(done);
+        };
+        let warn = |w: &str| bar.suspend(|| eprintln!("warning: {w}"));
+        let outcome = raywave::bench::run(
+            &options,
+            &Hooks {
+                progress: &progress,
+                warn: &warn,
+            },
+        );
+        bar.finish_and_clear();
+        return Ok(outcome?.exit_code());
     };
+    let points = options.sweep.points().len();
+    if points > 1 || options.sweep.threads.len() > 1 {
+        return Err(UsageError(format!(
+            "--against times one point, but the flags sweep {points}: give one --size, one \
+             --shadow-samples and one --threads"
+        ))
+        .into());
+    }
     let options = AbOptions {
         other: other.clone(),
         scene: args.scene.clone().or_else(|| args.input.clone()),
         render_flags: args.image.flags(),
         engines: match args.engine {
-            Some(e) => vec![e.into()],
-            None => vec![
-                raywave::engine::Engine::Wavefront,
-                raywave::engine::Engine::Reference,
-            ],
+            BenchEngine::Both => vec![Engine::Wavefront, Engine::Reference],
+            one => one.engines(),
         },
-        threads: args.threads,
+        threads: args.threads.first().copied(),
         rounds: args.rounds,
         warmup: args.warmup,
         threshold_pct: args.threshold.unwrap_or(AB_THRESHOLD_PCT),

@@ -317,6 +317,10 @@ pub fn normalize_args(args: impl IntoIterator<Item = OsString>) -> Result<Normal
             return Ok(());
         };
         let target = if target == "-o" { "--output" } else { target };
+        // `bench --size W H --size W H` sweeps sizes (raywave's own spelling only).
+        if command == "bench" && target == "--size" && spelling == "--size" {
+            return Ok(());
+        }
         if let Some((_, first)) = set_by.iter().find(|(t, _)| *t == target) {
             return Err(UsageError(format!(
                 "`{first}` and `{spelling}` both set {what}: expected it once"

@@ -1,12 +1,26 @@
-//! `raywave info`: the version, the build's SIMD path and the default thread count.
+//! `raywave info`: the version, the build (commit, profile, target, features, RUSTFLAGS), the
+//! build's SIMD path and the default thread count.
 
 use anyhow::Result;
 
-/// Prints the three lines.
+/// Prints the lines.
 pub fn run() -> Result<()> {
+    let b = raywave::build_info::current();
     raywave::terminal::print(&format!(
-        "raywave {}\nsimd    {}\nthreads {} (rayon default; --threads N to change)\n",
+        "raywave {}\ncommit  {}\nbuild   {} · {}\nrustflags {}\nfeatures {}\nsimd    {}\nthreads {} (rayon default; --threads N to change)\n",
         env!("CARGO_PKG_VERSION"),
+        match b.dirty {
+            Some(true) => format!("{} (dirty)", b.commit),
+            _ => b.commit.clone(),
+        },
+        b.profile,
+        b.target,
+        if b.rustflags.is_empty() {
+            "(none)"
+        } else {
+            &b.rustflags
+        },
+        b.target_features,
         raywave::simd_path(),
         rayon::current_num_threads()
     ))

@@ -29,7 +29,7 @@ pub mod values;
 pub mod variance;
 pub mod view;
 
-use clap::{Parser, Subcommand};
+use clap::{ArgMatches, CommandFactory, FromArgMatches, Parser, Subcommand};
 
 /// raywave: a SIMD wavefront ray tracer for the lab's Cornell-box scenes.
 #[derive(Parser, Debug)]
@@ -67,4 +67,12 @@ pub enum Command {
     /// and FLIP, per channel, over the image or a mask; a false-colour map of the error
     /// (exit 3 past --fail-above).
     Diff(diff::DiffArgs),
+}
+
+/// Parses the command line, keeping clap's matches: `bench --compare` asks them which flags
+/// were given (`ArgMatches::value_source`).
+pub fn parse(args: &[std::ffi::OsString]) -> Result<(Cli, ArgMatches), clap::Error> {
+    let matches = Cli::command().try_get_matches_from(args)?;
+    let cli = Cli::from_arg_matches(&matches)?;
+    Ok((cli, matches))
 }

@@ -1,0 +1,104 @@
+//! Timing the engines at one point: untimed warm-up runs, then timed runs in rounds, each
+//! round running every engine once and starting one engine later than the round before, so
+//! that no engine always runs after the same one (and inherits its caches, its heat, the
+//! turbo state it left).
+//!
+//! ```text
+//! prepare each engine (BVH, tables) on the pool
+//! warm-up:  for w in 0..warmup: every engine once, untimed
+//! timed:    for round in 0..runs: engines rotated by round, each once; seconds, rays, stages
+//! per engine: medians of every figure, and the summary of the headline figures
+//! ```
+
+use super::record::{EngineRecord, KindRates, Measurement, StageFigure, summarise};
+use crate::engine::{Engine, Prepared};
+use crate::film::Film;
+use crate::scene::Scene;
+use crate::settings::RenderSettings;
+use crate::wavefront::DEFAULT_BATCH_SIZE;
+use std::time::Instant;
+
+/// Warm-up and timed runs of `engines` on `pool`; `tick` is called after each run (warm-up
+/// included). Records come back in `engines`' order.
+pub fn measure(
+    pool: &rayon::ThreadPool,
+    scene: &Scene,
+    settings: &RenderSettings,
+    engines: &[Engine],
+    warmup: u32,
+    runs: u32,
+    tick: &(dyn Fn() + Sync),
+) -> Vec<EngineRecord> {
+    pool.install(|| timed(scene, settings, engines, warmup, runs, tick))
+}
+
+fn timed(
+    scene: &Scene,
+    settings: &RenderSettings,
+    engines: &[Engine],
+    warmup: u32,
+    runs: u32,
+    tick: &(dyn Fn() + Sync),
+) -> Vec<EngineRecord> {
+    let prepared: Vec<Prepared> = engines
+        .iter()
+        .map(|engine| engine.prepare(scene, settings, DEFAULT_BATCH_SIZE))
+        .collect();
+    let time = |engine: &Prepared| {
+        let start = Instant::now();
+        let (film, stats) = engine.render(&|| {});
+        let seconds = start.elapsed().as_secs_f64();
+        drop::<Film>(film);
+        let stages = match engine.engine() {
+            Engine::Wavefront => stats.stage_rows().iter().map(StageFigure::from).collect(),
+            Engine::Reference => Vec::new(),
+        };
+        Measurement {
+            seconds,
+            rays: stats.counts,
+            rays_per_second: KindRates::measured(&stats, seconds),
+            stages,
+        }
+    };
+    for _ in 0..warmup {
+        for engine in &prepared {
+            time(engine);
+            tick();
+        }
+    }
+    let mut measured: Vec<Vec<Measurement>> = vec![Vec::new(); prepared.len()];
+    for round in 0..runs as usize {
+        for i in round_order(prepared.len(), round) {
+            measured[i].push(time(&prepared[i]));
+            tick();
+        }
+    }
+    prepared
+        .iter()
+        .zip(measured)
+        .map(|(engine, runs)| EngineRecord {
+            engine: engine.engine().name().to_string(),
+            median: Measurement::median_of(&runs),
+            summary: summarise(&runs),
+            runs,
+        })
+        .collect()
+}
+
+/// The order in which round `round` runs `n` engines: 0..n rotated by `round`, so each engine
+/// goes first in turn.
+pub fn round_order(n: usize, round: usize) -> Vec<usize> {
+    (0..n).map(|i| (i + round) % n.max(1)).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn each_engine_goes_first_in_turn() {
+        assert_eq!(super::round_order(2, 0), [0, 1]);
+        assert_eq!(super::round_order(2, 1), [1, 0]);
+        assert_eq!(super::round_order(2, 2), [0, 1]);
+        assert_eq!(super::round_order(1, 5), [0]);
+        assert_eq!(super::round_order(3, 1), [1, 2, 0]);
+    }
+}

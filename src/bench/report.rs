@@ -1,0 +1,214 @@
+//! What `raywave bench` prints for one record: the header, the medians by kind and by stage,
+//! the headline figures with min, median, 95% interval and max; and the warnings a noisy
+//! measurement deserves (outlier runs, wide intervals, a loaded machine).
+
+use super::record::{BenchRecord, FigureSummary};
+use crate::settings::{RenderSettings, ShadowMode};
+use std::fmt::Write as _;
+
+/// A median whose 95% interval is wider than this share of it, in percent, is called noisy.
+pub const NOISY_WIDTH_PCT: f64 = 10.0;
+
+/// The printed report of one record: header, then per engine its kinds and stages, then the
+/// headline figures.
+pub fn report(r: &BenchRecord) -> String {
+    let s = &r.setup.settings;
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "raywave {} · commit {} · {} {} · simd {} · {} thread(s) · {}",
+        r.raywave,
+        r.build.short_commit(),
+        r.build.profile,
+        r.build.target,
+        r.simd,
+        r.setup.threads,
+        r.machine.cpu
+    );
+    let shadows = match s.shadows {
+        ShadowMode::Soft => format!("soft, {} {} points", s.shadow_samples, s.sampler.name()),
+        ShadowMode::Hard => "hard".to_string(),
+        ShadowMode::Off => "off".to_string(),
+    };
+    // The lighting is named only when it is not the lab's.
+    let lab = RenderSettings::default();
+    let lighting = if (s.light_model, s.ambient) == (lab.light_model, lab.ambient) {
+        String::new()
+    } else {
+        let [r, g, b] = s.ambient;
+        format!(", light model {:?}, ambient {r} {g} {b}", s.light_model).to_lowercase()
+    };
+    let _ = writeln!(
+        out,
+        "scene   {} · {}×{}, {} bounces, shadows {shadows}, {} aa{lighting}",
+        r.setup.scene.source, s.width, s.height, s.bounces, s.aa_samples
+    );
+    let _ = writeln!(
+        out,
+        "runs    {} warm-up + {} timed per engine, engines alternating; medians below",
+        r.warmup, r.runs
+    );
+    // Each kind over the thread-time of its own work (`-`: not measured, as for the reference,
+    // timed without timers), the total over the wall clock.
+    let _ = writeln!(
+        out,
+        "{:<10} {:<12} {:>12} {:>10} {:>16}",
+        "engine", "kind", "rays", "seconds", "Mrays/thread-s"
+    );
+    for e in &r.engines {
+        let m = &e.median;
+        let k = &m.rays_per_second;
+        for (kind, rays, rate) in [
+            ("camera", m.rays.camera, k.camera),
+            ("shadow", m.rays.shadow, k.shadow),
+            ("reflection", m.rays.reflection, k.reflection),
+        ] {
+            let rate = rate.map_or("-".to_string(), |r| format!("{:.2}", r / 1e6));
+            let _ = writeln!(
+                out,
+                "{:<10} {kind:<12} {rays:>12} {:>10} {rate:>16}",
+                e.engine, ""
+            );
+        }
+        let _ = writeln!(
+            out,
+            "{:<10} {:<12} {:>12} {:>10.3} {:>16.2}  (Mrays/s, wall clock)",
+            e.engine,
+            "total",
+            m.rays.total(),
+            m.seconds,
+            k.total / 1e6
+        );
+    }
+    if r.engines.iter().any(|e| !e.median.stages.is_empty()) {
+        let _ = writeln!(
+            out,
+            "{:<10} {:<12} {:>12} {:>10} {:>16}",
+            "engine", "stage", "rays", "thread-s", "Mrays/thread-s"
+        );
+    }
+    for e in &r.engines {
+        for st in &e.median.stages {
+            let _ = writeln!(
+                out,
+                "{:<10} {:<12} {:>12} {:>10.4} {:>16.2}",
+                e.engine,
+                st.stage,
+                st.rays,
+                st.thread_seconds,
+                st.rays_per_thread_second / 1e6
+            );
+        }
+    }
+    let _ = writeln!(
+        out,
+        "{:<10} {:<17} {:>8} {:>8} {:>18} {:>8}  outliers",
+        "engine", "figure", "min", "median", "95% interval", "max"
+    );
+    for e in &r.engines {
+        for f in &e.summary {
+            let _ = writeln!(
+                out,
+                "{:<10} {:<17} {:>8.2} {:>8.2} {:>18} {:>8.2}  {}",
+                e.engine,
+                f.figure,
+                f.min / 1e6,
+                f.median / 1e6,
+                f.interval_text(1e-6, 2),
+                f.max / 1e6,
+                outlier_text(f)
+            );
+        }
+    }
+    let _ = writeln!(
+        out,
+        "totals in Mrays/s (wall clock), kinds and stages in Mrays/thread-s (the reference has no stages)"
+    );
+    out
+}
+
+fn outlier_text(f: &FigureSummary) -> String {
+    if f.outliers.is_empty() {
+        "-".to_string()
+    } else {
+        f.outliers
+            .iter()
+            .map(|i| format!("run {}", i + 1))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+}
+
+/// The warnings for one record: each figure with outlier runs (by the modified Z-score) and
+/// each whose interval is wider than [`NOISY_WIDTH_PCT`] of its median, named.
+pub fn warnings(r: &BenchRecord, point: &str) -> Vec<String> {
+    let at = if point.is_empty() {
+        String::new()
+    } else {
+        format!(" at {point}")
+    };
+    let mut out = Vec::new();
+    let mut noisy = Vec::new();
+    for e in &r.engines {
+        for f in &e.summary {
+            if !f.outliers.is_empty() {
+                let values: Vec<String> = f
+                    .outliers
+                    .iter()
+                    .map(|&i| {
+                        let run = &e.runs[i.min(e.runs.len().saturating_sub(1))];
+                        let v = if f.figure == "total" {
+                            run.rays_per_second.total
+                        } else {
+                            let name = f.figure.trim_start_matches("stage ");
+                            run.stages
+                                .iter()
+                                .find(|s| s.stage == name)
+                                .map_or(f64::NAN, |s| s.rays_per_thread_second)
+                        };
+                        format!("run {} at {:.2}", i + 1, v / 1e6)
+                    })
+                    .collect();
+                out.push(format!(
+                    "{} {}{at}: outlier run(s) {} against a median of {:.2} (modified Z-score \
+                     above {}): something else ran during them?",
+                    e.engine,
+                    f.figure,
+                    values.join(", "),
+                    f.median / 1e6,
+                    crate::statistics::OUTLIER_Z
+                ));
+            }
+            if let Some(w) = f.relative_width_pct().filter(|w| *w > NOISY_WIDTH_PCT) {
+                noisy.push(format!(
+                    "{} {} {} ({w:.0}%)",
+                    e.engine,
+                    f.figure,
+                    f.interval_text(1e-6, 2)
+                ));
+            }
+        }
+    }
+    if !noisy.is_empty() {
+        out.push(format!(
+            "noisy{at}: the 95% interval of the median is wider than {NOISY_WIDTH_PCT}% of it \
+             for {}; a quieter machine, more --runs or a larger image narrow it",
+            noisy.join(", ")
+        ));
+    }
+    out
+}
+
+/// A warning when the machine's 1-minute load average exceeds its logical CPUs (read from
+/// /proc/loadavg before the bench starts): other processes then compete for every core.
+pub fn load_warning() -> Option<String> {
+    let text = std::fs::read_to_string("/proc/loadavg").ok()?;
+    let load: f64 = text.split_whitespace().next()?.parse().ok()?;
+    let cpus = crate::machine::logical_cpus();
+    (load > cpus as f64).then(|| {
+        format!(
+            "the load average is {load:.2} on {cpus} logical CPU(s) before the bench: other \
+             processes compete for the cores, so expect noisy figures"
+        )
+    })
+}
