@@ -20,6 +20,7 @@
 
 pub mod cache;
 pub mod command;
+pub mod fits;
 pub mod mask;
 pub mod plot;
 pub mod report;
@@ -31,7 +32,6 @@ use crate::film::ToneMap;
 use crate::sampling::LightSampler;
 use crate::scene::Scene;
 use crate::settings::{RenderSettings, ShadowMode};
-use crate::statistics::{BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, bootstrap_interval};
 use crate::stats::RayCounts;
 use anyhow::{Result, bail};
 use glam::Vec3;
@@ -39,6 +39,7 @@ use serde::Serialize;
 use std::time::Instant;
 
 pub use cache::Cache;
+pub use fits::{Matching, Slope, match_budget};
 pub use mask::{Regions, penumbra_mask};
 pub use stats::{ErrorStats, LogLogFit, deterministic, error_stats, loglog_fit, per_image_errors};
 
@@ -203,9 +204,6 @@ impl Region {
     }
 }
 
-/// The lab's budget of random points that [`StudyResult::matching`] is about.
-pub const LAB_RANDOM_POINTS: f64 = 150.0;
-
 /// One line of the results: a (sampler, N, region).
 #[derive(Clone, Debug, Serialize)]
 pub struct Row {
@@ -236,6 +234,11 @@ pub struct Row {
     pub efficiency: f64,
     /// 95% interval of `efficiency` (bootstrap over seeds of mean MSE and median time).
     pub efficiency_interval: Option<[f64; 2]>,
+    /// `efficiency` over random's at the same N and region (None without random).
+    pub efficiency_vs_random: Option<f64>,
+    /// 95% interval of `efficiency_vs_random`, resampling the same seeds for both samplers
+    /// (their renders were timed in the same rounds, so a slow round slows both).
+    pub efficiency_vs_random_interval: Option<[f64; 2]>,
     /// Per seed (seeds 1..=K): MSE.
     #[serde(skip)]
     pub seed_mse: Vec<f64>,
@@ -245,39 +248,6 @@ pub struct Row {
     /// Per seed: seconds for its image.
     #[serde(skip)]
     pub seed_seconds: Vec<f64>,
-}
-
-/// The fitted slope for a (sampler, region).
-#[derive(Clone, Debug, Serialize)]
-pub struct Slope {
-    /// Sampler name.
-    pub sampler: &'static str,
-    /// Region.
-    pub region: Region,
-    /// The fit (None with fewer than two fitted budgets with non-zero MSE).
-    pub fit: Option<LogLogFit>,
-    /// 95% interval of the slope (bootstrap over seeds).
-    pub slope_interval: Option<[f64; 2]>,
-    /// The budgets fitted.
-    pub fitted: Vec<u32>,
-    /// The budgets left out (see [`Row::excluded_from_fit`]).
-    pub excluded: Vec<u32>,
-}
-
-/// The budget at which a sampler's fitted MSE equals random's fitted MSE at
-/// [`LAB_RANDOM_POINTS`], for a (sampler, region).
-#[derive(Clone, Debug, Serialize)]
-pub struct Matching {
-    /// Sampler name.
-    pub sampler: &'static str,
-    /// Region.
-    pub region: Region,
-    /// The random budget matched.
-    pub random_n: f64,
-    /// The matching budget (None without both fits, or when the sampler's error does not fall).
-    pub budget: Option<f64>,
-    /// 95% interval (bootstrap over seeds); an end of `null` in JSON is unbounded.
-    pub interval: Option<[f64; 2]>,
 }
 
 /// Everything a study found.
@@ -311,46 +281,6 @@ pub struct StudyResult {
     pub thumbnails: Vec<(LightSampler, u32, image::RgbImage)>,
 }
 
-/// The mean of `xs` over the indices `idx` (all of `xs` when `idx` is None).
-fn mean_at(xs: &[f64], idx: Option<&[usize]>) -> f64 {
-    match idx {
-        Some(idx) => idx.iter().map(|&i| xs[i]).sum::<f64>() / idx.len().max(1) as f64,
-        None => xs.iter().sum::<f64>() / xs.len().max(1) as f64,
-    }
-}
-
-/// The log-log fit of `rows` (one sampler and region, the fitted budgets), on the seeds `idx`
-/// (a bootstrap resample) or on the rows' own MSE.
-fn fit_rows(rows: &[&Row], idx: Option<&[usize]>) -> Option<LogLogFit> {
-    let pts: Vec<(f64, f64)> = rows
-        .iter()
-        .map(|r| {
-            let mse = match idx {
-                Some(_) => mean_at(&r.seed_mse, idx),
-                None => r.stats.mse,
-            };
-            (r.n as f64, mse)
-        })
-        .collect();
-    loglog_fit(&pts)
-}
-
-/// The N at which `other`'s line reaches `random`'s MSE at `random_n`; +∞ when `other`'s
-/// error does not fall with N.
-pub fn match_budget(random: LogLogFit, other: LogLogFit, random_n: f64) -> f64 {
-    let target = random.intercept + random.slope * random_n.log10();
-    if other.slope < 0.0 {
-        10f64.powf((target - other.intercept) / other.slope)
-    } else {
-        f64::INFINITY
-    }
-}
-
-/// A bootstrap interval over `k` seeds with the study's resamples and seed.
-fn interval(k: usize, stat: impl FnMut(&[usize]) -> f64) -> Option<[f64; 2]> {
-    bootstrap_interval(k, BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, stat).map(|(a, b)| [a, b])
-}
-
 /// The rows of one (sampler, N): one per region.
 struct Measured<'a> {
     sampler: LightSampler,
@@ -373,11 +303,12 @@ fn rows_of(m: &Measured, reference: &Converged, masks: &[Vec<bool>; 3]) -> Vec<R
             let per = per_image_errors(&m.images, &reference.film.pixels, mask);
             let seed_mse: Vec<f64> = per.iter().map(|e| e.0).collect();
             let seed_bias: Vec<f64> = per.iter().map(|e| e.1).collect();
-            let mse_interval = interval(k, |idx| mean_at(&seed_mse, Some(idx)));
+            let mse_interval = fits::interval(k, |idx| fits::mean_at(&seed_mse, Some(idx)));
             let times = &m.times;
-            let efficiency_interval = interval(k, |idx| {
+            let efficiency_interval = fits::interval(k, |idx| {
                 let t: Vec<f64> = idx.iter().map(|&i| times[i]).collect();
-                1.0 / (mean_at(&seed_mse, Some(idx)) * crate::statistics::median(&t).max(1e-12))
+                1.0 / (fits::mean_at(&seed_mse, Some(idx))
+                    * crate::statistics::median(&t).max(1e-12))
             });
             Row {
                 sampler: m.sampler.name(),
@@ -396,6 +327,8 @@ fn rows_of(m: &Measured, reference: &Converged, masks: &[Vec<bool>; 3]) -> Vec<R
                     f64::INFINITY
                 },
                 efficiency_interval,
+                efficiency_vs_random: None,
+                efficiency_vs_random_interval: None,
                 seed_mse,
                 seed_bias,
                 seed_seconds: m.times.clone(),
@@ -497,69 +430,9 @@ pub fn run_study(
         )
     });
     let k = config.seeds as usize;
-    let fitted = |sampler: LightSampler, region: Region| -> Vec<&Row> {
-        rows.iter()
-            .filter(|r| r.sampler == sampler.name() && r.region == region && !r.excluded_from_fit)
-            .collect()
-    };
-    let mut slopes = Vec::new();
-    for &sampler in samplers {
-        for region in Region::ALL {
-            let pts = fitted(sampler, region);
-            let fit = fit_rows(&pts, None);
-            let slope_interval = fit.and_then(|_| {
-                interval(k, |idx| {
-                    fit_rows(&pts, Some(idx)).map_or(f64::NAN, |f| f.slope)
-                })
-            });
-            slopes.push(Slope {
-                sampler: sampler.name(),
-                region,
-                fit,
-                slope_interval,
-                fitted: pts.iter().map(|r| r.n).collect(),
-                excluded: rows
-                    .iter()
-                    .filter(|r| {
-                        r.sampler == sampler.name() && r.region == region && r.excluded_from_fit
-                    })
-                    .map(|r| r.n)
-                    .collect(),
-            });
-        }
-    }
-    let mut matching = Vec::new();
-    if samplers.contains(&LightSampler::Random) {
-        for &sampler in samplers.iter().filter(|&&s| s != LightSampler::Random) {
-            for region in Region::ALL {
-                // Both lines over the budgets both fit, so that a sampler equal to random on
-                // them (lab above N = 1) matches at exactly 150.
-                let (random, other) = (
-                    fitted(LightSampler::Random, region),
-                    fitted(sampler, region),
-                );
-
-                let (random, other) = (common(&random, &other), common(&other, &random));
-                let budget = fit_rows(&random, None)
-                    .zip(fit_rows(&other, None))
-                    .map(|(r, o)| match_budget(r, o, LAB_RANDOM_POINTS));
-                let interval = budget.and_then(|_| {
-                    interval(k, |idx| {
-                        fit_rows(&random, Some(idx))
-                            .zip(fit_rows(&other, Some(idx)))
-                            .map_or(f64::NAN, |(r, o)| match_budget(r, o, LAB_RANDOM_POINTS))
-                    })
-                });
-                matching.push(Matching {
-                    sampler: sampler.name(),
-                    region,
-                    random_n: LAB_RANDOM_POINTS,
-                    budget: budget.filter(|b| b.is_finite()),
-                    interval,
-                });
-            }
-        }
-    }
+    fits::efficiency_ratios(&mut rows, k);
+    let slopes = fits::slopes(&rows, samplers, k);
+    let matching = fits::matching(&rows, samplers, k);
     Ok(StudyResult {
         config: config.clone(),
         scene: scene.source.clone(),
@@ -574,14 +447,6 @@ pub fn run_study(
         heatmaps,
         thumbnails,
     })
-}
-
-/// The rows of `a` whose budget `b` also has.
-fn common<'r>(a: &[&'r Row], b: &[&Row]) -> Vec<&'r Row> {
-    a.iter()
-        .filter(|r| b.iter().any(|o| o.n == r.n))
-        .copied()
-        .collect()
 }
 
 impl StudyResult {

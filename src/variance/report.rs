@@ -51,7 +51,7 @@ pub const SCHEMA: [(&str, &str); 14] = [
     ),
     (
         "rows",
-        "per sampler, N and region: mse, bias, bias_bound, variance, pixels; mse_interval; excluded_from_fit; seconds (median per image) and seconds_interval; rays, rays_per_second; efficiency = 1/(mse·seconds) and efficiency_interval. Intervals are 95%, [low, high]; null when there are too few seeds (an end of null is unbounded)",
+        "per sampler, N and region: mse, bias, bias_bound, variance, pixels; mse_interval; excluded_from_fit; seconds (median per image) and seconds_interval; rays, rays_per_second; efficiency = 1/(mse·seconds) and efficiency_interval; efficiency_vs_random (over random's at the same N and region) and its interval. Intervals are 95%, [low, high]; null when there are too few seeds (an end of null is unbounded)",
     ),
     (
         "slopes",
@@ -242,7 +242,7 @@ impl StudyResult {
             );
             let _ = writeln!(
                 s,
-                "  {:<10} {:>5} {:<29} {:>10} {:>9} {:>10} {:<22} {:>7} {:<29}",
+                "  {:<10} {:>5} {:<29} {:>10} {:>9} {:>10} {:<22} {:>7} {:<29} {:<20}",
                 "sampler",
                 "N",
                 "MSE [95%]",
@@ -251,7 +251,8 @@ impl StudyResult {
                 "variance",
                 "ms/image [95%]",
                 "Mrays/s",
-                "1/(MSE·s) [95%]"
+                "1/(MSE·s) [95%]",
+                "vs random [95%]"
             );
             for r in self.rows.iter().filter(|r| r.region == *region) {
                 let ms = r.seconds_interval.map(|[a, b]| [a * 1e3, b * 1e3]);
@@ -264,7 +265,7 @@ impl StudyResult {
                 }
                 let _ = writeln!(
                     s,
-                    "  {:<10} {:>5} {:<29} {:>10.2e} {:>9.2e} {:>10.3e} {:<22} {:>7.2} {:<29}{}",
+                    "  {:<10} {:>5} {:<29} {:>10.2e} {:>9.2e} {:>10.3e} {:<22} {:>7.2} {:<29} {:<20}{}",
                     r.sampler,
                     r.n,
                     sci_iv(r.stats.mse, r.mse_interval),
@@ -274,6 +275,9 @@ impl StudyResult {
                     fixed_iv(r.seconds * 1e3, ms, 2),
                     r.rays_per_second / 1e6,
                     sci_iv(r.efficiency, r.efficiency_interval),
+                    r.efficiency_vs_random
+                        .map(|v| fixed_iv(v, r.efficiency_vs_random_interval, 2))
+                        .unwrap_or_else(|| "-".into()),
                     if notes.is_empty() {
                         String::new()
                     } else {
@@ -314,7 +318,7 @@ impl StudyResult {
                 s,
                 "\nbudget matching the MSE of {} random points (the lab's choice), from the fits \
                  [95%]:",
-                super::LAB_RANDOM_POINTS
+                super::fits::LAB_RANDOM_POINTS
             );
             for sampler in self
                 .config
@@ -326,7 +330,7 @@ impl StudyResult {
                     self.matching
                         .iter()
                         .find(|m| m.sampler == sampler.name() && m.region == region)
-                        .and_then(|m| m.budget.map(|b| fixed_iv(b, m.interval, 0)))
+                        .and_then(|m| m.budget.map(|b| fixed_iv(b, m.interval, 1)))
                         .unwrap_or_else(|| "-".into())
                 };
                 let _ = writeln!(
@@ -347,7 +351,8 @@ impl StudyResult {
         let mut s = String::from(
             "sampler,n,region,pixels,mse,mse_low,mse_high,bias,bias_bound,variance,\
              excluded_from_fit,seconds,seconds_low,seconds_high,rays,rays_per_second,\
-             efficiency,efficiency_low,efficiency_high\n",
+             efficiency,efficiency_low,efficiency_high,efficiency_vs_random,\
+             efficiency_vs_random_low,efficiency_vs_random_high\n",
         );
         let iv = |i: Option<[f64; 2]>| match i {
             Some([a, b]) => format!("{a:e},{b:e}"),
@@ -356,7 +361,7 @@ impl StudyResult {
         for r in &self.rows {
             let _ = writeln!(
                 s,
-                "{},{},{},{},{:e},{},{:e},{:e},{:e},{},{:e},{},{},{:e},{:e},{}",
+                "{},{},{},{},{:e},{},{:e},{:e},{:e},{},{:e},{},{},{:e},{:e},{},{},{}",
                 r.sampler,
                 r.n,
                 r.region.name(),
@@ -372,7 +377,11 @@ impl StudyResult {
                 r.rays,
                 r.rays_per_second,
                 r.efficiency,
-                iv(r.efficiency_interval)
+                iv(r.efficiency_interval),
+                r.efficiency_vs_random
+                    .map(|v| format!("{v:e}"))
+                    .unwrap_or_default(),
+                iv(r.efficiency_vs_random_interval)
             );
         }
         s
