@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 pub const SCHEMA_VERSION: u32 = 2;
 
 /// The keys of `results.json`, each with what it holds.
-pub const SCHEMA: [(&str, &str); 14] = [
+pub const SCHEMA: [(&str, &str); 15] = [
     (
         "schema",
         "this table: the layout's version and what each key holds",
@@ -48,6 +48,10 @@ pub const SCHEMA: [(&str, &str); 14] = [
     (
         "reference_mse",
         "the converged reference's own error variance per region",
+    ),
+    (
+        "reference_cached",
+        "true if the converged reference was read from the cache",
     ),
     (
         "rows",
