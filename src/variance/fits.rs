@@ -1,7 +1,7 @@
 //! What a study fits across budgets and samplers, each with a 95% interval by bootstrap over
 //! the seeds (`statistics::bootstrap_interval`; every statistic sees the same resamples): the
 //! slope of log MSE against log N, the budget matching the lab's 150 random points, and each
-//! sampler's efficiency relative to random.
+//! sampler's error and efficiency relative to random.
 //!
 //! ```text
 //! fitted(sampler, region) = its rows minus those excluded_from_fit (seed-independent: bias)
@@ -180,9 +180,10 @@ fn efficiency_at(row: &Row, idx: &[usize]) -> f64 {
     1.0 / (mean_at(&row.seed_mse, Some(idx)) * median(&t).max(1e-12))
 }
 
-/// Fills every row's efficiency relative to random's at the same N and region, with its
-/// interval (the same seeds resampled for both: seed k of every sampler ran in round k).
-pub fn efficiency_ratios(rows: &mut [Row], k: usize) {
+/// Fills every row's error reduction (random's MSE over its own) and efficiency relative to
+/// random's, at the same N and region, with their intervals (the same seeds resampled for
+/// both: seed k of every sampler ran in round k, so a slow round slows both).
+pub fn ratios_to_random(rows: &mut [Row], k: usize) {
     let random: Vec<Row> = rows
         .iter()
         .filter(|r| r.sampler == LightSampler::Random.name())
@@ -196,8 +197,13 @@ pub fn efficiency_ratios(rows: &mut [Row], k: usize) {
             continue;
         };
         row.efficiency_vs_random = Some(row.efficiency / base.efficiency);
+        row.error_reduction = Some(base.stats.mse / row.stats.mse);
         let this: &Row = row;
-        let iv = interval(k, |idx| efficiency_at(this, idx) / efficiency_at(base, idx));
-        row.efficiency_vs_random_interval = iv;
+        let efficiency = interval(k, |idx| efficiency_at(this, idx) / efficiency_at(base, idx));
+        let error = interval(k, |idx| {
+            mean_at(&base.seed_mse, Some(idx)) / mean_at(&this.seed_mse, Some(idx))
+        });
+        row.efficiency_vs_random_interval = efficiency;
+        row.error_reduction_interval = error;
     }
 }

@@ -234,6 +234,11 @@ pub struct Row {
     pub efficiency: f64,
     /// 95% interval of `efficiency` (bootstrap over seeds of mean MSE and median time).
     pub efficiency_interval: Option<[f64; 2]>,
+    /// Random's MSE over this one at the same N and region: how many times less error than
+    /// random (None without random).
+    pub error_reduction: Option<f64>,
+    /// 95% interval of `error_reduction` (bootstrap over seeds, the same seeds for both).
+    pub error_reduction_interval: Option<[f64; 2]>,
     /// `efficiency` over random's at the same N and region (None without random).
     pub efficiency_vs_random: Option<f64>,
     /// 95% interval of `efficiency_vs_random`, resampling the same seeds for both samplers
@@ -327,6 +332,8 @@ fn rows_of(m: &Measured, reference: &Converged, masks: &[Vec<bool>; 3]) -> Vec<R
                     f64::INFINITY
                 },
                 efficiency_interval,
+                error_reduction: None,
+                error_reduction_interval: None,
                 efficiency_vs_random: None,
                 efficiency_vs_random_interval: None,
                 seed_mse,
@@ -430,7 +437,7 @@ pub fn run_study(
         )
     });
     let k = config.seeds as usize;
-    fits::efficiency_ratios(&mut rows, k);
+    fits::ratios_to_random(&mut rows, k);
     let slopes = fits::slopes(&rows, samplers, k);
     let matching = fits::matching(&rows, samplers, k);
     Ok(StudyResult {

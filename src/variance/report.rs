@@ -55,7 +55,7 @@ pub const SCHEMA: [(&str, &str); 15] = [
     ),
     (
         "rows",
-        "per sampler, N and region: mse, bias, bias_bound, variance, pixels; mse_interval; excluded_from_fit; seconds (median per image) and seconds_interval; rays, rays_per_second; efficiency = 1/(mse·seconds) and efficiency_interval; efficiency_vs_random (over random's at the same N and region) and its interval. Intervals are 95%, [low, high]; null when there are too few seeds (an end of null is unbounded)",
+        "per sampler, N and region: mse, bias, bias_bound, variance, pixels; mse_interval; excluded_from_fit; seconds (median per image) and seconds_interval; rays, rays_per_second; efficiency = 1/(mse·seconds) and efficiency_interval; efficiency_vs_random (over random's at the same N and region) and its interval; error_reduction (random's MSE over this one's) and its interval. Intervals are 95%, [low, high]; null when there are too few seeds (an end of null is unbounded)",
     ),
     (
         "slopes",
@@ -246,10 +246,11 @@ impl StudyResult {
             );
             let _ = writeln!(
                 s,
-                "  {:<10} {:>5} {:<29} {:>10} {:>9} {:>10} {:<22} {:>7} {:<29} {:<20}",
+                "  {:<10} {:>5} {:<29} {:<22} {:>10} {:>9} {:>10} {:<22} {:>7} {:<29} {:<20}",
                 "sampler",
                 "N",
                 "MSE [95%]",
+                "random/MSE [95%]",
                 "bias",
                 "±bound",
                 "variance",
@@ -269,10 +270,13 @@ impl StudyResult {
                 }
                 let _ = writeln!(
                     s,
-                    "  {:<10} {:>5} {:<29} {:>10.2e} {:>9.2e} {:>10.3e} {:<22} {:>7.2} {:<29} {:<20}{}",
+                    "  {:<10} {:>5} {:<29} {:<22} {:>10.2e} {:>9.2e} {:>10.3e} {:<22} {:>7.2} {:<29} {:<20}{}",
                     r.sampler,
                     r.n,
                     sci_iv(r.stats.mse, r.mse_interval),
+                    r.error_reduction
+                        .map(|v| fixed_iv(v, r.error_reduction_interval, 2))
+                        .unwrap_or_else(|| "-".into()),
                     r.stats.bias,
                     r.stats.bias_bound,
                     r.stats.variance,
@@ -356,7 +360,8 @@ impl StudyResult {
             "sampler,n,region,pixels,mse,mse_low,mse_high,bias,bias_bound,variance,\
              excluded_from_fit,seconds,seconds_low,seconds_high,rays,rays_per_second,\
              efficiency,efficiency_low,efficiency_high,efficiency_vs_random,\
-             efficiency_vs_random_low,efficiency_vs_random_high\n",
+             efficiency_vs_random_low,efficiency_vs_random_high,error_reduction,\
+             error_reduction_low,error_reduction_high\n",
         );
         let iv = |i: Option<[f64; 2]>| match i {
             Some([a, b]) => format!("{a:e},{b:e}"),
@@ -365,7 +370,7 @@ impl StudyResult {
         for r in &self.rows {
             let _ = writeln!(
                 s,
-                "{},{},{},{},{:e},{},{:e},{:e},{:e},{},{:e},{},{},{:e},{:e},{},{},{}",
+                "{},{},{},{},{:e},{},{:e},{:e},{:e},{},{:e},{},{},{:e},{:e},{},{},{},{},{}",
                 r.sampler,
                 r.n,
                 r.region.name(),
@@ -385,7 +390,11 @@ impl StudyResult {
                 r.efficiency_vs_random
                     .map(|v| format!("{v:e}"))
                     .unwrap_or_default(),
-                iv(r.efficiency_vs_random_interval)
+                iv(r.efficiency_vs_random_interval),
+                r.error_reduction
+                    .map(|v| format!("{v:e}"))
+                    .unwrap_or_default(),
+                iv(r.error_reduction_interval)
             );
         }
         s
