@@ -102,7 +102,7 @@ fn common<'r>(a: &[&'r Row], b: &[&Row]) -> Vec<&'r Row> {
 }
 
 /// The rows fitted for `sampler` in `region`.
-fn fitted<'r>(rows: &'r [Row], sampler: LightSampler, region: Region) -> Vec<&'r Row> {
+fn fitted(rows: &[Row], sampler: LightSampler, region: Region) -> Vec<&Row> {
     rows.iter()
         .filter(|r| r.sampler == sampler.name() && r.region == region && !r.excluded_from_fit)
         .collect()
