@@ -126,6 +126,7 @@ fn panel(
             .iter()
             .map(|r| (x_of(r, axis).0, r.stats.mse))
             .collect();
+        // The slope is against N: only the top row's legend gives it.
         let slope = result
             .slopes
             .iter()
@@ -135,6 +136,7 @@ fn panel(
                 Some([a, b]) => format!(" (slope {:.2} [{a:.2}, {b:.2}])", f.slope),
                 None => format!(" (slope {:.2})", f.slope),
             })
+            .filter(|_| axis == Axis::Budget)
             .unwrap_or_default();
         // The lab's strategy draws random's points for N > 1: dash it so both show.
         let series = if *sampler == LightSampler::Lab {
