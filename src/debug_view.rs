@@ -1,6 +1,8 @@
 //! The lab's debug view: every ray traced for one pixel, printed as a tree and drawn over the
-//! image (projected through the camera). Camera and mirror rays are yellow and cyan, shadow rays
-//! green when the light point is visible and red when blocked.
+//! image (projected through the camera), in the debug view's colours (`trace::palette`): camera
+//! rays white, mirror rays red, shadow rays green when the light point is visible and magenta
+//! when blocked. `raywave render --debug-pixel` fills a recorder from `trace::trace_pixel`'s
+//! tree ([`RayRecorder::from_tree`]).
 
 use crate::camera::CameraRays;
 use crate::geometry::{Hit, Ray};
@@ -74,6 +76,37 @@ impl TraceLog for RayRecorder {
 }
 
 impl RayRecorder {
+    /// The rays of a traced pixel's tree, in its order; rays that miss end at the tree's
+    /// `miss_length`.
+    pub fn from_tree(tree: &crate::trace::RayTree) -> RayRecorder {
+        use crate::trace::SegmentKind;
+        let rays = tree
+            .segments
+            .iter()
+            .map(|s| LoggedRay {
+                bounce: s.depth,
+                kind: match s.kind {
+                    SegmentKind::Camera | SegmentKind::Reflection => LoggedKind::Path {
+                        hit: s.hit.as_ref().map(|h| h.primitive.id),
+                    },
+                    SegmentKind::Shadow => {
+                        let info = s.shadow.as_ref();
+                        LoggedKind::Shadow {
+                            light: info.map_or(0, |i| i.light),
+                            blocked: info.and_then(|i| i.blocked),
+                        }
+                    }
+                },
+                from: Vec3::from_array(s.origin),
+                to: Vec3::from_array(s.end),
+            })
+            .collect();
+        RayRecorder {
+            rays,
+            miss_length: tree.miss_length,
+        }
+    }
+
     /// The rays in tree order. The tracer logs a mirror ray before the shadow rays of the hit
     /// that spawned it (the recursion returns first), so each camera ray's chain (one hit per
     /// depth) is sorted stably by (depth, path ray before shadow rays).
@@ -137,14 +170,16 @@ impl RayRecorder {
     /// Draws the rays over `img`, projected through `camera`.
     pub fn draw(&self, img: &mut image::RgbImage, camera: &CameraRays) {
         for r in &self.rays {
+            use crate::trace::palette;
             let colour = match r.kind {
-                LoggedKind::Path { .. } if r.bounce == 0 => [255, 230, 0],
-                LoggedKind::Path { .. } => [0, 230, 255],
+                LoggedKind::Path { .. } if r.bounce == 0 => palette::CAMERA,
+                LoggedKind::Path { .. } => palette::REFLECTION,
                 LoggedKind::Shadow {
                     blocked: Some(true),
                     ..
-                } => [255, 40, 40],
-                LoggedKind::Shadow { .. } => [40, 255, 40],
+                } => palette::SHADOW_BLOCKED,
+                LoggedKind::Shadow { blocked: None, .. } => palette::SHADOW_UNTESTED,
+                LoggedKind::Shadow { .. } => palette::SHADOW_VISIBLE,
             };
             draw_segment(img, camera, r.from, r.to, colour);
         }
@@ -155,8 +190,8 @@ impl RayRecorder {
                 && let Some((x, y)) = project(camera, r.to)
             {
                 for d in -4..=4 {
-                    put(img, x as i64 + d, y as i64, [255, 230, 0]);
-                    put(img, x as i64, y as i64 + d, [255, 230, 0]);
+                    put(img, x as i64 + d, y as i64, crate::trace::palette::CAMERA);
+                    put(img, x as i64, y as i64 + d, crate::trace::palette::CAMERA);
                 }
             }
         }

@@ -60,6 +60,7 @@ pub mod error;
 pub mod false_colour;
 pub mod film;
 pub mod geometry;
+pub mod image_diff;
 pub mod machine;
 pub mod meshgen;
 pub mod options;
@@ -76,7 +77,9 @@ pub mod spawn;
 pub mod statistics;
 pub mod stats;
 pub mod terminal;
+pub mod trace;
 pub mod variance;
+pub mod view;
 pub mod wavefront;
 
 /// Which SIMD instructions this build uses for the lane type `f32x8` (from the `wide` crate),

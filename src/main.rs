@@ -1,6 +1,8 @@
 //! The `raywave` command. `main` owns the exit code: 0 on success, 2 for a usage error (clap),
-//! 3 when `raywave bench --compare` finds a regression, 1 for anything else, printed once with
-//! its cause chain; 130 after SIGINT and 143 after SIGTERM (`output::write`). The command line itself is in `cli/`, one file per command.
+//! 3 when `raywave bench --compare` finds a regression or `raywave diff --fail-above` a figure
+//! past its threshold, 1 for anything else, printed once with its cause chain; 130 after SIGINT
+//! and 143 after SIGTERM (`output::write`), but 0 when `raywave view` is stopped by them, its
+//! normal end. The command line itself is in `cli/`, one file per command.
 
 mod cli;
 
@@ -27,8 +29,11 @@ fn main() -> ExitCode {
             return ExitCode::from(e.exit_code().clamp(0, 255) as u8);
         }
     };
-    // SIGINT/SIGTERM: remove unfinished temporary files, exit 130/143.
-    if let Err(e) = raywave::output::install_signal_cleanup() {
+    // SIGINT/SIGTERM: remove unfinished temporary files, exit 130/143. `raywave view` writes no
+    // files and stops on them by design: it handles them itself and exits 0.
+    if !matches!(cli.command, Command::View(_))
+        && let Err(e) = raywave::output::install_signal_cleanup()
+    {
         eprintln!("error: {e:#}");
         return ExitCode::from(1);
     }
@@ -45,8 +50,15 @@ fn main() -> ExitCode {
         Command::Info => cli::info::run(),
         Command::Meshgen(args) => cli::meshgen::run(&args),
         Command::Variance(args) => cli::variance::run(&args),
+        Command::View(args) => cli::view::run(&args),
+        Command::TracePixel(args) => cli::trace_pixel::run(&args),
         // Exit 3 when --compare finds a regression (raywave::bench::EXIT_REGRESSION).
         Command::Bench(args) => match cli::bench::run(&args) {
+            Ok(code) => return ExitCode::from(code),
+            Err(e) => Err(e),
+        },
+        // Exit 3 when the figure is past --fail-above (raywave::image_diff::EXIT_FAILED).
+        Command::Diff(args) => match cli::diff::run(&args) {
             Ok(code) => return ExitCode::from(code),
             Err(e) => Err(e),
         },

@@ -22,7 +22,7 @@ use crate::shading::shade;
 use crate::spawn::{
     SurfaceHit, falloff, light_end, light_offset, mirror_ray, shadow_ray, surface_hit,
 };
-use crate::stats::RayCounts;
+use crate::stats::{KindClock, KindTimes, RayCounts, RayKind};
 use glam::Vec3;
 use rayon::prelude::*;
 
@@ -87,6 +87,34 @@ impl<'a> Reference<'a> {
         (film, counts)
     }
 
+    /// [`Reference::render`] with the thread-time of each kind's work measured: camera = the
+    /// camera ray and its closest hit, reflection = the mirror ray and its closest hit,
+    /// shadow = the whole light loop (spawn, occlusion, Shade). A separate copy of the loop
+    /// (the clock is a type parameter), so `render` carries no timer; this one reads the clock
+    /// two or three times per path segment (a reading that ends one interval starts the
+    /// next), which costs time: docs/SCHEMA.md gives the measured overhead. Same image, same
+    /// counts.
+    pub fn render_timed(&self, on_row: &(dyn Fn() + Sync)) -> (Film, RayCounts, KindTimes) {
+        let w = self.settings.width as usize;
+        let mut film = Film::new(self.settings.width, self.settings.height);
+        let (counts, times) = film
+            .pixels
+            .par_chunks_mut(w)
+            .enumerate()
+            .map(|(row, out)| {
+                let mut counts = RayCounts::default();
+                let mut times = KindTimes::default();
+                let first = (row * w) as u32;
+                for (i, px) in out.iter_mut().enumerate() {
+                    *px = self.pixel_clocked(first + i as u32, &mut counts, &mut (), &mut times);
+                }
+                on_row();
+                (counts, times)
+            })
+            .reduce(Default::default, |a, b| (a.0 + b.0, a.1 + b.1));
+        (film, counts, times)
+    }
+
     /// Pixels `first..first + out.len()` into `out`, without a trace log: the loop `render`
     /// runs for each row. Not generic, so it is compiled once, in this crate: the
     /// instruction-count gate (`tests/icount.rs`) calls it to count the code the renderer
@@ -99,6 +127,18 @@ impl<'a> Reference<'a> {
 
     /// The colour of one pixel: the mean over its antialiasing samples.
     pub fn pixel(&self, pixel: u32, counts: &mut RayCounts, log: &mut impl TraceLog) -> Vec3 {
+        self.pixel_clocked(pixel, counts, log, &mut ())
+    }
+
+    /// [`Reference::pixel`], reporting each kind's work to `clock`.
+    #[inline]
+    fn pixel_clocked(
+        &self,
+        pixel: u32,
+        counts: &mut RayCounts,
+        log: &mut impl TraceLog,
+        clock: &mut impl KindClock,
+    ) -> Vec3 {
         let n = self.settings.aa_samples.max(1);
         let mut sum = Vec3::ZERO;
         for sample in 0..n {
@@ -109,28 +149,43 @@ impl<'a> Reference<'a> {
                 light: 0,
                 seed: self.settings.seed,
             };
+            let start = clock.mark();
             let ray = self.camera.sample_ray(pixel, sample, n, self.settings.seed);
             counts.camera += 1;
-            sum += self.trace(&ray, key, counts, log);
+            sum += self.trace(&ray, key, counts, log, clock, start);
         }
         sum / n as f32
     }
 
-    fn trace(
+    #[allow(clippy::too_many_arguments)]
+    fn trace<M: Copy>(
         &self,
         ray: &Ray,
         key: SampleKey,
         counts: &mut RayCounts,
         log: &mut impl TraceLog,
+        clock: &mut impl KindClock<Mark = M>,
+        start: M,
     ) -> Vec3 {
+        // `start` is when this ray's making began (its kind's work: making it, then its
+        // closest hit and the surface data there).
+        let kind = if key.bounce == 0 {
+            RayKind::Camera
+        } else {
+            RayKind::Reflection
+        };
         let hit = self
             .accel
             .closest(self.scene, ray, f32::INFINITY, self.settings.two_sided);
         log.path_ray(key.bounce, ray, &hit);
         if !hit.is_hit() {
+            clock.since(kind, start);
             return self.settings.background();
         }
         let surface = surface_hit(self.scene, hit.prim, ray, hit.t, self.settings.two_sided);
+        // One reading ends this ray's work and starts what follows (the few operations of
+        // the ambient term go with it).
+        let mut start = clock.since(kind, start);
         let material = self.scene.material_of(hit.prim);
         let mut color = Vec3::from_array(self.settings.ambient) * material.diffuse;
         if material.is_reflective() && key.bounce < self.settings.bounces {
@@ -140,9 +195,13 @@ impl<'a> Reference<'a> {
                 bounce: key.bounce + 1,
                 ..key
             };
-            color += material.reflective * self.trace(&next, bounced, counts, log);
+            color += material.reflective * self.trace(&next, bounced, counts, log, clock, start);
+            // The mirror ray's path took its own time: the light loop starts now.
+            start = clock.mark();
         }
-        color + self.direct(&surface, -ray.direction, material, key, counts, log)
+        let direct = self.direct(&surface, -ray.direction, material, key, counts, log);
+        clock.since(RayKind::Shadow, start);
+        color + direct
     }
 
     /// Σ over lights and their N points of Shade / N for the visible points.

@@ -1,19 +1,25 @@
 //! The `--stats-json` file of `raywave render`: one render's figures, with the machine, the
-//! build and the settings. It shares [`Machine`], [`KindRates`] and [`StageFigure`] with
-//! `raywave bench`'s records, so both describe a machine and a stage alike.
+//! build and the settings. It shares [`Machine`], [`KindRates`], [`StageFigure`] and the
+//! layout version ([`FORMAT`](crate::bench::record::FORMAT)) with `raywave bench`'s records, so both describe a machine, a
+//! kind and a stage alike; docs/SCHEMA.md describes both and docs/schema/ holds their JSON
+//! Schemas, generated from these types by [`schemas`].
 
-use crate::bench::record::{KindRates, StageFigure};
+use crate::bench::record::{BenchRecord, KindRates, StageFigure};
 use crate::engine::Engine;
 use crate::machine::Machine;
 use crate::settings::RenderSettings;
-use crate::stats::RayCounts;
+use crate::wavefront::stats::RenderStats;
+use schemars::JsonSchema;
 use serde::Serialize;
 use std::io::Write;
 use std::path::Path;
 
 /// Everything `--stats-json` writes.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, JsonSchema)]
 pub struct RenderRecord {
+    /// Layout version, shared with bench records (`raywave::bench::record::FORMAT`).
+    #[schemars(extend("const" = crate::bench::record::FORMAT))]
+    pub format: u32,
     /// raywave's version.
     pub raywave: &'static str,
     /// The machine (without its host name).
@@ -34,14 +40,22 @@ pub struct RenderRecord {
     pub defaults: DefaultsUsed,
     /// Wall-clock seconds of the render.
     pub seconds: f64,
-    /// Rays and rays per second by kind: camera, shadow, reflection, total.
+    /// Rays by kind with each kind's rate per thread-second of its own work, and the total
+    /// per wall-clock second.
     pub rays: KindFigures,
-    /// Per stage (`None` for the reference, which has no stages).
+    /// How the kinds' thread-seconds were measured: `stage timers` (wavefront),
+    /// `instrumented pass` (the reference: a second render of the frame with timers, so the
+    /// timed render had none).
+    pub kinds_timed_by: &'static str,
+    /// Wall-clock seconds of the reference's instrumented pass (null for the wavefront
+    /// engine): beside `seconds`, the timers' cost.
+    pub instrumented_seconds: Option<f64>,
+    /// Per stage (null for the reference, which has no stages).
     pub stages: Option<Vec<StageFigure>>,
 }
 
 /// The scene's size, and the wavefront engine's BVH.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, JsonSchema)]
 pub struct SceneFigures {
     /// File path, or `<built-in ...>`.
     pub source: String,
@@ -51,14 +65,14 @@ pub struct SceneFigures {
     pub spheres: usize,
     /// Lights.
     pub lights: usize,
-    /// Whether the wavefront engine built a mesh BVH (`None` for the reference).
+    /// Whether the wavefront engine built a mesh BVH (null for the reference).
     pub bvh: Option<bool>,
     /// How long that took.
     pub bvh_build_seconds: Option<f64>,
 }
 
 /// Whose defaults filled the settings no flag set.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, JsonSchema)]
 pub struct DefaultsUsed {
     /// `raywave`, `lab` or `rpi`.
     pub from: &'static str,
@@ -67,53 +81,106 @@ pub struct DefaultsUsed {
     pub settings: Vec<&'static str>,
 }
 
-/// One kind's rays and rays per wall-clock second.
-#[derive(Clone, Copy, Debug, Serialize)]
+/// One kind's rays, the thread-time of its work, and its rate over that time.
+#[derive(Clone, Copy, Debug, Serialize, JsonSchema)]
 pub struct KindFigure {
     /// Rays cast.
     pub rays: u64,
-    /// Rays per wall-clock second.
+    /// Thread-seconds of this kind's work, summed over worker threads (null: not measured).
+    pub thread_seconds: Option<f64>,
+    /// rays / thread_seconds (null: not measured, or no rays).
+    pub rays_per_thread_second: Option<f64>,
+}
+
+/// All rays over the frame's wall-clock time.
+#[derive(Clone, Copy, Debug, Serialize, JsonSchema)]
+pub struct TotalFigure {
+    /// Rays cast, all kinds.
+    pub rays: u64,
+    /// Wall-clock seconds of the render.
+    pub seconds: f64,
+    /// rays / seconds: the headline figure.
     pub rays_per_second: f64,
 }
 
-/// [`KindFigure`] for each kind.
-#[derive(Clone, Copy, Debug, Serialize)]
+/// [`KindFigure`] for each kind, and the total.
+#[derive(Clone, Copy, Debug, Serialize, JsonSchema)]
 pub struct KindFigures {
-    /// Camera rays.
+    /// Camera rays: making them and their closest hits.
     pub camera: KindFigure,
-    /// Shadow rays.
+    /// Shadow rays: spawning them, the occlusion tests and the Shade sums.
     pub shadow: KindFigure,
-    /// Mirror rays.
+    /// Mirror rays: making them and their closest hits.
     pub reflection: KindFigure,
-    /// All rays.
-    pub total: KindFigure,
+    /// All rays per wall-clock second.
+    pub total: TotalFigure,
 }
 
 impl KindFigures {
-    /// The counts, and each divided by `seconds` as bench records do it ([`KindRates`]).
-    pub fn new(counts: &RayCounts, seconds: f64) -> KindFigures {
-        let rates = KindRates::new(counts, seconds);
-        let figure = |rays, rays_per_second| KindFigure {
+    /// The counts of `stats`, each kind over its thread-time when `stats` measured it
+    /// ([`KindRates::measured`], as bench records do it), the total over wall-clock `seconds`.
+    pub fn new(stats: &RenderStats, seconds: f64) -> KindFigures {
+        let counts = &stats.counts;
+        let rates = KindRates::measured(stats, seconds);
+        let times = stats.kind_time.map(|t| [t.camera, t.shadow, t.reflection]);
+        let figure = |i: usize, rays, rate| KindFigure {
             rays,
-            rays_per_second,
+            thread_seconds: times.map(|t: [std::time::Duration; 3]| t[i].as_secs_f64()),
+            rays_per_thread_second: rate,
         };
         KindFigures {
-            camera: figure(counts.camera, rates.camera),
-            shadow: figure(counts.shadow, rates.shadow),
-            reflection: figure(counts.reflection, rates.reflection),
-            total: figure(counts.total(), rates.total),
+            camera: figure(0, counts.camera, rates.camera),
+            shadow: figure(1, counts.shadow, rates.shadow),
+            reflection: figure(2, counts.reflection, rates.reflection),
+            total: TotalFigure {
+                rays: counts.total(),
+                seconds,
+                rays_per_second: rates.total,
+            },
         }
     }
 
-    /// (kind, figure) in report order.
-    pub fn rows(&self) -> [(&'static str, KindFigure); 4] {
+    /// (kind, figure) for camera, shadow and reflection, in report order.
+    pub fn kinds(&self) -> [(&'static str, KindFigure); 3] {
         [
             ("camera", self.camera),
             ("shadow", self.shadow),
             ("reflection", self.reflection),
-            ("total", self.total),
         ]
     }
+}
+
+/// The JSON Schemas of the `--stats-json` file and of a bench record, as (file name, pretty
+/// JSON with a final newline): docs/schema/ holds these, and tests/schema.rs checks that it
+/// still does.
+pub fn schemas() -> [(&'static str, String); 2] {
+    // The files as written: every field required (an absent value is written as null),
+    // except the few left out when empty (a bench record's host name in `--stats-json`).
+    let settings = schemars::generate::SchemaSettings::draft2020_12().for_serialize();
+    let pretty = |schema: schemars::Schema| {
+        let mut text = serde_json::to_string_pretty(&schema).unwrap_or_default();
+        text.push('\n');
+        text
+    };
+    [
+        (
+            "render-record.schema.json",
+            pretty(
+                settings
+                    .clone()
+                    .into_generator()
+                    .into_root_schema_for::<RenderRecord>(),
+            ),
+        ),
+        (
+            "bench-record.schema.json",
+            pretty(
+                settings
+                    .into_generator()
+                    .into_root_schema_for::<BenchRecord>(),
+            ),
+        ),
+    ]
 }
 
 impl RenderRecord {
@@ -127,20 +194,46 @@ impl RenderRecord {
             Ok(writeln!(w)?)
         })
     }
+
+    /// [`RenderRecord::write`] with one more top-level entry, `key` (e.g. `mse_reference`,
+    /// the render's error against `render --mse-reference`).
+    pub fn write_with(
+        &self,
+        path: &Path,
+        key: &str,
+        value: serde_json::Value,
+    ) -> anyhow::Result<()> {
+        let mut json = serde_json::to_value(self)?;
+        json[key] = value;
+        crate::film::write_atomically(path, |w| {
+            serde_json::to_writer_pretty(&mut *w, &json)?;
+            Ok(writeln!(w)?)
+        })
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bench::record::FORMAT;
 
     #[test]
     fn the_file_keeps_its_keys_sorted_and_names_no_host() {
-        let counts = RayCounts {
-            camera: 4,
-            shadow: 6,
-            reflection: 2,
+        let stats = RenderStats {
+            counts: crate::stats::RayCounts {
+                camera: 4,
+                shadow: 6,
+                reflection: 2,
+            },
+            kind_time: Some(crate::stats::KindTimes {
+                camera: std::time::Duration::from_millis(500),
+                shadow: std::time::Duration::from_millis(1500),
+                reflection: std::time::Duration::ZERO,
+            }),
+            ..RenderStats::default()
         };
         let record = RenderRecord {
+            format: FORMAT,
             raywave: "0",
             machine: Machine {
                 hostname: String::new(),
@@ -164,7 +257,9 @@ mod tests {
                 settings: vec!["size"],
             },
             seconds: 2.0,
-            rays: KindFigures::new(&counts, 2.0),
+            rays: KindFigures::new(&stats, 2.0),
+            kinds_timed_by: "instrumented pass",
+            instrumented_seconds: Some(2.5),
             stages: None,
         };
         let dir = tempfile::tempdir().unwrap();
@@ -183,7 +278,14 @@ mod tests {
         assert!(text.contains("\"for\": [\n      \"size\"\n    ]"), "{text}");
         let json: serde_json::Value = serde_json::from_str(&text).unwrap();
         assert_eq!(json["rays"]["total"]["rays"], 12);
-        assert_eq!(json["rays"]["shadow"]["rays_per_second"], 3.0);
+        assert_eq!(json["rays"]["total"]["rays_per_second"], 6.0);
+        // Each kind over its own thread-time, not over the frame's 2 s.
+        assert_eq!(json["rays"]["camera"]["rays_per_thread_second"], 8.0);
+        assert_eq!(json["rays"]["shadow"]["rays_per_thread_second"], 4.0);
+        assert_eq!(json["rays"]["shadow"]["thread_seconds"], 1.5);
+        // Rays, but no time measured for them: no rate.
+        assert!(json["rays"]["reflection"]["rays_per_thread_second"].is_null());
+        assert_eq!(json["format"], FORMAT);
         assert_eq!(json["engine"], "reference");
         assert!(json["stages"].is_null() && json["scene"]["bvh"].is_null());
     }

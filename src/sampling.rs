@@ -15,7 +15,7 @@ pub mod rng;
 pub const CAMERA_LIGHT: u32 = u32::MAX;
 
 /// How points are chosen on an area light.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(rename_all = "lowercase")]
 pub enum LightSampler {
     /// N independent uniform points on the light.

@@ -5,7 +5,7 @@ use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
 /// How shadows are computed.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(rename_all = "lowercase")]
 pub enum ShadowMode {
     /// The lab's starting point: every light counts as visible (no shadow rays).
@@ -17,7 +17,9 @@ pub enum ShadowMode {
 }
 
 /// How a light's colour reaches a shaded point.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum LightModel {
     /// The lab's: Lc = 0.2·ke·area, with no fall-off with distance.
@@ -29,7 +31,7 @@ pub enum LightModel {
 }
 
 /// Everything that decides the image, apart from the scene.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 pub struct RenderSettings {
     /// Image width in pixels.
     pub width: u32,

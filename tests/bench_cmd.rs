@@ -41,6 +41,25 @@ fn save_then_compare_passes_and_the_record_is_complete() {
     ] {
         assert!(stdout.contains(needle), "missing `{needle}` in:\n{stdout}");
     }
+    // Kinds per thread-second of their own work: measured for the wavefront engine, `-` for
+    // the reference (timed without timers); totals per wall-clock second.
+    let line = |start: &str| {
+        stdout
+            .lines()
+            .find(|l| l.starts_with(start))
+            .unwrap_or_else(|| panic!("no `{start}` line in:\n{stdout}"))
+            .to_string()
+    };
+    assert!(line("reference  camera").ends_with(" -"), "{stdout}");
+    assert!(!line("wavefront  camera").ends_with(" -"), "{stdout}");
+    assert!(
+        line("engine     kind").ends_with("Mrays/thread-s"),
+        "{stdout}"
+    );
+    assert!(
+        line("wavefront  total").ends_with("(Mrays/s, wall clock)"),
+        "{stdout}"
+    );
     let path = dir.path().join(".raywave-bench/before.json");
     let record: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
@@ -91,8 +110,8 @@ fn an_inflated_record_makes_compare_exit_3_with_the_table() {
         serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
     for engine in record["engines"].as_array_mut().unwrap() {
         let median = &mut engine["median"];
-        let total = median["rays_per_second"]["total"].as_f64().unwrap();
-        median["rays_per_second"]["total"] = (total * 100.0).into();
+        let total = median["rates"]["total_per_second"].as_f64().unwrap();
+        median["rates"]["total_per_second"] = (total * 100.0).into();
         for stage in median["stages"].as_array_mut().unwrap() {
             let v = stage["rays_per_thread_second"].as_f64().unwrap();
             stage["rays_per_thread_second"] = (v * 100.0).into();

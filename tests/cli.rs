@@ -494,3 +494,49 @@ fn rpi_style_room_is_not_blown_out_under_the_rpi_light_model() {
     assert!(saturated < 0.05, "{saturated} of the pixels saturate");
     assert!(lit > 0.5, "only {lit} of the pixels are lit");
 }
+
+#[test]
+fn stats_tables_give_each_kind_over_its_own_thread_time_and_the_total_over_the_wall_clock() {
+    for (engine, timed_by) in [
+        ("wavefront", "kinds timed by the stage timers"),
+        ("reference", "kinds timed by a second pass with timers"),
+    ] {
+        let dir = dir_with(&["cornell_box_reflective_spheres.obj"]);
+        let line =
+            format!("cornell_box_reflective_spheres.obj --size 16 12 --engine {engine} --stats");
+        let out = raywave(dir.path(), &words(&line));
+        assert!(out.status.success(), "{}", stderr(&out));
+        let text = stdout(&out);
+        let row = |kind: &str| -> Vec<String> {
+            text.lines()
+                .find(|l| l.split_whitespace().next() == Some(kind))
+                .unwrap_or_else(|| panic!("no `{kind}` row in:\n{text}"))
+                .split_whitespace()
+                .map(str::to_string)
+                .collect()
+        };
+        assert_eq!(
+            row("kind"),
+            ["kind", "rays", "thread-s", "Mrays/thread-s"],
+            "{text}"
+        );
+        for kind in ["camera", "shadow", "reflection"] {
+            let r = row(kind);
+            // rays, thread-seconds, Mrays per thread-second: all measured, for both engines.
+            assert_eq!(r.len(), 4, "{text}");
+            assert!(r[3].parse::<f64>().is_ok_and(|x| x > 0.0), "{kind}: {text}");
+        }
+        assert!(text.contains("wall s") && text.contains(timed_by), "{text}");
+        // The total is its rays over the wall-clock seconds of the summary's `time` line.
+        let total = row("total");
+        let rays: f64 = total[1].parse().unwrap();
+        let seconds: f64 = total[2].parse().unwrap();
+        let rate: f64 = total[3].parse().unwrap();
+        if seconds >= 0.01 {
+            assert!(
+                (rays / seconds / 1e6 - rate).abs() <= 0.01 * rate + 0.01,
+                "{text}"
+            );
+        }
+    }
+}

@@ -73,7 +73,7 @@ fn records_with_nothing_valid_to_compare_are_refused() {
             "a record whose total rate is zero",
             |d| {
                 doctored_record(d, |j| {
-                    median(j, "reference")["rays_per_second"]["total"] = 0.into()
+                    median(j, "reference")["rates"]["total_per_second"] = 0.into()
                 })
             },
             "engine reference: total rate 0, expected a positive number",
@@ -82,7 +82,7 @@ fn records_with_nothing_valid_to_compare_are_refused() {
             "a record whose total rate is negative",
             |d| {
                 doctored_record(d, |j| {
-                    median(j, "wavefront")["rays_per_second"]["total"] = (-5.0).into()
+                    median(j, "wavefront")["rates"]["total_per_second"] = (-5.0).into()
                 })
             },
             "engine wavefront: total rate -5, expected a positive number",
@@ -123,7 +123,7 @@ fn records_that_do_not_parse_name_the_file_and_what_was_expected() {
             "a record with a NaN rate (null in JSON)",
             |d| {
                 doctored_record(d, |j| {
-                    median(j, "wavefront")["rays_per_second"]["total"] = serde_json::Value::Null
+                    median(j, "wavefront")["rates"]["total_per_second"] = serde_json::Value::Null
                 })
             },
             "not a valid bench record: invalid type: null, expected f64",
@@ -132,7 +132,7 @@ fn records_that_do_not_parse_name_the_file_and_what_was_expected() {
             "a record with a word for a rate",
             |d| {
                 doctored_record(d, |j| {
-                    median(j, "wavefront")["rays_per_second"]["total"] = "fast".into()
+                    median(j, "wavefront")["rates"]["total_per_second"] = "fast".into()
                 })
             },
             "invalid type: string \"fast\", expected f64",
@@ -150,7 +150,12 @@ fn records_that_do_not_parse_name_the_file_and_what_was_expected() {
         unreadable(
             "a record of another format version",
             |d| doctored_record(d, |j| j["format"] = 99.into()),
-            "bench record format 99, expected 1",
+            "bench record format 99, expected 2",
+        ),
+        unreadable(
+            "a record of format 1 (its kind rates were per wall-clock second of the frame)",
+            |d| doctored_record(d, |j| j["format"] = 1.into()),
+            "bench record format 1, expected 2: its figures mean other things (docs/SCHEMA.md)",
         ),
         Case {
             name: "a record that is a FIFO (must not hang)",
@@ -205,8 +210,8 @@ fn inflated(dir: &Path) {
     doctored_record(dir, |j| {
         for e in j["engines"].as_array_mut().unwrap() {
             let m = &mut e["median"];
-            let total = m["rays_per_second"]["total"].as_f64().unwrap();
-            m["rays_per_second"]["total"] = (total * 1000.0).into();
+            let total = m["rates"]["total_per_second"].as_f64().unwrap();
+            m["rates"]["total_per_second"] = (total * 1000.0).into();
         }
     })
 }

@@ -4,19 +4,24 @@
 pub use crate::machine::Machine;
 use crate::settings::RenderSettings;
 use crate::stats::RayCounts;
-use crate::wavefront::stats::StageRow;
+use crate::wavefront::stats::{RenderStats, StageRow};
 use anyhow::{Context, Result, bail};
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use std::io::Write;
 use std::path::Path;
 
-/// Bumped when the layout of a record changes; older records are refused with a message.
-pub const FORMAT: u32 = 1;
+/// The layout version of bench records and `--stats-json` files (both carry it as `format`),
+/// bumped when either layout changes; records of another version are refused with a message.
+/// 2: per-kind rates per thread-second of the kind's own work (were: per wall-clock second of
+/// the whole frame), and `--stats-json` carries `format` too. docs/SCHEMA.md has the rule.
+pub const FORMAT: u32 = 2;
 
 /// One `raywave bench` invocation.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct BenchRecord {
     /// Layout version ([`FORMAT`]).
+    #[schemars(extend("const" = FORMAT))]
     pub format: u32,
     /// raywave's version.
     pub raywave: String,
@@ -39,7 +44,7 @@ pub struct BenchRecord {
 }
 
 /// Scene, settings and threads: the work and the resources it was given.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct Setup {
     /// The scene.
     pub scene: SceneId,
@@ -53,7 +58,7 @@ pub struct Setup {
 
 /// Which scene: its name and a hash of its text, so a renamed copy still compares and an
 /// edited file does not.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct SceneId {
     /// File path, or `<built-in ...>` (informative only; not compared).
     pub source: String,
@@ -68,7 +73,7 @@ pub struct SceneId {
 }
 
 /// One engine's figures.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct EngineRecord {
     /// "reference" or "wavefront".
     pub engine: String,
@@ -79,56 +84,107 @@ pub struct EngineRecord {
 }
 
 /// What one render measured (or the medians of several).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct Measurement {
     /// Wall-clock seconds of the render.
     pub seconds: f64,
     /// Rays cast, by kind.
     pub rays: RayCounts,
-    /// Rays per wall-clock second, by kind.
+    /// The total per wall-clock second; each kind per thread-second of its own work.
+    #[serde(rename = "rates")]
     pub rays_per_second: KindRates,
     /// Per stage (wavefront only; empty for the reference, which has no stages).
     pub stages: Vec<StageFigure>,
 }
 
-/// Rays per second by kind.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+/// How fast each kind of ray was handled. A kind's rate is its rays per thread-second of
+/// that kind's own work ([`crate::stats::KindTimes`]: for the wavefront engine from its stage
+/// timers), so it says how fast that work went whatever else the frame did; the total is all
+/// rays per wall-clock second of the frame, the headline figure. A kind is null (`None`) when
+/// its time was not measured (the reference in `raywave bench`, which times it without
+/// timers) or it cast no rays.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct KindRates {
-    /// Camera rays.
-    pub camera: f64,
-    /// Shadow rays.
-    pub shadow: f64,
-    /// Mirror rays.
-    pub reflection: f64,
-    /// All rays: the headline figure.
+    /// Camera rays per thread-second of camera work.
+    #[serde(rename = "camera_per_thread_second")]
+    pub camera: Option<f64>,
+    /// Shadow rays per thread-second of shadow work.
+    #[serde(rename = "shadow_per_thread_second")]
+    pub shadow: Option<f64>,
+    /// Mirror rays per thread-second of mirror work.
+    #[serde(rename = "reflection_per_thread_second")]
+    pub reflection: Option<f64>,
+    /// All rays per wall-clock second: the headline figure.
+    #[serde(rename = "total_per_second")]
     pub total: f64,
 }
 
 impl KindRates {
-    /// Each count divided by `seconds`.
+    /// The total rate alone: `rays.total()` per wall-clock `seconds`, no kind measured.
     pub fn new(rays: &RayCounts, seconds: f64) -> KindRates {
-        let per_s = |n: u64| n as f64 / seconds.max(1e-9);
         KindRates {
-            camera: per_s(rays.camera),
-            shadow: per_s(rays.shadow),
-            reflection: per_s(rays.reflection),
-            total: per_s(rays.total()),
+            camera: None,
+            shadow: None,
+            reflection: None,
+            total: rays.total() as f64 / seconds.max(1e-9),
         }
     }
 
-    /// (kind, rays/s) in report order.
-    pub fn rows(&self) -> [(&'static str, f64); 4] {
+    /// The total per wall-clock `seconds`, and each kind per thread-second of its work when
+    /// `stats` measured it.
+    pub fn measured(stats: &RenderStats, seconds: f64) -> KindRates {
+        let total = KindRates::new(&stats.counts, seconds);
+        match &stats.kind_time {
+            Some(times) => KindRates {
+                camera: per_thread_second(stats.counts.camera, times.camera),
+                shadow: per_thread_second(stats.counts.shadow, times.shadow),
+                reflection: per_thread_second(stats.counts.reflection, times.reflection),
+                ..total
+            },
+            None => total,
+        }
+    }
+
+    /// (kind, rate) in report order, for the kinds that have one, then the total.
+    pub fn rows(&self) -> Vec<(&'static str, f64)> {
         [
             ("camera", self.camera),
             ("shadow", self.shadow),
             ("reflection", self.reflection),
-            ("total", self.total),
+            ("total", Some(self.total)),
         ]
+        .into_iter()
+        .filter_map(|(kind, rate)| Some((kind, rate?)))
+        .collect()
+    }
+
+    /// Each rate's median over `rates` (a kind only when every run measured it).
+    pub fn median_of(rates: &[KindRates]) -> KindRates {
+        let kind = |f: fn(&KindRates) -> Option<f64>| {
+            rates
+                .iter()
+                .map(f)
+                .collect::<Option<Vec<f64>>>()
+                .filter(|v| !v.is_empty())
+                .map(|v| median(&v))
+        };
+        KindRates {
+            camera: kind(|r| r.camera),
+            shadow: kind(|r| r.shadow),
+            reflection: kind(|r| r.reflection),
+            total: median(&rates.iter().map(|r| r.total).collect::<Vec<_>>()),
+        }
     }
 }
 
+/// `rays` per thread-second of `time`: `None` without rays or time.
+pub fn per_thread_second(rays: u64, time: std::time::Duration) -> Option<f64> {
+    let seconds = time.as_secs_f64();
+    (rays > 0 && seconds > 0.0).then(|| rays as f64 / seconds)
+}
+
 /// One wavefront stage's figures.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct StageFigure {
     /// Stage name (generate, intersect, shadow, reflect, film).
     pub stage: String,
@@ -192,12 +248,9 @@ impl Measurement {
         Measurement {
             seconds,
             rays: first.rays,
-            rays_per_second: KindRates {
-                camera: pick(&|r| r.rays_per_second.camera),
-                shadow: pick(&|r| r.rays_per_second.shadow),
-                reflection: pick(&|r| r.rays_per_second.reflection),
-                total: pick(&|r| r.rays_per_second.total),
-            },
+            rays_per_second: KindRates::median_of(
+                &runs.iter().map(|r| r.rays_per_second).collect::<Vec<_>>(),
+            ),
             stages,
         }
     }
@@ -262,8 +315,8 @@ pub fn load(path: &Path, name: &str) -> Result<BenchRecord> {
     let format = value.get("format").and_then(|f| f.as_u64());
     if format != Some(FORMAT as u64) {
         bail!(
-            "{}: bench record format {}, expected {FORMAT}: save it again with \
-             `raywave bench --save {name}`",
+            "{}: bench record format {}, expected {FORMAT}: its figures mean other things \
+             (docs/SCHEMA.md); save it again with `raywave bench --save {name}`",
             path.display(),
             format.map_or("missing".to_string(), |f| f.to_string())
         );
@@ -388,8 +441,8 @@ mod tests {
         assert!(e.contains("a.json: not a JSON bench record"), "{e}");
         std::fs::write(&path, r#"{"format": 99}"#).unwrap();
         let e = format!("{:#}", load(&path, "a").unwrap_err());
-        assert!(e.contains("format 99, expected 1"), "{e}");
-        std::fs::write(&path, r#"{"format": 1}"#).unwrap();
+        assert!(e.contains("format 99, expected 2"), "{e}");
+        std::fs::write(&path, r#"{"format": 2}"#).unwrap();
         let e = format!("{:#}", load(&path, "a").unwrap_err());
         assert!(e.contains("a.json: not a valid bench record"), "{e}");
     }

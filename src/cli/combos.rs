@@ -14,6 +14,10 @@ use raywave::settings::ShadowMode;
 pub fn meaningless(command: &Command, typed: &dyn Fn(&str) -> String) -> Vec<String> {
     let mut out = Vec::new();
     match command {
+        Command::TracePixel(args) => {
+            image(&args.image, typed, &mut out);
+            out.extend(super::trace_pixel::meaningless(args));
+        }
         Command::Render(args) => {
             image(&args.image, typed, &mut out);
             if args.tonemap == ToneMapArg::Exp
@@ -36,6 +40,7 @@ pub fn meaningless(command: &Command, typed: &dyn Fn(&str) -> String) -> Vec<Str
             }
         }
         Command::Bench(args) => image(&args.image, typed, &mut out),
+        Command::View(args) => image(&args.image, typed, &mut out),
         _ => {}
     }
     out

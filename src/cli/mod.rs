@@ -10,18 +10,24 @@
 //! render.rs    raywave render: summary, --stats, --stats-json, --debug-pixel
 //! bench.rs     raywave bench -> raywave::bench::BenchOptions
 //! variance.rs  raywave variance -> raywave::variance::command::VarianceOptions
+//! view.rs      raywave view -> raywave::view::ViewOptions (the browser debug window)
+//! trace_pixel.rs  raywave trace-pixel: one pixel's ray tree (JSON, OBJ, PLY, PNG)
+//! diff.rs      raywave diff -> raywave::image_diff
 //! meshgen.rs, info.rs
 //! ```
 
 pub mod bench;
 pub mod combos;
+pub mod diff;
 pub mod foreign;
 pub mod image;
 pub mod info;
 pub mod meshgen;
 pub mod render;
+pub mod trace_pixel;
 pub mod values;
 pub mod variance;
+pub mod view;
 
 use clap::{Parser, Subcommand};
 
@@ -51,4 +57,14 @@ pub enum Command {
     /// Time both engines on a scene (rays/s per kind and stage); save and compare records
     /// (exit 3 when a figure regresses past --threshold).
     Bench(bench::BenchArgs),
+    /// The lab's debug window in the browser: the render, coarse to fine, the scene in 3D, a
+    /// pixel's ray tree, two samplers side by side (a local server on 127.0.0.1).
+    View(view::ViewArgs),
+    /// Trace one pixel as its render does and show its ray tree: a summary, or JSON, OBJ/PLY
+    /// and a PNG from a debug camera (checked against both engines' render of that pixel).
+    TracePixel(trace_pixel::TracePixelArgs),
+    /// Compare two images (PNG, PPM, PFM, EXR): MSE, relative MSE, largest difference, PSNR
+    /// and FLIP, per channel, over the image or a mask; a false-colour map of the error
+    /// (exit 3 past --fail-above).
+    Diff(diff::DiffArgs),
 }

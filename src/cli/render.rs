@@ -5,25 +5,26 @@ use super::image::ImageArgs;
 use super::values::{EngineArg, ToneMapArg};
 use anyhow::Result;
 use clap::Args;
+use image::RgbImage;
 use raywave::bench::record::StageFigure;
 use raywave::camera::CameraRays;
 use raywave::debug_view::RayRecorder;
-use raywave::engine::{Engine, thread_pool};
+use raywave::engine::{Engine, Prepared, thread_pool};
 use raywave::error::UsageError;
+use raywave::film::{Film, ToneMap};
 use raywave::film::{OutputFormat, check_hdr_path, output_format};
+use raywave::image_diff::{self, Encoding, FileInfo, Image, Region, read_image};
 use raywave::machine::Machine;
 use raywave::options::{BackgroundSource, Effective};
 use raywave::output::OutputPlan;
 use raywave::output::memory::{self, RenderFootprint};
-use raywave::reference::Reference;
 use raywave::report::{DefaultsUsed, KindFigures, RenderRecord, SceneFigures};
 use raywave::scene::{Scene, load_scene};
 use raywave::settings::{LightModel, ShadowMode};
-use raywave::stats::RayCounts;
 use raywave::terminal::{print, progress_bar};
 use raywave::wavefront::stats::RenderStats;
 use std::fmt::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// `raywave render` flags.
@@ -81,6 +82,11 @@ pub struct RenderArgs {
     /// renders are also refused when they exceed the memory available.
     #[arg(long, value_name = "SIZE", value_parser = raywave::output::memory::parse_size)]
     pub max_memory: Option<u64>,
+    /// After rendering, print the image's error against this reference (PNG, PPM, PFM or
+    /// EXR; the figures of `raywave diff`): a float reference is compared with the linear
+    /// image, an 8-bit one with the 8-bit image written.
+    #[arg(long, value_name = "REF")]
+    pub mse_reference: Option<PathBuf>,
 }
 
 impl RenderArgs {
@@ -136,6 +142,25 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         ))
         .into());
     }
+    // The reference is read and its size checked before the long part.
+    let reference = match &args.mse_reference {
+        Some(path) => {
+            let image = read_image(path)?;
+            if (image.width, image.height) != (settings.width, settings.height) {
+                return Err(UsageError(format!(
+                    "--mse-reference {} is {}×{} but the render is {}×{}: expected a reference of the render's size",
+                    path.display(),
+                    image.width,
+                    image.height,
+                    settings.width,
+                    settings.height
+                ))
+                .into());
+            }
+            Some((path, image))
+        }
+        None => None,
+    };
     let pool = thread_pool(args.threads)?;
     let threads = pool.current_num_threads();
     let engine_choice = Engine::from(args.engine);
@@ -172,39 +197,28 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         Engine::Reference => setup_start,
         Engine::Wavefront => Instant::now(),
     };
-    let (film, stats) = pool.install(|| engine.render(&|| progress.inc(1)));
+    let (film, mut stats) = pool.install(|| engine.render(&|| progress.inc(1)));
     let seconds = start.elapsed().as_secs_f64();
     progress.finish_and_clear();
-    let report = Report {
-        counts: stats.counts,
-        seconds,
-        stages: engine.bvh_build_seconds().map(|bvh| (stats, bvh)),
-    };
-
     let mut img = match format {
         OutputFormat::Ldr(_) => Some(film.to_rgb8(args.tonemap.into())),
         OutputFormat::Linear => None,
     };
     if let Some(px) = &args.debug_pixel {
-        let mut recorder = RayRecorder {
-            miss_length: 10.0,
-            ..Default::default()
-        };
-        let pixel = px[1] * settings.width + px[0];
-        // The debug view follows the reference's recursion (both engines trace the same rays).
-        let reference = Reference::new(&scene, &settings);
-        let colour = reference.pixel(pixel, &mut RayCounts::default(), &mut recorder);
+        // The tree both engines trace for the pixel (raywave::trace), checked against both.
+        let mut tree = raywave::trace::trace_pixel(&scene, &settings, px[0], px[1])
+            .map_err(|e| UsageError(format!("--debug-pixel: {e}")))?;
+        tree.check = Some(raywave::trace::check_pixel(&scene, &settings, &tree));
         say(&format!(
-            "rays traced for pixel ({}, {}), colour {:.5}:\n{}",
+            "rays traced for pixel ({}, {}):\n{}",
             px[0],
             px[1],
-            colour,
-            recorder.report(&scene)
+            raywave::trace::summary(&tree)
         ))?;
         match &mut img {
             Some(img) => {
                 let camera = CameraRays::new(&scene.camera, settings.width, settings.height);
-                recorder.draw(img, &camera);
+                RayRecorder::from_tree(&tree).draw(img, &camera);
             }
             None => eprintln!(
                 "note: the rays are drawn only over an 8-bit image; {} holds the linear image alone",
@@ -219,13 +233,54 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if let Some(hdr) = &args.hdr {
         film.write_hdr(hdr)?;
     }
+    let reference_error = match &reference {
+        Some((path, image)) => Some(reference_error(
+            path,
+            image,
+            &film,
+            img.as_ref(),
+            args.tonemap.into(),
+        )?),
+        None => None,
+    };
+    // The reference's render carries no timer; its kinds are timed by a second pass with
+    // timers, only when the figures are asked for (its image is dropped, as are these first:
+    // the memory check counted one film).
+    drop((img, film));
+    let mut instrumented_seconds = None;
+    if let (Prepared::Reference(reference), true) =
+        (&engine, args.stats || args.stats_json.is_some())
+    {
+        let progress = progress_bar(
+            units,
+            "{spinner} timing ray kinds (a second pass, with timers) [{bar:40}] {pos}/{len} rows, {elapsed} (eta {eta})",
+            args.quiet,
+        );
+        let start = Instant::now();
+        let (_, counts, times) = pool.install(|| reference.render_timed(&|| progress.inc(1)));
+        instrumented_seconds = Some(start.elapsed().as_secs_f64());
+        progress.finish_and_clear();
+        debug_assert_eq!(counts, stats.counts);
+        stats.kind_time = Some(times);
+    }
+    let report = Report {
+        stats,
+        seconds,
+        stages: engine.bvh_build_seconds().map(|bvh| (stats, bvh)),
+        instrumented_seconds,
+    };
+
     let run = RunInfo {
         engine: engine_choice,
         threads,
         batch_size: args.batch_size,
     };
     if let Some(path) = &args.stats_json {
-        record(&scene, &effective, &run, &report).write(path)?;
+        let record = record(&scene, &effective, &run, &report);
+        match &reference_error {
+            Some((_, json)) => record.write_with(path, "mse_reference", json.clone())?,
+            None => record.write(path)?,
+        }
     }
     if !args.quiet {
         let extra = args
@@ -242,7 +297,43 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if args.stats {
         say(&stats_table(&report))?;
     }
+    if let Some((text, _)) = &reference_error {
+        say(text)?;
+    }
     Ok(())
+}
+
+/// The render's error against `--mse-reference`, as text and as JSON: the linear image against
+/// a float reference, the 8-bit image written (`rgb8`, else the film tone mapped) against an
+/// 8- or 16-bit one, so that `raywave diff` on the files gives the same figures.
+fn reference_error(
+    path: &Path,
+    reference: &Image,
+    film: &Film,
+    rgb8: Option<&RgbImage>,
+    tone: ToneMap,
+) -> Result<(String, serde_json::Value)> {
+    let (render, compared_as) = if reference.encoding == Encoding::Float {
+        (Image::from_film(film, "render"), "linear floats")
+    } else {
+        let image = match rgb8 {
+            Some(img) => Image::from_rgb8(img, "render"),
+            None => Image::from_rgb8(&film.to_rgb8(tone), "render"),
+        };
+        (image, "the 8-bit image")
+    };
+    let region = Region::whole(render.width, render.height);
+    let comparison = image_diff::compare(&render, reference, &region)?;
+    let info = FileInfo::of(path, reference);
+    let text = format!(
+        "error of the render ({compared_as}) against --mse-reference {}\n{}",
+        info.describe(),
+        image_diff::text::table(&comparison)
+    );
+    let mut json = serde_json::to_value(&comparison)?;
+    json["reference"] = serde_json::to_value(&info)?;
+    json["compared_as"] = compared_as.into();
+    Ok((text, json))
 }
 
 /// The scene (an input) and every output of a render, for the checks before any work.
@@ -260,6 +351,9 @@ fn output_plan(args: &RenderArgs) -> OutputPlan {
     }
     if let Some(json) = &args.stats_json {
         plan = plan.output("--stats-json", json);
+    }
+    if let Some(reference) = &args.mse_reference {
+        plan = plan.input("--mse-reference", reference);
     }
     plan
 }
@@ -343,7 +437,7 @@ fn summary(scene: &Scene, effective: &Effective, run: &RunInfo, report: &Report)
         )
     };
     let _ = writeln!(out, "default {defaulted}");
-    let counts = &report.counts;
+    let counts = &report.stats.counts;
     let _ = writeln!(
         out,
         "rays    {} total: {} camera, {} shadow, {} reflection",
@@ -370,30 +464,85 @@ struct RunInfo {
 
 /// What a render measured.
 struct Report {
-    counts: RayCounts,
+    /// Ray counts, and each kind's thread-time when measured.
+    stats: RenderStats,
     seconds: f64,
     /// Wavefront only: per-stage figures, and the BVH build time if a BVH was used.
     stages: Option<(RenderStats, Option<f64>)>,
+    /// Reference only, with --stats or --stats-json: the wall-clock seconds of the second,
+    /// instrumented pass that timed the kinds.
+    instrumented_seconds: Option<f64>,
 }
 
 impl Report {
-    /// Rays and rays per wall-clock second by kind, as the JSON gives them.
+    /// Rays by kind, each kind per thread-second of its work, the total per wall-clock second,
+    /// as the JSON gives them.
     fn kinds(&self) -> KindFigures {
-        KindFigures::new(&self.counts, self.seconds)
+        KindFigures::new(&self.stats, self.seconds)
+    }
+
+    /// How the kinds' thread-time was measured, as the JSON names it.
+    fn kinds_timed_by(&self) -> &'static str {
+        match self.instrumented_seconds {
+            Some(_) => "instrumented pass",
+            None => "stage timers",
+        }
     }
 }
 
-/// The `--stats` tables: rays by kind, then (wavefront) the BVH build and each stage.
+/// The `--stats` tables: rays by kind (each kind over the thread-time of its own work, the
+/// total over the wall clock), then (wavefront) the BVH build and each stage.
 fn stats_table(report: &Report) -> String {
     let mut out = String::new();
-    let _ = writeln!(out, "{:<12} {:>14} {:>14}", "kind", "rays", "Mrays/s");
-    for (kind, figure) in report.kinds().rows() {
-        let rays = figure.rays;
+    let kinds = report.kinds();
+    let _ = writeln!(
+        out,
+        "{:<12} {:>14} {:>14} {:>20}",
+        "kind", "rays", "thread-s", "Mrays/thread-s"
+    );
+    let or_dash = |x: Option<f64>, scale: f64, digits: usize| {
+        x.map_or("-".to_string(), |x| format!("{:.digits$}", x * scale))
+    };
+    for (kind, figure) in kinds.kinds() {
         let _ = writeln!(
             out,
-            "{kind:<12} {rays:>14} {:>14.2}",
-            figure.rays_per_second / 1e6
+            "{kind:<12} {:>14} {:>14} {:>20}",
+            figure.rays,
+            or_dash(figure.thread_seconds, 1.0, 4),
+            or_dash(figure.rays_per_thread_second, 1e-6, 2)
         );
+    }
+    let total = kinds.total;
+    let _ = writeln!(
+        out,
+        "{:<12} {:>14} {:>14} {:>20}",
+        "", "", "wall s", "Mrays/s"
+    );
+    let _ = writeln!(
+        out,
+        "{:<12} {:>14} {:>14.3} {:>20.2}",
+        "total",
+        total.rays,
+        total.seconds,
+        total.rays_per_second / 1e6
+    );
+    match report.instrumented_seconds {
+        Some(pass) => {
+            let _ = writeln!(
+                out,
+                "kinds timed by a second pass with timers: {pass:.3} s against the render's \
+                 {:.3} s ({:+.1}%); the render itself had no timers",
+                report.seconds,
+                (pass / report.seconds.max(1e-9) - 1.0) * 100.0
+            );
+        }
+        None => {
+            let _ = writeln!(
+                out,
+                "kinds timed by the stage timers: camera = generate + intersect of camera rays, \
+                 reflection = reflect + intersect of mirror rays, shadow = shadow; film in none"
+            );
+        }
     }
     if let Some((_, Some(build))) = &report.stages {
         let _ = writeln!(out, "bvh build {build:.3} s");
@@ -407,7 +556,7 @@ fn stats_table(report: &Report) -> String {
         for row in stats.stage_rows() {
             let _ = writeln!(
                 out,
-                "{:<12} {:>14} {:>14.3} {:>20.2}",
+                "{:<12} {:>14} {:>14.4} {:>20.2}",
                 row.stage,
                 row.rays,
                 row.thread_seconds,
@@ -428,6 +577,7 @@ fn record(scene: &Scene, effective: &Effective, run: &RunInfo, report: &Report) 
         None => (None, None),
     };
     RenderRecord {
+        format: raywave::bench::record::FORMAT,
         raywave: env!("CARGO_PKG_VERSION"),
         // The record has never named the host.
         machine: Machine {
@@ -453,6 +603,8 @@ fn record(scene: &Scene, effective: &Effective, run: &RunInfo, report: &Report) 
         },
         seconds: report.seconds,
         rays: report.kinds(),
+        kinds_timed_by: report.kinds_timed_by(),
+        instrumented_seconds: report.instrumented_seconds,
         stages,
     }
 }

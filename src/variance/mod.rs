@@ -41,7 +41,9 @@ use std::time::Instant;
 pub use cache::Cache;
 pub use fits::{Matching, Slope, match_budget};
 pub use mask::{Regions, penumbra_mask};
-pub use stats::{ErrorStats, LogLogFit, deterministic, error_stats, loglog_fit, per_image_errors};
+pub use stats::{
+    ErrorStats, LogLogFit, deterministic, error_stats, loglog_fit, per_image_errors, pixel_mse,
+};
 
 /// Renders one image: the engine is the caller's choice (the fastest one, normally).
 pub type RenderFn<'a> = dyn Fn(&Scene, &RenderSettings) -> (Film, RayCounts) + Sync + 'a;
@@ -413,17 +415,7 @@ pub fn run_study(
             };
             rows.extend(rows_of(&measured, &reference, &masks));
             if n == config.heatmap_n {
-                let images = &measured.images;
-                let map = (0..reference.film.pixels.len())
-                    .map(|p| {
-                        let sq: f32 = images
-                            .iter()
-                            .map(|img| (img[p] - reference.film.pixels[p]).length_squared())
-                            .sum();
-                        sq / (3 * images.len()) as f32
-                    })
-                    .collect();
-                heatmaps.push((sampler, map));
+                heatmaps.push((sampler, pixel_mse(&measured.images, &reference.film.pixels)));
             }
         }
     }

@@ -4,7 +4,7 @@
 //! The font is embedded (DejaVu Sans, via the `dejavu` crate), so plots need no system fonts.
 
 use super::{Region, Row, StudyResult};
-use crate::false_colour::{Scale, figure, register_font};
+use crate::false_colour::{self, Scale, figure, register_font};
 use crate::film::write_atomically;
 use crate::sampling::LightSampler;
 use anyhow::{Context, Result, anyhow};
@@ -243,4 +243,20 @@ pub fn heatmaps(result: &StudyResult, dir: &Path) -> Result<Vec<PathBuf>> {
         written.push(path);
     }
     Ok(written)
+}
+
+/// Per-pixel MSE maps (each `w` × `h`) as images on one shared log scale
+/// ([`false_colour::Scale::from_values`]: the 1st to the 99.9th percentile of all maps' positive
+/// values; dark = low error, bright = high), so that the maps compare directly; also returns
+/// that scale as (lo, hi) in log10. `None` when no map has a positive value.
+pub fn heat_images(maps: &[&[f32]], w: u32, h: u32) -> Option<(Vec<image::RgbImage>, [f32; 2])> {
+    let scale = false_colour::Scale::from_values(maps.iter().flat_map(|m| m.iter()), true)?;
+    let images = maps
+        .iter()
+        .map(|map| false_colour::map_image(map, w, h, &scale))
+        .collect();
+    Some((
+        images,
+        [scale.low.log10() as f32, scale.high.log10() as f32],
+    ))
 }

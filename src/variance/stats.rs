@@ -77,6 +77,20 @@ pub fn error_stats(
     }
 }
 
+/// The squared error of each pixel against `reference`, averaged over channels and `images`:
+/// the heat maps' values.
+pub fn pixel_mse(images: &[&[Vec3]], reference: &[Vec3]) -> Vec<f32> {
+    (0..reference.len())
+        .map(|p| {
+            let sq: f32 = images
+                .iter()
+                .map(|img| (img[p] - reference[p]).length_squared())
+                .sum();
+            sq / (3 * images.len().max(1)) as f32
+        })
+        .collect()
+}
+
 /// Mean squared error and mean signed error of each image of `images` against `reference`
 /// over the pixels where `region` is true (the per-seed figures that [`error_stats`] pools):
 /// one `(mse, bias)` per image, `(0, 0)` for an empty region.

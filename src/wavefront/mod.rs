@@ -34,6 +34,7 @@ pub mod stats;
 use crate::film::Film;
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
+use crate::stats::RayKind;
 use batch::{HitBatch, Radiance, RayBatch, ShadowQueue};
 use context::Context;
 use glam::Vec3;
@@ -154,26 +155,29 @@ impl<'a> Wavefront<'a> {
         st: &mut RenderStats,
     ) {
         let ctx = &self.ctx;
-        st.time(Stage::Generate, || {
+        st.time_kind(Stage::Generate, RayKind::Camera, || {
             generate::camera_rays(ctx, first, out.len() as u32, &mut ws.rays);
             ws.radiance.reset(ws.rays.len());
         });
         st.counts.camera += ws.rays.len() as u64;
+        // The first batch holds the camera rays, every later one mirror rays.
+        let mut traced = RayKind::Camera;
         while !ws.rays.is_empty() {
-            st.time(Stage::Intersect, || {
+            st.time_kind(Stage::Intersect, traced, || {
                 intersect::closest(ctx, &ws.rays, &mut ws.hits);
             });
-            st.counts.shadow += st.time(Stage::Shadow, || {
+            st.counts.shadow += st.time_kind(Stage::Shadow, RayKind::Shadow, || {
                 let capacity = self.queue_capacity;
                 shadow::direct_light(ctx, &ws.rays, &mut ws.hits, &mut ws.shadow, capacity)
             });
             st.time(Stage::Film, || {
                 film::accumulate(ctx, &ws.rays, &ws.hits, &mut ws.radiance);
             });
-            st.counts.reflection += st.time(Stage::Reflect, || {
+            st.counts.reflection += st.time_kind(Stage::Reflect, RayKind::Reflection, || {
                 reflect::mirror_rays(ctx, &ws.rays, &ws.hits, &mut ws.next)
             });
             std::mem::swap(&mut ws.rays, &mut ws.next);
+            traced = RayKind::Reflection;
         }
         st.time(Stage::Film, || {
             film::resolve(&ws.radiance, ctx.settings.aa_samples, out);

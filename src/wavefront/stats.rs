@@ -1,6 +1,6 @@
-//! Per-stage timing and ray counts of a wavefront render.
+//! Per-stage timing, per-kind timing and ray counts of a wavefront render.
 
-use crate::stats::RayCounts;
+use crate::stats::{KindTimes, RayCounts, RayKind};
 use serde::Serialize;
 use std::ops::Add;
 use std::time::{Duration, Instant};
@@ -42,13 +42,18 @@ impl Stage {
     }
 }
 
-/// Rays by kind and thread-time by stage, summed over tiles.
+/// Rays by kind, thread-time by stage and by kind, summed over tiles.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct RenderStats {
     /// Rays cast, by kind (live lanes only).
     pub counts: RayCounts,
-    /// Thread-time spent in each stage, in `Stage::ALL` order.
+    /// Thread-time spent in each stage, in `Stage::ALL` order (zero for the reference).
     pub stage_time: [Duration; 5],
+    /// Thread-time spent on each kind's work; `None` when it was not measured (the reference
+    /// unless asked, see `Reference::render_timed`). The wavefront engine's comes from the
+    /// stage timers: camera = generate + intersect of the camera rays; reflection = reflect +
+    /// intersect of the mirror rays; shadow = the shadow stage; film belongs to no kind.
+    pub kind_time: Option<KindTimes>,
 }
 
 impl RenderStats {
@@ -58,6 +63,18 @@ impl RenderStats {
         let start = Instant::now();
         let out = f();
         self.stage_time[stage as usize] += start.elapsed();
+        out
+    }
+
+    /// Runs `f`, adding its duration to `stage` and to `kind`'s work (the same reading of
+    /// the clock: no timer more than [`RenderStats::time`]).
+    #[inline]
+    pub fn time_kind<T>(&mut self, stage: Stage, kind: RayKind, f: impl FnOnce() -> T) -> T {
+        let start = Instant::now();
+        let out = f();
+        let d = start.elapsed();
+        self.stage_time[stage as usize] += d;
+        self.kind_time.get_or_insert_default().add(kind, d);
         out
     }
 
@@ -116,6 +133,10 @@ impl Add for RenderStats {
         for (a, b) in self.stage_time.iter_mut().zip(o.stage_time) {
             *a += b;
         }
+        self.kind_time = match (self.kind_time, o.kind_time) {
+            (Some(a), Some(b)) => Some(a + b),
+            (a, b) => a.or(b),
+        };
         self
     }
 }

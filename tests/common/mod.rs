@@ -3,16 +3,19 @@
 //! `scenes` (bare and bundled scenes, the bias tests' lights and settings), `analytic` (the
 //! closed-form penumbra scene), `strategies`
 //! (proptest inputs), `random` (seeded inputs from `rand`), `bin` (running the binary in a
-//! scratch directory), `hostile` (the hostile-input catalogue's harness).
+//! scratch directory), `hostile` (the hostile-input catalogue's harness), `view` (`raywave view`
+//! on a free port, and raw HTTP requests to it).
 #![allow(dead_code, unused_imports)]
 
 pub mod analytic;
 pub mod bin;
+pub mod docs;
 pub mod hostile;
 pub mod random;
 pub mod rays;
 pub mod scenes;
 pub mod strategies;
+pub mod view;
 
 pub use random::{Draw, TestRng, seeded};
 pub use rays::{edge_rays, ray, triangle};

@@ -1,0 +1,338 @@
+//! `raywave diff A B`: reads two images, compares A with the reference B over the whole image
+//! or a mask, prints the figures (and writes them as JSON), draws the per-pixel error, and
+//! exits 3 when `--fail-above` is passed.
+
+use super::values::DefaultsArg;
+use anyhow::{Result, bail};
+use clap::{Args, ValueEnum};
+use raywave::error::UsageError;
+use raywave::film::{ldr_format, write_atomically};
+use raywave::image_diff::{
+    self, Comparison, EXIT_FAILED, FileInfo, Image, Metric, Region, read_image,
+};
+use raywave::options::ImageOptions;
+use raywave::output::{OutputPlan, is_stdio};
+use raywave::sampling::LightSampler;
+use raywave::scene::load_scene;
+use raywave::terminal::print;
+use serde::Serialize;
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+
+/// `--metric` on the command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum MetricArg {
+    /// Mean squared error.
+    Mse,
+    /// Relative MSE: mean (a−b)²/(b+0.01)² (pbrt-v4's MRSE).
+    Relmse,
+    /// Largest |a − b|.
+    Max,
+    /// PSNR in dB against a peak of 1 (--fail-above fails when it is BELOW the value).
+    Psnr,
+    /// FLIP's mean (needs the `flip` feature).
+    Flip,
+}
+
+impl From<MetricArg> for Metric {
+    fn from(m: MetricArg) -> Metric {
+        match m {
+            MetricArg::Mse => Metric::Mse,
+            MetricArg::Relmse => Metric::Relmse,
+            MetricArg::Max => Metric::Max,
+            MetricArg::Psnr => Metric::Psnr,
+            MetricArg::Flip => Metric::Flip,
+        }
+    }
+}
+
+/// Flags of `raywave diff`.
+#[derive(Args, Debug, Clone)]
+pub struct DiffArgs {
+    /// The image checked (PNG, PPM, PFM or EXR).
+    pub a: PathBuf,
+    /// The reference it is compared with (relMSE divides by it, FLIP takes it as reference).
+    pub b: PathBuf,
+    /// Compare only some pixels: `penumbra` (shadow edges, computed from the scene below as
+    /// `raywave variance` does) or an image file whose non-zero pixels are inside (write
+    /// `./penumbra` for a file of that name).
+    #[arg(long, value_name = "penumbra|FILE")]
+    pub mask: Option<PathBuf>,
+    /// Write a false-colour map of --metric's per-pixel error, with a colour bar (.png or .ppm).
+    #[arg(long, value_name = "FILE")]
+    pub out: Option<PathBuf>,
+    /// The figure --fail-above tests and --out draws.
+    #[arg(long, value_enum, default_value = "mse")]
+    pub metric: MetricArg,
+    /// Exit 3 when the overall --metric figure is above X (for psnr: below X).
+    #[arg(long, value_name = "X", value_parser = parse_threshold, allow_negative_numbers = true)]
+    pub fail_above: Option<f64>,
+    /// Also compute FLIP, NVIDIA's perceptual error (implied by --metric flip).
+    #[arg(long)]
+    pub flip: bool,
+    /// Write the figures as JSON (`-`: standard output; the table then goes to standard error).
+    #[arg(long, value_name = "FILE")]
+    pub json: Option<PathBuf>,
+    /// Scene the images were rendered from [default: the built-in scene].
+    #[arg(long, help_heading = "With --mask penumbra")]
+    pub scene: Option<PathBuf>,
+    /// Mirror bounces the images were rendered with [default: the --defaults' (5; lab, rpi: 0)].
+    #[arg(long, help_heading = "With --mask penumbra", value_parser = clap::value_parser!(u32).range(0..=64))]
+    pub bounces: Option<u32>,
+    /// Whose defaults fill the bounces [default: raywave].
+    #[arg(long, value_enum, help_heading = "With --mask penumbra")]
+    pub defaults: Option<DefaultsArg>,
+    /// Quads around each RPI cylinder ring of the scene [default: 20].
+    #[arg(long, help_heading = "With --mask penumbra", value_parser = clap::value_parser!(u32).range(3..=65536))]
+    pub ring_segments: Option<u32>,
+    /// The images were rendered with --two-sided.
+    #[arg(long, help_heading = "With --mask penumbra")]
+    pub two_sided: bool,
+    /// Points per light per hit for the penumbra test.
+    #[arg(long, default_value_t = 1024, help_heading = "With --mask penumbra", value_parser = clap::value_parser!(u32).range(1..=65536))]
+    pub mask_samples: u32,
+}
+
+fn parse_threshold(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(x) if x.is_finite() => Ok(x),
+        Ok(_) => Err(format!("expected a finite number, found `{s}`")),
+        Err(_) => Err(format!("expected a number, found `{s}`")),
+    }
+}
+
+const PENUMBRA: &str = "penumbra";
+
+impl DiffArgs {
+    fn penumbra(&self) -> bool {
+        self.mask.as_deref().map(Path::as_os_str) == Some(std::ffi::OsStr::new(PENUMBRA))
+    }
+
+    fn mask_file(&self) -> Option<&Path> {
+        self.mask.as_deref().filter(|_| !self.penumbra())
+    }
+}
+
+/// What `--json` writes.
+#[derive(Serialize)]
+struct Record<'a> {
+    a: &'a FileInfo,
+    b: &'a FileInfo,
+    #[serde(flatten)]
+    comparison: &'a Comparison,
+    metric: Metric,
+    value: Option<f64>,
+    fail_above: Option<f64>,
+    failed: bool,
+}
+
+/// Runs the comparison; the exit code is 3 when `--fail-above` is passed, else 0.
+pub fn run(args: &DiffArgs) -> Result<u8> {
+    let metric = Metric::from(args.metric);
+    let want_flip = args.flip || metric == Metric::Flip;
+    if want_flip && !image_diff::FLIP_AVAILABLE {
+        return Err(UsageError(
+            "--flip and --metric flip need raywave built with the `flip` feature (on by default; it needs a C++ compiler)".into(),
+        )
+        .into());
+    }
+    if let Some(out) = &args.out
+        && ldr_format(out).is_err()
+    {
+        return Err(UsageError(format!(
+            "--out {}: expected a figure file ending in .png or .ppm",
+            out.display()
+        ))
+        .into());
+    }
+    let scene_flags: Vec<&str> = [
+        ("--scene", args.scene.is_some()),
+        ("--bounces", args.bounces.is_some()),
+        ("--defaults", args.defaults.is_some()),
+        ("--ring-segments", args.ring_segments.is_some()),
+        ("--two-sided", args.two_sided),
+    ]
+    .iter()
+    .filter(|(_, given)| *given)
+    .map(|(flag, _)| *flag)
+    .collect();
+    if !scene_flags.is_empty() && !args.penumbra() {
+        eprintln!(
+            "warning: {} {} no effect without --mask penumbra",
+            scene_flags.join(", "),
+            if scene_flags.len() == 1 {
+                "has"
+            } else {
+                "have"
+            }
+        );
+    }
+    let mut plan = OutputPlan::new().input("A", &args.a).input("B", &args.b);
+    if let Some(mask) = args.mask_file() {
+        plan = plan.input("--mask", mask);
+    }
+    if let (true, Some(scene)) = (args.penumbra(), &args.scene) {
+        plan = plan.input("--scene", scene);
+    }
+    if let Some(out) = &args.out {
+        plan = plan.output("--out", out);
+    }
+    if let Some(json) = &args.json {
+        plan = plan.output("--json", json);
+    }
+    plan.check()?;
+    plan.refuse_binary_on_terminal(&["--out"])?;
+
+    let a = read_image(&args.a)?;
+    let b = read_image(&args.b)?;
+    let (a_name, b_name) = (
+        format!("A {}", args.a.display()),
+        format!("B {}", args.b.display()),
+    );
+    image_diff::check_same_size(&a, &a_name, &b, &b_name)
+        .map_err(|e| UsageError::from_error(&e))?;
+    let (a_info, b_info) = (FileInfo::of(&args.a, &a), FileInfo::of(&args.b, &b));
+    let mut text = format!(
+        "A        {}\nB        {}, the reference\n",
+        a_info.describe(),
+        b_info.describe()
+    );
+    if (a.encoding == image_diff::Encoding::Float) != (b.encoding == image_diff::Encoding::Float) {
+        text.push_str(
+            "note     one image holds linear floats and the other 8/16-bit values: the stored values are compared as they are\n",
+        );
+    }
+    let region = region(args, &a)?;
+    let mut comparison = image_diff::compare(&a, &b, &region)?;
+    let flip_map = if want_flip {
+        Some(image_diff::add_flip(&mut comparison, &a, &b, &region)?)
+    } else {
+        None
+    };
+    text.push_str(&image_diff::text::table(&comparison));
+
+    let value = comparison.value(metric);
+    let failed = match (args.fail_above, value) {
+        (Some(threshold), Some(v)) => metric.fails(v, threshold),
+        _ => false,
+    };
+    if let Some(out) = &args.out {
+        let errors = match (&flip_map, metric) {
+            (Some(map), Metric::Flip) => map.clone(),
+            _ => image_diff::pixel_errors(&a, &b, &region, metric),
+        };
+        let within = match (args.penumbra(), args.mask_file()) {
+            (true, _) => " in the penumbra (outside: black)".to_string(),
+            (_, Some(mask)) => format!(" in {} (outside: black)", file_name(mask)),
+            _ => String::new(),
+        };
+        let title = format!(
+            "{} vs {}: {}{within}",
+            file_name(&args.a),
+            file_name(&args.b),
+            match metric {
+                Metric::Mse | Metric::Psnr => "squared error",
+                Metric::Relmse => "relative squared error",
+                Metric::Max => "largest |a − b|",
+                Metric::Flip => "FLIP error",
+            },
+        );
+        let fig = image_diff::figure(&errors, a.width, a.height, metric, &title)?;
+        raywave::film::write_rgb8(&fig, out)?;
+        text.push_str(&format!("wrote    {}\n", out.display()));
+    }
+    if let Some(json) = &args.json {
+        let record = Record {
+            a: &a_info,
+            b: &b_info,
+            comparison: &comparison,
+            metric,
+            value,
+            fail_above: args.fail_above,
+            failed,
+        };
+        let value = serde_json::to_value(&record)?;
+        write_atomically(json, |w| {
+            serde_json::to_writer_pretty(&mut *w, &value)?;
+            Ok(writeln!(w)?)
+        })?;
+    }
+    if let (Some(threshold), Some(v)) = (args.fail_above, value) {
+        let (verdict, relation) = match (failed, metric) {
+            (true, Metric::Psnr) => ("FAIL", "below"),
+            (true, _) => ("FAIL", "above"),
+            (false, Metric::Psnr) => ("pass", "not below"),
+            (false, _) => ("pass", "not above"),
+        };
+        let shown = match metric {
+            Metric::Psnr => format!("{v:.2} dB"),
+            _ => format!("{v:.4e}"),
+        };
+        text.push_str(&format!(
+            "{verdict:<8} {} {shown} is {relation} --fail-above {threshold}\n",
+            metric.name()
+        ));
+    }
+    if args.json.as_deref().is_some_and(is_stdio) {
+        eprint!("{text}");
+    } else {
+        print(&text)?;
+    }
+    Ok(if failed { EXIT_FAILED } else { 0 })
+}
+
+fn file_name(path: &Path) -> String {
+    path.file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| path.display().to_string())
+}
+
+/// The pixels compared: every one, a mask file's non-zero ones, or the penumbra.
+fn region(args: &DiffArgs, a: &Image) -> Result<Region> {
+    if let Some(path) = args.mask_file() {
+        let mask = read_image(path)?;
+        image_diff::check_same_size(
+            &mask,
+            &format!("--mask {}", path.display()),
+            a,
+            &format!("A {}", args.a.display()),
+        )
+        .map_err(|e| UsageError::from_error(&e))?;
+        return Ok(Region::from_mask_image(&mask, path.display().to_string()));
+    }
+    if !args.penumbra() {
+        return Ok(Region::whole(a.width, a.height));
+    }
+    let options = ImageOptions {
+        size: Some([a.width, a.height]),
+        bounces: args.bounces,
+        shadows: None,
+        shadow_samples: None,
+        sampler: LightSampler::Stratified,
+        aa: None,
+        background: None,
+        ambient: None,
+        light_model: None,
+        ring_segments: args.ring_segments,
+        defaults: args.defaults.map(Into::into),
+    };
+    let scene = load_scene(args.scene.as_deref(), &options.parse_options())?.scene;
+    for w in &scene.warnings {
+        eprintln!("{w}");
+    }
+    if scene.lights.is_empty() {
+        bail!(
+            "{}: --mask penumbra needs a scene with an area light, found none",
+            scene.source
+        );
+    }
+    let mut settings = options
+        .resolve(scene.background.map(|c| c.to_array()))
+        .settings;
+    settings.two_sided = args.two_sided;
+    let regions = raywave::variance::mask::penumbra_mask(&scene, &settings, args.mask_samples);
+    Ok(Region {
+        name: format!("penumbra of {}, {} bounces", scene.source, settings.bounces),
+        inside: regions.penumbra,
+    })
+}

@@ -1,0 +1,122 @@
+//! The tree's sum against the pixel as each engine renders it.
+//!
+//! Each engine renders the one pixel through its own per-pixel loop: the reference's
+//! `Reference::pixel` (what its `render` runs for every pixel), the wavefront engine's
+//! `render_tile` on a tile of that one pixel (a pixel's value does not depend on the tile it is
+//! in: every lane is bit-equal to the scalar twins and each pixel is summed in sample order).
+
+use super::tree::{KindCounts, PixelCheck, RayCountCheck, RayTree, SegmentKind};
+use crate::reference::Reference;
+use crate::scene::Scene;
+use crate::settings::RenderSettings;
+use crate::stats::RayCounts;
+use crate::wavefront::stats::RenderStats;
+use crate::wavefront::{Wavefront, Workspace};
+use glam::Vec3;
+
+/// The accepted difference between the tree's sum and a rendered pixel, relative to
+/// max(1, the pixel's largest channel): the engines add the same f32 terms in other orders
+/// (nested kr ⊙ (...) instead of distributed over the path), a few ulps per term; 1e-5 is
+/// about 80 ulps at 1.
+pub const TOLERANCE: f64 = 1e-5;
+
+/// Which renderer computes a pixel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PixelEngine {
+    /// `Reference::pixel`.
+    Reference,
+    /// `Wavefront::render_tile` on a one-pixel tile.
+    Wavefront,
+}
+
+/// Pixel `index` (row-major) as `engine` renders it, in linear RGB.
+pub fn render_pixel(
+    engine: PixelEngine,
+    scene: &Scene,
+    settings: &RenderSettings,
+    index: u32,
+) -> Vec3 {
+    render_pixel_counted(engine, scene, settings, index).0
+}
+
+/// Pixel `index` as `engine` renders it, and the rays the engine counts for it.
+pub fn render_pixel_counted(
+    engine: PixelEngine,
+    scene: &Scene,
+    settings: &RenderSettings,
+    index: u32,
+) -> (Vec3, RayCounts) {
+    match engine {
+        PixelEngine::Reference => {
+            let mut counts = RayCounts::default();
+            let colour = Reference::new(scene, settings).pixel(index, &mut counts, &mut ());
+            (colour, counts)
+        }
+        PixelEngine::Wavefront => {
+            let batch = settings.aa_samples.max(1) as usize;
+            let wavefront = Wavefront::new(scene, settings, batch);
+            let mut out = [Vec3::ZERO];
+            let mut stats = RenderStats::default();
+            wavefront.render_tile(index, &mut out, &mut Workspace::default(), &mut stats);
+            (out[0], stats.counts)
+        }
+    }
+}
+
+fn kinds(counts: &RayCounts) -> KindCounts {
+    KindCounts {
+        camera: counts.camera,
+        reflection: counts.reflection,
+        shadow: counts.shadow,
+    }
+}
+
+/// The tree's rays by kind, shadow rays counted where the occlusion test ran (as the engines
+/// count them).
+pub fn tree_counts(tree: &RayTree) -> KindCounts {
+    let of = |k: SegmentKind| tree.segments.iter().filter(|s| s.kind == k).count() as u64;
+    KindCounts {
+        camera: of(SegmentKind::Camera),
+        reflection: of(SegmentKind::Reflection),
+        shadow: tree
+            .segments
+            .iter()
+            .filter(|s| s.shadow.as_ref().is_some_and(|i| i.blocked.is_some()))
+            .count() as u64,
+    }
+}
+
+/// Renders the tree's pixel with both engines and compares it with the tree's sum.
+pub fn check_pixel(scene: &Scene, settings: &RenderSettings, tree: &RayTree) -> PixelCheck {
+    let index = tree.pixel.index;
+    let (reference, reference_rays) =
+        render_pixel_counted(PixelEngine::Reference, scene, settings, index);
+    let (wavefront, wavefront_rays) =
+        render_pixel_counted(PixelEngine::Wavefront, scene, settings, index);
+    let rays = RayCountCheck {
+        tree: tree_counts(tree),
+        reference: kinds(&reference_rays),
+        wavefront: kinds(&wavefront_rays),
+    };
+    let difference = |p: Vec3| {
+        (0..3)
+            .map(|c| (tree.sum[c] - f64::from(p[c])).abs())
+            .fold(0.0f64, f64::max)
+    };
+    let magnitude = f64::from(reference.max_element().max(wavefront.max_element())).max(1.0);
+    let tolerance = TOLERANCE * magnitude;
+    let (rd, wd) = (difference(reference), difference(wavefront));
+    PixelCheck {
+        sum: tree.sum,
+        reference: reference.to_array(),
+        wavefront: wavefront.to_array(),
+        reference_difference: rd,
+        wavefront_difference: wd,
+        tolerance,
+        agrees: rd <= tolerance
+            && wd <= tolerance
+            && rays.tree == rays.reference
+            && rays.tree == rays.wavefront,
+        rays,
+    }
+}

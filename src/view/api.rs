@@ -1,0 +1,180 @@
+//! The API's handlers: each takes the shared [`State`] and the request's parts, and returns a
+//! reply or an [`ApiError`] (a 4xx naming what was wrong with the request).
+
+use super::compare::{CompareRequest, Comparisons};
+use super::http::{ApiError, Reply, number, query};
+use super::jobs::{ENGINES, Jobs};
+use super::scene_json::{CameraFrame, SceneJson};
+use super::settings::{Resolved, ViewSettings};
+use super::tree;
+use crate::quote::quote;
+use crate::sampling::LightSampler;
+use crate::scene::Scene;
+use serde::Serialize;
+use std::sync::Arc;
+
+/// Everything the handlers share.
+pub struct State {
+    /// The scene, read once at start.
+    pub scene: Arc<Scene>,
+    /// The settings the command line gave: what a request leaves out.
+    pub base: Resolved,
+    /// The render jobs.
+    pub jobs: Arc<Jobs>,
+    /// The comparisons.
+    pub comparisons: Comparisons,
+    /// The worker threads renders run on.
+    pub pool: Arc<rayon::ThreadPool>,
+    /// The port served (for the Host check).
+    pub port: u16,
+    /// The scene's geometry as JSON, made once.
+    pub scene_json: Vec<u8>,
+}
+
+/// `GET /api/scene`.
+pub fn scene(state: &State) -> Reply {
+    Reply::bytes("application/json", state.scene_json.clone())
+}
+
+/// The JSON of `GET /api/scene`, made once at start.
+pub fn scene_json(scene: &Scene, base: &Resolved) -> Vec<u8> {
+    #[derive(Serialize)]
+    struct Body<'a> {
+        scene: SceneJson,
+        settings: ViewSettings,
+        samplers: Vec<&'a str>,
+        engines: Vec<&'a str>,
+        simd: &'a str,
+        palette: tree::Palette,
+    }
+    serde_json::to_vec(&Body {
+        scene: SceneJson::new(scene),
+        settings: base.to_json(),
+        samplers: LightSampler::ALL.iter().map(|s| s.name()).collect(),
+        engines: ENGINES.iter().map(|e| e.name()).collect(),
+        simd: crate::simd_path(),
+        palette: tree::PALETTE,
+    })
+    .unwrap_or_default()
+}
+
+/// `POST /api/render`: starts a job.
+pub fn render(state: &State, body: &[u8]) -> Result<Reply, ApiError> {
+    let resolved = ViewSettings::parse(body)?.resolve(&state.base)?;
+    let job = state.jobs.submit(resolved);
+    Ok(with_frame(job.status(), &job.resolved))
+}
+
+/// The job status with the render camera's frame, for the 3D view.
+fn with_frame(status: super::jobs::JobStatus, resolved: &Resolved) -> Reply {
+    #[derive(Serialize)]
+    struct Body {
+        #[serde(flatten)]
+        status: super::jobs::JobStatus,
+        frame: CameraFrame,
+    }
+    Reply::json(&Body {
+        status,
+        frame: CameraFrame::new(
+            &resolved.camera,
+            resolved.settings.width,
+            resolved.settings.height,
+        ),
+    })
+}
+
+fn job_id(text: &str) -> Result<u64, ApiError> {
+    text.parse()
+        .map_err(|_| ApiError::bad(format!("expected a job number, found `{}`", quote(text))))
+}
+
+fn find_job(state: &State, text: &str) -> Result<Arc<super::jobs::Job>, ApiError> {
+    job_by_id(state, job_id(text)?)
+}
+
+fn job_by_id(state: &State, id: u64) -> Result<Arc<super::jobs::Job>, ApiError> {
+    state.jobs.get(id).ok_or_else(|| {
+        ApiError::not_found(format!(
+            "no render job {id}: only the last {} are kept",
+            super::jobs::KEPT_JOBS
+        ))
+    })
+}
+
+/// `GET /api/render/{job}`.
+pub fn render_status(state: &State, job: &str) -> Result<Reply, ApiError> {
+    let job = find_job(state, job)?;
+    Ok(with_frame(job.status(), &job.resolved))
+}
+
+/// `GET /api/render/{job}/{level}.png`.
+pub fn render_png(state: &State, job: &str, level: &str) -> Result<Reply, ApiError> {
+    let job = find_job(state, job)?;
+    let k: usize = level
+        .strip_suffix(".png")
+        .and_then(|k| k.parse().ok())
+        .ok_or_else(|| {
+            ApiError::bad(format!(
+                "expected a level as N.png, found `{}`",
+                quote(level)
+            ))
+        })?;
+    if k >= job.sizes.len() {
+        return Err(ApiError::not_found(format!(
+            "job {} has levels 0..{}, not {k}",
+            job.id,
+            job.sizes.len()
+        )));
+    }
+    let png = job.png(k).ok_or_else(|| {
+        ApiError::not_found(format!(
+            "level {k} of job {} is not rendered (yet): see GET /api/render/{}",
+            job.id, job.id
+        ))
+    })?;
+    Ok(Reply::bytes("image/png", png.as_ref().clone()))
+}
+
+/// `GET /api/pixel?job=J&x=X&y=Y`: the ray tree of pixel (x, y) of job J's full-size image.
+pub fn pixel(state: &State, q: &str) -> Result<Reply, ApiError> {
+    let pairs = query(q, &["job", "x", "y"])?;
+    let job = job_by_id(state, number(&pairs, "job")?)?;
+    let (x, y): (u32, u32) = (number(&pairs, "x")?, number(&pairs, "y")?);
+    let scene = super::jobs::with_camera(&state.scene, &job.resolved.camera);
+    Ok(Reply::json(&tree::pixel_tree(
+        &scene,
+        &job.resolved.settings,
+        x,
+        y,
+    )?))
+}
+
+/// `POST /api/compare`.
+pub fn compare(state: &State, body: &[u8]) -> Result<Reply, ApiError> {
+    let request = CompareRequest::parse(body)?;
+    let result = state
+        .comparisons
+        .run(&request, &state.scene, &state.base, &state.pool)?;
+    Ok(Reply::json(&result))
+}
+
+/// `GET /api/compare/{id}/{name}.png`.
+pub fn compare_png(state: &State, id: &str, name: &str) -> Result<Reply, ApiError> {
+    let n: u64 = id.parse().map_err(|_| {
+        ApiError::bad(format!(
+            "expected a comparison number, found `{}`",
+            quote(id)
+        ))
+    })?;
+    let png = name
+        .strip_suffix(".png")
+        .and_then(|name| state.comparisons.png(n, name))
+        .ok_or_else(|| {
+            ApiError::not_found(format!(
+                "no image `{}` in comparison {n} (only the last {} are kept)",
+                quote(name),
+                super::compare::KEPT
+            ))
+        })?;
+    Ok(Reply::bytes("image/png", png.as_ref().clone()))
+}

@@ -1,0 +1,366 @@
+//! The comparison mode: two light samplers at the same budget (N points per light), side by
+//! side, each with its per-pixel error against the converged reference as a heat map on one
+//! shared scale, so "which light points?" is answered by looking. The machinery is the
+//! variance study's (`variance::converged_reference`, `pixel_mse`, `error_stats`,
+//! `penumbra_mask`, `plot::heat_images`) at a size that finishes in seconds.
+//!
+//! ```text
+//! reference = converged_reference(stratified, 2 × reference_samples)     (no disk cache)
+//! for each sampler: K renders (seeds 1..=K) at N points
+//!     heat = pixel_mse(renders, reference); MSE whole and penumbra, mean ± standard error over seeds
+//! ```
+
+use super::http::ApiError;
+use super::settings::{Resolved, ViewSettings};
+use crate::engine::Engine;
+use crate::film::{Film, ToneMap};
+use crate::sampling::LightSampler;
+use crate::scene::Scene;
+use crate::statistics::median;
+use crate::variance::{
+    StudyConfig, converged_reference, error_stats, penumbra_mask, pixel_mse, plot::heat_images,
+};
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+use std::collections::VecDeque;
+use std::sync::{Arc, Mutex};
+use std::time::Instant;
+
+/// How many comparisons are kept for their images.
+pub const KEPT: usize = 4;
+/// Points per light per hit for the penumbra mask.
+const MASK_SAMPLES: u32 = 64;
+
+fn default_samplers() -> [LightSampler; 2] {
+    [LightSampler::Random, LightSampler::Stratified]
+}
+fn default_n() -> u32 {
+    4
+}
+fn default_seeds() -> u32 {
+    4
+}
+fn default_size() -> u32 {
+    64
+}
+fn default_reference_samples() -> u32 {
+    1024
+}
+
+/// What the page asks to compare.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CompareRequest {
+    /// Bounces, light model, camera, engine (size, shadows, sampler and seed are the
+    /// comparison's own).
+    #[serde(default)]
+    pub settings: ViewSettings,
+    /// The two samplers.
+    #[serde(default = "default_samplers")]
+    pub samplers: [LightSampler; 2],
+    /// The budget: points per light per hit, the same for both.
+    #[serde(default = "default_n")]
+    pub n: u32,
+    /// Renders (seeds) per sampler, for the heat map and the standard error.
+    #[serde(default = "default_seeds")]
+    pub seeds: u32,
+    /// The longer side of the images.
+    #[serde(default = "default_size")]
+    pub size: u32,
+    /// Stratified points per light in each half of the converged reference.
+    #[serde(default = "default_reference_samples")]
+    pub reference_samples: u32,
+}
+
+impl CompareRequest {
+    /// Parses and range-checks a request body (an empty body is every default).
+    pub fn parse(body: &[u8]) -> Result<CompareRequest, ApiError> {
+        let text = if body.iter().all(u8::is_ascii_whitespace) {
+            &b"{}"[..]
+        } else {
+            body
+        };
+        let r: CompareRequest = serde_json::from_slice(text).map_err(|e| {
+            ApiError::bad(format!(
+                "comparison: {}",
+                crate::quote::quote(&e.to_string())
+            ))
+        })?;
+        let check = |name: &str, v: u32, lo: u32, hi: u32| {
+            if (lo..=hi).contains(&v) {
+                Ok(())
+            } else {
+                Err(ApiError::bad(format!(
+                    "comparison: {name} must be in {lo}..={hi}, found {v}"
+                )))
+            }
+        };
+        check("n", r.n, 1, 256)?;
+        check("seeds", r.seeds, 2, 16)?;
+        check("size", r.size, 8, 256)?;
+        check("reference_samples", r.reference_samples, 16, 4096)?;
+        if r.reference_samples < 4 * r.n {
+            return Err(ApiError::bad(format!(
+                "comparison: reference_samples ({}) must be at least 4 × n ({}), or the reference is no better than what it measures",
+                r.reference_samples, r.n
+            )));
+        }
+        Ok(r)
+    }
+}
+
+/// A mean over seeds and its standard error.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Estimate {
+    /// Mean.
+    pub mean: f64,
+    /// Standard error of the mean (sample standard deviation / √K).
+    pub se: f64,
+}
+
+impl Estimate {
+    fn of(values: &[f64]) -> Estimate {
+        let k = values.len() as f64;
+        let mean = values.iter().sum::<f64>() / k.max(1.0);
+        let var = if values.len() > 1 {
+            values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (k - 1.0)
+        } else {
+            0.0
+        };
+        Estimate {
+            mean,
+            se: (var / k.max(1.0)).sqrt(),
+        }
+    }
+}
+
+/// One sampler's side.
+#[derive(Clone, Debug, Serialize)]
+pub struct Side {
+    /// The sampler.
+    pub sampler: LightSampler,
+    /// URL of its first render (seed 1).
+    pub image: String,
+    /// URL of its heat map.
+    pub heat: String,
+    /// MSE per image over the whole image: mean ± standard error over the seeds.
+    pub mse: Estimate,
+    /// The same over the penumbra (pixels with a partly visible light on their path).
+    pub mse_penumbra: Option<Estimate>,
+    /// Mean signed error over everything, and four standard errors of it (no bias expected
+    /// within that bound).
+    pub bias: [f64; 2],
+    /// Median seconds per render.
+    pub seconds: f64,
+}
+
+/// What the page shows.
+#[derive(Clone, Debug, Serialize)]
+pub struct Comparison {
+    /// Its id (for the image URLs).
+    pub id: u64,
+    /// Image size.
+    pub width: u32,
+    /// Image size.
+    pub height: u32,
+    /// Points per light per hit, for both samplers.
+    pub n: u32,
+    /// Renders per sampler.
+    pub seeds: u32,
+    /// Stratified points per light in each half of the reference.
+    pub reference_samples: u32,
+    /// The reference's own per-pixel error variance, averaged: should be far below the MSEs.
+    pub reference_noise: f64,
+    /// URL of the reference image.
+    pub reference: String,
+    /// The heat maps' shared scale, log10 of the per-pixel MSE at dark and at bright.
+    pub heat_scale: Option<[f32; 2]>,
+    /// Pixels in the penumbra.
+    pub penumbra_pixels: usize,
+    /// The two sides.
+    pub sides: Vec<Side>,
+    /// Seconds for the whole comparison.
+    pub seconds: f64,
+}
+
+/// An image of a comparison and its name in the URL.
+type NamedPng = (String, Arc<Vec<u8>>);
+
+/// Kept comparisons and their images.
+#[derive(Default)]
+pub struct Comparisons {
+    next: std::sync::atomic::AtomicU64,
+    kept: Mutex<VecDeque<(u64, Vec<NamedPng>)>>,
+    /// Held while one runs: a second request gets 409 instead of halving the first one's speed.
+    pub running: Mutex<()>,
+}
+
+impl Comparisons {
+    /// The PNG `name` of comparison `id`.
+    pub fn png(&self, id: u64, name: &str) -> Option<Arc<Vec<u8>>> {
+        let kept = self.kept.lock().unwrap_or_else(|e| e.into_inner());
+        kept.iter()
+            .find(|(i, _)| *i == id)
+            .and_then(|(_, imgs)| imgs.iter().find(|(n, _)| n == name))
+            .map(|(_, png)| png.clone())
+    }
+
+    /// Runs a comparison on `pool`.
+    pub fn run(
+        &self,
+        request: &CompareRequest,
+        scene: &Scene,
+        base: &Resolved,
+        pool: &rayon::ThreadPool,
+    ) -> Result<Comparison, ApiError> {
+        let _running = self.running.try_lock().map_err(|_| {
+            ApiError::status(
+                409,
+                "a comparison is already running: try again when it has finished",
+            )
+        })?;
+        let start = Instant::now();
+        let resolved = request.settings.resolve(base)?;
+        let scene = super::jobs::with_camera(scene, &resolved.camera);
+        let (w, h) = (resolved.settings.width, resolved.settings.height);
+        let longer = w.max(h) as f32;
+        let base_settings = crate::settings::RenderSettings {
+            width: ((w as f32 / longer * request.size as f32).round() as u32).max(1),
+            height: ((h as f32 / longer * request.size as f32).round() as u32).max(1),
+            ..resolved.settings.clone()
+        };
+        let config = StudyConfig {
+            budgets: vec![request.n],
+            samplers: request.samplers.to_vec(),
+            seeds: request.seeds,
+            reference_samples: request.reference_samples,
+            mask_samples: MASK_SAMPLES,
+            heatmap_n: request.n,
+            ..StudyConfig::standard(base_settings)
+        };
+        let engine: Engine = resolved.engine;
+        let render = |s: &Scene, settings: &crate::settings::RenderSettings| {
+            pool.install(|| engine.image(s, settings))
+        };
+        let internal = |e: anyhow::Error| ApiError::status(500, format!("{e:#}"));
+        let reference = converged_reference(&scene, b"raywave view", &config, &render, None)
+            .map_err(internal)?;
+        let regions = pool.install(|| penumbra_mask(&scene, &config.base, MASK_SAMPLES));
+        let whole = regions.whole();
+        let id = self.next.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+        let url = |name: &str| format!("/api/compare/{id}/{name}.png");
+        let mut pngs = vec![(
+            "reference".to_string(),
+            Arc::new(png(&reference.film).map_err(internal)?),
+        )];
+        let mut maps = Vec::new();
+        let mut sides = Vec::new();
+        for (i, &sampler) in request.samplers.iter().enumerate() {
+            let mut films = Vec::new();
+            let mut times = Vec::new();
+            for k in 1..=request.seeds {
+                let t = Instant::now();
+                films.push(render(&scene, &config.run_settings(sampler, request.n, k)).0);
+                times.push(t.elapsed().as_secs_f64());
+            }
+            let images: Vec<&[Vec3]> = films.iter().map(|f| f.pixels.as_slice()).collect();
+            let per_seed = |mask: &[bool]| {
+                let v: Vec<f64> = images
+                    .iter()
+                    .map(|img| {
+                        error_stats(&[img], &reference.film.pixels, &reference.noise, mask).mse
+                    })
+                    .collect();
+                Estimate::of(&v)
+            };
+            let all = error_stats(&images, &reference.film.pixels, &reference.noise, &whole);
+            let side_name = if i == 0 { "a" } else { "b" };
+            pngs.push((
+                format!("image-{side_name}"),
+                Arc::new(png(&films[0]).map_err(internal)?),
+            ));
+            maps.push(pixel_mse(&images, &reference.film.pixels));
+            sides.push(Side {
+                sampler,
+                image: url(&format!("image-{side_name}")),
+                heat: url(&format!("heat-{side_name}")),
+                mse: per_seed(&whole),
+                mse_penumbra: regions
+                    .penumbra
+                    .iter()
+                    .any(|&b| b)
+                    .then(|| per_seed(&regions.penumbra)),
+                bias: [all.bias, all.bias_bound],
+                seconds: median(&times),
+            });
+        }
+        let map_refs: Vec<&[f32]> = maps.iter().map(Vec::as_slice).collect();
+        let (wc, hc) = (config.base.width, config.base.height);
+        let heat = heat_images(&map_refs, wc, hc);
+        let heat_scale = heat.as_ref().map(|(_, s)| *s);
+        let heat_imgs = heat
+            .map(|(imgs, _)| imgs)
+            .unwrap_or_else(|| vec![image::RgbImage::new(wc, hc); 2]);
+        for (img, name) in heat_imgs.iter().zip(["heat-a", "heat-b"]) {
+            pngs.push((
+                name.to_string(),
+                Arc::new(super::jobs::encode_png(img).map_err(internal)?),
+            ));
+        }
+        let noise = reference.noise.iter().map(|&v| v as f64).sum::<f64>()
+            / reference.noise.len().max(1) as f64;
+        let mut kept = self.kept.lock().unwrap_or_else(|e| e.into_inner());
+        kept.push_back((id, pngs));
+        while kept.len() > KEPT {
+            kept.pop_front();
+        }
+        Ok(Comparison {
+            id,
+            width: wc,
+            height: hc,
+            n: request.n,
+            seeds: request.seeds,
+            reference_samples: request.reference_samples,
+            reference_noise: noise,
+            reference: url("reference"),
+            heat_scale,
+            penumbra_pixels: regions.penumbra.iter().filter(|&&b| b).count(),
+            sides,
+            seconds: start.elapsed().as_secs_f64(),
+        })
+    }
+}
+
+fn png(film: &Film) -> anyhow::Result<Vec<u8>> {
+    super::jobs::encode_png(&film.to_rgb8(ToneMap::Clamp))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn requests_are_checked() {
+        let r = CompareRequest::parse(b"").unwrap();
+        assert_eq!(r.samplers, default_samplers());
+        assert_eq!((r.n, r.seeds, r.size), (4, 4, 64));
+        for (body, expected) in [
+            (&br#"{"n": 0}"#[..], "n must be in"),
+            (br#"{"seeds": 1}"#, "seeds must be in"),
+            (br#"{"samplers": ["random"]}"#, "invalid length"),
+            (br#"{"n": 64, "reference_samples": 128}"#, "at least 4"),
+            (br#"{"colour": 1}"#, "unknown field"),
+        ] {
+            let e = CompareRequest::parse(body).unwrap_err();
+            assert!(e.message.contains(expected), "{}", e.message);
+        }
+    }
+
+    #[test]
+    fn the_estimate_is_mean_and_standard_error() {
+        let e = Estimate::of(&[1.0, 3.0]);
+        assert_eq!(e.mean, 2.0);
+        // sample sd √2, over √2.
+        assert!((e.se - 1.0).abs() < 1e-12);
+    }
+}

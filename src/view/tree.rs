@@ -1,0 +1,70 @@
+//! One pixel's ray tree for the page: `raywave::trace`'s [`RayTree`] (every segment the
+//! render's recursion casts for the pixel, its outcome and the colour it adds), checked against
+//! both engines' render of that pixel, and the palette the page draws it with.
+
+use super::http::ApiError;
+use crate::scene::Scene;
+use crate::settings::RenderSettings;
+use crate::trace::palette::{self, Rgb};
+use crate::trace::{RayTree, TraceError, check_pixel, trace_pixel};
+use serde::Serialize;
+
+/// The most segments a tree may have before it is traced (its JSON is about 1 KB a segment, and
+/// the page draws and lists each one).
+pub const MAX_TREE_SEGMENTS: u64 = 50_000;
+
+/// The most segments one pixel's tree can have: per camera sample, a camera or mirror ray at
+/// each depth, each followed by its shadow rays.
+pub fn max_segments(scene: &Scene, settings: &RenderSettings) -> u64 {
+    let per_hit = 1 + scene.lights.len() as u64 * settings.points_per_light() as u64;
+    settings.aa_samples.max(1) as u64 * (settings.bounces as u64 + 1) * per_hit
+}
+
+/// The ray tree of pixel (x, y) (from the top-left), with `check` filled in; a pixel outside
+/// the image, or settings whose tree could pass [`MAX_TREE_SEGMENTS`], are a 400.
+pub fn pixel_tree(
+    scene: &Scene,
+    settings: &RenderSettings,
+    x: u32,
+    y: u32,
+) -> Result<RayTree, ApiError> {
+    let bound = max_segments(scene, settings);
+    if bound > MAX_TREE_SEGMENTS {
+        return Err(ApiError::bad(format!(
+            "this pixel's tree could have {bound} segments (aa × (bounces + 1) × (1 + lights × \
+             points per light)): the viewer shows at most {MAX_TREE_SEGMENTS}; lower aa, bounces \
+             or shadow samples"
+        )));
+    }
+    let mut tree =
+        trace_pixel(scene, settings, x, y).map_err(|e: TraceError| ApiError::bad(e.to_string()))?;
+    tree.check = Some(check_pixel(scene, settings, &tree));
+    Ok(tree)
+}
+
+/// The colours of the 3D view, `raywave::trace::palette`'s (the lab's).
+#[derive(Serialize)]
+pub struct Palette {
+    /// Camera rays.
+    pub camera: Rgb,
+    /// Reflection rays.
+    pub reflection: Rgb,
+    /// Shadow rays that reach their light point.
+    pub shadow_visible: Rgb,
+    /// Shadow rays that something blocks (drawn dashed past the blocker).
+    pub shadow_blocked: Rgb,
+    /// Shadow rays with shadows off (not tested).
+    pub shadow_untested: Rgb,
+    /// The render camera.
+    pub main_camera: Rgb,
+}
+
+/// The palette.
+pub const PALETTE: Palette = Palette {
+    camera: palette::CAMERA,
+    reflection: palette::REFLECTION,
+    shadow_visible: palette::SHADOW_VISIBLE,
+    shadow_blocked: palette::SHADOW_BLOCKED,
+    shadow_untested: palette::SHADOW_UNTESTED,
+    main_camera: palette::MAIN_CAMERA,
+};

@@ -1,0 +1,318 @@
+//! Running the commands a documentation page shows, so that no page can drift from the code.
+//!
+//! ```text
+//! for each line of every ```sh block of the page (comments stripped):
+//!     raywave ...                 run with the built binary in one scratch directory holding a
+//!     cargo run --release [-- A]  copy of scenes/, in page order, shortened by the page's
+//!                                 QUICK table; exit 0 (a comparison may also exit 3, having
+//!                                 compared)
+//!     cargo ...                   must be a command `.ci/run` covers: `cargo bench`/`cargo
+//!                                 test` of a target that exists, with only known flags
+//!     anything else               must be in the page's MANUAL list, with the page saying why
+//! ```
+
+use super::bin::{raywave, scenes, stderr, stdout};
+use std::collections::BTreeSet;
+use std::path::Path;
+
+const ROOT: &str = env!("CARGO_MANIFEST_DIR");
+
+/// How to shorten one subcommand's runs: (subcommand, flag, values). A flag the command gives
+/// is replaced, one it lacks is added.
+pub type Quick = [(&'static str, &'static str, &'static [&'static str])];
+
+/// A page and how its commands are run.
+pub struct Page {
+    /// Path from the repository root, for messages.
+    pub path: &'static str,
+    /// The page's text.
+    pub text: &'static str,
+    /// Shortenings.
+    pub quick: &'static Quick,
+    /// Commands not run, each with the reason the page gives.
+    pub manual: &'static [(&'static str, &'static str)],
+}
+
+/// The ```sh lines of a page, comments and blank lines dropped.
+pub fn commands(doc: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut in_sh = false;
+    for line in doc.lines() {
+        let trimmed = line.trim();
+        if let Some(lang) = trimmed.strip_prefix("```") {
+            in_sh = !in_sh && matches!(lang, "sh" | "bash" | "shell" | "console");
+            continue;
+        }
+        if !in_sh {
+            continue;
+        }
+        let command = trimmed.split(" #").next().unwrap_or("").trim();
+        if !command.is_empty() && !command.starts_with('#') {
+            out.push(command.to_string());
+        }
+    }
+    out
+}
+
+/// The binary's arguments when `words` runs it: `raywave ARGS` or `cargo run --release [--
+/// ARGS]`; `None` for any other command.
+pub fn raywave_args<'a>(words: &[&'a str]) -> Option<Vec<&'a str>> {
+    match words {
+        ["raywave", args @ ..] => Some(args.to_vec()),
+        ["cargo", "run", "--release"] => Some(Vec::new()),
+        ["cargo", "run", "--release", "--", args @ ..] => Some(args.to_vec()),
+        _ => None,
+    }
+}
+
+/// The subcommand `args` runs: `render` when the first word is a scene, a flag or absent.
+fn subcommand(args: &[String]) -> &str {
+    match args.first().map(String::as_str) {
+        Some(w) if !w.starts_with('-') && !w.contains(['.', '/']) => w,
+        _ => "render",
+    }
+}
+
+/// `args` with QUICK's values for its subcommand. A `bench --against OTHER` runs against this
+/// build itself (an A/A comparison), in its fewest rounds and without `--runs` (which the A/B
+/// mode does not take).
+pub fn shorten(args: &[&str], quick: &Quick) -> Vec<String> {
+    let mut out: Vec<String> = args.iter().map(|w| w.to_string()).collect();
+    if let Some(i) = out.iter().position(|w| w == "--against") {
+        out[i + 1] = env!("CARGO_BIN_EXE_raywave").to_string();
+        out.extend(["--rounds", "6", "--warmup", "0"].map(String::from));
+    }
+    let ab = out.iter().any(|w| w == "--against");
+    let sub = subcommand(&out).to_string();
+    for (s, flag, values) in quick {
+        if *s != sub || (ab && *flag == "--runs") {
+            continue;
+        }
+        if let Some(i) = out.iter().position(|w| w == flag) {
+            out.splice(
+                i + 1..i + 1 + values.len(),
+                values.iter().map(|v| v.to_string()),
+            );
+        } else {
+            out.push(flag.to_string());
+            out.extend(values.iter().map(|v| v.to_string()));
+        }
+    }
+    out
+}
+
+/// Runs every raywave command of `page` in page order in one scratch directory (holding a copy
+/// of scenes/ and, as `scene.obj`, the bundled Cornell box); returns how many ran.
+pub fn run_in_page_order(page: &Page) -> usize {
+    let dir = tempfile::tempdir().unwrap();
+    let copy = dir.path().join("scenes");
+    std::fs::create_dir(&copy).unwrap();
+    for entry in std::fs::read_dir(scenes()).unwrap() {
+        let from = entry.unwrap().path();
+        std::fs::copy(&from, copy.join(from.file_name().unwrap())).unwrap();
+    }
+    std::fs::copy(
+        scenes().join("cornell_box.obj"),
+        dir.path().join("scene.obj"),
+    )
+    .unwrap();
+    let mut ran = 0;
+    for command in commands(page.text) {
+        let words: Vec<&str> = command.split_whitespace().collect();
+        let Some(args) = raywave_args(&words) else {
+            continue;
+        };
+        if page.manual.iter().any(|(m, _)| *m == command) {
+            continue;
+        }
+        assert!(
+            !command.contains(['"', '\'', '|', '>', '<', '$', '`']),
+            "{}: `{command}`: quoting, pipes and redirections are not supported here",
+            page.path
+        );
+        let args = shorten(&args, page.quick);
+        let flags: Vec<&str> = args.iter().map(String::as_str).collect();
+        let out = raywave(dir.path(), &flags);
+        let (stdout, stderr) = (stdout(&out), stderr(&out));
+        let code = out.status.code();
+        // A comparison of sub-millisecond renders may call noise a regression (exit 3); it must
+        // still have compared.
+        let compared = code == Some(3)
+            && (args.iter().any(|a| a == "--compare" || a == "compare")
+                && stdout.contains("verdict")
+                || args.iter().any(|a| a == "--against") && stdout.contains("95% interval"));
+        assert!(
+            code == Some(0) || compared,
+            "{}: `{command}` (run as `raywave {}`) exited {code:?}:\n{stdout}\n{stderr}",
+            page.path,
+            args.join(" ")
+        );
+        println!(
+            "{}: ran `raywave {}`: exit {code:?}",
+            page.path,
+            args.join(" ")
+        );
+        ran += 1;
+    }
+    ran
+}
+
+/// Commands of `page` that are neither run here nor covered by `.ci/run` nor listed as manual.
+pub fn uncovered(page: &Page) -> Vec<String> {
+    let mut problems = Vec::new();
+    for command in commands(page.text) {
+        let words: Vec<&str> = command.split_whitespace().collect();
+        if raywave_args(&words).is_some() || page.manual.iter().any(|(m, _)| *m == command) {
+            continue;
+        }
+        if let Err(why) = check_cargo(&words) {
+            problems.push(format!("{}: `{command}`: {why}", page.path));
+        }
+    }
+    problems
+}
+
+/// Manual commands the page no longer shows.
+pub fn stale_manual(page: &Page) -> Vec<String> {
+    let cmds = commands(page.text);
+    page.manual
+        .iter()
+        .filter(|(m, _)| !cmds.iter().any(|c| c == m))
+        .map(|(m, why)| {
+            format!(
+                "{}: MANUAL lists `{m}` ({why}), no longer on the page",
+                page.path
+            )
+        })
+        .collect()
+}
+
+/// Names declared by `[[bench]]` in Cargo.toml.
+fn bench_targets() -> BTreeSet<String> {
+    let toml = std::fs::read_to_string(Path::new(ROOT).join("Cargo.toml")).unwrap();
+    let mut names = BTreeSet::new();
+    let mut in_bench = false;
+    for line in toml.lines().map(str::trim) {
+        if line.starts_with('[') {
+            in_bench = line == "[[bench]]";
+        } else if in_bench && let Some(v) = line.strip_prefix("name") {
+            names.insert(
+                v.trim_start_matches([' ', '='])
+                    .trim_matches('"')
+                    .to_string(),
+            );
+        }
+    }
+    names
+}
+
+/// Integration tests: the files of tests/.
+fn test_targets() -> BTreeSet<String> {
+    std::fs::read_dir(Path::new(ROOT).join("tests"))
+        .unwrap()
+        .filter_map(|e| {
+            let p = e.ok()?.path();
+            if p.extension()? != "rs" {
+                return None;
+            }
+            Some(p.file_stem()?.to_string_lossy().into_owned())
+        })
+        .collect()
+}
+
+/// Why a `cargo` command is not covered by `.ci/run`, or Ok.
+pub fn check_cargo(words: &[&str]) -> Result<(), String> {
+    let mut words = words;
+    // Environment assignments a page may use, each only on the command it belongs to: the
+    // deliberate re-record switch (the variance bench, the icount test), and the switches of
+    // two benches' measuring modes. CI runs those benches in test mode, which ignores the
+    // switches but runs the same measuring code once (mesh_rays: one interleaved round;
+    // scaling: one round at 64²).
+    let mut env = Vec::new();
+    while let Some(w) = words.first().filter(|w| w.contains('=')) {
+        env.push(*w);
+        words = &words[1..];
+    }
+    let target = |flag: &str| {
+        words
+            .iter()
+            .position(|w| *w == flag)
+            .and_then(|i| words.get(i + 1))
+            .copied()
+    };
+    let positive = |v: &str| v.parse::<u32>().is_ok_and(|n| n > 0);
+    for w in &env {
+        let (bench, test) = (target("--bench"), target("--test"));
+        let known = match w.split_once('=') {
+            Some(("RAYWAVE_RECORD", "1")) => bench == Some("variance") || test == Some("icount"),
+            Some(("RAYWAVE_INTERLEAVE", v)) => positive(v) && bench == Some("mesh_rays"),
+            Some(("RAYWAVE_MESH", "12k" | "1M")) => bench == Some("mesh_rays"),
+            Some(("RAYWAVE_ROUNDS", v)) => positive(v) && bench == Some("scaling"),
+            _ => false,
+        };
+        if !known {
+            return Err(format!(
+                "environment assignment {w} is not one this command takes"
+            ));
+        }
+    }
+    let (cargo_args, program_args) = match words.iter().position(|w| *w == "--") {
+        Some(i) => (&words[..i], &words[i + 1..]),
+        None => (words, &[][..]),
+    };
+    let [cargo, sub, rest @ ..] = cargo_args else {
+        return Err("expected `cargo SUBCOMMAND ...`".into());
+    };
+    if *cargo != "cargo" {
+        return Err("not a cargo command".into());
+    }
+    let mut i = 0;
+    while i < rest.len() {
+        match (rest[i], rest.get(i + 1)) {
+            ("--release" | "--all-targets", _) => i += 1,
+            ("--bench", Some(name)) if *sub != "build" => {
+                if !bench_targets().contains(*name) {
+                    return Err(format!("no [[bench]] named {name} in Cargo.toml"));
+                }
+                i += 2;
+            }
+            ("--test", Some(name)) if *sub == "test" => {
+                if !test_targets().contains(*name) {
+                    return Err(format!("no tests/{name}.rs"));
+                }
+                i += 2;
+            }
+            (flag, _) => {
+                return Err(format!(
+                    "`{flag}` is not built by .ci/run (cargo test --release --all-targets)"
+                ));
+            }
+        }
+    }
+    match *sub {
+        "build" | "test" => {
+            if let Some(a) = program_args.iter().find(|a| **a != "--nocapture") {
+                return Err(format!("test argument {a} is not what .ci/run passes"));
+            }
+        }
+        "bench" => {
+            // Criterion's own flags: .ci/run runs the same target once in test mode.
+            let mut j = 0;
+            while j < program_args.len() {
+                match program_args[j] {
+                    "--save-baseline" | "--baseline" | "--warm-up-time" | "--measurement-time"
+                    | "--noise-threshold" | "--sample-size"
+                        if j + 1 < program_args.len() =>
+                    {
+                        j += 2
+                    }
+                    "--test" | "--quick" => j += 1,
+                    filter if !filter.starts_with('-') => j += 1,
+                    flag => return Err(format!("criterion flag {flag} is not in the list")),
+                }
+            }
+        }
+        other => return Err(format!("cargo {other} is not run by .ci/run")),
+    }
+    Ok(())
+}
