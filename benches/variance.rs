@@ -10,7 +10,8 @@
 //!     images = wavefront render, seeds 1..=SEEDS                  (fixed: pure hash of seed)
 //!     MSE    = error_stats(images, reference, penumbra)          src/variance
 //!     compare with the record; criterion times one render (seed 1)
-//! table: sampler, N, penumbra MSE, record, change, whole-image MSE, ms/image
+//! table: sampler, N, penumbra MSE, its 95% interval over seeds (bootstrap, as the study),
+//!        record, change, whole-image MSE, ms/image
 //! ```
 //!
 //! With fixed seeds every MSE is a deterministic function of the code, so a change is a real
@@ -30,8 +31,11 @@ use raywave::film::Film;
 use raywave::sampling::LightSampler;
 use raywave::scene::Scene;
 use raywave::settings::RenderSettings;
+use raywave::statistics::{BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, bootstrap_interval};
 use raywave::stats::RayCounts;
-use raywave::variance::{StudyConfig, converged_reference, error_stats, penumbra_mask};
+use raywave::variance::{
+    StudyConfig, converged_reference, error_stats, penumbra_mask, per_image_errors,
+};
 use serde::{Deserialize, Serialize};
 use std::hint::black_box;
 use std::path::{Path, PathBuf};
@@ -164,6 +168,9 @@ fn criterion_mean(sampler: &str, n: u32, since: std::time::SystemTime) -> Option
 struct Measured {
     figure: Figure,
     rays: u64,
+    /// 95% interval of the penumbra MSE by bootstrap over the seeds (the study's statistics):
+    /// how far another set of seeds could move the figure, beside the exact gate.
+    penumbra_interval: Option<(f64, f64)>,
 }
 
 fn measure(scene: &Scene, config: &StudyConfig) -> (usize, Vec<Measured>) {
@@ -218,7 +225,17 @@ fn measure(scene: &Scene, config: &StudyConfig) -> (usize, Vec<Measured>) {
             let mse = |mask: &[bool]| {
                 error_stats(&images, &reference.film.pixels, &reference.noise, mask).mse
             };
+            let seed_mse: Vec<f64> =
+                per_image_errors(&images, &reference.film.pixels, &regions.penumbra)
+                    .iter()
+                    .map(|e| e.0)
+                    .collect();
+            let penumbra_interval =
+                bootstrap_interval(seed_mse.len(), BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, |idx| {
+                    idx.iter().map(|&i| seed_mse[i]).sum::<f64>() / idx.len() as f64
+                });
             out.push(Measured {
+                penumbra_interval,
                 figure: Figure {
                     sampler: sampler.name().to_string(),
                     n,
@@ -338,8 +355,16 @@ fn main() {
         }
     );
     println!(
-        "{:<11} {:>4} {:>14} {:>14} {:>10} {:>14} {:>9} {:>8}",
-        "sampler", "N", "penumbra MSE", "record", "change", "whole MSE", "ms", "Mrays/s"
+        "{:<11} {:>4} {:>14} {:>22} {:>14} {:>10} {:>14} {:>9} {:>8}",
+        "sampler",
+        "N",
+        "penumbra MSE",
+        "95% over seeds",
+        "record",
+        "change",
+        "whole MSE",
+        "ms",
+        "Mrays/s"
     );
     for m in &measured {
         let f = &m.figure;
@@ -394,8 +419,12 @@ fn main() {
             ),
             None => ("-".into(), "-".into()),
         };
+        let spread = m
+            .penumbra_interval
+            .map(|(a, b)| format!("[{a:.3e}, {b:.3e}]"))
+            .unwrap_or_else(|| "-".into());
         println!(
-            "{:<11} {:>4} {:>14.6e} {:>14} {:>10} {:>14.6e} {ms:>9} {rate:>8}{}",
+            "{:<11} {:>4} {:>14.6e} {spread:>22} {:>14} {:>10} {:>14.6e} {ms:>9} {rate:>8}{}",
             f.sampler, f.n, f.penumbra_mse, cells.0, cells.1, f.whole_mse, cells.2
         );
     }

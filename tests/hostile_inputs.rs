@@ -25,8 +25,10 @@ const VARIANCE_OUT: &[&str] = &[
     "r",
     "r/table.txt",
     "r/results.csv",
+    "r/seeds.csv",
     "r/results.json",
     "r/mse.png",
+    "r/contact_sheet.png",
     "r/heat_random_N4.png",
 ];
 

@@ -246,47 +246,26 @@ fn light_points_stay_on_the_light() {
 
 #[test]
 fn matching_budget_inverts_the_fits() {
-    use raywave::variance::{LogLogFit, Slope, StudyConfig, StudyResult};
+    use raywave::variance::{LogLogFit, match_budget};
     // random: MSE = 1/N; stratified: MSE = N^-1.5. Random at 150 gives 1/150; stratified
     // matches it at N = 150^(1/1.5) = 28.2.
-    let slopes = vec![
-        Slope {
-            sampler: "random",
-            region: Region::Penumbra,
-            fit: Some(LogLogFit {
-                slope: -1.0,
-                intercept: 0.0,
-            }),
-        },
-        Slope {
-            sampler: "stratified",
-            region: Region::Penumbra,
-            fit: Some(LogLogFit {
-                slope: -1.5,
-                intercept: 0.0,
-            }),
-        },
-    ];
-    let result = StudyResult {
-        config: StudyConfig::standard(RenderSettings::preview()),
-        scene: "synthetic".into(),
-        engine: "none".into(),
-        region_pixels: [0; 3],
-        reference_mse: [0.0; 3],
-        reference_cached: false,
-        rows: Vec::new(),
-        slopes,
-        heatmaps: Vec::new(),
+    let random = LogLogFit {
+        slope: -1.0,
+        intercept: 0.0,
     };
-    let n = result
-        .matching_budget(LightSampler::Stratified, Region::Penumbra, 150.0)
-        .unwrap();
+    let stratified = LogLogFit {
+        slope: -1.5,
+        intercept: 0.0,
+    };
+    let n = match_budget(random, stratified, 150.0);
     assert!((n - 150f64.powf(1.0 / 1.5)).abs() < 1e-6, "{n}");
-    assert!(
-        result
-            .matching_budget(LightSampler::Sobol, Region::Penumbra, 150.0)
-            .is_none()
-    );
+    // Random against itself matches at 150; an error that does not fall never matches.
+    assert!((match_budget(random, random, 150.0) - 150.0).abs() < 1e-9);
+    let flat = LogLogFit {
+        slope: 0.0,
+        intercept: -3.0,
+    };
+    assert_eq!(match_budget(random, flat, 150.0), f64::INFINITY);
 }
 
 /// The whole study, end to end, on the lab's scene at a small size with the wavefront engine:

@@ -13,11 +13,13 @@ use std::path::PathBuf;
 pub struct VarianceArgs {
     /// Scene file; without one, the built-in lab Cornell box with mirror spheres.
     pub scene: Option<PathBuf>,
-    /// Light-sample budgets N, comma-separated.
-    #[arg(long, value_delimiter = ',', default_values_t = [1u32, 4, 16, 64, 256], value_parser = clap::value_parser!(u32).range(1..=65536))]
+    /// Light-sample budgets N: comma- or space-separated (`1,4,16` or `1 4 16`; with spaces,
+    /// give SCENE before this flag).
+    #[arg(long, num_args = 1.., value_delimiter = ',', default_values_t = [1u32, 4, 16, 64, 256], value_parser = clap::value_parser!(u32).range(1..=65536))]
     pub budgets: Vec<u32>,
-    /// Samplers to compare, comma-separated.
-    #[arg(long, value_enum, value_delimiter = ',', default_values_t = SamplerArg::ALL)]
+    /// Samplers to compare: comma- or space-separated (`random,sobol` or `random sobol`; with
+    /// spaces, give SCENE before this flag).
+    #[arg(long, value_enum, num_args = 1.., value_delimiter = ',', default_values_t = SamplerArg::ALL)]
     pub samplers: Vec<SamplerArg>,
     /// Seeds (independent renders) per sampler and budget; at least 2, for the variance.
     #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(2..=1024))]
@@ -34,10 +36,12 @@ pub struct VarianceArgs {
     /// Points per light per hit for the penumbra mask.
     #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=65536))]
     pub mask_samples: u32,
-    /// The budget whose per-pixel error maps are drawn (must be one of --budgets).
+    /// The budget whose per-pixel error maps are drawn; a value that is not one of --budgets
+    /// picks the nearest of them on a log scale (with a note on standard error).
     #[arg(long, default_value_t = 16)]
     pub heatmap_n: u32,
-    /// Directory for table.txt, results.csv, results.json, mse.png and the heat maps.
+    /// Directory for table.txt, results.csv, seeds.csv, results.json, mse.png,
+    /// contact_sheet.png and the heat maps.
     #[arg(long, default_value = "variance-report")]
     pub out: PathBuf,
     /// Directory caching converged references (keyed by the scene bytes parsed, the settings
@@ -103,12 +107,7 @@ fn output_plan(options: &VarianceOptions) -> OutputPlan {
     if let Some(scene) = &options.scene {
         plan = plan.input("SCENE", scene);
     }
-    let mut names: Vec<String> = ["table.txt", "results.csv", "results.json", "mse.png"]
-        .map(String::from)
-        .to_vec();
-    for s in &options.samplers {
-        names.push(format!("heat_{}_N{}.png", s.name(), options.heatmap_n));
-    }
+    let names = raywave::variance::report::file_names(&options.samplers, options.heatmap_budget());
     for name in names {
         plan = plan.output_in_new_dir("--out", &options.out.join(name));
     }

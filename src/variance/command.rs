@@ -30,7 +30,8 @@ pub struct VarianceOptions {
     pub reference_samples: u32,
     /// Points per light per hit for the penumbra mask.
     pub mask_samples: u32,
-    /// The budget whose per-pixel error maps are drawn (one of `budgets`).
+    /// The budget whose per-pixel error maps are drawn (the nearest of `budgets` if it is not
+    /// one, see [`VarianceOptions::heatmap_budget`]).
     pub heatmap_n: u32,
     /// Directory for the tables, plots and heat maps.
     pub out: PathBuf,
@@ -53,12 +54,17 @@ pub struct VarianceOptions {
 impl VarianceOptions {
     /// Checks the flags against each other; errors name the flag.
     pub fn validate(&self) -> Result<()> {
-        // Every seed's image is kept until its statistics are taken.
-        let bytes = self.seeds as u64 * self.size[0] as u64 * self.size[1] as u64 * 12;
+        // Every seed's image of every sampler at one N is kept until its statistics are taken
+        // (the samplers are interleaved), and one 8-bit render per sampler and N for the
+        // contact sheet.
+        let pixels = self.size[0] as u64 * self.size[1] as u64;
+        let samplers = self.samplers.len().max(1) as u64;
+        let bytes = pixels * samplers * (self.seeds as u64 * 12 + self.budgets.len() as u64 * 3);
         if bytes > MAX_STUDY_BYTES {
             return Err(UsageError(format!(
-                "--seeds {} at --size {} {} would hold {:.1} GiB of images at once: expected at most {} GiB; use fewer seeds or a smaller size",
+                "--seeds {} of {} samplers at --size {} {} would hold {:.1} GiB of images at once: expected at most {} GiB; use fewer seeds or samplers, or a smaller size",
                 self.seeds,
+                samplers,
                 self.size[0],
                 self.size[1],
                 bytes as f64 / (1u64 << 30) as f64,
@@ -72,12 +78,10 @@ impl VarianceOptions {
                 self.out.display()
             );
         }
-        if !self.budgets.contains(&self.heatmap_n) {
-            return Err(UsageError(format!(
-                "--heatmap-n {} is not one of --budgets {:?}: expected one of the budgets",
-                self.heatmap_n, self.budgets
-            ))
-            .into());
+        if self.budgets.is_empty() {
+            return Err(
+                UsageError("--budgets is empty: expected at least one budget N".into()).into(),
+            );
         }
         if self.samplers.is_empty() {
             return Err(UsageError(
@@ -88,6 +92,22 @@ impl VarianceOptions {
         }
         Ok(())
     }
+
+    /// The budget whose heat maps are drawn: `heatmap_n` if it is one of the budgets, else the
+    /// budget nearest to it on a log scale (budgets grow by factors), the smaller on a tie.
+    pub fn heatmap_budget(&self) -> u32 {
+        nearest_budget(&self.budgets, self.heatmap_n).unwrap_or(self.heatmap_n)
+    }
+}
+
+/// The budget of `budgets` nearest to `n` on a log scale (|log b − log n| smallest), the
+/// smaller of two at the same distance; None for no budgets.
+pub fn nearest_budget(budgets: &[u32], n: u32) -> Option<u32> {
+    let distance = |b: u32| ((b.max(1) as f64).ln() - (n.max(1) as f64).ln()).abs();
+    budgets
+        .iter()
+        .copied()
+        .min_by(|&a, &b| distance(a).total_cmp(&distance(b)).then(a.cmp(&b)))
 }
 
 /// The largest total size of the K images a study holds at once.
@@ -154,16 +174,25 @@ pub fn run(args: &VarianceOptions) -> Result<()> {
             .unwrap_or(RenderSettings::default().background),
         ..RenderSettings::default()
     };
+    let heatmap_n = args.heatmap_budget();
+    if heatmap_n != args.heatmap_n {
+        eprintln!(
+            "note: --heatmap-n {} is not one of --budgets; drawing the heat maps at the nearest budget, N = {heatmap_n}",
+            args.heatmap_n
+        );
+    }
     let config = StudyConfig {
         budgets,
         samplers,
         seeds: args.seeds,
         reference_samples: args.reference_samples,
         mask_samples: args.mask_samples,
-        heatmap_n: args.heatmap_n,
+        heatmap_n,
         ..StudyConfig::standard(base)
     };
-    let steps = 2 + (config.samplers.len() * config.budgets.len()) as u64 * config.seeds as u64;
+    // The reference, the mask, then per sampler and N a warm-up render and K timed ones.
+    let steps =
+        2 + (config.samplers.len() * config.budgets.len()) as u64 * (config.seeds as u64 + 1);
     let bar = progress_bar(
         steps,
         "{spinner} variance [{bar:30}] {pos}/{len} {msg} ({elapsed}, eta {eta})",

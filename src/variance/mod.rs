@@ -6,32 +6,44 @@
 //! reference = mean of two independent stratified renders at N_ref   (cached on disk)
 //! noise(ref) ≈ (A − B)² / 4 per pixel                                   (checked below the errors)
 //! regions   = penumbra_mask(scene)                                      (dense stratified visibility)
-//! for sampler, for N, for seed k < K: image_k = render(N, sampler, seed k)
-//!     MSE, bias (with bound), variance across seeds, time, rays/s, 1/(MSE·time)   per region
-//! slope of log MSE against log N                                        per sampler and region
+//! for N:
+//!     for sampler: warm-up render, seed 0 (untimed; kept for the contact sheet)
+//!     for seed k in 1..=K: for sampler in samplers rotated by k: image = render(N, sampler, k)
+//!                                                   (timed: interleaved, so drift hits all alike)
+//!     per sampler and region: MSE, bias (with bound), variance across seeds, per-seed MSE,
+//!     median time, rays/s, 1/(MSE·time)
+//! slope of log MSE against log N over the noisy points      per sampler and region
+//! budget matching 150 random points                          per sampler and region
+//! 95% intervals: MSE, slope, efficiency, matching budget by bootstrap over seeds
+//!                (statistics::bootstrap_interval); time by the median's sign-test interval
 //! ```
 
 pub mod cache;
 pub mod command;
+pub mod fits;
 pub mod mask;
 pub mod plot;
+pub mod report;
+pub mod sheet;
 pub mod stats;
 
 use crate::film::Film;
+use crate::film::ToneMap;
 use crate::sampling::LightSampler;
 use crate::scene::Scene;
 use crate::settings::{RenderSettings, ShadowMode};
 use crate::stats::RayCounts;
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 use glam::Vec3;
 use serde::Serialize;
-use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 pub use cache::Cache;
+pub use fits::{Matching, Slope, match_budget};
 pub use mask::{Regions, penumbra_mask};
-pub use stats::{ErrorStats, LogLogFit, error_stats, loglog_fit, pixel_mse};
+pub use stats::{
+    ErrorStats, LogLogFit, deterministic, error_stats, loglog_fit, per_image_errors, pixel_mse,
+};
 
 /// Renders one image: the engine is the caller's choice (the fastest one, normally).
 pub type RenderFn<'a> = dyn Fn(&Scene, &RenderSettings) -> (Film, RayCounts) + Sync + 'a;
@@ -206,25 +218,43 @@ pub struct Row {
     /// Error statistics over the K seeds.
     #[serde(flatten)]
     pub stats: ErrorStats,
-    /// Median seconds per image over the K seeds.
+    /// 95% interval of `mse` (bootstrap over seeds); None with fewer than two seeds.
+    pub mse_interval: Option<[f64; 2]>,
+    /// The sampler draws the same points whatever the seed at this N ([`deterministic`]), or
+    /// its images did not vary across seeds: the error is bias, and the point is left out of
+    /// the slope and matching-budget fits.
+    pub excluded_from_fit: bool,
+    /// Median seconds per image over the K timed renders.
     pub seconds: f64,
+    /// 95% interval of `seconds` (the median's sign-test interval); None below 6 seeds.
+    pub seconds_interval: Option<[f64; 2]>,
     /// Rays per image (all kinds).
     pub rays: u64,
-    /// Rays per second.
+    /// Rays per second at the median time.
     pub rays_per_second: f64,
     /// 1 / (MSE × seconds): higher is better.
     pub efficiency: f64,
-}
-
-/// The fitted slope for a (sampler, region).
-#[derive(Clone, Debug, Serialize)]
-pub struct Slope {
-    /// Sampler name.
-    pub sampler: &'static str,
-    /// Region.
-    pub region: Region,
-    /// The fit (None with fewer than two budgets with non-zero MSE).
-    pub fit: Option<LogLogFit>,
+    /// 95% interval of `efficiency` (bootstrap over seeds of mean MSE and median time).
+    pub efficiency_interval: Option<[f64; 2]>,
+    /// Random's MSE over this one at the same N and region: how many times less error than
+    /// random (None without random).
+    pub error_reduction: Option<f64>,
+    /// 95% interval of `error_reduction` (bootstrap over seeds, the same seeds for both).
+    pub error_reduction_interval: Option<[f64; 2]>,
+    /// `efficiency` over random's at the same N and region (None without random).
+    pub efficiency_vs_random: Option<f64>,
+    /// 95% interval of `efficiency_vs_random`, resampling the same seeds for both samplers
+    /// (their renders were timed in the same rounds, so a slow round slows both).
+    pub efficiency_vs_random_interval: Option<[f64; 2]>,
+    /// Per seed (seeds 1..=K): MSE.
+    #[serde(skip)]
+    pub seed_mse: Vec<f64>,
+    /// Per seed: mean signed error.
+    #[serde(skip)]
+    pub seed_bias: Vec<f64>,
+    /// Per seed: seconds for its image.
+    #[serde(skip)]
+    pub seed_seconds: Vec<f64>,
 }
 
 /// Everything a study found.
@@ -236,6 +266,8 @@ pub struct StudyResult {
     pub scene: String,
     /// Engine used.
     pub engine: String,
+    /// Worker threads the renders ran on.
+    pub threads: usize,
     /// Pixels in each region.
     pub region_pixels: [usize; 3],
     /// Mean error variance of the reference per region (its own MSE).
@@ -246,9 +278,72 @@ pub struct StudyResult {
     pub rows: Vec<Row>,
     /// One slope per (sampler, region).
     pub slopes: Vec<Slope>,
+    /// One per (sampler other than random, region), when random was studied.
+    pub matching: Vec<Matching>,
     /// Per-sampler per-pixel MSE at `heatmap_n` (not serialised).
     #[serde(skip)]
     pub heatmaps: Vec<(LightSampler, Vec<f32>)>,
+    /// Per (sampler, N): the warm-up render (seed 0), tone-mapped, for the contact sheet.
+    #[serde(skip)]
+    pub thumbnails: Vec<(LightSampler, u32, image::RgbImage)>,
+}
+
+/// The rows of one (sampler, N): one per region.
+struct Measured<'a> {
+    sampler: LightSampler,
+    n: u32,
+    images: Vec<&'a [Vec3]>,
+    times: Vec<f64>,
+    rays: u64,
+}
+
+fn rows_of(m: &Measured, reference: &Converged, masks: &[Vec<bool>; 3]) -> Vec<Row> {
+    let k = m.images.len();
+    let (seconds, lo, hi) = crate::statistics::median_with_interval(&m.times);
+    let seconds_interval = (lo.is_finite() && hi.is_finite()).then_some([lo, hi]);
+    let excluded_sampler = deterministic(m.sampler, m.n);
+    Region::ALL
+        .iter()
+        .zip(masks)
+        .map(|(region, mask)| {
+            let stats = error_stats(&m.images, &reference.film.pixels, &reference.noise, mask);
+            let per = per_image_errors(&m.images, &reference.film.pixels, mask);
+            let seed_mse: Vec<f64> = per.iter().map(|e| e.0).collect();
+            let seed_bias: Vec<f64> = per.iter().map(|e| e.1).collect();
+            let mse_interval = fits::interval(k, |idx| fits::mean_at(&seed_mse, Some(idx)));
+            let times = &m.times;
+            let efficiency_interval = fits::interval(k, |idx| {
+                let t: Vec<f64> = idx.iter().map(|&i| times[i]).collect();
+                1.0 / (fits::mean_at(&seed_mse, Some(idx))
+                    * crate::statistics::median(&t).max(1e-12))
+            });
+            Row {
+                sampler: m.sampler.name(),
+                n: m.n,
+                region: *region,
+                stats,
+                mse_interval,
+                excluded_from_fit: excluded_sampler || (stats.pixels > 0 && stats.variance == 0.0),
+                seconds,
+                seconds_interval,
+                rays: m.rays,
+                rays_per_second: m.rays as f64 / seconds.max(1e-12),
+                efficiency: if stats.mse > 0.0 {
+                    1.0 / (stats.mse * seconds.max(1e-12))
+                } else {
+                    f64::INFINITY
+                },
+                efficiency_interval,
+                error_reduction: None,
+                error_reduction_interval: None,
+                efficiency_vs_random: None,
+                efficiency_vs_random_interval: None,
+                seed_mse,
+                seed_bias,
+                seed_seconds: m.times.clone(),
+            }
+        })
+        .collect()
 }
 
 /// Runs the study. `progress` is called after each render with a short label.
@@ -280,76 +375,76 @@ pub fn run_study(
             .fold((0.0f64, 0usize), |(s, c), (v, _)| (s + *v as f64, c + 1));
         if count == 0 { 0.0 } else { sum / count as f64 }
     });
+    let samplers = &config.samplers;
     let mut rows = Vec::new();
     let mut heatmaps = Vec::new();
-    for &sampler in &config.samplers {
-        for &n in &config.budgets {
-            let mut films = Vec::new();
-            let mut times = Vec::new();
-            let mut rays = 0u64;
-            for k in 0..config.seeds {
-                let settings = config.run_settings(sampler, n, k + 1);
+    let mut thumbnails = Vec::new();
+    for &n in &config.budgets {
+        // Warm-up: caches, page tables and the thread pool reach their working state before
+        // the first timed render; the images (seed 0, used by no timed render) are kept.
+        for &sampler in samplers {
+            let (film, _) = render(scene, &config.run_settings(sampler, n, 0));
+            thumbnails.push((sampler, n, film.to_rgb8(ToneMap::Clamp)));
+            progress(&format!("{} N={n} warm-up", sampler.name()));
+        }
+        let mut films: Vec<Vec<crate::film::Film>> = vec![Vec::new(); samplers.len()];
+        let mut times = vec![Vec::new(); samplers.len()];
+        let mut rays = vec![0u64; samplers.len()];
+        for k in 0..config.seeds {
+            // Rotate the order per seed, so that no sampler always runs first (or after the
+            // same one): slow drifts of the machine fall on every sampler alike.
+            for j in 0..samplers.len() {
+                let i = (j + k as usize) % samplers.len();
+                let settings = config.run_settings(samplers[i], n, k + 1);
                 let start = Instant::now();
                 let (film, counts) = render(scene, &settings);
-                times.push(start.elapsed().as_secs_f64());
-                rays += counts.total();
-                films.push(film);
-                progress(&format!("{} N={n} seed {}", sampler.name(), k + 1));
+                times[i].push(start.elapsed().as_secs_f64());
+                rays[i] += counts.total();
+                films[i].push(film);
+                progress(&format!("{} N={n} seed {}", samplers[i].name(), k + 1));
             }
-            let seconds = crate::statistics::median(&times);
-            let rays = rays / config.seeds.max(1) as u64;
-            let images: Vec<&[Vec3]> = films.iter().map(|f| f.pixels.as_slice()).collect();
-            for (region, mask) in Region::ALL.iter().zip(&masks) {
-                let stats = error_stats(&images, &reference.film.pixels, &reference.noise, mask);
-                rows.push(Row {
-                    sampler: sampler.name(),
-                    n,
-                    region: *region,
-                    stats,
-                    seconds,
-                    rays,
-                    rays_per_second: rays as f64 / seconds.max(1e-12),
-                    efficiency: if stats.mse > 0.0 {
-                        1.0 / (stats.mse * seconds.max(1e-12))
-                    } else {
-                        f64::INFINITY
-                    },
-                });
-            }
+        }
+        for (i, &sampler) in samplers.iter().enumerate() {
+            let images: Vec<&[Vec3]> = films[i].iter().map(|f| f.pixels.as_slice()).collect();
+            let measured = Measured {
+                sampler,
+                n,
+                images,
+                times: std::mem::take(&mut times[i]),
+                rays: rays[i] / config.seeds.max(1) as u64,
+            };
+            rows.extend(rows_of(&measured, &reference, &masks));
             if n == config.heatmap_n {
-                heatmaps.push((sampler, pixel_mse(&images, &reference.film.pixels)));
+                heatmaps.push((sampler, pixel_mse(&measured.images, &reference.film.pixels)));
             }
         }
     }
-    let slopes = config
-        .samplers
-        .iter()
-        .flat_map(|&sampler| {
-            let rows = &rows;
-            Region::ALL.iter().map(move |&region| {
-                let pts: Vec<(f64, f64)> = rows
-                    .iter()
-                    .filter(|r| r.sampler == sampler.name() && r.region == region)
-                    .map(|r| (r.n as f64, r.stats.mse))
-                    .collect();
-                Slope {
-                    sampler: sampler.name(),
-                    region,
-                    fit: loglog_fit(&pts),
-                }
-            })
-        })
-        .collect();
+    // Report order: sampler, then N, then region (the rows were made N first).
+    let position = |name: &str| samplers.iter().position(|s| s.name() == name);
+    rows.sort_by_key(|r| {
+        (
+            position(r.sampler),
+            config.budgets.iter().position(|&b| b == r.n),
+            Region::ALL.iter().position(|&g| g == r.region),
+        )
+    });
+    let k = config.seeds as usize;
+    fits::ratios_to_random(&mut rows, k);
+    let slopes = fits::slopes(&rows, samplers, k);
+    let matching = fits::matching(&rows, samplers, k);
     Ok(StudyResult {
         config: config.clone(),
         scene: scene.source.clone(),
         engine: engine.to_string(),
+        threads: rayon::current_num_threads(),
         region_pixels,
         reference_mse,
         reference_cached: reference.cached,
         rows,
         slopes,
+        matching,
         heatmaps,
+        thumbnails,
     })
 }
 
@@ -367,197 +462,5 @@ impl StudyResult {
     pub fn reference_margin(&self, region: Region) -> f64 {
         let i = Region::ALL.iter().position(|&r| r == region).unwrap_or(0);
         self.smallest_mse(region) / self.reference_mse[i].max(1e-30)
-    }
-
-    /// The N at which `sampler`'s fitted MSE in `region` equals random sampling's fitted MSE
-    /// at `random_n` (the lab's question: what matches 150 random points?). None without fits.
-    pub fn matching_budget(
-        &self,
-        sampler: LightSampler,
-        region: Region,
-        random_n: f64,
-    ) -> Option<f64> {
-        let fit = |name: &str| {
-            self.slopes
-                .iter()
-                .find(|s| s.sampler == name && s.region == region)
-                .and_then(|s| s.fit)
-        };
-        let random = fit(LightSampler::Random.name())?;
-        let other = fit(sampler.name())?;
-        let target = random.intercept + random.slope * random_n.log10();
-        (other.slope < 0.0).then(|| 10f64.powf((target - other.intercept) / other.slope))
-    }
-
-    /// A readable report: one table per region, the slopes, and the checks.
-    pub fn table(&self) -> String {
-        let mut s = String::new();
-        let _ = writeln!(
-            s,
-            "variance study: {} at {}×{}, {} bounces, {} seeds per point, engine {}",
-            self.scene,
-            self.config.base.width,
-            self.config.base.height,
-            self.config.base.bounces,
-            self.config.seeds,
-            self.engine
-        );
-        for (i, region) in Region::ALL.iter().enumerate() {
-            if self.region_pixels[i] == 0 {
-                let _ = writeln!(
-                    s,
-                    "\n{}: no pixels in this region, nothing measured",
-                    region.name()
-                );
-                continue;
-            }
-            let _ = writeln!(
-                s,
-                "\n{} ({} pixels; reference MSE {:.2e}, {:.0}× below the smallest measured)",
-                region.name(),
-                self.region_pixels[i],
-                self.reference_mse[i],
-                self.reference_margin(*region)
-            );
-            let _ = writeln!(
-                s,
-                "  {:<11} {:>5} {:>10} {:>11} {:>10} {:>10} {:>9} {:>8} {:>11}",
-                "sampler",
-                "N",
-                "MSE",
-                "bias",
-                "±bound",
-                "variance",
-                "ms/image",
-                "Mrays/s",
-                "1/(MSE·s)"
-            );
-            for r in self.rows.iter().filter(|r| r.region == *region) {
-                let _ = writeln!(
-                    s,
-                    "  {:<11} {:>5} {:>10.3e} {:>11.2e} {:>10.2e} {:>10.3e} {:>9.1} {:>8.2} {:>11.3e}{}",
-                    r.sampler,
-                    r.n,
-                    r.stats.mse,
-                    r.stats.bias,
-                    r.stats.bias_bound,
-                    r.stats.variance,
-                    r.seconds * 1e3,
-                    r.rays_per_second / 1e6,
-                    r.efficiency,
-                    if r.stats.bias.abs() > r.stats.bias_bound {
-                        "  BIASED?"
-                    } else {
-                        ""
-                    }
-                );
-            }
-        }
-        let _ = writeln!(s, "\nslope of log MSE against log N:");
-        let _ = writeln!(
-            s,
-            "  {:<11} {:>8} {:>9} {:>8}",
-            "sampler", "whole", "penumbra", "lit"
-        );
-        for sampler in &self.config.samplers {
-            let slope = |region: Region| {
-                self.slopes
-                    .iter()
-                    .find(|sl| sl.sampler == sampler.name() && sl.region == region)
-                    .and_then(|sl| sl.fit)
-                    .map(|f| format!("{:.3}", f.slope))
-                    .unwrap_or_else(|| "-".into())
-            };
-            let _ = writeln!(
-                s,
-                "  {:<11} {:>8} {:>9} {:>8}",
-                sampler.name(),
-                slope(Region::Whole),
-                slope(Region::Penumbra),
-                slope(Region::Lit)
-            );
-        }
-        if self.config.samplers.contains(&LightSampler::Random) {
-            let _ = writeln!(
-                s,
-                "\nbudget matching the MSE of 150 random points (the lab's choice), from the fits \
-                 (lab's fit includes its biased N = 1 point):"
-            );
-            for sampler in self
-                .config
-                .samplers
-                .iter()
-                .filter(|&&x| x != LightSampler::Random)
-            {
-                let n = |region| {
-                    self.matching_budget(*sampler, region, 150.0)
-                        .map(|n| format!("{n:.0}"))
-                        .unwrap_or_else(|| "-".into())
-                };
-                let _ = writeln!(
-                    s,
-                    "  {:<11} {:>8} {:>9} {:>8}",
-                    sampler.name(),
-                    n(Region::Whole),
-                    n(Region::Penumbra),
-                    n(Region::Lit)
-                );
-            }
-        }
-        s
-    }
-
-    /// The rows as CSV.
-    pub fn csv(&self) -> String {
-        let mut s = String::from(
-            "sampler,n,region,pixels,mse,bias,bias_bound,variance,seconds,rays,rays_per_second,efficiency\n",
-        );
-        for r in &self.rows {
-            let _ = writeln!(
-                s,
-                "{},{},{},{},{:e},{:e},{:e},{:e},{:e},{},{:e},{:e}",
-                r.sampler,
-                r.n,
-                r.region.name(),
-                r.stats.pixels,
-                r.stats.mse,
-                r.stats.bias,
-                r.stats.bias_bound,
-                r.stats.variance,
-                r.seconds,
-                r.rays,
-                r.rays_per_second,
-                r.efficiency
-            );
-        }
-        s
-    }
-
-    /// Writes table.txt, results.csv, results.json, mse.png and the heat maps into `dir`;
-    /// returns the paths written.
-    pub fn write(&self, dir: &Path) -> Result<Vec<PathBuf>> {
-        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
-        let mut written = Vec::new();
-        let text = |name: &str, body: String, written: &mut Vec<PathBuf>| -> Result<()> {
-            let path = dir.join(name);
-            crate::film::write_atomically(&path, |w| {
-                std::io::Write::write_all(w, body.as_bytes())?;
-                Ok(())
-            })?;
-            written.push(path);
-            Ok(())
-        };
-        text("table.txt", self.table(), &mut written)?;
-        text("results.csv", self.csv(), &mut written)?;
-        text(
-            "results.json",
-            serde_json::to_string_pretty(self)?,
-            &mut written,
-        )?;
-        let plot_path = dir.join("mse.png");
-        plot::mse_plot(self, &plot_path)?;
-        written.push(plot_path);
-        written.extend(plot::heatmaps(self, dir)?);
-        Ok(written)
     }
 }

@@ -1,11 +1,14 @@
-//! Pictures of a study: MSE against N on log-log axes (one panel per region, one line per
-//! sampler) and per-pixel error heat maps on one shared log scale. The font is embedded
-//! (DejaVu Sans, via the `dejavu` crate), so plots need no system fonts.
+//! Pictures of a study: MSE against N and MSE against time per image, on log-log axes (one
+//! panel per region, one line per sampler, 95% intervals as bars), and per-pixel error heat
+//! maps on one log scale shared by all samplers (`crate::false_colour`: title and colour bar).
+//! The font is embedded (DejaVu Sans, via the `dejavu` crate), so plots need no system fonts.
 
-use super::{Region, StudyResult};
-use crate::false_colour::{self, register_font};
+use super::{Region, Row, StudyResult};
+use crate::false_colour::{self, Scale, figure, register_font};
 use crate::film::write_atomically;
+use crate::sampling::LightSampler;
 use anyhow::{Context, Result, anyhow};
+use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
 
@@ -16,95 +19,188 @@ const PALETTE: [RGBColor; 4] = [
     RGBColor(214, 39, 40),
 ];
 
-/// Draws `mse.png`: three log-log panels (whole, penumbra, lit).
+/// Which quantity a panel puts on its x axis.
+#[derive(Clone, Copy, PartialEq)]
+enum Axis {
+    /// Light samples N.
+    Budget,
+    /// Median milliseconds per image.
+    Time,
+}
+
+/// (x, its interval) of a row on `axis`.
+fn x_of(r: &Row, axis: Axis) -> (f64, Option<[f64; 2]>) {
+    match axis {
+        Axis::Budget => (r.n as f64, None),
+        Axis::Time => (
+            r.seconds * 1e3,
+            r.seconds_interval.map(|[a, b]| [a * 1e3, b * 1e3]),
+        ),
+    }
+}
+
+/// A range for a log axis holding `values` (all positive), padded by `pad` times.
+fn log_range(values: impl Iterator<Item = f64>, pad: f64, empty: (f64, f64)) -> (f64, f64) {
+    let (lo, hi) = values
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .fold((f64::INFINITY, 0.0f64), |(lo, hi), v| {
+            (lo.min(v), hi.max(v))
+        });
+    if lo.is_finite() && hi > 0.0 {
+        (lo / pad, hi * pad)
+    } else {
+        empty
+    }
+}
+
+/// One panel: MSE of every sampler in `region` against `axis`, with 95% intervals.
+fn panel(
+    area: &DrawingArea<BitMapBackend, Shift>,
+    result: &StudyResult,
+    region: Region,
+    axis: Axis,
+) -> Result<()> {
+    let err = |e| anyhow!("plot: {e}");
+    let rows: Vec<&Row> = result
+        .rows
+        .iter()
+        .filter(|r| r.region == region && r.stats.mse > 0.0)
+        .collect();
+    let (y_lo, y_hi) = log_range(
+        rows.iter().flat_map(|r| {
+            let [a, b] = r.mse_interval.unwrap_or([r.stats.mse; 2]);
+            [r.stats.mse, a, b]
+        }),
+        1.6,
+        (1e-6, 1.0),
+    );
+    let (x_lo, x_hi) = log_range(
+        rows.iter().flat_map(|r| {
+            let (x, iv) = x_of(r, axis);
+            let [a, b] = iv.unwrap_or([x; 2]);
+            [x, a, b]
+        }),
+        1.5,
+        (0.5, 400.0),
+    );
+    let i = Region::ALL.iter().position(|&r| r == region).unwrap_or(0);
+    let what = match axis {
+        Axis::Budget => "MSE against N",
+        Axis::Time => "MSE against time",
+    };
+    let mut chart = ChartBuilder::on(area)
+        .caption(
+            format!("{}: {what} ({} px)", region.name(), result.region_pixels[i]),
+            ("sans-serif", 20),
+        )
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(70)
+        .build_cartesian_2d((x_lo..x_hi).log_scale(), (y_lo..y_hi).log_scale())
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc(match axis {
+            Axis::Budget => "light samples N",
+            Axis::Time => "ms per image (median)",
+        })
+        .y_desc("MSE")
+        .y_label_formatter(&|y| format!("{y:.0e}"))
+        .x_label_formatter(&|x| {
+            if *x >= 1.0 {
+                format!("{x:.0}")
+            } else {
+                format!("{x:.2}")
+            }
+        })
+        .label_style(("sans-serif", 14))
+        .draw()
+        .map_err(err)?;
+    for (k, sampler) in result.config.samplers.iter().enumerate() {
+        let colour = PALETTE[k % PALETTE.len()];
+        let mine: Vec<&&Row> = rows
+            .iter()
+            .filter(|r| r.sampler == sampler.name())
+            .collect();
+        let pts: Vec<(f64, f64)> = mine
+            .iter()
+            .map(|r| (x_of(r, axis).0, r.stats.mse))
+            .collect();
+        // The slope is against N: only the top row's legend gives it.
+        let slope = result
+            .slopes
+            .iter()
+            .find(|s| s.sampler == sampler.name() && s.region == region)
+            .and_then(|s| s.fit.map(|f| (f, s.slope_interval)))
+            .map(|(f, iv)| match iv {
+                Some([a, b]) => format!(" (slope {:.2} [{a:.2}, {b:.2}])", f.slope),
+                None => format!(" (slope {:.2})", f.slope),
+            })
+            .filter(|_| axis == Axis::Budget)
+            .unwrap_or_default();
+        // The lab's strategy draws random's points for N > 1: dash it so both show.
+        let series = if *sampler == LightSampler::Lab {
+            chart.draw_series(DashedLineSeries::new(
+                pts.clone(),
+                8,
+                6,
+                colour.stroke_width(2),
+            ))
+        } else {
+            chart.draw_series(LineSeries::new(pts.clone(), colour.stroke_width(2)))
+        };
+        series
+            .map_err(err)?
+            .label(format!("{}{slope}", sampler.name()))
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
+            });
+        chart
+            .draw_series(pts.iter().map(|&p| Circle::new(p, 4, colour.filled())))
+            .map_err(err)?;
+        // 95% intervals: MSE vertically, time horizontally.
+        let mut bars = Vec::new();
+        for r in &mine {
+            let (x, x_iv) = x_of(r, axis);
+            if let Some([a, b]) = r.mse_interval {
+                bars.push(PathElement::new(
+                    vec![(x, a.max(y_lo)), (x, b.min(y_hi))],
+                    colour,
+                ));
+            }
+            if let Some([a, b]) = x_iv {
+                bars.push(PathElement::new(
+                    vec![(a.max(x_lo), r.stats.mse), (b.min(x_hi), r.stats.mse)],
+                    colour,
+                ));
+            }
+        }
+        chart.draw_series(bars).map_err(err)?;
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 13))
+        .draw()
+        .map_err(err)?;
+    Ok(())
+}
+
+/// Draws `mse.png`: MSE against N (top row) and against median time per image (bottom row),
+/// one log-log panel per region (whole, penumbra, lit), 95% intervals as bars.
 pub fn mse_plot(result: &StudyResult, path: &Path) -> Result<()> {
     register_font();
-    let (w, h) = (1500u32, 520u32);
+    let (w, h) = (1500u32, 1040u32);
     let mut buffer = vec![0u8; (w * h * 3) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut buffer, (w, h)).into_drawing_area();
         root.fill(&WHITE).map_err(|e| anyhow!("plot: {e}"))?;
-        let panels = root.split_evenly((1, 3));
-        let budgets = &result.config.budgets;
-        let x_lo = *budgets.iter().min().unwrap_or(&1) as f64 / 1.5;
-        let x_hi = *budgets.iter().max().unwrap_or(&256) as f64 * 1.5;
-        for (panel, region) in panels.iter().zip(Region::ALL) {
-            let rows: Vec<_> = result
-                .rows
-                .iter()
-                .filter(|r| r.region == region && r.stats.mse > 0.0)
-                .collect();
-            let (y_lo, y_hi) = rows.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), r| {
-                (lo.min(r.stats.mse), hi.max(r.stats.mse))
-            });
-            let (y_lo, y_hi) = if rows.is_empty() {
-                (1e-6, 1.0)
-            } else {
-                (y_lo / 2.0, y_hi * 2.0)
-            };
-            let i = Region::ALL.iter().position(|&r| r == region).unwrap_or(0);
-            let mut chart = ChartBuilder::on(panel)
-                .caption(
-                    format!("{} ({} px)", region.name(), result.region_pixels[i]),
-                    ("sans-serif", 22),
-                )
-                .margin(12)
-                .x_label_area_size(40)
-                .y_label_area_size(70)
-                .build_cartesian_2d((x_lo..x_hi).log_scale(), (y_lo..y_hi).log_scale())
-                .map_err(|e| anyhow!("plot: {e}"))?;
-            chart
-                .configure_mesh()
-                .x_desc("light samples N")
-                .y_desc("MSE")
-                .y_label_formatter(&|y| format!("{y:.0e}"))
-                .x_label_formatter(&|x| format!("{x:.0}"))
-                .label_style(("sans-serif", 14))
-                .draw()
-                .map_err(|e| anyhow!("plot: {e}"))?;
-            for (k, sampler) in result.config.samplers.iter().enumerate() {
-                let colour = PALETTE[k % PALETTE.len()];
-                let pts: Vec<(f64, f64)> = rows
-                    .iter()
-                    .filter(|r| r.sampler == sampler.name())
-                    .map(|r| (r.n as f64, r.stats.mse))
-                    .collect();
-                let slope = result
-                    .slopes
-                    .iter()
-                    .find(|s| s.sampler == sampler.name() && s.region == region)
-                    .and_then(|s| s.fit)
-                    .map(|f| format!(" (slope {:.2})", f.slope))
-                    .unwrap_or_default();
-                // The lab's strategy draws random's points for N > 1: dash it so both show.
-                let series = if *sampler == crate::sampling::LightSampler::Lab {
-                    chart.draw_series(DashedLineSeries::new(
-                        pts.clone(),
-                        8,
-                        6,
-                        colour.stroke_width(2),
-                    ))
-                } else {
-                    chart.draw_series(LineSeries::new(pts.clone(), colour.stroke_width(2)))
-                };
-                series
-                    .map_err(|e| anyhow!("plot: {e}"))?
-                    .label(format!("{}{slope}", sampler.name()))
-                    .legend(move |(x, y)| {
-                        PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
-                    });
-                chart
-                    .draw_series(pts.iter().map(|&p| Circle::new(p, 4, colour.filled())))
-                    .map_err(|e| anyhow!("plot: {e}"))?;
-            }
-            chart
-                .configure_series_labels()
-                .position(SeriesLabelPosition::UpperRight)
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .label_font(("sans-serif", 14))
-                .draw()
-                .map_err(|e| anyhow!("plot: {e}"))?;
+        let panels = root.split_evenly((2, 3));
+        for (j, region) in Region::ALL.iter().enumerate() {
+            panel(&panels[j], result, *region, Axis::Budget)?;
+            panel(&panels[3 + j], result, *region, Axis::Time)?;
         }
         root.present().map_err(|e| anyhow!("plot: {e}"))?;
     }
@@ -115,20 +211,31 @@ pub fn mse_plot(result: &StudyResult, path: &Path) -> Result<()> {
     })
 }
 
-/// Writes `heat_<sampler>_N<n>.png` for every sampler (see [`heat_images`]).
+/// Writes `heat_<sampler>_N<n>.png` for every sampler: per-pixel MSE over the seeds on one log
+/// scale shared by all samplers (dark = low error, bright = high), with a title and a
+/// labelled colour bar, so the maps compare directly and each reads on its own.
 pub fn heatmaps(result: &StudyResult, dir: &Path) -> Result<Vec<PathBuf>> {
-    let (w, h) = (result.config.base.width, result.config.base.height);
-    let maps: Vec<&[f32]> = result.heatmaps.iter().map(|(_, m)| m.as_slice()).collect();
-    let Some((images, _)) = heat_images(&maps, w, h) else {
+    let Some(scale) = Scale::from_values(result.heatmaps.iter().flat_map(|(_, m)| m), true) else {
         return Ok(Vec::new());
     };
+    let (w, h) = (result.config.base.width, result.config.base.height);
+    let n = result.config.heatmap_n;
     let mut written = Vec::new();
-    for ((sampler, _), img) in result.heatmaps.iter().zip(images) {
-        let path = dir.join(format!(
-            "heat_{}_N{}.png",
+    for (sampler, map) in &result.heatmaps {
+        let title = format!(
+            "{}, N = {n}: per-pixel MSE over {} seeds",
             sampler.name(),
-            result.config.heatmap_n
-        ));
+            result.config.seeds
+        );
+        let img = figure(
+            map,
+            w,
+            h,
+            &scale,
+            &title,
+            "MSE per pixel, mean of R, G, B; one scale for all samplers",
+        )?;
+        let path = dir.join(format!("heat_{}_N{n}.png", sampler.name()));
         write_atomically(&path, |out| {
             img.write_to(out, image::ImageFormat::Png)
                 .map_err(anyhow::Error::from)
@@ -148,5 +255,8 @@ pub fn heat_images(maps: &[&[f32]], w: u32, h: u32) -> Option<(Vec<image::RgbIma
         .iter()
         .map(|map| false_colour::map_image(map, w, h, &scale))
         .collect();
-    Some((images, [scale.low.log10() as f32, scale.high.log10() as f32]))
+    Some((
+        images,
+        [scale.low.log10() as f32, scale.high.log10() as f32],
+    ))
 }

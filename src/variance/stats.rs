@@ -2,6 +2,7 @@
 //! reference over a region, and the log-log slope of MSE against N. Tested on synthetic data,
 //! where the right answers are known in closed form.
 
+use crate::sampling::LightSampler;
 use glam::Vec3;
 use serde::Serialize;
 
@@ -90,6 +91,42 @@ pub fn pixel_mse(images: &[&[Vec3]], reference: &[Vec3]) -> Vec<f32> {
         .collect()
 }
 
+/// Mean squared error and mean signed error of each image of `images` against `reference`
+/// over the pixels where `region` is true (the per-seed figures that [`error_stats`] pools):
+/// one `(mse, bias)` per image, `(0, 0)` for an empty region.
+pub fn per_image_errors(
+    images: &[&[Vec3]],
+    reference: &[Vec3],
+    region: &[bool],
+) -> Vec<(f64, f64)> {
+    images
+        .iter()
+        .map(|img| {
+            let (mut sum_sq, mut sum, mut count) = (0.0f64, 0.0f64, 0usize);
+            for p in (0..reference.len()).filter(|&p| region[p]) {
+                for c in 0..3 {
+                    let e = img[p][c] as f64 - reference[p][c] as f64;
+                    sum_sq += e * e;
+                    sum += e;
+                    count += 1;
+                }
+            }
+            if count == 0 {
+                (0.0, 0.0)
+            } else {
+                (sum_sq / count as f64, sum / count as f64)
+            }
+        })
+        .collect()
+}
+
+/// True when `sampler` draws the same points at budget `n` whatever the seed, so that its
+/// error there is bias, not noise, and does not lie on the N^-slope line of its noisy points:
+/// the lab's strategy at N = 1 (the light's centre). Such points are left out of the fits.
+pub fn deterministic(sampler: LightSampler, n: u32) -> bool {
+    matches!((sampler, n), (LightSampler::Lab, 1))
+}
+
 /// A least-squares line through (log10 x, log10 y).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct LogLogFit {
@@ -163,6 +200,22 @@ mod tests {
         let s = error_stats(&[&c, &d], &reference, &noise, &region);
         assert!((s.bias - 0.06).abs() < 1e-6);
         assert!(s.bias.abs() > s.bias_bound, "{s:?}");
+    }
+
+    #[test]
+    fn per_image_errors_pool_to_the_study_mse() {
+        let reference = vec![Vec3::splat(0.5); 3];
+        let a = vec![Vec3::splat(0.75); 3];
+        let b = vec![Vec3::new(0.5, 0.5, 0.25); 3];
+        let region = [true, false, true];
+        let e = per_image_errors(&[&a, &b], &reference, &region);
+        assert_eq!(e, vec![(0.0625, 0.25), (0.0625 / 3.0, -0.25 / 3.0)]);
+        assert_eq!(
+            per_image_errors(&[&a], &reference, &[false; 3]),
+            vec![(0.0, 0.0)]
+        );
+        assert!(deterministic(LightSampler::Lab, 1));
+        assert!(!deterministic(LightSampler::Lab, 4) && !deterministic(LightSampler::Random, 1));
     }
 
     #[test]

@@ -1,0 +1,512 @@
+//! A study's results as files: the table as printed, `results.csv` (one row per sampler, N and
+//! region, with 95% intervals), `seeds.csv` (one row per seed), and a self-describing
+//! `results.json` (schema, version, commit, machine, settings, rows, slopes, matching budgets,
+//! per-seed rows), plus the plots, heat maps and contact sheet.
+
+use super::{Region, Row, StudyConfig, StudyResult, plot, sheet};
+use crate::machine::Machine;
+use crate::sampling::LightSampler;
+use anyhow::{Context, Result};
+use serde::Serialize;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// Version of `results.json`'s layout; raised whenever a key changes meaning or goes away.
+pub const SCHEMA_VERSION: u32 = 2;
+
+/// The keys of `results.json`, each with what it holds.
+pub const SCHEMA: [(&str, &str); 15] = [
+    (
+        "schema",
+        "this table: the layout's version and what each key holds",
+    ),
+    (
+        "raywave_version",
+        "the version of raywave that ran the study",
+    ),
+    (
+        "commit",
+        "the source commit raywave was built from (\"unknown\" outside a checkout)",
+    ),
+    (
+        "commit_dirty",
+        "true if the source tree had uncommitted changes; null if unknown",
+    ),
+    ("created", "when the study finished, UTC, RFC 3339"),
+    (
+        "machine",
+        "host name, CPU model, logical CPUs, OS and architecture",
+    ),
+    (
+        "settings",
+        "everything the figures depend on: scene, engine, threads, the study's configuration (render settings, budgets, samplers, seeds, reference and mask samples, heat-map budget) and the bootstrap's resamples, seed and level",
+    ),
+    (
+        "region_pixels",
+        "pixels in each region (whole, penumbra, lit)",
+    ),
+    (
+        "reference_mse",
+        "the converged reference's own error variance per region",
+    ),
+    (
+        "reference_cached",
+        "true if the converged reference was read from the cache",
+    ),
+    (
+        "rows",
+        "per sampler, N and region: mse, bias, bias_bound, variance, pixels; mse_interval; excluded_from_fit; seconds (median per image) and seconds_interval; rays, rays_per_second; efficiency = 1/(mse·seconds) and efficiency_interval; efficiency_vs_random (over random's at the same N and region) and its interval; error_reduction (random's MSE over this one's) and its interval. Intervals are 95%, [low, high]; null when there are too few seeds (an end of null is unbounded)",
+    ),
+    (
+        "slopes",
+        "per sampler and region: the least-squares fit of log10 MSE against log10 N (slope, intercept), slope_interval, the budgets fitted and those excluded",
+    ),
+    (
+        "matching",
+        "per sampler (other than random) and region: the budget whose fitted MSE equals random's at random_n points, and its interval",
+    ),
+    (
+        "seeds",
+        "one row per sampler, N, region and seed: mse, bias, seconds of that seed's image",
+    ),
+    (
+        "outputs",
+        "the other files of the report and what they show",
+    ),
+];
+
+/// The files a study writes into its directory (`heatmap_n` is the budget drawn).
+pub fn file_names(samplers: &[LightSampler], heatmap_n: u32) -> Vec<String> {
+    let mut names: Vec<String> = [
+        "table.txt",
+        "results.csv",
+        "seeds.csv",
+        "results.json",
+        "mse.png",
+        "contact_sheet.png",
+    ]
+    .map(String::from)
+    .to_vec();
+    for s in samplers {
+        names.push(format!("heat_{}_N{heatmap_n}.png", s.name()));
+    }
+    names
+}
+
+/// The commit this build came from and whether its tree was dirty: the one place the report
+/// asks, so that its source can change in one line.
+fn build_commit() -> (String, Option<bool>) {
+    crate::bench::record::git_commit()
+}
+
+/// One seed's image of a (sampler, N), over one region.
+#[derive(Serialize)]
+struct SeedRow {
+    sampler: &'static str,
+    n: u32,
+    region: Region,
+    seed: u32,
+    mse: f64,
+    bias: f64,
+    seconds: f64,
+}
+
+/// The settings block of `results.json`.
+#[derive(Serialize)]
+struct Settings<'a> {
+    scene: &'a str,
+    engine: &'a str,
+    threads: usize,
+    study: &'a StudyConfig,
+    bootstrap: Bootstrap,
+}
+
+#[derive(Serialize)]
+struct Bootstrap {
+    resamples: usize,
+    seed: u64,
+    level: f64,
+    unit: &'static str,
+}
+
+#[derive(Serialize)]
+struct Schema {
+    version: u32,
+    fields: std::collections::BTreeMap<&'static str, &'static str>,
+}
+
+/// `results.json`.
+#[derive(Serialize)]
+struct Document<'a> {
+    schema: Schema,
+    raywave_version: &'static str,
+    commit: String,
+    commit_dirty: Option<bool>,
+    created: String,
+    machine: Machine,
+    settings: Settings<'a>,
+    region_pixels: std::collections::BTreeMap<&'static str, usize>,
+    reference_mse: std::collections::BTreeMap<&'static str, f64>,
+    reference_cached: bool,
+    rows: &'a [Row],
+    slopes: &'a [super::Slope],
+    matching: &'a [super::Matching],
+    seeds: Vec<SeedRow>,
+    outputs: std::collections::BTreeMap<String, String>,
+}
+
+/// `v` in scientific notation with its interval: `6.37e-4 [6.1e-4, 6.6e-4]`.
+fn sci_iv(v: f64, iv: Option<[f64; 2]>) -> String {
+    match iv {
+        Some([a, b]) => format!("{v:.3e} [{}, {}]", end(a, 2), end(b, 2)),
+        None => format!("{v:.3e} [-]"),
+    }
+}
+
+/// One end of an interval, scientific with `digits` decimals, `inf` when unbounded.
+fn end(v: f64, digits: usize) -> String {
+    if v.is_finite() {
+        format!("{v:.digits$e}")
+    } else {
+        "inf".to_string()
+    }
+}
+
+/// A fixed-point value with its interval: `-1.49 [-1.55, -1.43]`.
+fn fixed_iv(v: f64, iv: Option<[f64; 2]>, digits: usize) -> String {
+    let e = |x: f64| {
+        if x.is_finite() {
+            format!("{x:.digits$}")
+        } else {
+            "inf".to_string()
+        }
+    };
+    match iv {
+        Some([a, b]) => format!("{} [{}, {}]", e(v), e(a), e(b)),
+        None => format!("{} [-]", e(v)),
+    }
+}
+
+impl StudyResult {
+    /// The per-seed rows, seeds 1..=K.
+    fn seed_rows(&self) -> Vec<SeedRow> {
+        let mut out = Vec::new();
+        for r in &self.rows {
+            for (k, mse) in r.seed_mse.iter().enumerate() {
+                out.push(SeedRow {
+                    sampler: r.sampler,
+                    n: r.n,
+                    region: r.region,
+                    seed: k as u32 + 1,
+                    mse: *mse,
+                    bias: r.seed_bias[k],
+                    seconds: r.seed_seconds[k],
+                });
+            }
+        }
+        out
+    }
+
+    /// A readable report: one table per region, the slopes and matching budgets with their
+    /// 95% intervals, and the checks.
+    pub fn table(&self) -> String {
+        let mut s = String::new();
+        let _ = writeln!(
+            s,
+            "variance study: {} at {}×{}, {} bounces, {} seeds per point, engine {}, {} threads",
+            self.scene,
+            self.config.base.width,
+            self.config.base.height,
+            self.config.base.bounces,
+            self.config.seeds,
+            self.engine,
+            self.threads
+        );
+        let _ = writeln!(
+            s,
+            "[low, high]: 95% intervals (MSE, efficiency, slopes, budgets: bootstrap over the \
+             seeds; time: the median's sign-test interval, from 6 seeds)"
+        );
+        for (i, region) in Region::ALL.iter().enumerate() {
+            if self.region_pixels[i] == 0 {
+                let _ = writeln!(
+                    s,
+                    "\n{}: no pixels in this region, nothing measured",
+                    region.name()
+                );
+                continue;
+            }
+            let _ = writeln!(
+                s,
+                "\n{} ({} pixels; reference MSE {:.2e}, {:.0}× below the smallest measured)",
+                region.name(),
+                self.region_pixels[i],
+                self.reference_mse[i],
+                self.reference_margin(*region)
+            );
+            let _ = writeln!(
+                s,
+                "  {:<10} {:>5} {:<29} {:<22} {:>10} {:>9} {:>10} {:<22} {:>7} {:<29} {:<20}",
+                "sampler",
+                "N",
+                "MSE [95%]",
+                "random/MSE [95%]",
+                "bias",
+                "±bound",
+                "variance",
+                "ms/image [95%]",
+                "Mrays/s",
+                "1/(MSE·s) [95%]",
+                "vs random [95%]"
+            );
+            for r in self.rows.iter().filter(|r| r.region == *region) {
+                let ms = r.seconds_interval.map(|[a, b]| [a * 1e3, b * 1e3]);
+                let mut notes = Vec::new();
+                if r.stats.bias.abs() > r.stats.bias_bound {
+                    notes.push("BIASED?");
+                }
+                if r.excluded_from_fit {
+                    notes.push("not fitted");
+                }
+                let _ = writeln!(
+                    s,
+                    "  {:<10} {:>5} {:<29} {:<22} {:>10.2e} {:>9.2e} {:>10.3e} {:<22} {:>7.2} {:<29} {:<20}{}",
+                    r.sampler,
+                    r.n,
+                    sci_iv(r.stats.mse, r.mse_interval),
+                    r.error_reduction
+                        .map(|v| fixed_iv(v, r.error_reduction_interval, 2))
+                        .unwrap_or_else(|| "-".into()),
+                    r.stats.bias,
+                    r.stats.bias_bound,
+                    r.stats.variance,
+                    fixed_iv(r.seconds * 1e3, ms, 2),
+                    r.rays_per_second / 1e6,
+                    sci_iv(r.efficiency, r.efficiency_interval),
+                    r.efficiency_vs_random
+                        .map(|v| fixed_iv(v, r.efficiency_vs_random_interval, 2))
+                        .unwrap_or_else(|| "-".into()),
+                    if notes.is_empty() {
+                        String::new()
+                    } else {
+                        format!("  {}", notes.join(", "))
+                    }
+                );
+            }
+        }
+        let _ = writeln!(
+            s,
+            "\nslope of log MSE against log N [95%] (points where the sampler ignores the seed, \
+             such as lab at N = 1, are bias, not noise, and are left out):"
+        );
+        let _ = writeln!(
+            s,
+            "  {:<10} {:<24} {:<24} {:<24}",
+            "sampler", "whole", "penumbra", "lit"
+        );
+        for sampler in &self.config.samplers {
+            let cell = |region: Region| {
+                self.slopes
+                    .iter()
+                    .find(|sl| sl.sampler == sampler.name() && sl.region == region)
+                    .and_then(|sl| sl.fit.map(|f| fixed_iv(f.slope, sl.slope_interval, 3)))
+                    .unwrap_or_else(|| "-".into())
+            };
+            let _ = writeln!(
+                s,
+                "  {:<10} {:<24} {:<24} {:<24}",
+                sampler.name(),
+                cell(Region::Whole),
+                cell(Region::Penumbra),
+                cell(Region::Lit)
+            );
+        }
+        if !self.matching.is_empty() {
+            let _ = writeln!(
+                s,
+                "\nbudget matching the MSE of {} random points (the lab's choice), from the fits \
+                 [95%]:",
+                super::fits::LAB_RANDOM_POINTS
+            );
+            for sampler in self
+                .config
+                .samplers
+                .iter()
+                .filter(|&&x| x != LightSampler::Random)
+            {
+                let cell = |region: Region| {
+                    self.matching
+                        .iter()
+                        .find(|m| m.sampler == sampler.name() && m.region == region)
+                        .and_then(|m| m.budget.map(|b| fixed_iv(b, m.interval, 1)))
+                        .unwrap_or_else(|| "-".into())
+                };
+                let _ = writeln!(
+                    s,
+                    "  {:<10} {:<24} {:<24} {:<24}",
+                    sampler.name(),
+                    cell(Region::Whole),
+                    cell(Region::Penumbra),
+                    cell(Region::Lit)
+                );
+            }
+        }
+        s
+    }
+
+    /// The rows as CSV, with the 95% intervals (empty cells where there is none).
+    pub fn csv(&self) -> String {
+        let mut s = String::from(
+            "sampler,n,region,pixels,mse,mse_low,mse_high,bias,bias_bound,variance,\
+             excluded_from_fit,seconds,seconds_low,seconds_high,rays,rays_per_second,\
+             efficiency,efficiency_low,efficiency_high,efficiency_vs_random,\
+             efficiency_vs_random_low,efficiency_vs_random_high,error_reduction,\
+             error_reduction_low,error_reduction_high\n",
+        );
+        let iv = |i: Option<[f64; 2]>| match i {
+            Some([a, b]) => format!("{a:e},{b:e}"),
+            None => ",".to_string(),
+        };
+        for r in &self.rows {
+            let _ = writeln!(
+                s,
+                "{},{},{},{},{:e},{},{:e},{:e},{:e},{},{:e},{},{},{:e},{:e},{},{},{},{},{}",
+                r.sampler,
+                r.n,
+                r.region.name(),
+                r.stats.pixels,
+                r.stats.mse,
+                iv(r.mse_interval),
+                r.stats.bias,
+                r.stats.bias_bound,
+                r.stats.variance,
+                r.excluded_from_fit,
+                r.seconds,
+                iv(r.seconds_interval),
+                r.rays,
+                r.rays_per_second,
+                r.efficiency,
+                iv(r.efficiency_interval),
+                r.efficiency_vs_random
+                    .map(|v| format!("{v:e}"))
+                    .unwrap_or_default(),
+                iv(r.efficiency_vs_random_interval),
+                r.error_reduction
+                    .map(|v| format!("{v:e}"))
+                    .unwrap_or_default(),
+                iv(r.error_reduction_interval)
+            );
+        }
+        s
+    }
+
+    /// One row per sampler, N, region and seed.
+    pub fn seeds_csv(&self) -> String {
+        let mut s = String::from("sampler,n,region,seed,mse,bias,seconds\n");
+        for r in self.seed_rows() {
+            let _ = writeln!(
+                s,
+                "{},{},{},{},{:e},{:e},{:e}",
+                r.sampler,
+                r.n,
+                r.region.name(),
+                r.seed,
+                r.mse,
+                r.bias,
+                r.seconds
+            );
+        }
+        s
+    }
+
+    /// `results.json`: the figures with everything needed to read and reproduce them.
+    pub fn json(&self) -> Result<String> {
+        let (commit, commit_dirty) = build_commit();
+        let by_region = |v: [f64; 3]| {
+            Region::ALL
+                .iter()
+                .zip(v)
+                .map(|(r, x)| (r.name(), x))
+                .collect()
+        };
+        let outputs = file_names(&self.config.samplers, self.config.heatmap_n)
+            .into_iter()
+            .filter(|n| n != "results.json")
+            .map(|n| {
+                let what = match n.as_str() {
+                    "table.txt" => "the report as printed",
+                    "results.csv" => "the rows of `rows`",
+                    "seeds.csv" => "the rows of `seeds`",
+                    "mse.png" => "MSE against N (top) and against time per image (bottom), per region, with 95% intervals",
+                    "contact_sheet.png" => "seed 0's render of every sampler (rows) and budget (columns)",
+                    _ => "per-pixel MSE at the heat-map budget, on one log scale shared by all samplers",
+                };
+                (n, what.to_string())
+            })
+            .collect();
+        let doc = Document {
+            schema: Schema {
+                version: SCHEMA_VERSION,
+                fields: SCHEMA.into_iter().collect(),
+            },
+            raywave_version: env!("CARGO_PKG_VERSION"),
+            commit,
+            commit_dirty,
+            created: crate::bench::record::now_utc(),
+            machine: Machine::current(),
+            settings: Settings {
+                scene: &self.scene,
+                engine: &self.engine,
+                threads: self.threads,
+                study: &self.config,
+                bootstrap: Bootstrap {
+                    resamples: crate::statistics::BOOTSTRAP_RESAMPLES,
+                    seed: crate::statistics::BOOTSTRAP_SEED,
+                    level: 0.95,
+                    unit: "seed: one resample draws K seeds with replacement, the same for every sampler, budget and region",
+                },
+            },
+            region_pixels: Region::ALL
+                .iter()
+                .zip(self.region_pixels)
+                .map(|(r, x)| (r.name(), x))
+                .collect(),
+            reference_mse: by_region(self.reference_mse),
+            reference_cached: self.reference_cached,
+            rows: &self.rows,
+            slopes: &self.slopes,
+            matching: &self.matching,
+            seeds: self.seed_rows(),
+            outputs,
+        };
+        Ok(serde_json::to_string_pretty(&doc)? + "\n")
+    }
+
+    /// Writes every file of [`file_names`] into `dir`; returns the paths written.
+    pub fn write(&self, dir: &Path) -> Result<Vec<PathBuf>> {
+        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+        let mut written = Vec::new();
+        let text = |name: &str, body: String, written: &mut Vec<PathBuf>| -> Result<()> {
+            let path = dir.join(name);
+            crate::film::write_atomically(&path, |w| {
+                std::io::Write::write_all(w, body.as_bytes())?;
+                Ok(())
+            })?;
+            written.push(path);
+            Ok(())
+        };
+        text("table.txt", self.table(), &mut written)?;
+        text("results.csv", self.csv(), &mut written)?;
+        text("seeds.csv", self.seeds_csv(), &mut written)?;
+        text("results.json", self.json()?, &mut written)?;
+        let plot_path = dir.join("mse.png");
+        plot::mse_plot(self, &plot_path)?;
+        written.push(plot_path);
+        let sheet_path = dir.join("contact_sheet.png");
+        if sheet::write(self, &sheet_path)? {
+            written.push(sheet_path);
+        }
+        written.extend(plot::heatmaps(self, dir)?);
+        Ok(written)
+    }
+}
