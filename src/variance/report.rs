@@ -93,10 +93,10 @@ pub fn file_names(samplers: &[LightSampler], heatmap_n: u32) -> Vec<String> {
     names
 }
 
-/// The commit this build came from and whether its tree was dirty: the one place the report
-/// asks, so that its source can change in one line.
+/// The commit this binary was built from and whether its tree was dirty (embedded by build.rs).
 fn build_commit() -> (String, Option<bool>) {
-    crate::bench::record::git_commit()
+    let build = crate::build_info::current();
+    (build.commit, build.dirty)
 }
 
 /// One seed's image of a (sampler, N), over one region.
