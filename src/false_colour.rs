@@ -20,8 +20,12 @@ use image::RgbImage;
 use plotters::prelude::*;
 use std::sync::Once;
 
-/// The map is upscaled by a whole factor until its shorter side reaches this many pixels.
+/// The map is upscaled by a whole factor until its shorter side reaches this many pixels, as
+/// long as its longer side stays within [`MAX_SIDE`].
 pub const MIN_SIDE: u32 = 256;
+
+/// The longest side an upscaled map may have (a map already longer is not upscaled).
+pub const MAX_SIDE: u32 = 2048;
 
 const TITLE_HEIGHT: u32 = 34;
 const MARGIN: u32 = 12;
@@ -155,7 +159,10 @@ pub fn figure(
         ));
     }
     register_font();
-    let factor = MIN_SIDE.div_ceil(width.min(height)).max(1);
+    let factor = MIN_SIDE
+        .div_ceil(width.min(height))
+        .min(MAX_SIDE / width.max(height))
+        .max(1);
     let (mw, mh) = (width * factor, height * factor);
     let fw = MARGIN + mw + MARGIN + BAR_WIDTH + BAR_LABELS;
     let fh = TITLE_HEIGHT + mh + FOOTER;
@@ -284,5 +291,9 @@ mod tests {
         assert_eq!(first, inferno(0.0));
         assert_eq!(last, inferno(1.0));
         assert!(figure(&values, 5, 4, &scale, "t", "u").is_err());
+        // A long, thin map is not blown up past MAX_SIDE.
+        let row = vec![1.0f32; 300];
+        let img = figure(&row, 300, 1, &scale, "t", "u").unwrap();
+        assert!(img.width() < MAX_SIDE + 300, "{}", img.width());
     }
 }

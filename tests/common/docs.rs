@@ -31,12 +31,19 @@ pub struct Page {
     pub quick: &'static Quick,
     /// Commands not run, each with the reason the page gives.
     pub manual: &'static [(&'static str, &'static str)],
+    /// Checks what a command left in the scratch directory (its arguments as run).
+    pub after: fn(&Path, &[String]),
 }
 
-/// The ```sh lines of a page, comments and blank lines dropped.
+/// An `after` that checks nothing.
+pub fn nothing(_: &Path, _: &[String]) {}
+
+/// The ```sh lines of a page, comments and blank lines dropped, a line ending in `\` joined
+/// with the next.
 pub fn commands(doc: &str) -> Vec<String> {
     let mut out = Vec::new();
     let mut in_sh = false;
+    let mut pending = String::new();
     for line in doc.lines() {
         let trimmed = line.trim();
         if let Some(lang) = trimmed.strip_prefix("```") {
@@ -47,8 +54,15 @@ pub fn commands(doc: &str) -> Vec<String> {
             continue;
         }
         let command = trimmed.split(" #").next().unwrap_or("").trim();
-        if !command.is_empty() && !command.starts_with('#') {
-            out.push(command.to_string());
+        if let Some(head) = command.strip_suffix('\\') {
+            pending.push_str(head.trim_end());
+            pending.push(' ');
+            continue;
+        }
+        let whole = std::mem::take(&mut pending) + command;
+        let whole = whole.trim();
+        if !whole.is_empty() && !whole.starts_with('#') {
+            out.push(whole.to_string());
         }
     }
     out
@@ -73,27 +87,38 @@ fn subcommand(args: &[String]) -> &str {
     }
 }
 
-/// `args` with QUICK's values for its subcommand. A `bench --against OTHER` runs against this
-/// build itself (an A/A comparison), in its fewest rounds and without `--runs` (which the A/B
-/// mode does not take).
+/// `args` with QUICK's values for its subcommand. Every occurrence of a flag is shortened (a
+/// bench sweep repeats `--size`: the k-th size is made 8k pixels wider, so that its points stay
+/// distinct). A `bench --against OTHER` runs against this build itself (an A/A comparison), in
+/// its fewest rounds and without `--runs` (which the A/B mode does not take). `bench compare`,
+/// `bench list` and `variance --clean-cache` take no image flags and run as written.
 pub fn shorten(args: &[&str], quick: &Quick) -> Vec<String> {
     let mut out: Vec<String> = args.iter().map(|w| w.to_string()).collect();
+    let sub = subcommand(&out).to_string();
+    let as_written = (sub == "bench" && matches!(args.get(1).copied(), Some("compare" | "list")))
+        || (sub == "variance" && args.contains(&"--clean-cache"));
+    if as_written {
+        return out;
+    }
     if let Some(i) = out.iter().position(|w| w == "--against") {
         out[i + 1] = env!("CARGO_BIN_EXE_raywave").to_string();
         out.extend(["--rounds", "6", "--warmup", "0"].map(String::from));
     }
     let ab = out.iter().any(|w| w == "--against");
-    let sub = subcommand(&out).to_string();
     for (s, flag, values) in quick {
         if *s != sub || (ab && *flag == "--runs") {
             continue;
         }
-        if let Some(i) = out.iter().position(|w| w == flag) {
-            out.splice(
-                i + 1..i + 1 + values.len(),
-                values.iter().map(|v| v.to_string()),
-            );
-        } else {
+        let at: Vec<usize> = (0..out.len()).filter(|&i| out[i] == *flag).collect();
+        for (k, &i) in at.iter().enumerate() {
+            let mut values: Vec<String> = values.iter().map(|v| v.to_string()).collect();
+            if *flag == "--size" {
+                let w: usize = values[0].parse().unwrap();
+                values[0] = (w + 8 * k).to_string();
+            }
+            out.splice(i + 1..i + 1 + values.len(), values);
+        }
+        if at.is_empty() {
             out.push(flag.to_string());
             out.extend(values.iter().map(|v| v.to_string()));
         }
