@@ -59,8 +59,8 @@ fn record(total: (f64, f64, f64), shadow_stage: (f64, f64, f64)) -> Value {
             "engine": "wavefront",
             "median": {
                 "seconds": 17508.0 / t.0, "rays": rays,
-                "rays_per_second": {"camera": 1.0, "shadow": 1.0, "reflection": 1.0,
-                                    "total": t.0},
+                "rates": {"camera_per_thread_second": 1.0, "shadow_per_thread_second": 1.0,
+                          "reflection_per_thread_second": 1.0, "total_per_second": t.0},
                 "stages": [{"stage": "shadow", "rays": 16384, "thread_seconds": 16384.0 / s.0,
                             "rays_per_thread_second": s.0}]
             },

@@ -13,7 +13,8 @@ use std::path::Path;
 const ROOT: &str = env!("CARGO_MANIFEST_DIR");
 
 /// `raywave view` serves until stopped; tests/view_http.rs and tests/view_browser.rs run it.
-const VIEW: &str = "a server that runs until Ctrl-C; tests/view_http.rs and tests/view_browser.rs run it";
+const VIEW: &str =
+    "a server that runs until Ctrl-C; tests/view_http.rs and tests/view_browser.rs run it";
 
 /// README.md: the set-up commands and the tour. Renders run at the page's sizes (each takes
 /// under a few seconds in a release build); the variance study is shortened.
@@ -90,14 +91,21 @@ const PAGES: [&Page; 3] = [&README, &BENCHMARKING, &SAMPLING];
 
 /// A study (not `--clean-cache`) leaves its table, results, per-seed rows and contact sheet.
 fn study_wrote_its_report(dir: &Path, args: &[String]) {
-    if args.first().map(String::as_str) != Some("variance") || args.iter().any(|a| a == "--clean-cache") {
+    if args.first().map(String::as_str) != Some("variance")
+        || args.iter().any(|a| a == "--clean-cache")
+    {
         return;
     }
     let report = args
         .iter()
         .position(|w| w == "--out")
         .map_or("variance-report", |i| args[i + 1].as_str());
-    for name in ["table.txt", "results.json", "seeds.csv", "contact_sheet.png"] {
+    for name in [
+        "table.txt",
+        "results.json",
+        "seeds.csv",
+        "contact_sheet.png",
+    ] {
         assert!(
             dir.join(report).join(name).is_file(),
             "`raywave {}` left no {report}/{name}",
@@ -146,7 +154,8 @@ fn sampling_commands_run_in_page_order() {
 
 #[test]
 fn continued_lines_are_one_command() {
-    let page = "```sh\nraywave trace-pixel 1 2 \\\n    --json t.json  # the tree\nraywave info\n```\n";
+    let page =
+        "```sh\nraywave trace-pixel 1 2 \\\n    --json t.json  # the tree\nraywave info\n```\n";
     assert_eq!(
         commands(page),
         ["raywave trace-pixel 1 2 --json t.json", "raywave info"]
@@ -156,7 +165,10 @@ fn continued_lines_are_one_command() {
 #[test]
 fn the_shortening_replaces_adds_and_keeps_sweep_points_apart() {
     let quick = BENCHMARKING.quick;
-    let out = shorten(&["bench", "--size", "512", "512", "--size", "256", "256"], quick);
+    let out = shorten(
+        &["bench", "--size", "512", "512", "--size", "256", "256"],
+        quick,
+    );
     assert_eq!(
         out.join(" "),
         "bench --size 24 24 --size 32 24 --runs 6 --shadow-samples 4"
@@ -175,7 +187,10 @@ fn the_shortening_replaces_adds_and_keeps_sweep_points_apart() {
     }
     // A scene path or a flag first: the default command, render.
     let out = shorten(&["scenes/x.obj", "-o", "x.png"], quick);
-    assert_eq!(out.join(" "), "scenes/x.obj -o x.png --size 24 24 --shadow-samples 4");
+    assert_eq!(
+        out.join(" "),
+        "scenes/x.obj -o x.png --size 24 24 --shadow-samples 4"
+    );
 }
 
 #[test]
@@ -190,7 +205,11 @@ fn ci_runs_the_readme_test_command() {
         last, "cargo test --release --all-targets",
         ".ci/run changed"
     );
-    assert!(commands(README.text).iter().any(|c| c == "cargo test --release --all-targets"));
+    assert!(
+        commands(README.text)
+            .iter()
+            .any(|c| c == "cargo test --release --all-targets")
+    );
 }
 
 #[test]
