@@ -435,6 +435,18 @@ fn the_diff_image_has_the_map_and_a_colour_bar() {
 }
 
 #[test]
+fn a_long_thin_image_gets_no_giant_figure() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_pfm(&d.join("a.pfm"), 300, &[[0.25; 3]; 300]);
+    write_pfm(&d.join("b.pfm"), 300, &[[0.5; 3]; 300]);
+    let out = raywave(d, &["diff", "a.pfm", "b.pfm", "--out", "d.png"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(stderr(&out).contains("too elongated"), "{}", stderr(&out));
+    assert!(!d.join("d.png").exists());
+}
+
+#[test]
 fn outputs_never_overwrite_an_input() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();

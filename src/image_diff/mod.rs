@@ -415,6 +415,9 @@ pub fn pixel_errors(a: &Image, b: &Image, region: &Region, metric: Metric) -> Ve
         .collect()
 }
 
+/// The longest side of an error figure, in pixels.
+pub const MAX_FIGURE_SIDE: u64 = 16384;
+
 /// The false-colour figure of a per-pixel error map: a log scale for the squared errors, a
 /// linear one for |a − b| and FLIP; NaN (outside the region) is drawn darkest.
 pub fn figure(
@@ -424,6 +427,17 @@ pub fn figure(
     metric: Metric,
     title: &str,
 ) -> Result<image::RgbImage> {
+    // The figure upscales the shorter side to MIN_SIDE: a long thin image would become a huge
+    // figure (a 16384×1 one, 4 million pixels wide).
+    let factor = false_colour::MIN_SIDE
+        .div_ceil(width.min(height).max(1))
+        .max(1) as u64;
+    if width.max(height) as u64 * factor > MAX_FIGURE_SIDE {
+        bail!(
+            "a {width}×{height} image is too elongated for an error figure: upscaled to {} pixels on its shorter side, its longer one would pass {MAX_FIGURE_SIDE}",
+            false_colour::MIN_SIDE
+        );
+    }
     let (label, log) = match metric {
         Metric::Mse | Metric::Psnr => ("(a − b)², mean of R G B", true),
         Metric::Relmse => ("(a − b)² / (b + 0.01)², mean of R G B", true),
