@@ -113,7 +113,11 @@ impl Scale {
         } else {
             (v - self.low) / (self.high - self.low)
         };
-        if t.is_nan() { 0.0 } else { t.clamp(0.0, 1.0) as f32 }
+        if t.is_nan() {
+            0.0
+        } else {
+            t.clamp(0.0, 1.0) as f32
+        }
     }
 
     /// The value at position `t` in [0, 1] (the inverse of [`Scale::position`] inside the
@@ -281,7 +285,9 @@ mod tests {
         assert_eq!(img.height(), TITLE_HEIGHT + 4 * factor + FOOTER);
         // The top-left map pixel and the bottom-right one carry the ends of the map.
         let first = img.get_pixel(MARGIN, TITLE_HEIGHT).0;
-        let last = img.get_pixel(MARGIN + 4 * factor - 1, TITLE_HEIGHT + 4 * factor - 1).0;
+        let last = img
+            .get_pixel(MARGIN + 4 * factor - 1, TITLE_HEIGHT + 4 * factor - 1)
+            .0;
         assert_eq!(first, inferno(0.0));
         assert_eq!(last, inferno(1.0));
         assert!(figure(&values, 5, 4, &scale, "t", "u").is_err());
