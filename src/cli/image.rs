@@ -2,7 +2,10 @@
 
 use super::values::{DefaultsArg, LightModelArg, SamplerArg, ShadowArg};
 use clap::Args;
-use raywave::options::ImageOptions;
+use raywave::options::{Effective, ImageOptions};
+use raywave::output::OutputPlan;
+use raywave::scene::{Scene, load_scene};
+use std::path::Path;
 
 /// The flags that shape the image, shared by `render` and `bench` so that both default alike
 /// (a bench record then measures what the same flags render). The defaults are the same with
@@ -116,6 +119,37 @@ impl ImageArgs {
             push("--defaults", vec![name(d)]);
         }
         out
+    }
+}
+
+/// Loads the scene at `path` (the built-in one for `None`; its warnings go to stderr) and
+/// resolves `image` against it, with the seed and the facing that the image flags do not hold:
+/// the one way `render`, `trace-pixel` and `view` turn their flags into a scene and settings.
+pub fn scene_and_settings(
+    path: Option<&Path>,
+    image: &ImageArgs,
+    seed: u32,
+    two_sided: bool,
+) -> anyhow::Result<(Scene, Effective)> {
+    let options = image.options();
+    let scene = load_scene(path, &options.parse_options())?.scene;
+    for w in &scene.warnings {
+        eprintln!("{w}");
+    }
+    let mut effective = options.resolve(scene.background.map(|c| c.to_array()));
+    effective.settings.seed = seed;
+    effective.settings.two_sided = two_sided;
+    Ok((scene, effective))
+}
+
+/// Prints text meant for the terminal: on stdout, or on stderr when one of `plan`'s outputs
+/// goes to stdout (so the text does not mix into it).
+pub fn say(plan: &OutputPlan, text: &str) -> anyhow::Result<()> {
+    if plan.uses_stdout() {
+        eprint!("{text}");
+        Ok(())
+    } else {
+        raywave::terminal::print(text)
     }
 }
 

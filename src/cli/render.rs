@@ -2,6 +2,7 @@
 //! image (and the linear floats, and the `--stats-json` record), then prints the summary.
 
 use super::image::ImageArgs;
+use super::image::scene_and_settings;
 use super::values::{EngineArg, ToneMapArg};
 use anyhow::Result;
 use clap::Args;
@@ -19,9 +20,9 @@ use raywave::options::{BackgroundSource, Effective};
 use raywave::output::OutputPlan;
 use raywave::output::memory::{self, RenderFootprint};
 use raywave::report::{DefaultsUsed, KindFigures, KindTiming, RenderRecord, SceneFigures};
-use raywave::scene::{Scene, load_scene};
+use raywave::scene::Scene;
 use raywave::settings::{LightModel, ShadowMode};
-use raywave::terminal::{print, progress_bar};
+use raywave::terminal::progress_bar;
 use raywave::wavefront::stats::RenderStats;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -94,14 +95,6 @@ impl RenderArgs {
     pub fn scene_path(&self) -> Option<&PathBuf> {
         self.scene.as_ref().or(self.input.as_ref())
     }
-
-    /// Turns the flags into settings; `scene_background` is the file's `background_color`.
-    pub fn settings(&self, scene_background: Option<[f32; 3]>) -> Effective {
-        let mut effective = self.image.options().resolve(scene_background);
-        effective.settings.seed = self.seed;
-        effective.settings.two_sided = self.two_sided;
-        effective
-    }
 }
 
 /// Renders as the flags say.
@@ -115,23 +108,13 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     plan.check()?;
     plan.refuse_binary_on_terminal(&["-o", "--hdr"])?;
     // Text meant for the terminal goes to stderr when an image or record goes to stdout.
-    let say = |text: &str| -> Result<()> {
-        if plan.uses_stdout() {
-            eprint!("{text}");
-            Ok(())
-        } else {
-            print(text)
-        }
-    };
-    let scene = load_scene(
+    let say = |text: &str| super::image::say(&plan, text);
+    let (scene, effective) = scene_and_settings(
         args.scene_path().map(PathBuf::as_path),
-        &args.image.options().parse_options(),
-    )?
-    .scene;
-    for w in &scene.warnings {
-        eprintln!("{w}");
-    }
-    let effective = args.settings(scene.background.map(|c| c.to_array()));
+        &args.image,
+        args.seed,
+        args.two_sided,
+    )?;
     let settings = effective.settings.clone();
     if let Some(px) = &args.debug_pixel
         && (px[0] >= settings.width || px[1] >= settings.height)

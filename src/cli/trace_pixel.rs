@@ -3,6 +3,7 @@
 //! as a readable summary when no output is asked for.
 
 use super::image::ImageArgs;
+use super::image::scene_and_settings;
 use super::values::ToneMapArg;
 use anyhow::{Context, Result};
 use clap::Args;
@@ -11,8 +12,7 @@ use raywave::engine::{Engine, thread_pool};
 use raywave::error::UsageError;
 use raywave::film::ldr_format;
 use raywave::output::{OutputPlan, write_output};
-use raywave::scene::load_scene;
-use raywave::terminal::{print, progress_bar};
+use raywave::terminal::progress_bar;
 use raywave::trace::draw::{Overlay, depth_buffer};
 use raywave::trace::view::ViewPlacement;
 use raywave::trace::{check_pixel, mesh, obj, ply, scene_bounds, summary, trace_pixel};
@@ -105,18 +105,13 @@ pub fn run(args: &TracePixelArgs) -> Result<()> {
     plan.check()?;
     plan.refuse_binary_on_terminal(&["--png"])?;
 
-    let scene_file = load_scene(args.scene.as_deref(), &args.image.options().parse_options())?;
-    let scene = scene_file.scene;
-    for w in &scene.warnings {
-        eprintln!("{w}");
-    }
-    let mut settings = args
-        .image
-        .options()
-        .resolve(scene.background.map(|c| c.to_array()))
-        .settings;
-    settings.seed = args.seed;
-    settings.two_sided = args.two_sided;
+    let (scene, effective) = scene_and_settings(
+        args.scene.as_deref(),
+        &args.image,
+        args.seed,
+        args.two_sided,
+    )?;
+    let settings = effective.settings;
     let mut tree =
         trace_pixel(&scene, &settings, args.x, args.y).map_err(|e| UsageError(e.to_string()))?;
     let placement = ViewPlacement {
@@ -138,14 +133,7 @@ pub fn run(args: &TracePixelArgs) -> Result<()> {
     tree.check = Some(check_pixel(&scene, &settings, &tree));
 
     // Text meant for the terminal goes to stderr when an output goes to stdout.
-    let say = |text: &str| -> Result<()> {
-        if plan.uses_stdout() {
-            eprint!("{text}");
-            Ok(())
-        } else {
-            print(text)
-        }
-    };
+    let say = |text: &str| super::image::say(&plan, text);
     let title = format!(
         "raywave trace-pixel {} {}: {}",
         args.x, args.y, scene.source

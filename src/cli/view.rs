@@ -1,12 +1,12 @@
 //! `raywave view` flags, turned into `raywave::view::ViewOptions`.
 
 use super::image::ImageArgs;
+use super::image::scene_and_settings;
 use super::values::EngineArg;
 use anyhow::Result;
 use clap::Args;
 use raywave::engine::Engine;
 use raywave::error::UsageError;
-use raywave::scene::load_scene;
 use raywave::view::settings::{MAX_CAMERA_SAMPLES, MAX_SIDE, Resolved};
 use raywave::view::{ViewOptions, run as serve};
 use std::path::PathBuf;
@@ -43,18 +43,13 @@ pub struct ViewArgs {
 
 /// Serves the page until Ctrl-C.
 pub fn run(args: &ViewArgs) -> Result<()> {
-    let file = load_scene(args.scene.as_deref(), &args.image.options().parse_options())?;
-    let scene = file.scene;
-    for w in &scene.warnings {
-        eprintln!("{w}");
-    }
-    let mut settings = args
-        .image
-        .options()
-        .resolve(scene.background.map(|c| c.to_array()))
-        .settings;
-    settings.seed = args.seed;
-    settings.two_sided = args.two_sided;
+    let (scene, effective) = scene_and_settings(
+        args.scene.as_deref(),
+        &args.image,
+        args.seed,
+        args.two_sided,
+    )?;
+    let settings = effective.settings;
     if settings.width > MAX_SIDE || settings.height > MAX_SIDE {
         return Err(UsageError(format!(
             "--size {} {}: the viewer renders at most {MAX_SIDE} pixels a side",
