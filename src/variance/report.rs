@@ -172,6 +172,19 @@ fn end(v: f64, digits: usize) -> String {
     }
 }
 
+/// One row of a per-region table: the sampler, then `cell` of the whole image, the penumbra
+/// and the lit region.
+fn region_row(s: &mut String, sampler: &str, cell: impl Fn(Region) -> String) {
+    let _ = writeln!(
+        s,
+        "  {:<10} {:<24} {:<24} {:<24}",
+        sampler,
+        cell(Region::Whole),
+        cell(Region::Penumbra),
+        cell(Region::Lit)
+    );
+}
+
 /// A fixed-point value with its interval: `-1.49 [-1.55, -1.43]`.
 fn fixed_iv(v: f64, iv: Option<[f64; 2]>, digits: usize) -> String {
     let e = |x: f64| {
@@ -312,14 +325,7 @@ impl StudyResult {
                     .and_then(|sl| sl.fit.map(|f| fixed_iv(f.slope, sl.slope_interval, 3)))
                     .unwrap_or_else(|| "-".into())
             };
-            let _ = writeln!(
-                s,
-                "  {:<10} {:<24} {:<24} {:<24}",
-                sampler.name(),
-                cell(Region::Whole),
-                cell(Region::Penumbra),
-                cell(Region::Lit)
-            );
+            region_row(&mut s, sampler.name(), cell);
         }
         if !self.matching.is_empty() {
             let _ = writeln!(
@@ -341,14 +347,7 @@ impl StudyResult {
                         .and_then(|m| m.budget.map(|b| fixed_iv(b, m.interval, 1)))
                         .unwrap_or_else(|| "-".into())
                 };
-                let _ = writeln!(
-                    s,
-                    "  {:<10} {:<24} {:<24} {:<24}",
-                    sampler.name(),
-                    cell(Region::Whole),
-                    cell(Region::Penumbra),
-                    cell(Region::Lit)
-                );
+                region_row(&mut s, sampler.name(), cell);
             }
         }
         s
