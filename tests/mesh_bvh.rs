@@ -1,9 +1,11 @@
 //! The wavefront engine's mesh BVH (`wavefront::bvh`): its traversal against brute force over
 //! every triangle (random rays through a generated mesh, a triangle soup, and a mesh full of
 //! coincident and degenerate triangles), and its batch entry points for lengths around the lane
-//! width against the reference's `Accel`. The leaf kernels are in `bvh_leaves.rs`.
+//! width against the reference's `Accel`; its occlusion on adversarial shadow rays
+//! (`mesh_occlusion/`). The leaf kernels are in `bvh_leaves.rs`.
 
 mod common;
+mod mesh_occlusion;
 
 use common::{Draw, ray, scene_of, seeded, triangle};
 use glam::Vec3;
