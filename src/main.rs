@@ -11,6 +11,7 @@ use raywave::error::UsageError;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
+    cli::phases::start();
     let normalized = match cli::foreign::normalize_args(std::env::args_os()) {
         Ok(n) => n,
         Err(e) => {

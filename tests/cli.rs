@@ -496,7 +496,7 @@ fn rpi_style_room_is_not_blown_out_under_the_rpi_light_model() {
 }
 
 #[test]
-fn stats_tables_give_each_kind_over_its_own_thread_time_and_the_total_over_the_wall_clock() {
+fn stats_tables_give_each_kind_over_its_own_thread_time_the_total_over_the_wall_clock_and_the_phases() {
     for (engine, timed_by) in [
         ("wavefront", "kinds timed by the stage timers"),
         ("reference", "kinds timed by a second pass with timers"),
@@ -527,6 +527,37 @@ fn stats_tables_give_each_kind_over_its_own_thread_time_and_the_total_over_the_w
             assert!(r[3].parse::<f64>().is_ok_and(|x| x > 0.0), "{kind}: {text}");
         }
         assert!(text.contains("wall s") && text.contains(timed_by), "{text}");
+        // The phases before the first ray and after the last, in milliseconds, and when the
+        // first ray was cast: the set-up phases add up to it.
+        let phases: Vec<&str> = text
+            .lines()
+            .skip_while(|l| l.split_whitespace().collect::<Vec<_>>() != ["phase", "ms"])
+            .collect();
+        let ms = |phase: &str| -> f64 {
+            let line = phases
+                .iter()
+                .find(|l| l.starts_with(phase))
+                .unwrap_or_else(|| panic!("no `{phase}` phase in:\n{text}"));
+            line[phase.len()..].trim().parse().expect("milliseconds")
+        };
+        let setup: f64 = [
+            "arguments and signals",
+            "outputs, scene, settings",
+            "thread pool",
+            "memory check",
+            "tables, BVH, progress bar",
+        ]
+        .map(ms)
+        .iter()
+        .sum();
+        assert!(ms("render") > 0.0 && ms("tone map, encode, write") > 0.0, "{text}");
+        let first = text
+            .lines()
+            .find_map(|l| l.strip_prefix("first ray "))
+            .and_then(|l| l.split(' ').next())
+            .and_then(|x| x.parse::<f64>().ok())
+            .unwrap_or_else(|| panic!("no `first ray` line in:\n{text}"));
+        assert!((first - setup).abs() <= 0.01, "{first} against {setup}: {text}");
         // The total is its rays over the wall-clock seconds of the summary's `time` line.
         let total = row("total");
         let rays: f64 = total[1].parse().unwrap();

@@ -23,6 +23,7 @@ pub mod foreign;
 pub mod image;
 pub mod info;
 pub mod meshgen;
+pub mod phases;
 pub mod render;
 pub mod trace_pixel;
 pub mod values;

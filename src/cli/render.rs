@@ -26,6 +26,7 @@ use raywave::terminal::progress_bar;
 use raywave::wavefront::stats::RenderStats;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
+use super::phases::Phases;
 use std::time::Instant;
 
 /// `raywave render` flags.
@@ -99,6 +100,8 @@ impl RenderArgs {
 
 /// Renders as the flags say.
 pub fn run(args: &RenderArgs) -> Result<()> {
+    let mut phases = Phases::since_main();
+    phases.mark("arguments and signals");
     // Check everything that can fail cheaply before the long part.
     let format = output_format(&args.output).map_err(|e| UsageError::from_error(&e))?;
     if let Some(hdr) = &args.hdr {
@@ -116,6 +119,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         args.two_sided,
     )?;
     let settings = effective.settings.clone();
+    phases.mark("outputs, scene, settings");
     if let Some(px) = &args.debug_pixel
         && (px[0] >= settings.width || px[1] >= settings.height)
     {
@@ -146,6 +150,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     };
     let pool = thread_pool(args.threads)?;
     let threads = pool.current_num_threads();
+    phases.mark("thread pool");
     let engine_choice = Engine::from(args.engine);
     let exr_to_stream = |p: &PathBuf| {
         p.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"))
@@ -163,6 +168,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         },
         args.max_memory,
     )?;
+    phases.mark("memory check");
 
     // The reference's set-up (its BVH for meshes) is timed with its render; the wavefront
     // engine's BVH build is reported on its own.
@@ -176,12 +182,14 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         ),
         args.quiet,
     );
+    phases.mark("tables, BVH, progress bar");
     let start = match engine_choice {
         Engine::Reference => setup_start,
         Engine::Wavefront => Instant::now(),
     };
     let (film, mut stats) = pool.install(|| engine.render(&|| progress.inc(1)));
     let seconds = start.elapsed().as_secs_f64();
+    phases.mark("render");
     progress.finish_and_clear();
     let mut img = match format {
         OutputFormat::Ldr(_) => Some(film.to_rgb8(args.tonemap.into())),
@@ -216,6 +224,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if let Some(hdr) = &args.hdr {
         film.write_hdr(hdr)?;
     }
+    phases.mark("tone map, encode, write");
     let reference_error = match &reference {
         Some((path, image)) => Some(reference_error(
             path,
@@ -279,6 +288,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     if args.stats {
         say(&stats_table(&report))?;
+        say(&phases.table("tables, BVH, progress bar"))?;
     }
     if let Some((text, _)) = &reference_error {
         say(text)?;
