@@ -496,7 +496,8 @@ fn rpi_style_room_is_not_blown_out_under_the_rpi_light_model() {
 }
 
 #[test]
-fn stats_tables_give_each_kind_over_its_own_thread_time_the_total_over_the_wall_clock_and_the_phases() {
+fn stats_tables_give_each_kind_over_its_own_thread_time_the_total_over_the_wall_clock_and_the_phases()
+ {
     for (engine, timed_by) in [
         ("wavefront", "kinds timed by the stage timers"),
         ("reference", "kinds timed by a second pass with timers"),
@@ -550,14 +551,20 @@ fn stats_tables_give_each_kind_over_its_own_thread_time_the_total_over_the_wall_
         .map(ms)
         .iter()
         .sum();
-        assert!(ms("render") > 0.0 && ms("tone map, encode, write") > 0.0, "{text}");
+        assert!(
+            ms("render") > 0.0 && ms("tone map, encode, write") > 0.0,
+            "{text}"
+        );
         let first = text
             .lines()
             .find_map(|l| l.strip_prefix("first ray "))
             .and_then(|l| l.split(' ').next())
             .and_then(|x| x.parse::<f64>().ok())
             .unwrap_or_else(|| panic!("no `first ray` line in:\n{text}"));
-        assert!((first - setup).abs() <= 0.01, "{first} against {setup}: {text}");
+        assert!(
+            (first - setup).abs() <= 0.01,
+            "{first} against {setup}: {text}"
+        );
         // The total is its rays over the wall-clock seconds of the summary's `time` line.
         let total = row("total");
         let rays: f64 = total[1].parse().unwrap();

@@ -80,6 +80,9 @@ mod tests {
         assert!(b >= a + 0.002, "{a} {b}");
         assert_eq!(p.until("c"), None);
         let table = p.table("b");
-        assert!(table.contains("first ray") && table.lines().count() == 4, "{table}");
+        assert!(
+            table.contains("first ray") && table.lines().count() == 4,
+            "{table}"
+        );
     }
 }

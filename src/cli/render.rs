@@ -3,6 +3,7 @@
 
 use super::image::ImageArgs;
 use super::image::scene_and_settings;
+use super::phases::Phases;
 use super::values::{EngineArg, ToneMapArg};
 use anyhow::Result;
 use clap::Args;
@@ -26,7 +27,6 @@ use raywave::terminal::progress_bar;
 use raywave::wavefront::stats::RenderStats;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-use super::phases::Phases;
 use std::time::Instant;
 
 /// `raywave render` flags.
