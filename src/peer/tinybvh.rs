@@ -24,7 +24,9 @@
 //! ```
 //!
 //! tinybvh's triangle tests are two-sided (|det| < 1e-6 is a miss in the plain layout's
-//! scalar test, an absolute bound that small triangles seen at a slant fall under;
+//! scalar test, an absolute bound that small triangles seen at a slant fall under: 209 of the
+//! 211 camera rays it disagrees with raywave on in the 1M box at 256×256, the other two
+//! through a crack between two triangles, which its test has no slack for;
 //! `BVH8_CPU` takes an approximate 1/det), and accept t ≥ 0 (plain: −0 too) or t > 0
 //! (`BVH8_CPU`) where raywave and Embree need t > 0. The ray sets leave every surface by 1e-4,
 //! but a ray that leaves the box's edge lies in the other wall's plane: the plain layout hits
