@@ -68,6 +68,10 @@ const BENCHMARKING: Page = Page {
             "RAYWAVE_INTERLEAVE=20 cargo bench --features embree --bench mesh_rays",
             "needs libembree3; .ci/run builds without the embree feature",
         ),
+        (
+            "RAYWAVE_PEER_TABLE=9 cargo bench --bench mesh_rays --features embree,tinybvh",
+            "needs libembree3 and builds tinybvh's C++; .ci/run builds without either feature",
+        ),
     ],
     after: nothing,
 };

@@ -1,5 +1,6 @@
 //! Peer comparison on mesh scenes: the same rays traced by obvhs's CWBVH one ray at a time, by
-//! raywave's wavefront intersect stage, and (feature `embree`) by Embree, with the hits compared.
+//! raywave's wavefront stages, and by Embree (feature `embree`) and tinybvh (feature
+//! `tinybvh`), with the hits compared.
 //!
 //! ```text
 //! RaySets::new(scene, seed):                      built once, from a fixed seed
@@ -7,16 +8,18 @@
 //!     shadow      from every primary hit to a uniform point on a light,
 //!                 a segment with tmax = distance − 1e-4
 //!     incoherent  from every primary hit in a uniformly random direction
-//!     shadow_fan  from every 8th primary hit, 8 segments to 8 random light points: the
-//!                 renderer's soft-shadow pattern (one origin per 8-ray packet)
+//!     fan16/64    from every n-th primary hit, n segments to n random light points, for
+//!                 n = 16 and 64: the renderer's soft-shadow pattern (one origin per n
+//!                 consecutive rays, so every 8-ray packet has one origin)
 //! each engine fills Hits { t, prim } (closest) or a Vec<bool> (occluded) per ray;
 //! agreement: same prim, or both hit with |Δt| ≤ 1e-4·max(1, t) (shared edges), or both miss.
 //! ```
 //!
 //! Every comparison is **two-sided**: Embree (as Debian builds it, without
-//! `EMBREE_BACKFACE_CULLING`) reports hits on both sides of a triangle, so raywave's kernels are
-//! called with `two_sided = true` here, whatever the lab's one-sided convention says; and the
-//! scene is `without_emitters`, since a two-sided light wall would hide the lab's box.
+//! `EMBREE_BACKFACE_CULLING`) and tinybvh report hits on both sides of a triangle, so raywave's
+//! kernels are called with `two_sided = true` here, whatever the lab's one-sided convention
+//! says; and the scene is `without_emitters`, since a two-sided light wall would hide the lab's
+//! box. The peers trace triangles only, so a scene with spheres is compared `without_spheres`.
 //!
 //! Rays are stored as wavefront `RayBatch`es of `BATCH` rays, so every engine reads the same
 //! structure-of-arrays columns and the wavefront stage gets its own input type without a copy
@@ -24,15 +27,17 @@
 
 #[cfg(feature = "embree")]
 pub mod embree;
+#[cfg(feature = "tinybvh")]
+pub mod tinybvh;
 
 use crate::camera::CameraRays;
-use crate::geometry::{Ray, intersect_triangle, obvhs_ray};
+use crate::geometry::{Ray, casters, intersect_triangle, obvhs_ray};
 use crate::scene::{NO_HIT, Scene};
 use crate::spawn::surface_hit;
 use crate::wavefront::batch::{HitBatch, PathId, RayBatch};
 use crate::wavefront::bvh::MeshBvh;
 use crate::wavefront::context::Context;
-use crate::wavefront::{DEFAULT_BATCH_SIZE, intersect};
+use crate::wavefront::{DEFAULT_BATCH_SIZE, intersect, simd};
 use glam::Vec3;
 use obvhs::{cwbvh::CwBvh, ray::RayHit};
 use std::time::{Duration, Instant};
@@ -50,10 +55,20 @@ pub fn without_emitters(scene: &Scene) -> Scene {
     peer
 }
 
+/// The scene without its spheres: what the peers, which trace triangles only, can compare
+/// on a scene such as the lab's box (whose three mirror spheres would be missing from their
+/// answers). Its materials, lights and camera are unchanged.
+pub fn without_spheres(scene: &Scene) -> Scene {
+    Scene {
+        spheres: Vec::new(),
+        ..scene.clone()
+    }
+}
+
 /// Rays per `RayBatch` of a ray set: the wavefront engine's default batch size.
 pub const BATCH: usize = DEFAULT_BATCH_SIZE;
 
-/// Which of the three ray sets.
+/// Which ray set.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum RayKind {
     /// Camera rays through pixel centres: coherent, closest hit.
@@ -62,25 +77,45 @@ pub enum RayKind {
     Shadow,
     /// From primary hits in uniformly random directions: incoherent, closest hit.
     Incoherent,
-    /// 8 segments from one primary hit to 8 light points, for every 8th hit: occlusion, one
-    /// origin per aligned block of 8 (how the renderer casts soft shadows).
-    ShadowFan,
+    /// n segments from one primary hit to n light points, for every n-th hit: occlusion, one
+    /// origin per aligned block of n (how the renderer casts soft shadows with n points per
+    /// light: its shadow queue holds them in (hit, light, j) order, 8 to a packet).
+    ShadowFan(u32),
 }
 
+/// The soft-shadow fan sizes of every `RaySets`: raywave's default 16 points per light and the
+/// lab benchmark's 64.
+pub const FAN_SIZES: [u32; 2] = [16, 64];
+
 impl RayKind {
-    /// Lower-case name, for benchmark ids and tables.
-    pub fn name(self) -> &'static str {
+    /// Lower-case name, for benchmark ids: `primary`, `shadow`, `incoherent`, `shadow_fan16`.
+    pub fn name(self) -> String {
         match self {
-            RayKind::Primary => "primary",
-            RayKind::Shadow => "shadow",
-            RayKind::Incoherent => "incoherent",
-            RayKind::ShadowFan => "shadow_fan",
+            RayKind::Primary => "primary".into(),
+            RayKind::Shadow => "shadow".into(),
+            RayKind::Incoherent => "incoherent".into(),
+            RayKind::ShadowFan(n) => format!("shadow_fan{n}"),
+        }
+    }
+
+    /// What the rays are, for table rows: `camera`, `hard shadow`, `soft shadow ×16`, ...
+    pub fn title(self) -> String {
+        match self {
+            RayKind::Primary => "camera".into(),
+            RayKind::Shadow => "hard shadow".into(),
+            RayKind::Incoherent => "incoherent".into(),
+            RayKind::ShadowFan(n) => format!("soft shadow ×{n}"),
         }
     }
 
     /// True for occlusion (any-hit) sets, false for closest-hit sets.
     pub fn is_occlusion(self) -> bool {
-        matches!(self, RayKind::Shadow | RayKind::ShadowFan)
+        matches!(self, RayKind::Shadow | RayKind::ShadowFan(_))
+    }
+
+    /// Whether the rays are coherent (Embree's context hint): every set but the incoherent one.
+    pub fn is_coherent(self) -> bool {
+        self != RayKind::Incoherent
     }
 }
 
@@ -144,7 +179,7 @@ impl RaySet {
     }
 }
 
-/// The three ray sets of one scene.
+/// The ray sets of one scene.
 #[derive(Clone, Debug)]
 pub struct RaySets {
     /// Camera rays, one per pixel.
@@ -153,8 +188,9 @@ pub struct RaySets {
     pub shadow: RaySet,
     /// One random-direction ray per primary hit.
     pub incoherent: RaySet,
-    /// 8 shadow segments from every 8th primary hit, in aligned blocks of 8.
-    pub shadow_fan: RaySet,
+    /// For each n of `FAN_SIZES`, in that order: n shadow segments from every n-th primary
+    /// hit, in aligned blocks of n (about one ray per primary hit, as the other sets).
+    pub fans: Vec<RaySet>,
 }
 
 impl RaySets {
@@ -174,9 +210,15 @@ impl RaySets {
         let mut rng = SplitMix64(seed);
         let mut shadow = RaySet::new(RayKind::Shadow);
         let mut incoherent = RaySet::new(RayKind::Incoherent);
-        let mut shadow_fan = RaySet::new(RayKind::ShadowFan);
-        // Its own stream, so adding the fan set left the other sets unchanged.
-        let mut fan_rng = SplitMix64(seed ^ 0xfa4_fa4_fa4);
+        let mut fans: Vec<RaySet> = FAN_SIZES
+            .iter()
+            .map(|&n| RaySet::new(RayKind::ShadowFan(n)))
+            .collect();
+        // Their own streams, so adding the fan sets left the other sets unchanged.
+        let mut fan_rngs: Vec<SplitMix64> = FAN_SIZES
+            .iter()
+            .map(|&n| SplitMix64(seed ^ 0xfa4_fa4_fa4 ^ u64::from(n)))
+            .collect();
         let mut hit_index = 0usize;
         let rays = primary
             .batches
@@ -220,11 +262,17 @@ impl RaySets {
             let r = (1.0 - z * z).max(0.0).sqrt();
             let direction = Vec3::new(r * phi.cos(), r * phi.sin(), z);
             incoherent.push(leave(direction), direction, f32::INFINITY);
-            if hit_index.is_multiple_of(8) && !scene.lights.is_empty() {
+            for (fan, fan_rng) in fans.iter_mut().zip(&mut fan_rngs) {
+                let RayKind::ShadowFan(n) = fan.kind else {
+                    unreachable!("fans are fan sets")
+                };
+                if !hit_index.is_multiple_of(n as usize) || scene.lights.is_empty() {
+                    continue;
+                }
                 let light = &scene.lights[fan_rng.below(scene.lights.len())];
                 // One origin for the block: on the side of the light's centre.
                 let origin = leave(light.centroid - hit.point);
-                for _ in 0..8 {
+                for _ in 0..n {
                     let target = light.point(fan_rng.unit(), fan_rng.unit());
                     let to_light = target - hit.point;
                     let dist = to_light.length();
@@ -235,7 +283,7 @@ impl RaySets {
                     } else {
                         (Vec3::Z, 0.0)
                     };
-                    shadow_fan.push(origin, l, tmax);
+                    fan.push(origin, l, tmax);
                 }
             }
             hit_index += 1;
@@ -244,18 +292,24 @@ impl RaySets {
             primary,
             shadow,
             incoherent,
-            shadow_fan,
+            fans,
         }
     }
 
-    /// The sets in the order primary, shadow, incoherent, shadow_fan.
-    pub fn all(&self) -> [&RaySet; 4] {
-        [
-            &self.primary,
-            &self.shadow,
-            &self.incoherent,
-            &self.shadow_fan,
-        ]
+    /// The fan set of `n` rays per origin (n from `FAN_SIZES`).
+    pub fn fan(&self, n: u32) -> &RaySet {
+        self.fans
+            .iter()
+            .find(|s| s.kind == RayKind::ShadowFan(n))
+            .unwrap_or_else(|| panic!("no fan of {n}: the sizes are {FAN_SIZES:?}"))
+    }
+
+    /// Every set, in table order: primary, shadow, the fans by size, incoherent.
+    pub fn all(&self) -> Vec<&RaySet> {
+        let mut sets = vec![&self.primary, &self.shadow];
+        sets.extend(&self.fans);
+        sets.push(&self.incoherent);
+        sets
     }
 }
 
@@ -431,24 +485,56 @@ fn traverse(
     }
 }
 
-/// The wavefront engine's occlusion path for meshes, over the set's batches.
+/// raywave's hit search as the intersect stage runs it (`intersect::closest` without the
+/// shading columns), over the set's batches: for meshes the BVH traversal
+/// (`intersect::mesh_hits`: camera rays in packets, others one at a time), for scenes below
+/// `BVH_MIN_TRIANGLES` the 8-wide brute-force kernel over every primitive
+/// (`simd::closest_hits`). t and prim into `out`, what the peers' calls produce.
+pub fn raywave_closest(ctx: &Context, set: &RaySet, out: &mut Hits) {
+    if ctx.accel.is_some() {
+        return wavefront_bvh_closest(ctx, set, out);
+    }
+    out.clear();
+    let scene = ctx.scene;
+    for batch in &set.batches {
+        let start = out.t.len();
+        out.t.resize(start + batch.len(), f32::INFINITY);
+        out.prim.resize(start + batch.len(), NO_HIT);
+        simd::closest_hits(
+            &scene.triangles,
+            &scene.spheres,
+            &intersect::columns(batch),
+            ctx.settings.two_sided,
+            &mut out.t[start..],
+            &mut out.prim[start..],
+        );
+    }
+}
+
+/// The wavefront engine's occlusion path, over the set's batches.
 ///
 /// `wavefront::shadow`'s occlusion pass hands the shadow queue's columns to
-/// `MeshBvh::occluded` for meshes; this hands it each batch's columns, so it times the same
-/// function (see `mesh_bvh` for scenes without a BVH).
+/// `MeshBvh::occluded` for meshes, and to the brute-force `simd::occluded` over the shadow
+/// casters (`geometry::casters`: every triangle when two-sided) and spheres for smaller scenes;
+/// this hands the same function each batch's columns.
 pub fn wavefront_occluded(ctx: &Context, set: &RaySet, out: &mut Vec<bool>) {
     out.clear();
-    let bvh = mesh_bvh(ctx);
+    let scene = ctx.scene;
     let two_sided = ctx.settings.two_sided;
     for batch in &set.batches {
         let start = out.len();
         out.resize(start + batch.len(), false);
-        bvh.occluded(
-            ctx.scene,
-            &intersect::columns(batch),
-            two_sided,
-            &mut out[start..],
-        );
+        let (rays, blocked) = (intersect::columns(batch), &mut out[start..]);
+        match &ctx.accel {
+            Some(bvh) => bvh.occluded(scene, &rays, two_sided, blocked),
+            None => simd::occluded(
+                casters(scene, &ctx.shadow_casters, two_sided),
+                &scene.spheres,
+                &rays,
+                two_sided,
+                blocked,
+            ),
+        }
     }
 }
 
@@ -480,7 +566,8 @@ pub struct Agreement {
     pub agree: usize,
     /// Of those, rays that hit different triangles at the same distance (a shared edge).
     pub same_t_other_prim: usize,
-    /// Of those, rays that one side saw hit within `NEAR_ORIGIN_T` and the other miss.
+    /// Of those, rays that one side saw hit within `NEAR_ORIGIN_T` and the other miss or hit
+    /// farther away.
     pub near_origin: usize,
 }
 
@@ -504,16 +591,19 @@ impl Agreement {
 /// on their shared edge.
 pub const EDGE_T_TOLERANCE: f32 = 1e-4;
 
-/// Under this distance a hit that one engine reports and the other misses counts as agreeing:
-/// a ray that starts on the edge where two faces meet (a camera ray hit the box's corner) lies
-/// on the other face's plane up to rounding and meets it at t ≈ 1e-7 or not at all; obvhs's slab
-/// test and an exact triangle test legitimately differ there (7 of 6,084 incoherent rays of the
-/// mesh test scene).
+/// Under this distance a hit that one engine reports counts as agreeing with whatever the other
+/// reports (a miss, or a hit farther on): a ray that starts on the edge where two faces meet (a
+/// camera ray hit the box's corner) lies on the other face's plane up to rounding and meets it
+/// at t ≈ 1e-7, at t = 0, or not at all. obvhs's slab test and an exact triangle test
+/// legitimately differ there (7 of 6,084 incoherent rays of the mesh test scene), and so do
+/// intervals: tinybvh's plain BVH accepts t = 0 (it rejects only t < 0, and −0 passes), where
+/// raywave and Embree need t > 0 and go on to the next surface (15 of 43,264 incoherent rays
+/// of the mesh test scene at 256×256).
 pub const NEAR_ORIGIN_T: f32 = 1e-5;
 
 /// Closest hits agree when both miss, both name the same triangle, both hit at distances
 /// within `EDGE_T_TOLERANCE · max(1, t)` (two triangles sharing the edge the ray crosses), or
-/// one misses and the other hits within `NEAR_ORIGIN_T` of the origin.
+/// one hits within `NEAR_ORIGIN_T` of the origin.
 pub fn hit_agreement(a: &Hits, b: &Hits) -> Agreement {
     assert_eq!(a.t.len(), b.t.len(), "hit lists of different lengths");
     let mut agreement = Agreement {
@@ -532,7 +622,34 @@ pub fn hit_agreement(a: &Hits, b: &Hits) -> Agreement {
         {
             agreement.agree += 1;
             agreement.same_t_other_prim += 1;
-        } else if (pa == NO_HIT) != (pb == NO_HIT) && a.t[i].min(b.t[i]) < NEAR_ORIGIN_T {
+        } else if a.t[i].min(b.t[i]) < NEAR_ORIGIN_T {
+            agreement.agree += 1;
+            agreement.near_origin += 1;
+        }
+    }
+    agreement
+}
+
+/// Occlusion answers against the blockers of a peer whose shadow query is a closest hit
+/// limited to tmax (tinybvh: `Hits` with `NO_HIT` for a free segment): they agree when both say
+/// the same, or, as for closest hits, when the peer's blocker lies within `NEAR_ORIGIN_T` of
+/// the origin (a segment that starts on another surface's plane).
+pub fn blocker_agreement(a: &[bool], blockers: &Hits) -> Agreement {
+    assert_eq!(
+        a.len(),
+        blockers.t.len(),
+        "answer lists of different lengths"
+    );
+    let mut agreement = Agreement {
+        rays: a.len(),
+        agree: 0,
+        same_t_other_prim: 0,
+        near_origin: 0,
+    };
+    for (&blocked, (&t, &prim)) in a.iter().zip(blockers.t.iter().zip(&blockers.prim)) {
+        if blocked == (prim != NO_HIT) {
+            agreement.agree += 1;
+        } else if t < NEAR_ORIGIN_T {
             agreement.agree += 1;
             agreement.near_origin += 1;
         }
