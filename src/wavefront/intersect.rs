@@ -1,8 +1,8 @@
 //! Stage 2, intersect: the closest hit of every ray, then what shading needs at it (point put
 //! back on its surface, normal flipped for two-sided faces, offset, material).
 //!
-//! Small scenes (below `BVH_MIN_TRIANGLES` triangles) go through the 8-wide kernel over every
-//! primitive; meshes go through the engine's 8-wide BVH (`bvh::MeshBvh`): camera rays in
+//! Small scenes (below `BVH_MIN_TRIANGLES` triangles) go through the brute-force kernel over
+//! every primitive, 8 or 16 rays at a time (the engine's lane width); meshes go through the engine's 8-wide BVH (`bvh::MeshBvh`): camera rays in
 //! packets of 8 neighbouring pixels (8 rays against one child box or one triangle per test),
 //! all other rays one at a time (one ray against 8 child boxes or 8 triangles). Its hits are
 //! brute force's (same t bits, ties to the lowest triangle id), as are the reference's
@@ -12,6 +12,7 @@
 use super::batch::{HitBatch, RayBatch};
 use super::bvh::MeshBvh;
 use super::context::Context;
+use super::lanes::{LaneWidth, f32x8, f32x16};
 use super::simd::{self, RayColumns};
 use crate::scene::{NO_HIT, Scene};
 use crate::spawn::face_the_ray;
@@ -52,7 +53,15 @@ pub fn closest(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch) {
     let scene = ctx.scene;
     let two_sided = ctx.settings.two_sided;
     match &ctx.accel {
-        None => simd::closest_hits(
+        None if ctx.lane_width == LaneWidth::Sixteen => simd::closest_hits_lanes::<f32x16>(
+            &scene.triangles,
+            &scene.spheres,
+            &columns(rays),
+            two_sided,
+            &mut hits.t,
+            &mut hits.prim,
+        ),
+        None => simd::closest_hits_lanes::<f32x8>(
             &scene.triangles,
             &scene.spheres,
             &columns(rays),
