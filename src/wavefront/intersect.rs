@@ -2,8 +2,9 @@
 //! back on its surface, normal flipped for two-sided faces, offset, material).
 //!
 //! Small scenes (below `BVH_MIN_TRIANGLES` triangles) go through the brute-force kernel over
-//! every primitive, 8 or 16 rays at a time (the engine's lane width); meshes go through the engine's 8-wide BVH (`bvh::MeshBvh`): camera rays in
-//! packets of 8 neighbouring pixels (8 rays against one child box or one triangle per test),
+//! every primitive, 8 or 16 rays at a time (the engine's lane width); meshes go through the
+//! engine's 8-wide BVH (`bvh::MeshBvh`) at either width: camera rays in packets of 8
+//! neighbouring pixels (8 rays against one child box or one triangle per test),
 //! all other rays one at a time (one ray against 8 child boxes or 8 triangles). Its hits are
 //! brute force's (same t bits, ties to the lowest triangle id), as are the reference's
 //! (`Accel::closest` over obvhs's CWBVH), except for the few axis-parallel rays obvhs's box

@@ -5,9 +5,10 @@
 //!     spawn:   for hit, for light, for point j < N:  the shadow ray of `spawn::shadow_ray`
 //!              (origin, l, tmax), queued when it has one (the point far enough above the
 //!              tangent plane, the hit above the light's moved plane)
-//!     occlude: N queued rays at a time (8 or 16), stop at the first blocker; small scenes test only the
-//!              triangles that can shadow a light (`geometry::shadow_casters`), meshes go one
-//!              ray at a time through `bvh::MeshBvh`, 8 boxes or 8 triangles per test
+//!     occlude: N queued rays at a time (8 or 16), stop at the first blocker; small scenes
+//!              test only the triangles that can shadow a light (`geometry::shadow_casters`),
+//!              meshes go one ray at a time through `bvh::MeshBvh`, 8 boxes or 8 triangles per
+//!              test
 //!     shade:   in queue order, direct[hit] += Shade(l) / N for the rays not blocked
 //! ```
 //!

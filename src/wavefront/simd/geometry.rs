@@ -8,8 +8,8 @@ use crate::scene::{NO_HIT, Sphere, Triangle};
 use crate::wavefront::lanes::{Lanes, f32x8, live_lanes, store_mask};
 use glam::Vec3;
 
-/// Möller–Trumbore's operands on N lanes (8 by default), as columns: ray origin o and direction d, triangle
-/// corner v0 and edges e1, e2. [`triangle8`] splats the triangle (8 rays, one triangle), the
+/// Möller–Trumbore's operands on N lanes (8 by default), as columns: ray origin o and
+/// direction d, triangle corner v0 and edges e1, e2. [`triangle8`] splats the triangle (8 rays, one triangle), the
 /// mesh BVH's leaf test splats the ray (one ray, 8 triangles); the arithmetic is
 /// [`moller_trumbore8`] and [`moller_trumbore8_blocks`] either way.
 #[derive(Clone, Copy)]
@@ -150,7 +150,7 @@ fn triangle8_blocks<V: Lanes>(tri: &Triangle, r: &Rays<V>, tmax: V, two_sided: b
 /// ```
 #[inline(always)]
 pub fn sphere8<V: Lanes>(s: &Sphere, r: &Rays<V>, tmax: V) -> V {
-    let Roots8 {
+    let Roots {
         ok, inv_a, c, q, ..
     } = SphereLanes::new(s, r).roots(r);
     let t0 = c / q;
@@ -175,7 +175,7 @@ struct SphereLanes<V> {
 }
 
 /// The roots' parts, t0 = c/q and t1 = q·(1/a), and which lanes have them (`ok`).
-struct Roots8<V> {
+struct Roots<V> {
     ok: V,
     a: V,
     inv_a: V,
@@ -211,7 +211,7 @@ impl<V: Lanes> SphereLanes<V> {
 
     /// The stable discriminant a·(r² − |oc − (b/a)·d|²) and q = −(b + sign(b)·√disc).
     #[inline(always)]
-    fn roots(&self, r: &Rays<V>) -> Roots8<V> {
+    fn roots(&self, r: &Rays<V>) -> Roots<V> {
         let (a, b, [ocx, ocy, ocz]) = (self.a, self.b, self.oc);
         let inv_a = V::ONE / a;
         let k = b * inv_a;
@@ -223,7 +223,7 @@ impl<V: Lanes> SphereLanes<V> {
         // copysign(√disc, b): the sign bit of b on the magnitude of √disc.
         let sign = V::splat(-0.0);
         let signed_root = (disc.sqrt() & !sign) | (b & sign);
-        Roots8 {
+        Roots {
             ok: disc.simd_ge(V::ZERO),
             a,
             inv_a,
@@ -376,7 +376,7 @@ fn sphere8_blocks<V: Lanes>(s: &Sphere, r: &Rays<V>, tmax: V) -> u32 {
     if lanes.all_miss() {
         return 0;
     }
-    let Roots8 { ok, a, c, q, .. } = lanes.roots(r);
+    let Roots { ok, a, c, q, .. } = lanes.roots(r);
     let t1_in_range = q.simd_gt(V::ZERO) & q.simd_lt(tmax * a);
     let t0_in_range = (c * q).simd_gt(V::ZERO) & c.abs().simd_lt(tmax * q.abs());
     (ok & (t1_in_range | t0_in_range)).to_bitmask()

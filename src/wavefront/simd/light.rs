@@ -1,6 +1,6 @@
-//! Light sampling on N lanes (8 or 16, one source generic over [`Lanes`]): the hashed uniforms, jittered strata and Owen-scrambled Sobol
-//! points of one (pixel, sample, bounce, light) stream on a parallelogram light, and the shadow
-//! rays from a hit to them.
+//! Light sampling on N lanes (8 or 16, one source generic over [`Lanes`]): the hashed
+//! uniforms, jittered strata and Owen-scrambled Sobol points of one (pixel, sample, bounce,
+//! light) stream on a parallelogram light, and the shadow rays from a hit to them.
 
 use crate::spawn::{LightEnd, SurfaceHit};
 use crate::wavefront::batch::ShadowBlock;

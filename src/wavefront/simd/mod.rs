@@ -4,9 +4,12 @@
 //! loads and masks come from `wavefront/lanes.rs`.
 //!
 //! The brute-force, light and shading kernels are written once, generic over the lane type
-//! (`lanes::Lanes`), and run 8 or 16 lanes wide (`lanes::LaneWidth`); the `…8` names are the
-//! 8-lane entry points, the `…_lanes` and unsuffixed generic ones take the width as a type
-//! parameter. The mesh BVH's kernels stay 8-wide.
+//! (`lanes::Lanes`), and run 8 or 16 lanes wide (`lanes::LaneWidth`). `closest_hits`,
+//! `occluded`, `light_points8`, `shadow_rays8` and `shade8` are their 8-lane entry points,
+//! `closest_hits_lanes`, `occluded_lanes`, `light_points`, `shadow_rays` and
+//! `shade::shade_lanes` take the width as a type parameter, and `triangle8`, `sphere8` and
+//! `moller_trumbore8` (names from the 8-wide days) take it from their operands. The mesh BVH's
+//! kernels stay 8-wide.
 //!
 //! Every kernel is a lane-by-lane copy of a scalar twin, with the same operations in the
 //! same order, so that with IEEE arithmetic (no FMA contraction: Rust never fuses `a * b + c`,
@@ -23,8 +26,8 @@
 //! | `shade::shade8`      | `shade::shade_terms`, twin of `shading::shade`           |
 //!
 //! Branches become masks: a lane that misses gets `f32::INFINITY`, exactly like the twins'
-//! sentinel. Batches whose length is not a multiple of the width are padded with lanes that cannot hit
-//! (tmax = 0, NaN directions), and the padding is never stored back.
+//! sentinel. Batches whose length is not a multiple of the width are padded with lanes that
+//! cannot hit (tmax = 0, NaN directions), and the padding is never stored back.
 
 mod geometry;
 mod light;
