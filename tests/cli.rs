@@ -592,7 +592,10 @@ fn lane_widths_give_the_same_image_and_name_their_path() {
     let info = stdout(&raywave(dir.path(), &["info"]));
     assert!(info.contains(&format!("simd    {simd_auto}")), "{info}");
     let lanes = if simd_auto.contains("f32x16") { 16 } else { 8 };
-    assert!(info.contains(&format!("lanes   {lanes} by default")), "{info}");
+    assert!(
+        info.contains(&format!("lanes   {lanes} by default")),
+        "{info}"
+    );
     // Not a width.
     let out = raywave(dir.path(), &["render", "--lanes", "4"]);
     assert!(!out.status.success());
