@@ -18,7 +18,8 @@ use std::ops::{Add, BitAnd, BitOr, BitXor, Div, Mul, Neg, Not, Shl, Shr, Sub};
 pub use wide::{f32x8, f32x16};
 pub(crate) use wide::{i32x8, u32x8};
 
-/// The SIMD width: lanes per vector, children per BVH node, triangles per block.
+/// The mesh BVH's width (children per node, triangles per block) and the lanes of `f32x8`; the
+/// width-generic kernels use `Lanes::N` instead.
 pub const LANES: usize = 8;
 
 /// `c[i..i + live]` in lanes 0..live (live ≤ 8), NaN in the lanes after them (which may lie
