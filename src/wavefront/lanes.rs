@@ -196,8 +196,8 @@ pub trait Lanes:
     fn to_array(self) -> Self::Array;
     /// `col[i..i + N]`, `pad` in the lanes past the column's end.
     fn load(col: &[f32], i: usize, pad: f32) -> Self;
-    /// The lane indices 0..N as floats.
-    fn lane_index() -> Self;
+    /// The lane indices 0..N as floats (a constant, as the 8-lane kernels' table was).
+    const LANE_INDEX: Self;
     /// Lane-wise `<`, all ones where true.
     fn simd_lt(self, rhs: Self) -> Self;
     /// Lane-wise `>`.
@@ -249,7 +249,7 @@ pub trait LanesU:
     /// Every lane `x`.
     fn splat(x: u32) -> Self;
     /// The lane indices 0..N.
-    fn lane_index() -> Self;
+    const LANE_INDEX: Self;
     /// All ones in the lanes whose top bit is set, else 0 (an arithmetic shift right by 31).
     fn sign_fill(self) -> Self;
     /// Every lane converted to float as a signed integer (exact below 2^24).
@@ -295,10 +295,15 @@ macro_rules! impl_lanes {
                     }
                 }
             }
-            #[inline(always)]
-            fn lane_index() -> Self {
-                $f::new(std::array::from_fn(|k| k as f32))
-            }
+            const LANE_INDEX: Self = {
+                let mut a = [0.0f32; $n];
+                let mut k = 0;
+                while k < $n {
+                    a[k] = k as f32;
+                    k += 1;
+                }
+                $f::new(a)
+            };
             #[inline(always)]
             fn simd_lt(self, rhs: Self) -> Self {
                 $f::simd_lt(self, rhs)
@@ -365,10 +370,15 @@ macro_rules! impl_lanes {
             fn splat(x: u32) -> Self {
                 $u::splat(x)
             }
-            #[inline(always)]
-            fn lane_index() -> Self {
-                $u::new(std::array::from_fn(|k| k as u32))
-            }
+            const LANE_INDEX: Self = {
+                let mut a = [0u32; $n];
+                let mut k = 0;
+                while k < $n {
+                    a[k] = k as u32;
+                    k += 1;
+                }
+                $u::new(a)
+            };
             #[inline(always)]
             fn sign_fill(self) -> Self {
                 let s: $i = wide::bytemuck::cast(self);
@@ -391,13 +401,17 @@ impl_lanes!(f32x16, u32x16, i32x16, 16, from_i32x16);
 
 use wide::{i32x16, u32x16};
 
-/// Stores lane k of `mask` as `out[k]` (`out.len()` ≤ 32), 8 lanes per lookup in
-/// [`MASK_BOOLS`]: one lookup at 8 lanes, two at 16 (not a 65536-entry table).
+/// Stores lane k of `mask` as `out[k]` for the `out.len()` ≤ `V::N` lanes of a chunk, 8 lanes
+/// per lookup in [`MASK_BOOLS`]: one lookup at 8 lanes (the 8-lane kernels' one copy), two at
+/// 16 (not a 65536-entry table).
 #[inline(always)]
-pub(crate) fn store_mask(out: &mut [bool], mask: u32) {
-    for (c, chunk) in out.chunks_mut(LANES).enumerate() {
-        let byte = (mask >> (8 * c)) & 0xff;
-        chunk.copy_from_slice(&MASK_BOOLS[byte as usize][..chunk.len()]);
+pub(crate) fn store_mask<V: Lanes>(out: &mut [bool], mask: u32) {
+    debug_assert!(out.len() <= V::N && V::N <= 2 * LANES);
+    let (low, high) = out.split_at_mut(out.len().min(LANES));
+    low.copy_from_slice(&MASK_BOOLS[(mask & 0xff) as usize][..low.len()]);
+    // `V::N` is a constant: at 8 lanes this is gone.
+    if V::N > LANES {
+        high.copy_from_slice(&MASK_BOOLS[((mask >> 8) & 0xff) as usize][..high.len()]);
     }
 }
 
@@ -454,7 +468,13 @@ mod tests {
         for mask in [0u32, 1, 0x80, 0x100, 0x8001, 0xffff, 0xa5c3] {
             for len in [0, 1, 7, 8, 9, 15, 16] {
                 let mut out = vec![true; len];
-                store_mask(&mut out, mask);
+                if len <= 8 {
+                    store_mask::<f32x8>(&mut out, mask);
+                    for (k, &b) in out.iter().enumerate() {
+                        assert_eq!(b, mask & (1 << k) != 0, "8 lanes: mask {mask:#x} lane {k}");
+                    }
+                }
+                store_mask::<f32x16>(&mut out, mask);
                 for (k, &b) in out.iter().enumerate() {
                     assert_eq!(b, mask & (1 << k) != 0, "mask {mask:#x} lane {k}");
                 }
@@ -464,8 +484,9 @@ mod tests {
 
     #[test]
     fn both_widths_have_their_lane_indices_and_sign_fill() {
-        assert_eq!(<f32x16 as Lanes>::lane_index().to_array()[15], 15.0);
-        assert_eq!(<f32x8 as Lanes>::lane_index().to_array()[7], 7.0);
+        assert_eq!(<f32x16 as Lanes>::LANE_INDEX.to_array()[15], 15.0);
+        assert_eq!(<f32x8 as Lanes>::LANE_INDEX.to_array()[7], 7.0);
+        assert_eq!(<u32x16 as LanesU>::LANE_INDEX.to_array()[9], 9);
         let u = <u32x16 as LanesU>::splat(0x8000_0001).sign_fill();
         assert_eq!(u.to_array(), [u32::MAX; 16]);
         let u = <u32x8 as LanesU>::splat(0x7fff_ffff).sign_fill();

@@ -175,16 +175,11 @@ pub fn shade_lanes<V: Lanes>(at: &HitLight, rays: &ShadowLanes) -> [V::Array; 3]
     let e_dot_r = (V::splat(e.x) * rx + V::splat(e.y) * ry + V::splat(e.z) * rz).to_array();
     let mut spec = V::Array::default();
     let mut with_highlight = V::Array::default();
-    for ((&e_dot_r, spec), on) in e_dot_r
-        .as_ref()
-        .iter()
-        .zip(spec.as_mut())
-        .zip(with_highlight.as_mut())
-    {
-        let base = e_dot_r.max(0.0);
+    for k in 0..V::N {
+        let base = e_dot_r[k].max(0.0);
         if !positive || base > 0.0 {
-            *spec = base.powf(m.shininess);
-            *on = 1.0;
+            spec[k] = base.powf(m.shininess);
+            with_highlight[k] = 1.0;
         }
     }
     let on = V::from_array(with_highlight).simd_gt(V::ZERO);

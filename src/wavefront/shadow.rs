@@ -182,6 +182,15 @@ fn occlude<V: Lanes>(ctx: &Context, queue: &mut ShadowQueue) {
     };
     let blocked = &mut queue.blocked[..n];
     match &ctx.accel {
+        // At 8 lanes the 8-lane entry point, a function of its own as it always was (`V::N` is a
+        // constant, so only one arm is compiled in each instantiation).
+        None if V::N == 8 => simd::occluded(
+            casters(scene, &ctx.shadow_casters, two_sided),
+            &scene.spheres,
+            &cols,
+            two_sided,
+            blocked,
+        ),
         None => simd::occluded_lanes::<V>(
             casters(scene, &ctx.shadow_casters, two_sided),
             &scene.spheres,

@@ -331,7 +331,7 @@ pub fn occluded_lanes<V: Lanes>(
             )
         };
         let lanes = (n - i).min(V::N);
-        store_mask(&mut out[i..i + lanes], blocked);
+        store_mask::<V>(&mut out[i..i + lanes], blocked);
     }
 }
 

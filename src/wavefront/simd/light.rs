@@ -92,7 +92,7 @@ pub fn light_points8(b: &LightBlock) -> [[f32; LANES]; 3] {
 /// `light.point(square_sample(sampler, key, j0 + k, count))`.
 #[inline]
 pub fn light_points<V: Lanes>(b: &LightBlock) -> [V::Array; 3] {
-    let j = V::U::splat(b.j0) + V::U::lane_index();
+    let j = V::U::splat(b.j0) + V::U::LANE_INDEX;
     let (u, v) = match b.sampler {
         BlockSampler::Random => (
             uniform8(b.prefix, j + j),
@@ -234,7 +234,7 @@ pub fn shadow_rays<V: Lanes>(
     let (lx, ly, lz) = (x / dist, y / dist, z / dist);
     let n_dot_l = V::splat(n.x) * lx + V::splat(n.y) * ly + V::splat(n.z) * lz;
     let tmax = dist * V::splat(end.ratio);
-    let first = V::lane_index().simd_lt(V::splat(lanes as f32));
+    let first = V::LANE_INDEX.simd_lt(V::splat(lanes as f32));
     let live = above.simd_gt(V::splat(end.margin)) & tmax.simd_gt(V::ZERO) & first;
     ShadowBlock {
         origin: hit.leaving_point(),
