@@ -13,7 +13,6 @@
 use super::batch::{HitBatch, RayBatch};
 use super::bvh::MeshBvh;
 use super::context::Context;
-use super::lanes::{LaneWidth, f32x16};
 use super::simd::{self, RayColumns};
 use crate::scene::{NO_HIT, Scene};
 use crate::spawn::face_the_ray;
@@ -54,17 +53,8 @@ pub fn closest(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch) {
     let scene = ctx.scene;
     let two_sided = ctx.settings.two_sided;
     match &ctx.accel {
-        None if ctx.lane_width == LaneWidth::Sixteen => simd::closest_hits_lanes::<f32x16>(
-            &scene.triangles,
-            &scene.spheres,
-            &columns(rays),
-            two_sided,
-            &mut hits.t,
-            &mut hits.prim,
-        ),
-        // The 8-lane entry point, a function of its own as it always was (inlined into this
-        // one, the loop cost 1.75% more instructions in tests/icount.rs).
-        None => simd::closest_hits(
+        None => simd::closest_hits_at(
+            ctx.lane_width,
             &scene.triangles,
             &scene.spheres,
             &columns(rays),
