@@ -14,6 +14,7 @@ use crate::scene::Scene;
 use crate::settings::RenderSettings;
 use crate::stats::RayCounts;
 use crate::wavefront::Wavefront;
+use crate::wavefront::lanes::LaneWidth;
 use crate::wavefront::stats::RenderStats;
 use serde::Serialize;
 
@@ -44,8 +45,22 @@ impl Engine {
         settings: &'a RenderSettings,
         batch_size: usize,
     ) -> Prepared<'a> {
+        self.prepare_lanes(scene, settings, batch_size, LaneWidth::Auto)
+    }
+
+    /// [`Engine::prepare`] with the wavefront engine's kernels run `lanes` wide (the reference
+    /// ignores it). Speed only: the image is the same at every width.
+    pub fn prepare_lanes<'a>(
+        self,
+        scene: &'a Scene,
+        settings: &'a RenderSettings,
+        batch_size: usize,
+        lanes: LaneWidth,
+    ) -> Prepared<'a> {
         match self {
-            Engine::Wavefront => Prepared::Wavefront(Wavefront::new(scene, settings, batch_size)),
+            Engine::Wavefront => Prepared::Wavefront(
+                Wavefront::new(scene, settings, batch_size).with_lane_width(lanes),
+            ),
             Engine::Reference => Prepared::Reference(Reference::new(scene, settings)),
         }
     }
@@ -90,6 +105,15 @@ impl Prepared<'_> {
         match self {
             Prepared::Wavefront(_) => Engine::Wavefront,
             Prepared::Reference(_) => Engine::Reference,
+        }
+    }
+
+    /// The SIMD path this engine's kernels run on (`raywave::simd_path_for` its lane width; the
+    /// build's default path for the scalar reference, as records have always said).
+    pub fn simd_path(&self) -> &'static str {
+        match self {
+            Prepared::Wavefront(w) => crate::simd_path_for(w.lane_width()),
+            Prepared::Reference(_) => crate::simd_path(),
         }
     }
 

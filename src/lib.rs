@@ -3,7 +3,7 @@
 //! Two engines render the same image from the same samples:
 //!
 //! - the **wavefront** engine ([`wavefront`]) moves rays through stages in structure-of-arrays
-//!   batches, 8 lanes at a time: generate → intersect → shadow → film → reflect, tiles spread
+//!   batches, 8 or 16 lanes at a time (16 on AVX-512 builds): generate → intersect → shadow → film → reflect, tiles spread
 //!   over cores with rayon, meshes through its own 8-wide BVH;
 //! - the **reference** ([`reference`](mod@reference)) is the lab's recursive renderer, one scalar ray at a
 //!   time, written to be obviously right: the twin every fast path is checked and timed
@@ -83,16 +83,41 @@ pub mod variance;
 pub mod view;
 pub mod wavefront;
 
-/// Which SIMD instructions this build uses for the lane type `f32x8` (from the `wide` crate),
-/// decided at compile time.
+/// Which SIMD instructions this build's wavefront engine uses by default (`--lanes auto`),
+/// decided at compile time: `f32x16` on AVX-512 builds, else `f32x8` (from the `wide` crate).
 pub fn simd_path() -> &'static str {
-    if cfg!(all(target_feature = "avx2", target_feature = "fma")) {
-        "avx2+fma (f32x8 in one 256-bit register)"
-    } else if cfg!(target_feature = "avx") {
-        "avx (f32x8 in one 256-bit register, no FMA)"
-    } else if cfg!(target_feature = "sse2") {
-        "sse2 (f32x8 as two 128-bit halves)"
-    } else {
-        "scalar fallback (no x86 SIMD)"
+    simd_path_for(wavefront::lanes::LaneWidth::Auto)
+}
+
+/// Which SIMD instructions the wavefront engine's kernels use at lane width `width`: the
+/// brute-force, light and shading kernels run that wide, the mesh BVH 8-wide.
+pub fn simd_path_for(width: wavefront::lanes::LaneWidth) -> &'static str {
+    use wavefront::lanes::LaneWidth;
+    let avx2 = cfg!(all(target_feature = "avx2", target_feature = "fma"));
+    match width.resolve() {
+        LaneWidth::Sixteen => {
+            if cfg!(target_feature = "avx512f") {
+                "avx512 (f32x16 in one 512-bit register)"
+            } else if avx2 {
+                "avx2+fma (f32x16 as two 256-bit halves)"
+            } else if cfg!(target_feature = "avx") {
+                "avx (f32x16 as two 256-bit halves, no FMA)"
+            } else if cfg!(target_feature = "sse2") {
+                "sse2 (f32x16 as four 128-bit quarters)"
+            } else {
+                "scalar fallback (f32x16, no x86 SIMD)"
+            }
+        }
+        _ => {
+            if avx2 {
+                "avx2+fma (f32x8 in one 256-bit register)"
+            } else if cfg!(target_feature = "avx") {
+                "avx (f32x8 in one 256-bit register, no FMA)"
+            } else if cfg!(target_feature = "sse2") {
+                "sse2 (f32x8 as two 128-bit halves)"
+            } else {
+                "scalar fallback (no x86 SIMD)"
+            }
+        }
     }
 }

@@ -24,7 +24,7 @@ pub struct RenderRecord {
     pub raywave: &'static str,
     /// The machine (without its host name).
     pub machine: Machine,
-    /// `raywave::simd_path()`.
+    /// The SIMD path the wavefront engine ran on (`raywave::simd_path_for` its `--lanes`).
     pub simd: &'static str,
     /// Worker threads.
     pub threads: usize,

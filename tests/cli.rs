@@ -578,3 +578,63 @@ fn stats_tables_give_each_kind_over_its_own_thread_time_the_total_over_the_wall_
         }
     }
 }
+
+/// `--lanes 8` and `--lanes 16` write the same image bytes, and the summary, the
+/// `--stats-json` record and `raywave info` name the path that ran.
+#[test]
+fn lane_widths_give_the_same_image_and_name_their_path() {
+    let dir = dir_with(&["cornell_box_reflective_spheres.obj"]);
+    let render = |lanes: &str| {
+        let png = format!("lanes{lanes}.png");
+        let json = format!("lanes{lanes}.json");
+        let out = raywave(
+            dir.path(),
+            &[
+                "render",
+                "cornell_box_reflective_spheres.obj",
+                "--size",
+                "48",
+                "40",
+                "--bounces",
+                "3",
+                "--shadows",
+                "soft",
+                "--shadow-samples",
+                "24",
+                "--lanes",
+                lanes,
+                "-o",
+                &png,
+                "--stats-json",
+                &json,
+            ],
+        );
+        assert!(out.status.success(), "{}", stderr(&out));
+        let record: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(dir.path().join(&json)).unwrap()).unwrap();
+        (
+            std::fs::read(dir.path().join(&png)).unwrap(),
+            summary_line(&out, "raywave"),
+            record["simd"].as_str().unwrap().to_string(),
+        )
+    };
+    let (png8, line8, simd8) = render("8");
+    let (png16, line16, simd16) = render("16");
+    assert!(png8 == png16, "--lanes 16 changed the image");
+    assert!(simd8.contains("f32x8"), "{simd8}");
+    assert!(simd16.contains("f32x16"), "{simd16}");
+    assert!(line8.contains(&format!("simd {simd8}")), "{line8}");
+    assert!(line16.contains(&format!("simd {simd16}")), "{line16}");
+    let (auto, _, simd_auto) = render("auto");
+    assert!(auto == png8);
+    let info = stdout(&raywave(dir.path(), &["info"]));
+    assert!(info.contains(&format!("simd    {simd_auto}")), "{info}");
+    let lanes = if simd_auto.contains("f32x16") { 16 } else { 8 };
+    assert!(
+        info.contains(&format!("lanes   {lanes} by default")),
+        "{info}"
+    );
+    // Not a width.
+    let out = raywave(dir.path(), &["render", "--lanes", "4"]);
+    assert!(!out.status.success());
+}

@@ -16,33 +16,39 @@ use crate::film::Film;
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
 use crate::wavefront::DEFAULT_BATCH_SIZE;
+use crate::wavefront::lanes::LaneWidth;
 use std::time::Instant;
 
-/// Warm-up and timed runs of `engines` on `pool`; `tick` is called after each run (warm-up
-/// included). Records come back in `engines`' order.
+/// Warm-up and timed runs of `engines` on `pool`, the wavefront engine `lanes` wide; `tick` is
+/// called after each run (warm-up included). Records come back in `engines`' order.
+// One more than clippy's 7: the lane width joined the point's settings, which are the
+// arguments' natural split (a struct for them would only be unpacked again below).
+#[allow(clippy::too_many_arguments)]
 pub fn measure(
     pool: &rayon::ThreadPool,
     scene: &Scene,
     settings: &RenderSettings,
     engines: &[Engine],
+    lanes: LaneWidth,
     warmup: u32,
     runs: u32,
     tick: &(dyn Fn() + Sync),
 ) -> Vec<EngineRecord> {
-    pool.install(|| timed(scene, settings, engines, warmup, runs, tick))
+    pool.install(|| timed(scene, settings, engines, lanes, warmup, runs, tick))
 }
 
 fn timed(
     scene: &Scene,
     settings: &RenderSettings,
     engines: &[Engine],
+    lanes: LaneWidth,
     warmup: u32,
     runs: u32,
     tick: &(dyn Fn() + Sync),
 ) -> Vec<EngineRecord> {
     let prepared: Vec<Prepared> = engines
         .iter()
-        .map(|engine| engine.prepare(scene, settings, DEFAULT_BATCH_SIZE))
+        .map(|engine| engine.prepare_lanes(scene, settings, DEFAULT_BATCH_SIZE, lanes))
         .collect();
     let time = |engine: &Prepared| {
         let start = Instant::now();

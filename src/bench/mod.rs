@@ -56,6 +56,8 @@ pub struct BenchOptions {
     pub sweep: sweep::Sweep,
     /// The engines to time, in record order (reference, then wavefront).
     pub engines: Vec<Engine>,
+    /// The wavefront engine's lane width (`--lanes`; speed only).
+    pub lanes: crate::wavefront::lanes::LaneWidth,
     /// Timed runs per engine.
     pub runs: u32,
     /// Untimed runs per engine before the timed ones.
@@ -259,6 +261,7 @@ pub fn run(args: &BenchOptions, hooks: &Hooks) -> Result<Outcome> {
             &scene,
             &plan.settings,
             &plan.engines,
+            args.lanes,
             args.warmup,
             args.runs,
             &tick,
@@ -277,7 +280,7 @@ pub fn run(args: &BenchOptions, hooks: &Hooks) -> Result<Outcome> {
                 os: std::env::consts::OS.to_string(),
                 arch: std::env::consts::ARCH.to_string(),
             },
-            simd: crate::simd_path().to_string(),
+            simd: crate::simd_path_for(args.lanes).to_string(),
             setup: plan.setup.clone(),
             runs: args.runs,
             warmup: args.warmup,

@@ -37,7 +37,7 @@ pub struct BenchRecord {
     pub timestamp: String,
     /// Where it ran.
     pub machine: Machine,
-    /// `raywave::simd_path()`.
+    /// The SIMD path the wavefront engine ran on (`raywave::simd_path_for` its `--lanes`).
     pub simd: String,
     /// What was measured: two records compare only when these are equal.
     pub setup: Setup,

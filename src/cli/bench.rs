@@ -48,6 +48,10 @@ pub struct BenchArgs {
     /// Which engines to time.
     #[arg(long, value_enum, default_value = "both")]
     pub engine: BenchEngine,
+    /// Lanes of the wavefront engine's kernels: auto (16 on an AVX-512 build, else 8), 8 or 16;
+    /// the record's `simd` names the path that ran.
+    #[arg(long, value_enum, default_value = "auto")]
+    pub lanes: super::values::LanesArg,
     /// Timed runs per engine (at least 6 for a 95% interval of the median).
     #[arg(long, default_value_t = DEFAULT_RUNS, value_parser = clap::value_parser!(u32).range(1..=1000))]
     pub runs: u32,
@@ -214,6 +218,7 @@ impl BenchArgs {
             image: self.image.options(),
             sweep,
             engines: self.engine.engines(),
+            lanes: self.lanes.into(),
             runs: self.runs,
             warmup: self.warmup,
             save: self.save.clone(),

@@ -1,5 +1,5 @@
 //! `raywave info`: the version, the build (commit, profile, target, features, RUSTFLAGS), the
-//! build's SIMD path and the default thread count.
+//! build's SIMD path and default lane width, and the default thread count.
 
 use anyhow::Result;
 
@@ -7,7 +7,7 @@ use anyhow::Result;
 pub fn run() -> Result<()> {
     let b = raywave::build_info::current();
     raywave::terminal::print(&format!(
-        "raywave {}\ncommit  {}\nbuild   {} · {}\nrustflags {}\nfeatures {}\nsimd    {}\nthreads {} (rayon default; --threads N to change)\n",
+        "raywave {}\ncommit  {}\nbuild   {} · {}\nrustflags {}\nfeatures {}\nsimd    {}\nlanes   {} by default (--lanes 8 or 16 forces a width; the same image either way)\nthreads {} (rayon default; --threads N to change)\n",
         env!("CARGO_PKG_VERSION"),
         match b.dirty {
             Some(true) => format!("{} (dirty)", b.commit),
@@ -22,6 +22,7 @@ pub fn run() -> Result<()> {
         },
         b.target_features,
         raywave::simd_path(),
+        raywave::wavefront::lanes::LaneWidth::NATIVE.lanes(),
         rayon::current_num_threads()
     ))
 }

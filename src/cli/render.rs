@@ -4,7 +4,7 @@
 use super::image::ImageArgs;
 use super::image::scene_and_settings;
 use super::phases::Phases;
-use super::values::{EngineArg, ToneMapArg};
+use super::values::{EngineArg, LanesArg, ToneMapArg};
 use anyhow::Result;
 use clap::Args;
 use image::RgbImage;
@@ -69,6 +69,10 @@ pub struct RenderArgs {
     /// Which engine renders the image.
     #[arg(long, value_enum, default_value = "wavefront")]
     pub engine: EngineArg,
+    /// Lanes of the wavefront engine's kernels: auto (16 on an AVX-512 build, else 8), 8 or 16.
+    /// Speed only: the image is the same.
+    #[arg(long, value_enum, default_value = "auto")]
+    pub lanes: LanesArg,
     /// Camera samples per wavefront tile: the unit of work and of memory.
     #[arg(long, default_value_t = raywave::wavefront::DEFAULT_BATCH_SIZE as u32,
           value_parser = clap::value_parser!(u32).range(1..=1 << 20))]
@@ -173,7 +177,12 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     // The reference's set-up (its BVH for meshes) is timed with its render; the wavefront
     // engine's BVH build is reported on its own.
     let setup_start = Instant::now();
-    let engine = engine_choice.prepare(&scene, &settings, args.batch_size as usize);
+    let engine = engine_choice.prepare_lanes(
+        &scene,
+        &settings,
+        args.batch_size as usize,
+        args.lanes.into(),
+    );
     let (units, unit) = engine.work_units(&settings);
     let progress = progress_bar(
         units,
@@ -264,6 +273,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
 
     let run = RunInfo {
         engine: engine_choice,
+        simd: engine.simd_path(),
         threads,
         batch_size: args.batch_size,
     };
@@ -369,7 +379,7 @@ fn summary(scene: &Scene, effective: &Effective, run: &RunInfo, report: &Report)
         "raywave {} · engine {} · simd {} · {} thread(s)",
         env!("CARGO_PKG_VERSION"),
         run.engine.name(),
-        raywave::simd_path(),
+        run.simd,
         run.threads
     );
     let rings = match scene.ring_count {
@@ -451,6 +461,8 @@ fn summary(scene: &Scene, effective: &Effective, run: &RunInfo, report: &Report)
 /// How the render ran, for the summary and the JSON.
 struct RunInfo {
     engine: Engine,
+    /// The SIMD path the engine ran on (`Prepared::simd_path`).
+    simd: &'static str,
     threads: usize,
     batch_size: u32,
 }
@@ -577,7 +589,7 @@ fn record(scene: &Scene, effective: &Effective, run: &RunInfo, report: &Report) 
             hostname: String::new(),
             ..Machine::current()
         },
-        simd: raywave::simd_path(),
+        simd: run.simd,
         threads: run.threads,
         engine: run.engine,
         batch_size: run.batch_size,

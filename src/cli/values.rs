@@ -8,6 +8,7 @@ use raywave::film::ToneMap;
 use raywave::options::Defaults;
 use raywave::sampling::LightSampler;
 use raywave::settings::{LightModel, ShadowMode};
+use raywave::wavefront::lanes::LaneWidth;
 
 /// Declares a clap value enum and its conversion into the library's enum of the same variants.
 macro_rules! mirror {
@@ -35,6 +36,21 @@ mirror! {
         Wavefront,
         /// The scalar recursive renderer, one ray at a time: the whole-image twin.
         Reference,
+    }
+}
+
+mirror! {
+    /// How many lanes the wavefront engine's brute-force, light and shading kernels run
+    /// (speed only: every width gives the same image; the mesh BVH is 8-wide either way).
+    LanesArg => LaneWidth {
+        /// 16 on a build for AVX-512 (one 512-bit register), else 8.
+        Auto,
+        /// f32x8.
+        #[value(name = "8")]
+        Eight,
+        /// f32x16 (two 256-bit halves without AVX-512).
+        #[value(name = "16")]
+        Sixteen,
     }
 }
 

@@ -317,25 +317,26 @@ impl ShadowQueue {
         self.len = i + 1;
     }
 
-    /// Queues 8 lanes from one origin (`simd::shadow_rays8`'s block: dead lanes already carry
-    /// `n_dot_l = 0`, `tmax = 0`).
+    /// Queues a block of 8 or 16 lanes from one origin (`simd::shadow_rays`'s block: dead
+    /// lanes already carry `n_dot_l = 0`, `tmax = 0`).
     #[inline]
-    pub fn push_block(&mut self, block: &ShadowBlock, path: u32, light: u32) {
-        let r = self.len..self.len + 8;
+    pub fn push_block<A: AsRef<[f32]>>(&mut self, block: &ShadowBlock<A>, path: u32, light: u32) {
+        let width = block.tmax.as_ref().len();
+        let r = self.len..self.len + width;
         self.origin_x[r.clone()].fill(block.origin.x);
         self.origin_y[r.clone()].fill(block.origin.y);
         self.origin_z[r.clone()].fill(block.origin.z);
-        self.direction_x[r.clone()].copy_from_slice(&block.l[0]);
-        self.direction_y[r.clone()].copy_from_slice(&block.l[1]);
-        self.direction_z[r.clone()].copy_from_slice(&block.l[2]);
-        self.tmax[r.clone()].copy_from_slice(&block.tmax);
-        self.n_dot_l[r.clone()].copy_from_slice(&block.n_dot_l);
+        self.direction_x[r.clone()].copy_from_slice(block.l[0].as_ref());
+        self.direction_y[r.clone()].copy_from_slice(block.l[1].as_ref());
+        self.direction_z[r.clone()].copy_from_slice(block.l[2].as_ref());
+        self.tmax[r.clone()].copy_from_slice(block.tmax.as_ref());
+        self.n_dot_l[r.clone()].copy_from_slice(block.n_dot_l.as_ref());
         if !self.dist.is_empty() {
-            self.dist[r.clone()].copy_from_slice(&block.dist);
+            self.dist[r.clone()].copy_from_slice(block.dist.as_ref());
         }
         self.path[r.clone()].fill(path);
         self.light[r].fill(light);
-        self.len += 8;
+        self.len += width;
     }
 
     /// Direction (l) of ray `i`.
@@ -349,20 +350,21 @@ impl ShadowQueue {
     }
 }
 
-/// Eight shadow rays from one hit to one light, as `simd::shadow_rays8` makes them: lane k is
-/// `spawn::shadow_ray`'s answer for point k, or a dead lane (tmax = 0, n·l = 0).
+/// 8 (or 16: `A` is the lanes' array) shadow rays from one hit to one light, as
+/// `simd::shadow_rays` makes them: lane k is `spawn::shadow_ray`'s answer for point k, or a
+/// dead lane (tmax = 0, n·l = 0).
 #[derive(Clone, Copy, Debug)]
-pub struct ShadowBlock {
+pub struct ShadowBlock<A = [f32; 8]> {
     /// The rays' common origin, off the surface.
     pub origin: Vec3,
     /// l x, y, z per lane.
-    pub l: [[f32; 8]; 3],
+    pub l: [A; 3],
     /// tmax per lane, 0 for a dead one.
-    pub tmax: [f32; 8],
+    pub tmax: A,
     /// n·l per lane, 0 for a dead one.
-    pub n_dot_l: [f32; 8],
+    pub n_dot_l: A,
     /// |target − point| per lane.
-    pub dist: [f32; 8],
+    pub dist: A,
     /// Live lanes as a bitmask.
     pub live: u32,
 }

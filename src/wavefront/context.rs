@@ -2,6 +2,7 @@
 //! once (material and light terms, the strata grid, the acceleration choice).
 
 use super::bvh::MeshBvh;
+use super::lanes::LaneWidth;
 use super::shade::MaterialTerms;
 use super::simd::BlockSampler;
 use crate::camera::CameraRays;
@@ -67,7 +68,10 @@ pub struct Context<'a> {
     pub lights: Vec<LightTerms>,
     /// Points per light (N).
     pub points_per_light: u32,
-    /// Stratum column of every point index (padded to a multiple of 8), as floats.
+    /// The lane width of the brute-force, light and shading kernels, resolved (`Eight` or
+    /// `Sixteen`): the build's native width unless [`Context::with_lane_width`] says otherwise.
+    pub lane_width: LaneWidth,
+    /// Stratum column of every point index (padded to a multiple of 16), as floats.
     pub cell_x: Vec<f32>,
     /// Stratum row of every point index.
     pub cell_y: Vec<f32>,
@@ -104,7 +108,8 @@ impl<'a> Context<'a> {
             .collect();
         let points_per_light = settings.points_per_light();
         let (nx, ny) = strata_grid(points_per_light);
-        let padded = (points_per_light as usize).div_ceil(8) * 8;
+        // Padded to whole blocks of the widest lanes, so every block's load is one vector.
+        let padded = (points_per_light as usize).div_ceil(16) * 16;
         let cell_x = (0..padded as u32).map(|j| (j % nx) as f32).collect();
         let cell_y = (0..padded as u32).map(|j| (j / nx) as f32).collect();
         Context {
@@ -130,10 +135,18 @@ impl<'a> Context<'a> {
             materials,
             lights,
             points_per_light,
+            lane_width: LaneWidth::NATIVE,
             cell_x,
             cell_y,
             grid: (nx as f32, ny as f32),
         }
+    }
+
+    /// The same context with the kernels run `width` lanes wide (`Auto`: the build's native
+    /// width). Speed only: every width gives the same image.
+    pub fn with_lane_width(mut self, width: LaneWidth) -> Self {
+        self.lane_width = width.resolve();
+        self
     }
 
     /// True when shadow rays are cast (hard or soft shadows).

@@ -1,9 +1,10 @@
 //! Stage 2, intersect: the closest hit of every ray, then what shading needs at it (point put
 //! back on its surface, normal flipped for two-sided faces, offset, material).
 //!
-//! Small scenes (below `BVH_MIN_TRIANGLES` triangles) go through the 8-wide kernel over every
-//! primitive; meshes go through the engine's 8-wide BVH (`bvh::MeshBvh`): camera rays in
-//! packets of 8 neighbouring pixels (8 rays against one child box or one triangle per test),
+//! Small scenes (below `BVH_MIN_TRIANGLES` triangles) go through the brute-force kernel over
+//! every primitive, 8 or 16 rays at a time (the engine's lane width); meshes go through the
+//! engine's 8-wide BVH (`bvh::MeshBvh`) at either width: camera rays in packets of 8
+//! neighbouring pixels (8 rays against one child box or one triangle per test),
 //! all other rays one at a time (one ray against 8 child boxes or 8 triangles). Its hits are
 //! brute force's (same t bits, ties to the lowest triangle id), as are the reference's
 //! (`Accel::closest` over obvhs's CWBVH), except for the few axis-parallel rays obvhs's box
@@ -52,7 +53,8 @@ pub fn closest(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch) {
     let scene = ctx.scene;
     let two_sided = ctx.settings.two_sided;
     match &ctx.accel {
-        None => simd::closest_hits(
+        None => simd::closest_hits_at(
+            ctx.lane_width,
             &scene.triangles,
             &scene.spheres,
             &columns(rays),

@@ -1,30 +1,26 @@
-//! The lane layer: everything the 8-wide kernels share about lanes, in one place (like
+//! The lane layer: everything the SIMD kernels share about lanes, in one place (like
 //! memchr's `vector.rs`). It owns the lane count, the padded loads from columns, the mask
 //! tables, the view of a vector as its 8 lanes, the bit casts between lane types, and the
 //! iterator over a bitmask's set lanes.
+//!
+//! It also owns the one lane abstraction, [`Lanes`] (and its unsigned sibling [`LanesU`]):
+//! the handful of operations the brute-force, light-sampling and shading kernels use,
+//! implemented for `f32x8` and `f32x16` by one macro. Those kernels are written once, generic
+//! over `V: Lanes`, and monomorphised for 8 and 16 lanes; the engine picks the width
+//! ([`LaneWidth`]). The mesh BVH stays 8-wide (8 children, 8 triangles per block) and uses the
+//! concrete `f32x8` and the free functions below.
 //!
 //! This is the only file of the crate that names the `wide` crate or `bytemuck`: the kernels
 //! (`simd/`, `shade.rs`, `bvh/`) take the lane types from here, and `tests/layering.rs` checks
 //! that nothing else reaches for them.
 
-pub(crate) use wide::{f32x8, i32x8, u32x8};
+use std::ops::{Add, BitAnd, BitOr, BitXor, Div, Mul, Neg, Not, Shl, Shr, Sub};
+pub use wide::{f32x8, f32x16};
+pub(crate) use wide::{i32x8, u32x8};
 
-/// The SIMD width: lanes per vector, children per BVH node, triangles per block.
+/// The mesh BVH's width (children per node, triangles per block) and the lanes of `f32x8`; the
+/// width-generic kernels use `Lanes::N` instead.
 pub const LANES: usize = 8;
-
-/// `col[i..i + 8]` as one vector, `pad` in the lanes past the column's end.
-#[inline(always)]
-pub(crate) fn load(col: &[f32], i: usize, pad: f32) -> f32x8 {
-    match col.get(i..i + LANES) {
-        Some(s) => f32x8::new(s.try_into().expect("8 lanes")),
-        None => {
-            let mut a = [pad; LANES];
-            let rest = &col[i.min(col.len())..];
-            a[..rest.len()].copy_from_slice(rest);
-            f32x8::new(a)
-        }
-    }
-}
 
 /// `c[i..i + live]` in lanes 0..live (live ≤ 8), NaN in the lanes after them (which may lie
 /// inside the column: a packet's dead lanes).
@@ -41,10 +37,10 @@ pub(crate) fn load_live(c: &[f32], i: usize, live: usize) -> f32x8 {
     }
 }
 
-/// The live lanes of the chunk starting at `i` of a batch of `len`, as a bitmask.
+/// The live lanes of the chunk of `V::N` starting at `i` of a batch of `len`, as a bitmask.
 #[inline(always)]
-pub(crate) fn live_lanes(i: usize, len: usize) -> u32 {
-    let n = (len - i).min(LANES);
+pub(crate) fn live_lanes<V: Lanes>(i: usize, len: usize) -> u32 {
+    let n = (len - i).min(V::N);
     (1u32 << n) - 1
 }
 
@@ -75,18 +71,6 @@ pub(crate) fn f32_from_bits(v: u32x8) -> f32x8 {
 /// Every lane's bits moved from a signed integer vector to a float vector (masks).
 #[inline(always)]
 pub(crate) fn f32_from_signed(v: i32x8) -> f32x8 {
-    wide::bytemuck::cast(v)
-}
-
-/// Unsigned lanes reinterpreted as signed (same bits).
-#[inline(always)]
-pub(crate) fn signed(v: u32x8) -> i32x8 {
-    wide::bytemuck::cast(v)
-}
-
-/// Signed lanes reinterpreted as unsigned (same bits).
-#[inline(always)]
-pub(crate) fn unsigned(v: i32x8) -> u32x8 {
     wide::bytemuck::cast(v)
 }
 
@@ -132,8 +116,304 @@ pub(crate) static MASK_LANES: [f32x8; 256] = {
     table
 };
 
-/// The lane indices 0..8 as floats, to build "lane < count" masks.
-pub(crate) const LANE_INDEX: [f32; LANES] = [0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0];
+/// Which lane width the wavefront engine's brute-force, light and shading kernels run at (the
+/// mesh BVH is 8-wide either way). It changes speed only: both widths give the same bits.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LaneWidth {
+    /// 16 lanes when the binary was built for AVX-512 (`target_feature = "avx512f"`, where
+    /// `f32x16` is one register), else 8.
+    #[default]
+    Auto,
+    /// `f32x8` (one AVX2 register, or two SSE halves).
+    Eight,
+    /// `f32x16` (one AVX-512 register, or two AVX2 halves without AVX-512).
+    Sixteen,
+}
+
+impl LaneWidth {
+    /// The width `Auto` stands for in this build: 16 with AVX-512, else 8.
+    pub const NATIVE: LaneWidth = if cfg!(target_feature = "avx512f") {
+        LaneWidth::Sixteen
+    } else {
+        LaneWidth::Eight
+    };
+
+    /// `Auto` resolved for this build: `Eight` or `Sixteen`.
+    pub fn resolve(self) -> LaneWidth {
+        match self {
+            LaneWidth::Auto => LaneWidth::NATIVE,
+            w => w,
+        }
+    }
+
+    /// Lanes per vector once resolved: 8 or 16.
+    pub fn lanes(self) -> usize {
+        match self.resolve() {
+            LaneWidth::Sixteen => 16,
+            _ => 8,
+        }
+    }
+}
+
+/// A float lane vector, as the width-generic kernels use it: lane k of every operation is the
+/// scalar operation on lane k (no fused multiply-add, no reordering), so a kernel written once
+/// gives the same bits per lane at either width. Implemented for `f32x8` and `f32x16` only.
+pub trait Lanes:
+    Copy
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+    + BitAnd<Output = Self>
+    + BitOr<Output = Self>
+    + Not<Output = Self>
+{
+    /// Lanes per vector.
+    const N: usize;
+    /// All lanes 0.
+    const ZERO: Self;
+    /// All lanes 1.
+    const ONE: Self;
+    /// The lanes as an array, `[f32; N]`.
+    type Array: Copy
+        + Default
+        + std::fmt::Debug
+        + AsRef<[f32]>
+        + AsMut<[f32]>
+        + std::ops::Index<usize, Output = f32>
+        + std::ops::IndexMut<usize>;
+    /// The unsigned integer vector of the same width (the hash-based samplers).
+    type U: LanesU<F = Self>;
+
+    /// Every lane `x`.
+    fn splat(x: f32) -> Self;
+    /// From an array.
+    fn from_array(a: Self::Array) -> Self;
+    /// Lane k = `f(k)`.
+    fn from_fn(f: impl FnMut(usize) -> f32) -> Self;
+    /// To an array.
+    fn to_array(self) -> Self::Array;
+    /// `col[i..i + N]`, `pad` in the lanes past the column's end.
+    fn load(col: &[f32], i: usize, pad: f32) -> Self;
+    /// The lane indices 0..N as floats (a constant, as the 8-lane kernels' table was).
+    const LANE_INDEX: Self;
+    /// Lane-wise `<`, all ones where true.
+    fn simd_lt(self, rhs: Self) -> Self;
+    /// Lane-wise `>`.
+    fn simd_gt(self, rhs: Self) -> Self;
+    /// Lane-wise `<=`.
+    fn simd_le(self, rhs: Self) -> Self;
+    /// Lane-wise `>=`.
+    fn simd_ge(self, rhs: Self) -> Self;
+    /// Lane-wise `!=`.
+    fn simd_ne(self, rhs: Self) -> Self;
+    /// Where this mask is set `t`, else `f`.
+    fn select(self, t: Self, f: Self) -> Self;
+    /// The sign bit of every lane, lane k in bit k.
+    fn to_bitmask(self) -> u32;
+    /// Some lane's mask set.
+    fn any(self) -> bool;
+    /// Every lane's mask set.
+    fn all(self) -> bool;
+    /// No lane's mask set.
+    fn none(self) -> bool;
+    /// Lane-wise square root (correctly rounded).
+    fn sqrt(self) -> Self;
+    /// Lane-wise |x|.
+    fn abs(self) -> Self;
+    /// Lane-wise minimum, NaN handling unspecified (`minps`).
+    fn fast_min(self, rhs: Self) -> Self;
+    /// Lane-wise minimum with `f32::min`'s NaN rule.
+    fn min(self, rhs: Self) -> Self;
+}
+
+/// The unsigned sibling of a [`Lanes`] type: u32 lanes, wrapping arithmetic.
+pub trait LanesU:
+    Copy
+    + Add<Output = Self>
+    + Mul<Output = Self>
+    + BitAnd<Output = Self>
+    + BitOr<Output = Self>
+    + BitXor<Output = Self>
+    + Not<Output = Self>
+    + Shr<u32, Output = Self>
+    + Shl<u32, Output = Self>
+{
+    /// The float vector of the same width.
+    type F: Lanes<U = Self>;
+    /// All lanes 0.
+    const ZERO: Self;
+    /// All lanes 1.
+    const ONE: Self;
+    /// Every lane `x`.
+    fn splat(x: u32) -> Self;
+    /// The lane indices 0..N.
+    const LANE_INDEX: Self;
+    /// All ones in the lanes whose top bit is set, else 0 (an arithmetic shift right by 31).
+    fn sign_fill(self) -> Self;
+    /// Every lane converted to float as a signed integer (exact below 2^24).
+    fn to_f32_signed(self) -> Self::F;
+    /// Every lane's bits read as a float.
+    fn bits_to_f32(self) -> Self::F;
+}
+
+macro_rules! impl_lanes {
+    ($f:ident, $u:ident, $i:ident, $n:literal, $from_i:ident) => {
+        impl Lanes for $f {
+            const N: usize = $n;
+            const ZERO: Self = $f::ZERO;
+            const ONE: Self = $f::ONE;
+            type Array = [f32; $n];
+            type U = $u;
+
+            #[inline(always)]
+            fn splat(x: f32) -> Self {
+                $f::splat(x)
+            }
+            #[inline(always)]
+            fn from_array(a: [f32; $n]) -> Self {
+                $f::new(a)
+            }
+            #[inline(always)]
+            fn from_fn(f: impl FnMut(usize) -> f32) -> Self {
+                $f::new(std::array::from_fn(f))
+            }
+            #[inline(always)]
+            fn to_array(self) -> [f32; $n] {
+                $f::to_array(self)
+            }
+            #[inline(always)]
+            fn load(col: &[f32], i: usize, pad: f32) -> Self {
+                match col.get(i..i + $n) {
+                    Some(s) => $f::new(s.try_into().expect("N lanes")),
+                    None => {
+                        let mut a = [pad; $n];
+                        let rest = &col[i.min(col.len())..];
+                        a[..rest.len()].copy_from_slice(rest);
+                        $f::new(a)
+                    }
+                }
+            }
+            const LANE_INDEX: Self = {
+                let mut a = [0.0f32; $n];
+                let mut k = 0;
+                while k < $n {
+                    a[k] = k as f32;
+                    k += 1;
+                }
+                $f::new(a)
+            };
+            #[inline(always)]
+            fn simd_lt(self, rhs: Self) -> Self {
+                $f::simd_lt(self, rhs)
+            }
+            #[inline(always)]
+            fn simd_gt(self, rhs: Self) -> Self {
+                $f::simd_gt(self, rhs)
+            }
+            #[inline(always)]
+            fn simd_le(self, rhs: Self) -> Self {
+                $f::simd_le(self, rhs)
+            }
+            #[inline(always)]
+            fn simd_ge(self, rhs: Self) -> Self {
+                $f::simd_ge(self, rhs)
+            }
+            #[inline(always)]
+            fn simd_ne(self, rhs: Self) -> Self {
+                $f::simd_ne(self, rhs)
+            }
+            #[inline(always)]
+            fn select(self, t: Self, f: Self) -> Self {
+                $f::select(self, t, f)
+            }
+            #[inline(always)]
+            fn to_bitmask(self) -> u32 {
+                $f::to_bitmask(self)
+            }
+            #[inline(always)]
+            fn any(self) -> bool {
+                $f::any(self)
+            }
+            #[inline(always)]
+            fn all(self) -> bool {
+                $f::all(self)
+            }
+            #[inline(always)]
+            fn none(self) -> bool {
+                $f::none(self)
+            }
+            #[inline(always)]
+            fn sqrt(self) -> Self {
+                $f::sqrt(self)
+            }
+            #[inline(always)]
+            fn abs(self) -> Self {
+                $f::abs(self)
+            }
+            #[inline(always)]
+            fn fast_min(self, rhs: Self) -> Self {
+                $f::fast_min(self, rhs)
+            }
+            #[inline(always)]
+            fn min(self, rhs: Self) -> Self {
+                $f::min(self, rhs)
+            }
+        }
+
+        impl LanesU for $u {
+            type F = $f;
+            const ZERO: Self = $u::ZERO;
+            const ONE: Self = $u::ONE;
+            #[inline(always)]
+            fn splat(x: u32) -> Self {
+                $u::splat(x)
+            }
+            const LANE_INDEX: Self = {
+                let mut a = [0u32; $n];
+                let mut k = 0;
+                while k < $n {
+                    a[k] = k as u32;
+                    k += 1;
+                }
+                $u::new(a)
+            };
+            #[inline(always)]
+            fn sign_fill(self) -> Self {
+                let s: $i = wide::bytemuck::cast(self);
+                wide::bytemuck::cast(s >> 31)
+            }
+            #[inline(always)]
+            fn to_f32_signed(self) -> $f {
+                $f::$from_i(wide::bytemuck::cast(self))
+            }
+            #[inline(always)]
+            fn bits_to_f32(self) -> $f {
+                wide::bytemuck::cast(self)
+            }
+        }
+    };
+}
+
+impl_lanes!(f32x8, u32x8, i32x8, 8, from_i32x8);
+impl_lanes!(f32x16, u32x16, i32x16, 16, from_i32x16);
+
+use wide::{i32x16, u32x16};
+
+/// Stores lane k of `mask` as `out[k]` for the `out.len()` ≤ `V::N` lanes of a chunk, 8 lanes
+/// per lookup in [`MASK_BOOLS`]: one lookup at 8 lanes (the 8-lane kernels' one copy), two at
+/// 16 (not a 65536-entry table).
+#[inline(always)]
+pub(crate) fn store_mask<V: Lanes>(out: &mut [bool], mask: u32) {
+    debug_assert!(out.len() <= V::N && V::N <= 2 * LANES);
+    let (low, high) = out.split_at_mut(out.len().min(LANES));
+    low.copy_from_slice(&MASK_BOOLS[(mask & 0xff) as usize][..low.len()]);
+    // `V::N` is a constant: at 8 lanes this is gone.
+    if V::N > LANES {
+        high.copy_from_slice(&MASK_BOOLS[((mask >> 8) & 0xff) as usize][..high.len()]);
+    }
+}
 
 /// The set bits of a mask, lowest first: `for k in set_bits(m)` visits every lane k whose bit is
 /// set, as the loop `while m != 0 { k = m.trailing_zeros(); m &= m - 1; ... }` does.
@@ -184,15 +464,53 @@ mod tests {
     }
 
     #[test]
+    fn masks_store_in_two_byte_lookups() {
+        for mask in [0u32, 1, 0x80, 0x100, 0x8001, 0xffff, 0xa5c3] {
+            for len in [0, 1, 7, 8, 9, 15, 16] {
+                let mut out = vec![true; len];
+                if len <= 8 {
+                    store_mask::<f32x8>(&mut out, mask);
+                    for (k, &b) in out.iter().enumerate() {
+                        assert_eq!(b, mask & (1 << k) != 0, "8 lanes: mask {mask:#x} lane {k}");
+                    }
+                }
+                store_mask::<f32x16>(&mut out, mask);
+                for (k, &b) in out.iter().enumerate() {
+                    assert_eq!(b, mask & (1 << k) != 0, "mask {mask:#x} lane {k}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn both_widths_have_their_lane_indices_and_sign_fill() {
+        assert_eq!(<f32x16 as Lanes>::LANE_INDEX.to_array()[15], 15.0);
+        assert_eq!(<f32x8 as Lanes>::LANE_INDEX.to_array()[7], 7.0);
+        assert_eq!(<u32x16 as LanesU>::LANE_INDEX.to_array()[9], 9);
+        let u = <u32x16 as LanesU>::splat(0x8000_0001).sign_fill();
+        assert_eq!(u.to_array(), [u32::MAX; 16]);
+        let u = <u32x8 as LanesU>::splat(0x7fff_ffff).sign_fill();
+        assert_eq!(u.to_array(), [0; 8]);
+        assert_eq!(LaneWidth::Eight.lanes(), 8);
+        assert_eq!(LaneWidth::Sixteen.lanes(), 16);
+        assert_eq!(LaneWidth::Auto.resolve(), LaneWidth::NATIVE);
+    }
+
+    #[test]
     fn padded_loads() {
         let c = [1.0, 2.0, 3.0];
         assert_eq!(
-            load(&c, 0, 9.0).to_array(),
+            <f32x8 as Lanes>::load(&c, 0, 9.0).to_array(),
             [1.0, 2.0, 3.0, 9.0, 9.0, 9.0, 9.0, 9.0]
         );
+        let wide = <f32x16 as Lanes>::load(&c, 1, 9.0).to_array();
+        assert_eq!(wide[..2], [2.0, 3.0]);
+        assert!(wide[2..].iter().all(|&x| x == 9.0));
         let got = load_live(&c, 1, 2).to_array();
         assert_eq!(got[..2], [2.0, 3.0]);
         assert!(got[2..].iter().all(|x| x.is_nan()));
-        assert_eq!(live_lanes(8, 11), 0b111);
+        assert_eq!(live_lanes::<f32x8>(8, 11), 0b111);
+        assert_eq!(live_lanes::<f32x16>(0, 40), 0xffff);
+        assert_eq!(live_lanes::<f32x16>(32, 40), 0xff);
     }
 }

@@ -1,12 +1,13 @@
 //! The lab's Shade in the wavefront engine: each material's terms computed once, the scalar
-//! Shade over them ([`shade_terms`], twin of `shading::shade`) and its 8-wide twin
-//! ([`shade8`]), side by side so that the twins read alike.
+//! Shade over them ([`shade_terms`], twin of `shading::shade`) and its SIMD twin
+//! ([`shade_lanes`], 8 or 16 lanes; [`shade8`] at 8), side by side so that the twins read
+//! alike.
 //!
 //! These live here rather than in `crate::shading`: the terms are the wavefront engine's
-//! per-render table (the reference shades from `Material` directly), and the 8-wide twin names
+//! per-render table (the reference shades from `Material` directly), and the SIMD twin names
 //! lane types, which stay inside the wavefront engine's kernels.
 
-use super::lanes::{LANES, f32x8, load};
+use super::lanes::{LANES, Lanes, f32x8};
 use crate::scene::Material;
 use crate::shading::AMBIENT;
 use glam::Vec3;
@@ -89,17 +90,17 @@ pub struct HitLight<'a> {
     pub weight: f32,
 }
 
-/// 8 shadow rays from one hit towards one light, as the queue holds them.
+/// 8 (or 16) shadow rays from one hit towards one light, as the queue holds them.
 #[derive(Clone, Copy, Debug)]
 pub struct ShadowLanes<'a> {
-    /// l: x, y, z of each ray's unit direction (8 entries each).
+    /// l: x, y, z of each ray's unit direction (one entry per lane each).
     pub l: [&'a [f32]; 3],
     /// n·l of each ray; ≤ 0 for a dead lane.
     pub n_dot_l: &'a [f32],
     /// Whether each ray is blocked.
     pub blocked: &'a [bool],
     /// Each ray's light fall-off (`spawn::falloff`), or `None` in the lab's model (exactly 1).
-    pub falloff: Option<&'a [f32; LANES]>,
+    pub falloff: Option<&'a [f32]>,
 }
 
 /// Shade · weight of 8 shadow rays cast from one hit towards one light: lane k equals
@@ -109,6 +110,13 @@ pub struct ShadowLanes<'a> {
 /// every x, −0 included), so the caller adds all 8 lanes in order without a branch.
 #[inline]
 pub fn shade8(at: &HitLight, rays: &ShadowLanes) -> [[f32; LANES]; 3] {
+    shade_lanes::<f32x8>(at, rays)
+}
+
+/// [`shade8`] on N lanes (8 or 16): lane k equals `shade_terms(..) * weight` bit for bit, as
+/// there; `rays` holds N entries per column.
+#[inline]
+pub fn shade_lanes<V: Lanes>(at: &HitLight, rays: &ShadowLanes) -> [V::Array; 3] {
     let HitLight {
         material: m,
         normal: n,
@@ -122,11 +130,11 @@ pub fn shade8(at: &HitLight, rays: &ShadowLanes) -> [[f32; LANES]; 3] {
         blocked,
         falloff,
     } = *rays;
-    let ndl = load(n_dot_l, 0, 0.0);
+    let ndl = V::load(n_dot_l, 0, 0.0);
     // Each lane's light colour: Lc · falloff (`spawn::falloff`), or Lc itself in the lab's
     // model, whose fall-off is exactly 1 (x · 1 = x, so both give the twin's bits).
     let lc = {
-        let splat = |c: f32| f32x8::splat(c);
+        let splat = |c: f32| V::splat(c);
         let (r, g, b) = (
             splat(light_color.x),
             splat(light_color.y),
@@ -135,48 +143,50 @@ pub fn shade8(at: &HitLight, rays: &ShadowLanes) -> [[f32; LANES]; 3] {
         match falloff {
             None => [r, g, b],
             Some(f) => {
-                let f = f32x8::new(*f);
+                let f = V::load(f, 0, 1.0);
                 [r * f, g * f, b * f]
             }
         }
     };
-    let open = f32x8::new(std::array::from_fn(|k| if blocked[k] { 0.0 } else { 1.0 }));
-    let adds = ndl.simd_gt(f32x8::ZERO) & open.simd_gt(f32x8::ZERO);
-    let nothing = f32x8::splat(-0.0);
-    let cr = f32x8::splat(m.ambient_emitted.x) + lc[0] * f32x8::splat(m.diffuse.x) * ndl;
-    let cg = f32x8::splat(m.ambient_emitted.y) + lc[1] * f32x8::splat(m.diffuse.y) * ndl;
-    let cb = f32x8::splat(m.ambient_emitted.z) + lc[2] * f32x8::splat(m.diffuse.z) * ndl;
+    let open = V::from_fn(|k| if blocked[k] { 0.0 } else { 1.0 });
+    let adds = ndl.simd_gt(V::ZERO) & open.simd_gt(V::ZERO);
+    let nothing = V::splat(-0.0);
+    let cr = V::splat(m.ambient_emitted.x) + lc[0] * V::splat(m.diffuse.x) * ndl;
+    let cg = V::splat(m.ambient_emitted.y) + lc[1] * V::splat(m.diffuse.y) * ndl;
+    let cb = V::splat(m.ambient_emitted.z) + lc[2] * V::splat(m.diffuse.z) * ndl;
     let positive = m.shininess > 0.0;
-    let w = f32x8::splat(weight);
+    let w = V::splat(weight);
     if positive && !m.is_reflective {
-        let out = |c: f32x8| adds.select(c * w, nothing).to_array();
+        let out = |c: V| adds.select(c * w, nothing).to_array();
         return [out(cr), out(cg), out(cb)];
     }
-    let (lx, ly, lz) = (load(l[0], 0, 0.0), load(l[1], 0, 0.0), load(l[2], 0, 0.0));
+    let (lx, ly, lz) = (
+        V::load(l[0], 0, 0.0),
+        V::load(l[1], 0, 0.0),
+        V::load(l[2], 0, 0.0),
+    );
     // r = normalize(2(n·l) n − l), glam's normalize: v · (1 / |v|).
-    let k = f32x8::splat(2.0) * ndl;
-    let rx = k * f32x8::splat(n.x) - lx;
-    let ry = k * f32x8::splat(n.y) - ly;
-    let rz = k * f32x8::splat(n.z) - lz;
-    let recip = f32x8::ONE / (rx * rx + ry * ry + rz * rz).sqrt();
+    let k = V::splat(2.0) * ndl;
+    let rx = k * V::splat(n.x) - lx;
+    let ry = k * V::splat(n.y) - ly;
+    let rz = k * V::splat(n.z) - lz;
+    let recip = V::ONE / (rx * rx + ry * ry + rz * rz).sqrt();
     let (rx, ry, rz) = (rx * recip, ry * recip, rz * recip);
-    let e_dot_r =
-        (f32x8::splat(e.x) * rx + f32x8::splat(e.y) * ry + f32x8::splat(e.z) * rz).to_array();
-    let mut spec = [0.0f32; LANES];
-    let mut with_highlight = [0.0f32; LANES];
-    for k in 0..LANES {
+    let e_dot_r = (V::splat(e.x) * rx + V::splat(e.y) * ry + V::splat(e.z) * rz).to_array();
+    let mut spec = V::Array::default();
+    let mut with_highlight = V::Array::default();
+    for k in 0..V::N {
         let base = e_dot_r[k].max(0.0);
         if !positive || base > 0.0 {
             spec[k] = base.powf(m.shininess);
             with_highlight[k] = 1.0;
         }
     }
-    let on = f32x8::new(with_highlight).simd_gt(f32x8::ZERO);
-    let s = f32x8::new(spec) * ndl;
+    let on = V::from_array(with_highlight).simd_gt(V::ZERO);
+    let s = V::from_array(spec) * ndl;
     let sc = m.specular;
-    let add = |c: f32x8, lc: f32x8, sc: f32| {
-        adds.select(on.select(c + lc * f32x8::splat(sc) * s, c) * w, nothing)
-    };
+    let add =
+        |c: V, lc: V, sc: f32| adds.select(on.select(c + lc * V::splat(sc) * s, c) * w, nothing);
     [
         add(cr, lc[0], sc.x).to_array(),
         add(cg, lc[1], sc.y).to_array(),

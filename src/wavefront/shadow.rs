@@ -5,21 +5,27 @@
 //!     spawn:   for hit, for light, for point j < N:  the shadow ray of `spawn::shadow_ray`
 //!              (origin, l, tmax), queued when it has one (the point far enough above the
 //!              tangent plane, the hit above the light's moved plane)
-//!     occlude: 8 queued rays at a time, stop at the first blocker; small scenes test only the
-//!              triangles that can shadow a light (`geometry::shadow_casters`), meshes go one
-//!              ray at a time through `bvh::MeshBvh`, 8 boxes or 8 triangles per test
+//!     occlude: N queued rays at a time (8 or 16), stop at the first blocker; small scenes
+//!              test only the triangles that can shadow a light (`geometry::shadow_casters`),
+//!              meshes go one ray at a time through `bvh::MeshBvh`, 8 boxes or 8 triangles per
+//!              test
 //!     shade:   in queue order, direct[hit] += Shade(l) / N for the rays not blocked
 //! ```
 //!
 //! Queue order is the reference's loop order, so each hit's sum is added in the same order and
-//! comes out bit-identical. Soft shadows on a parallelogram light (every lab light) go 8 points
-//! at a time, every sampler with an 8-wide twin (`simd::light_points8`); hard shadows and
-//! other light shapes call the scalar sampling code one point at a time.
+//! comes out bit-identical. Soft shadows on a parallelogram light (every lab light) go N points
+//! at a time, every sampler with a SIMD twin (`simd::light_points`); hard shadows and other
+//! light shapes call the scalar sampling code one point at a time.
+//!
+//! N is the engine's lane width (`lanes::LaneWidth`, 8 or 16): the stage is generic over the
+//! lane type, and with 16 lanes the queue holds aligned blocks of 16 points per (hit, light).
+//! Dead lanes add −0.0 and each hit's sum is still added in point order, so both widths give
+//! the same bits.
 
 use super::batch::{HitBatch, RayBatch, ShadowQueue};
 use super::context::Context;
-use super::lanes::LANES;
-use super::shade::{HitLight, ShadowLanes, shade_terms, shade8};
+use super::lanes::{LaneWidth, Lanes, f32x8, f32x16};
+use super::shade::{HitLight, ShadowLanes, shade_lanes, shade_terms};
 use super::simd::{self, LightBlock, RayColumns};
 use crate::geometry::casters;
 use crate::sampling::{SampleKey, mix32, square_sample};
@@ -48,12 +54,29 @@ pub fn direct_light(
     queue: &mut ShadowQueue,
     capacity: usize,
 ) -> u64 {
+    match ctx.lane_width {
+        LaneWidth::Sixteen => direct_light_lanes::<f32x16>(ctx, rays, hits, queue, capacity),
+        _ => direct_light_lanes::<f32x8>(ctx, rays, hits, queue, capacity),
+    }
+}
+
+/// [`direct_light`] at the lane width of `V`. Never inlined, so that the 8-lane stage is one
+/// function as it was before the 16-lane path, whatever codegen unit the dispatcher lands in
+/// (inlined, its instruction count in tests/icount.rs moved by 0.5–2.2% from build to build).
+#[inline(never)]
+fn direct_light_lanes<V: Lanes>(
+    ctx: &Context,
+    rays: &RayBatch,
+    hits: &mut HitBatch,
+    queue: &mut ShadowQueue,
+    capacity: usize,
+) -> u64 {
     let n = rays.len();
     for c in [&mut hits.direct_r, &mut hits.direct_g, &mut hits.direct_b] {
         c[..n].fill(0.0);
     }
-    // Room for one hit's rays at least, each light's points padded to whole 8-lane blocks.
-    let per_hit = ctx.lights.len() * (ctx.points_per_light as usize).div_ceil(LANES) * LANES;
+    // Room for one hit's rays at least, each light's points padded to whole N-lane blocks.
+    let per_hit = ctx.lights.len() * (ctx.points_per_light as usize).div_ceil(V::N) * V::N;
     queue.reset(
         capacity.max(per_hit),
         ctx.settings.light_model != LightModel::Lab,
@@ -63,22 +86,22 @@ pub fn direct_light(
     while next < n {
         queue.len = 0;
         while next < n && queue.room() >= per_hit {
-            cast += spawn(ctx, rays, hits, next, queue);
+            cast += spawn::<V>(ctx, rays, hits, next, queue);
             next += 1;
         }
         if ctx.casts_shadow_rays() {
-            occlude(ctx, queue); // writes every entry
+            occlude::<V>(ctx, queue); // writes every entry
         } else {
             queue.blocked[..queue.len].fill(false);
         }
-        shade(ctx, rays, hits, queue);
+        shade::<V>(ctx, rays, hits, queue);
     }
     if ctx.casts_shadow_rays() { cast } else { 0 }
 }
 
 /// Queues the shadow rays of hit `i`, in (light, point) order.
 /// Returns the number of live rays queued.
-fn spawn(
+fn spawn<V: Lanes>(
     ctx: &Context,
     rays: &RayBatch,
     hits: &HitBatch,
@@ -113,10 +136,10 @@ fn spawn(
                     edge_u,
                     edge_v,
                 };
-                for j0 in (0..count).step_by(LANES) {
-                    let target = simd::light_points8(&LightBlock { j0, ..block });
-                    let lanes = ((count - j0) as usize).min(LANES);
-                    let block = simd::shadow_rays8(&hit, &target, &end, lanes);
+                for j0 in (0..count).step_by(V::N) {
+                    let target = simd::light_points::<V>(&LightBlock { j0, ..block });
+                    let lanes = ((count - j0) as usize).min(V::N);
+                    let block = simd::shadow_rays::<V>(&hit, &target, &end, lanes);
                     if block.live != 0 {
                         queue.push_block(&block, i as u32, li as u32);
                         cast += block.live.count_ones() as u64;
@@ -143,7 +166,7 @@ fn spawn(
 }
 
 /// Sets `queue.blocked` for every queued ray (both kernels write every entry).
-fn occlude(ctx: &Context, queue: &mut ShadowQueue) {
+fn occlude<V: Lanes>(ctx: &Context, queue: &mut ShadowQueue) {
     let scene = ctx.scene;
     let two_sided = ctx.settings.two_sided;
     let n = queue.len;
@@ -162,7 +185,16 @@ fn occlude(ctx: &Context, queue: &mut ShadowQueue) {
     };
     let blocked = &mut queue.blocked[..n];
     match &ctx.accel {
-        None => simd::occluded(
+        // At 8 lanes the 8-lane entry point, a function of its own as it always was (`V::N` is a
+        // constant, so only one arm is compiled in each instantiation).
+        None if V::N == 8 => simd::occluded(
+            casters(scene, &ctx.shadow_casters, two_sided),
+            &scene.spheres,
+            &cols,
+            two_sided,
+            blocked,
+        ),
+        None => simd::occluded_lanes::<V>(
             casters(scene, &ctx.shadow_casters, two_sided),
             &scene.spheres,
             &cols,
@@ -176,14 +208,14 @@ fn occlude(ctx: &Context, queue: &mut ShadowQueue) {
 }
 
 /// Adds Shade / N of every unblocked queued ray to its hit, in queue order. Aligned blocks of
-/// 8 rays from one hit to one light (soft shadows) are shaded 8 lanes at a time, then added
-/// lane by lane in order.
-fn shade(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch, queue: &ShadowQueue) {
+/// N rays (the lane width) from one hit to one light (soft shadows) are shaded N lanes at a
+/// time, then added lane by lane in order.
+fn shade<V: Lanes>(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch, queue: &ShadowQueue) {
     let weight = 1.0 / ctx.points_per_light as f32;
     let model = ctx.settings.light_model;
     let mut q = 0;
     while q < queue.len {
-        let end = q + LANES;
+        let end = q + V::N;
         // The queue is sorted by (hit, light): equal ends mean one hit and one light.
         if end <= queue.len
             && queue.path[q] == queue.path[end - 1]
@@ -192,8 +224,13 @@ fn shade(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch, queue: &ShadowQueu
             let i = queue.path[q] as usize;
             let m = &ctx.materials[hits.material[i] as usize];
             // Distances are kept only under a light model with fall-off (`ShadowQueue::dist`).
-            let falloffs: Option<[f32; LANES]> = (!queue.dist.is_empty())
-                .then(|| std::array::from_fn(|k| falloff(model, queue.dist[q + k])));
+            let falloffs: Option<V::Array> = (!queue.dist.is_empty()).then(|| {
+                let mut f = V::Array::default();
+                for (f, &d) in f.as_mut().iter_mut().zip(&queue.dist[q..end]) {
+                    *f = falloff(model, d);
+                }
+                f
+            });
             // In the order the kernel's operands were always evaluated: the hit, the rays, the
             // light (`shade8`'s instruction count moves with it).
             let (normal, to_eye) = (hits.normal(i), -rays.direction(i));
@@ -205,7 +242,7 @@ fn shade(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch, queue: &ShadowQueu
                 ],
                 n_dot_l: &queue.n_dot_l[q..end],
                 blocked: &queue.blocked[q..end],
-                falloff: falloffs.as_ref(),
+                falloff: falloffs.as_ref().map(|f| f.as_ref()),
             };
             let at = HitLight {
                 material: m,
@@ -214,10 +251,10 @@ fn shade(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch, queue: &ShadowQueu
                 light_color: ctx.lights[queue.light[q] as usize].color,
                 weight,
             };
-            let c = shade8(&at, &lanes);
+            let c = shade_lanes::<V>(&at, &lanes);
             // In lane order, like the reference's loop; lanes that add nothing hold −0.0.
             let (mut r, mut g, mut b) = (hits.direct_r[i], hits.direct_g[i], hits.direct_b[i]);
-            for ((cr, cg), cb) in c[0].iter().zip(&c[1]).zip(&c[2]) {
+            for ((cr, cg), cb) in c[0].as_ref().iter().zip(c[1].as_ref()).zip(c[2].as_ref()) {
                 r += cr;
                 g += cg;
                 b += cb;

@@ -1,30 +1,31 @@
-//! Ray–primitive kernels: Möller–Trumbore and the stable sphere test on 8 lanes, and the
-//! brute-force closest-hit and occlusion loops of scenes without a BVH.
+//! Ray–primitive kernels: Möller–Trumbore and the stable sphere test on N lanes (8 or 16, one
+//! source generic over [`Lanes`]), and the brute-force closest-hit and occlusion loops of
+//! scenes without a BVH.
 
-use super::{RayColumns, Rays8};
+use super::{RayColumns, Rays};
 use crate::geometry::{EDGE_EPSILON, MISS_MARGIN, T_MIN};
 use crate::scene::{NO_HIT, Sphere, Triangle};
-use crate::wavefront::lanes::{LANES, MASK_BOOLS, f32x8, live_lanes, load};
+use crate::wavefront::lanes::{LaneWidth, Lanes, f32x8, f32x16, live_lanes, store_mask};
 use glam::Vec3;
 
-/// Möller–Trumbore's operands on 8 lanes, as columns: ray origin o and direction d, triangle
-/// corner v0 and edges e1, e2. [`triangle8`] splats the triangle (8 rays, one triangle), the
+/// Möller–Trumbore's operands on N lanes (8 by default), as columns: ray origin o and
+/// direction d, triangle corner v0 and edges e1, e2. [`triangle8`] splats the triangle (8 rays, one triangle), the
 /// mesh BVH's leaf test splats the ray (one ray, 8 triangles); the arithmetic is
 /// [`moller_trumbore8`] and [`moller_trumbore8_blocks`] either way.
 #[derive(Clone, Copy)]
-pub(crate) struct TriangleLanes {
-    pub o: [f32x8; 3],
-    pub d: [f32x8; 3],
-    pub v0: [f32x8; 3],
-    pub e1: [f32x8; 3],
-    pub e2: [f32x8; 3],
+pub(crate) struct TriangleLanes<V = f32x8> {
+    pub o: [V; 3],
+    pub d: [V; 3],
+    pub v0: [V; 3],
+    pub e1: [V; 3],
+    pub e2: [V; 3],
 }
 
-impl TriangleLanes {
-    /// One triangle against 8 rays.
+impl<V: Lanes> TriangleLanes<V> {
+    /// One triangle against N rays.
     #[inline(always)]
-    fn splat_triangle(tri: &Triangle, r: &Rays8) -> TriangleLanes {
-        let splat = |v: Vec3| [f32x8::splat(v.x), f32x8::splat(v.y), f32x8::splat(v.z)];
+    fn splat_triangle(tri: &Triangle, r: &Rays<V>) -> TriangleLanes<V> {
+        let splat = |v: Vec3| [V::splat(v.x), V::splat(v.y), V::splat(v.z)];
         TriangleLanes {
             o: [r.ox, r.oy, r.oz],
             d: [r.dx, r.dy, r.dz],
@@ -35,7 +36,7 @@ impl TriangleLanes {
     }
 }
 
-/// Möller–Trumbore on 8 lanes; lane k equals `intersect_triangle(tri_k, ray_k, tmax_k,
+/// Möller–Trumbore on N lanes; lane k equals `intersect_triangle(tri_k, ray_k, tmax_k,
 /// two_sided)`, the same operations in the same order.
 ///
 /// ```text
@@ -44,7 +45,7 @@ impl TriangleLanes {
 /// hit = facing ∧ u ≥ −ε ∧ v ≥ −ε ∧ u + v ≤ 1 + ε ∧ T_MIN < t < tmax   → t, else ∞
 /// ```
 #[inline(always)]
-pub(crate) fn moller_trumbore8(m: &TriangleLanes, tmax: f32x8, two_sided: bool) -> f32x8 {
+pub(crate) fn moller_trumbore8<V: Lanes>(m: &TriangleLanes<V>, tmax: V, two_sided: bool) -> V {
     let [ox, oy, oz] = m.o;
     let [dx, dy, dz] = m.d;
     let [e1x, e1y, e1z] = m.e1;
@@ -55,11 +56,11 @@ pub(crate) fn moller_trumbore8(m: &TriangleLanes, tmax: f32x8, two_sided: bool) 
     let pz = dx * e2y - e2x * dy;
     let det = e1x * px + e1y * py + e1z * pz;
     let facing = if two_sided {
-        det.simd_ne(f32x8::ZERO)
+        det.simd_ne(V::ZERO)
     } else {
-        det.simd_gt(f32x8::ZERO)
+        det.simd_gt(V::ZERO)
     };
-    let inv_det = f32x8::ONE / det;
+    let inv_det = V::ONE / det;
     let tx = ox - m.v0[0];
     let ty = oy - m.v0[1];
     let tz = oz - m.v0[2];
@@ -71,20 +72,24 @@ pub(crate) fn moller_trumbore8(m: &TriangleLanes, tmax: f32x8, two_sided: bool) 
     let v = (dx * qx + dy * qy + dz * qz) * inv_det;
     let t = (e2x * qx + e2y * qy + e2z * qz) * inv_det;
     let hit = facing
-        & u.simd_ge(f32x8::splat(-EDGE_EPSILON))
-        & v.simd_ge(f32x8::splat(-EDGE_EPSILON))
-        & (u + v).simd_le(f32x8::splat(1.0 + EDGE_EPSILON))
-        & t.simd_gt(f32x8::splat(T_MIN))
+        & u.simd_ge(V::splat(-EDGE_EPSILON))
+        & v.simd_ge(V::splat(-EDGE_EPSILON))
+        & (u + v).simd_le(V::splat(1.0 + EDGE_EPSILON))
+        & t.simd_gt(V::splat(T_MIN))
         & t.simd_lt(tmax);
-    hit.select(t, f32x8::splat(f32::INFINITY))
+    hit.select(t, V::splat(f32::INFINITY))
 }
 
 /// The lanes that block, as a bitmask: `moller_trumbore8(..) < tmax`, with the same values
-/// computed in an order that lets all 8 lanes leave early: after det when no lane faces its
+/// computed in an order that lets all N lanes leave early: after det when no lane faces its
 /// triangle (for one-sided faces about half the walls of a box, seen from a coherent packet of
 /// shadow rays), and after t when no lane's t is in (T_MIN, tmax) (the walls behind the light).
 #[inline(always)]
-pub(crate) fn moller_trumbore8_blocks(m: &TriangleLanes, tmax: f32x8, two_sided: bool) -> u32 {
+pub(crate) fn moller_trumbore8_blocks<V: Lanes>(
+    m: &TriangleLanes<V>,
+    tmax: V,
+    two_sided: bool,
+) -> u32 {
     let [ox, oy, oz] = m.o;
     let [dx, dy, dz] = m.d;
     let [e1x, e1y, e1z] = m.e1;
@@ -94,14 +99,14 @@ pub(crate) fn moller_trumbore8_blocks(m: &TriangleLanes, tmax: f32x8, two_sided:
     let pz = dx * e2y - e2x * dy;
     let det = e1x * px + e1y * py + e1z * pz;
     let facing = if two_sided {
-        det.simd_ne(f32x8::ZERO)
+        det.simd_ne(V::ZERO)
     } else {
-        det.simd_gt(f32x8::ZERO)
+        det.simd_gt(V::ZERO)
     };
     if facing.none() {
         return 0;
     }
-    let inv_det = f32x8::ONE / det;
+    let inv_det = V::ONE / det;
     let tx = ox - m.v0[0];
     let ty = oy - m.v0[1];
     let tz = oz - m.v0[2];
@@ -109,33 +114,33 @@ pub(crate) fn moller_trumbore8_blocks(m: &TriangleLanes, tmax: f32x8, two_sided:
     let qy = tz * e1x - e1z * tx;
     let qz = tx * e1y - e1x * ty;
     let t = (e2x * qx + e2y * qy + e2z * qz) * inv_det;
-    let in_range = facing & t.simd_gt(f32x8::splat(T_MIN)) & t.simd_lt(tmax);
+    let in_range = facing & t.simd_gt(V::splat(T_MIN)) & t.simd_lt(tmax);
     if in_range.none() {
         return 0;
     }
     let u = (tx * px + ty * py + tz * pz) * inv_det;
     let v = (dx * qx + dy * qy + dz * qz) * inv_det;
     (in_range
-        & u.simd_ge(f32x8::splat(-EDGE_EPSILON))
-        & v.simd_ge(f32x8::splat(-EDGE_EPSILON))
-        & (u + v).simd_le(f32x8::splat(1.0 + EDGE_EPSILON)))
+        & u.simd_ge(V::splat(-EDGE_EPSILON))
+        & v.simd_ge(V::splat(-EDGE_EPSILON))
+        & (u + v).simd_le(V::splat(1.0 + EDGE_EPSILON)))
     .to_bitmask()
 }
 
-/// Möller–Trumbore for 8 rays against one triangle; lane k equals
+/// Möller–Trumbore for N rays against one triangle; lane k equals
 /// `intersect_triangle(tri, ray_k, tmax_k, two_sided)`.
 #[inline(always)]
-pub fn triangle8(tri: &Triangle, r: &Rays8, tmax: f32x8, two_sided: bool) -> f32x8 {
+pub fn triangle8<V: Lanes>(tri: &Triangle, r: &Rays<V>, tmax: V, two_sided: bool) -> V {
     moller_trumbore8(&TriangleLanes::splat_triangle(tri, r), tmax, two_sided)
 }
 
 /// The lanes that `tri` blocks, as a bitmask (`moller_trumbore8_blocks`).
 #[inline(always)]
-fn triangle8_blocks(tri: &Triangle, r: &Rays8, tmax: f32x8, two_sided: bool) -> u32 {
+fn triangle8_blocks<V: Lanes>(tri: &Triangle, r: &Rays<V>, tmax: V, two_sided: bool) -> u32 {
     moller_trumbore8_blocks(&TriangleLanes::splat_triangle(tri, r), tmax, two_sided)
 }
 
-/// Ray–sphere for 8 rays; lane k equals `intersect_sphere(sphere, ray_k, tmax_k)`: the stable
+/// Ray–sphere for N rays; lane k equals `intersect_sphere(sphere, ray_k, tmax_k)`: the stable
 /// form, see there.
 ///
 /// ```text
@@ -144,8 +149,8 @@ fn triangle8_blocks(tri: &Triangle, r: &Rays8, tmax: f32x8, two_sided: bool) -> 
 /// t = near > T_MIN ? near : far;  hit = disc ≥ 0 ∧ T_MIN < t < tmax   → t, else ∞
 /// ```
 #[inline(always)]
-pub fn sphere8(s: &Sphere, r: &Rays8, tmax: f32x8) -> f32x8 {
-    let Roots8 {
+pub fn sphere8<V: Lanes>(s: &Sphere, r: &Rays<V>, tmax: V) -> V {
+    let Roots {
         ok, inv_a, c, q, ..
     } = SphereLanes::new(s, r).roots(r);
     let t0 = c / q;
@@ -153,37 +158,37 @@ pub fn sphere8(s: &Sphere, r: &Rays8, tmax: f32x8) -> f32x8 {
     let first = t0.simd_lt(t1);
     let near = first.select(t0, t1);
     let far = first.select(t1, t0);
-    let t_min = f32x8::splat(T_MIN);
+    let t_min = V::splat(T_MIN);
     let t = near.simd_gt(t_min).select(near, far);
     let hit = ok & t.simd_gt(t_min) & t.simd_lt(tmax);
-    hit.select(t, f32x8::splat(f32::INFINITY))
+    hit.select(t, V::splat(f32::INFINITY))
 }
 
-/// One sphere against 8 rays, up to the discriminant: what [`sphere8`] and `sphere8_blocks`
+/// One sphere against N rays, up to the discriminant: what [`sphere8`] and `sphere8_blocks`
 /// share (lane-wise twin of `geometry::sphere_roots`).
-struct SphereLanes {
-    oc: [f32x8; 3],
-    a: f32x8,
-    b: f32x8,
-    oc2: f32x8,
+struct SphereLanes<V> {
+    oc: [V; 3],
+    a: V,
+    b: V,
+    oc2: V,
     r2: f32,
 }
 
 /// The roots' parts, t0 = c/q and t1 = q·(1/a), and which lanes have them (`ok`).
-struct Roots8 {
-    ok: f32x8,
-    a: f32x8,
-    inv_a: f32x8,
-    c: f32x8,
-    q: f32x8,
+struct Roots<V> {
+    ok: V,
+    a: V,
+    inv_a: V,
+    c: V,
+    q: V,
 }
 
-impl SphereLanes {
+impl<V: Lanes> SphereLanes<V> {
     #[inline(always)]
-    fn new(s: &Sphere, r: &Rays8) -> SphereLanes {
-        let ocx = r.ox - f32x8::splat(s.center.x);
-        let ocy = r.oy - f32x8::splat(s.center.y);
-        let ocz = r.oz - f32x8::splat(s.center.z);
+    fn new(s: &Sphere, r: &Rays<V>) -> SphereLanes<V> {
+        let ocx = r.ox - V::splat(s.center.x);
+        let ocy = r.oy - V::splat(s.center.y);
+        let ocz = r.oz - V::splat(s.center.z);
         SphereLanes {
             a: r.dx * r.dx + r.dy * r.dy + r.dz * r.dz,
             b: ocx * r.dx + ocy * r.dy + ocz * r.dz,
@@ -200,27 +205,26 @@ impl SphereLanes {
     #[inline(always)]
     fn all_miss(&self) -> bool {
         let (a, b) = (self.a, self.b);
-        let c = self.oc2 * f32x8::splat(1.0 - MISS_MARGIN)
-            - f32x8::splat(self.r2 * (1.0 + MISS_MARGIN));
-        (b * b - a * c).simd_lt(f32x8::ZERO).all()
+        let c = self.oc2 * V::splat(1.0 - MISS_MARGIN) - V::splat(self.r2 * (1.0 + MISS_MARGIN));
+        (b * b - a * c).simd_lt(V::ZERO).all()
     }
 
     /// The stable discriminant a·(r² − |oc − (b/a)·d|²) and q = −(b + sign(b)·√disc).
     #[inline(always)]
-    fn roots(&self, r: &Rays8) -> Roots8 {
+    fn roots(&self, r: &Rays<V>) -> Roots<V> {
         let (a, b, [ocx, ocy, ocz]) = (self.a, self.b, self.oc);
-        let inv_a = f32x8::ONE / a;
+        let inv_a = V::ONE / a;
         let k = b * inv_a;
         let fx = ocx - k * r.dx;
         let fy = ocy - k * r.dy;
         let fz = ocz - k * r.dz;
-        let r2 = f32x8::splat(self.r2);
+        let r2 = V::splat(self.r2);
         let disc = a * (r2 - (fx * fx + fy * fy + fz * fz));
         // copysign(√disc, b): the sign bit of b on the magnitude of √disc.
-        let sign = f32x8::splat(-0.0);
+        let sign = V::splat(-0.0);
         let signed_root = (disc.sqrt() & !sign) | (b & sign);
-        Roots8 {
-            ok: disc.simd_ge(f32x8::ZERO),
+        Roots {
+            ok: disc.simd_ge(V::ZERO),
             a,
             inv_a,
             c: self.oc2 - r2,
@@ -240,30 +244,66 @@ pub fn closest_hits(
     t_out: &mut [f32],
     prim_out: &mut [u32],
 ) {
+    closest_hits_lanes::<f32x8>(triangles, spheres, rays, two_sided, t_out, prim_out);
+}
+
+/// [`closest_hits`] at lane width `width` (`Auto` as the build's native width).
+///
+/// The width is dispatched here, in a function of its own, not in `intersect::closest`: with
+/// the 16-lane loop inlined there, that stage's own per-hit loop took 1.1–1.75% more
+/// instructions at 8 lanes (tests/icount.rs).
+#[inline(never)]
+pub fn closest_hits_at(
+    width: LaneWidth,
+    triangles: &[Triangle],
+    spheres: &[Sphere],
+    rays: &RayColumns,
+    two_sided: bool,
+    t_out: &mut [f32],
+    prim_out: &mut [u32],
+) {
+    match width.resolve() {
+        LaneWidth::Sixteen => {
+            closest_hits_lanes::<f32x16>(triangles, spheres, rays, two_sided, t_out, prim_out);
+        }
+        _ => closest_hits_lanes::<f32x8>(triangles, spheres, rays, two_sided, t_out, prim_out),
+    }
+}
+
+/// [`closest_hits`] at the lane width of `V` (8 or 16): the same answers.
+#[inline(never)]
+pub fn closest_hits_lanes<V: Lanes>(
+    triangles: &[Triangle],
+    spheres: &[Sphere],
+    rays: &RayColumns,
+    two_sided: bool,
+    t_out: &mut [f32],
+    prim_out: &mut [u32],
+) {
     let n = rays.len();
     debug_assert!(t_out.len() == n && prim_out.len() == n);
-    let no_hit = f32x8::splat(f32::from_bits(NO_HIT));
+    let no_hit = V::splat(f32::from_bits(NO_HIT));
     let base = triangles.len() as u32;
-    for i in (0..n).step_by(LANES) {
-        let r = Rays8::load(rays, i);
-        let mut best_t = load(rays.tmax, i, 0.0);
+    for i in (0..n).step_by(V::N) {
+        let r = Rays::<V>::load(rays, i);
+        let mut best_t = V::load(rays.tmax, i, 0.0);
         // Primitive ids ride in float lanes as raw bits: `select` only moves bits.
         let mut best_prim = no_hit;
         for (k, tri) in triangles.iter().enumerate() {
             let t = triangle8(tri, &r, best_t, two_sided);
             let closer = t.simd_lt(best_t);
             best_t = closer.select(t, best_t);
-            best_prim = closer.select(f32x8::splat(f32::from_bits(k as u32)), best_prim);
+            best_prim = closer.select(V::splat(f32::from_bits(k as u32)), best_prim);
         }
         for (k, s) in spheres.iter().enumerate() {
             let t = sphere8(s, &r, best_t);
             let closer = t.simd_lt(best_t);
             best_t = closer.select(t, best_t);
-            best_prim = closer.select(f32x8::splat(f32::from_bits(base + k as u32)), best_prim);
+            best_prim = closer.select(V::splat(f32::from_bits(base + k as u32)), best_prim);
         }
         let ts = best_t.to_array();
         let ps = best_prim.to_array();
-        for lane in 0..(n - i).min(LANES) {
+        for lane in 0..(n - i).min(V::N) {
             let prim = ps[lane].to_bits();
             prim_out[i + lane] = prim;
             t_out[i + lane] = if prim == NO_HIT {
@@ -276,8 +316,19 @@ pub fn closest_hits(
 }
 
 /// For every ray, whether anything blocks it in (T_MIN, tmax). Spheres first, then triangles;
-/// a chunk of 8 stops as soon as all its live lanes are blocked.
+/// a chunk of N lanes stops as soon as all its live lanes are blocked.
 pub fn occluded(
+    triangles: &[Triangle],
+    spheres: &[Sphere],
+    rays: &RayColumns,
+    two_sided: bool,
+    out: &mut [bool],
+) {
+    occluded_lanes::<f32x8>(triangles, spheres, rays, two_sided, out);
+}
+
+/// [`occluded`] at the lane width of `V` (8 or 16): the same answers.
+pub fn occluded_lanes<V: Lanes>(
     triangles: &[Triangle],
     spheres: &[Sphere],
     rays: &RayColumns,
@@ -286,12 +337,12 @@ pub fn occluded(
 ) {
     let n = rays.len();
     debug_assert!(out.len() == n);
-    for i in (0..n).step_by(LANES) {
-        let r = Rays8::load(rays, i);
-        let tmax = load(rays.tmax, i, 0.0);
+    for i in (0..n).step_by(V::N) {
+        let r = Rays::<V>::load(rays, i);
+        let tmax = V::load(rays.tmax, i, 0.0);
         // A lane with tmax ≤ 0 (dead, or a light point within T_MIN) can never be blocked, so
         // it does not hold up the early exit.
-        let live = live_lanes(i, n) & tmax.simd_gt(f32x8::ZERO).to_bitmask();
+        let live = live_lanes::<V>(i, n) & tmax.simd_gt(V::ZERO).to_bitmask();
         let blocked = if live == 0 {
             0
         } else {
@@ -303,8 +354,8 @@ pub fn occluded(
                 |tri| triangle8_blocks(tri, &r, tmax, two_sided),
             )
         };
-        let lanes = (n - i).min(LANES);
-        out[i..i + lanes].copy_from_slice(&MASK_BOOLS[(blocked & 0xff) as usize][..lanes]);
+        let lanes = (n - i).min(V::N);
+        store_mask::<V>(&mut out[i..i + lanes], blocked);
     }
 }
 
@@ -344,13 +395,13 @@ fn occluded8(
 /// (With the margin added as a separate term, this test cost 15% more instructions in the
 /// occlusion loop than folded into c.)
 #[inline(always)]
-fn sphere8_blocks(s: &Sphere, r: &Rays8, tmax: f32x8) -> u32 {
+fn sphere8_blocks<V: Lanes>(s: &Sphere, r: &Rays<V>, tmax: V) -> u32 {
     let lanes = SphereLanes::new(s, r);
     if lanes.all_miss() {
         return 0;
     }
-    let Roots8 { ok, a, c, q, .. } = lanes.roots(r);
-    let t1_in_range = q.simd_gt(f32x8::ZERO) & q.simd_lt(tmax * a);
-    let t0_in_range = (c * q).simd_gt(f32x8::ZERO) & c.abs().simd_lt(tmax * q.abs());
+    let Roots { ok, a, c, q, .. } = lanes.roots(r);
+    let t1_in_range = q.simd_gt(V::ZERO) & q.simd_lt(tmax * a);
+    let t0_in_range = (c * q).simd_gt(V::ZERO) & c.abs().simd_lt(tmax * q.abs());
     (ok & (t1_in_range | t0_in_range)).to_bitmask()
 }
