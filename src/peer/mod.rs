@@ -37,6 +37,7 @@ use crate::spawn::surface_hit;
 use crate::wavefront::batch::{HitBatch, PathId, RayBatch};
 use crate::wavefront::bvh::MeshBvh;
 use crate::wavefront::context::Context;
+use crate::wavefront::lanes::LaneWidth;
 use crate::wavefront::{DEFAULT_BATCH_SIZE, intersect, simd};
 use glam::Vec3;
 use obvhs::{cwbvh::CwBvh, ray::RayHit};
@@ -488,8 +489,8 @@ fn traverse(
 /// raywave's hit search as the intersect stage runs it (`intersect::closest` without the
 /// shading columns), over the set's batches: for meshes the BVH traversal
 /// (`intersect::mesh_hits`: camera rays in packets, others one at a time), for scenes below
-/// `BVH_MIN_TRIANGLES` the 8-wide brute-force kernel over every primitive
-/// (`simd::closest_hits`). t and prim into `out`, what the peers' calls produce.
+/// `BVH_MIN_TRIANGLES` the brute-force kernel over every primitive at the build's native lane
+/// width, as the stage runs it (`simd::closest_hits_at`, 16 lanes with AVX-512). t and prim into `out`, what the peers' calls produce.
 pub fn raywave_closest(ctx: &Context, set: &RaySet, out: &mut Hits) {
     if ctx.accel.is_some() {
         return wavefront_bvh_closest(ctx, set, out);
@@ -500,7 +501,8 @@ pub fn raywave_closest(ctx: &Context, set: &RaySet, out: &mut Hits) {
         let start = out.t.len();
         out.t.resize(start + batch.len(), f32::INFINITY);
         out.prim.resize(start + batch.len(), NO_HIT);
-        simd::closest_hits(
+        simd::closest_hits_at(
+            LaneWidth::Auto,
             &scene.triangles,
             &scene.spheres,
             &intersect::columns(batch),
@@ -514,7 +516,8 @@ pub fn raywave_closest(ctx: &Context, set: &RaySet, out: &mut Hits) {
 /// The wavefront engine's occlusion path, over the set's batches.
 ///
 /// `wavefront::shadow`'s occlusion pass hands the shadow queue's columns to
-/// `MeshBvh::occluded` for meshes, and to the brute-force `simd::occluded` over the shadow
+/// `MeshBvh::occluded` for meshes, and to the brute-force `simd::occluded_at` (the build's
+/// native lane width, as the stage runs it) over the shadow
 /// casters (`geometry::casters`: every triangle when two-sided) and spheres for smaller scenes;
 /// this hands the same function each batch's columns.
 pub fn wavefront_occluded(ctx: &Context, set: &RaySet, out: &mut Vec<bool>) {
@@ -527,7 +530,8 @@ pub fn wavefront_occluded(ctx: &Context, set: &RaySet, out: &mut Vec<bool>) {
         let (rays, blocked) = (intersect::columns(batch), &mut out[start..]);
         match &ctx.accel {
             Some(bvh) => bvh.occluded(scene, &rays, two_sided, blocked),
-            None => simd::occluded(
+            None => simd::occluded_at(
+                LaneWidth::Auto,
                 casters(scene, &ctx.shadow_casters, two_sided),
                 &scene.spheres,
                 &rays,

@@ -327,6 +327,23 @@ pub fn occluded(
     occluded_lanes::<f32x8>(triangles, spheres, rays, two_sided, out);
 }
 
+/// [`occluded`] at lane width `width` (`Auto` as the build's native width), dispatched in a
+/// function of its own as [`closest_hits_at`] is.
+#[inline(never)]
+pub fn occluded_at(
+    width: LaneWidth,
+    triangles: &[Triangle],
+    spheres: &[Sphere],
+    rays: &RayColumns,
+    two_sided: bool,
+    out: &mut [bool],
+) {
+    match width.resolve() {
+        LaneWidth::Sixteen => occluded_lanes::<f32x16>(triangles, spheres, rays, two_sided, out),
+        _ => occluded_lanes::<f32x8>(triangles, spheres, rays, two_sided, out),
+    }
+}
+
 /// [`occluded`] at the lane width of `V` (8 or 16): the same answers.
 pub fn occluded_lanes<V: Lanes>(
     triangles: &[Triangle],
