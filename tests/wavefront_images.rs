@@ -238,13 +238,35 @@ fn sixteen_and_eight_lanes_give_the_same_bytes_on_every_scene() {
 fn auto_lanes_follow_the_build() {
     use raywave::wavefront::lanes::LaneWidth;
     let scene = Scene::builtin_default();
-    let s = &modes()[0];
     let native = if cfg!(target_feature = "avx512f") {
         LaneWidth::Sixteen
     } else {
         LaneWidth::Eight
     };
-    assert_eq!(Wavefront::new(&scene, s, 64).lane_width(), native);
-    let auto = Wavefront::new(&scene, s, 64).with_lane_width(LaneWidth::Auto);
-    assert_eq!(auto.lane_width(), native);
+    // The build's native width where a light has more than 8 points, or no shadow rays are
+    // cast; 8 lanes for hard shadows and for 8 points or fewer, where a 16-lane block would be
+    // mostly dead lanes.
+    for (shadows, points, want) in [
+        (ShadowMode::Soft, 16, native),
+        (ShadowMode::Soft, 9, native),
+        (ShadowMode::Off, 1, native),
+        (ShadowMode::Soft, 8, LaneWidth::Eight),
+        (ShadowMode::Soft, 4, LaneWidth::Eight),
+        (ShadowMode::Hard, 1, LaneWidth::Eight),
+    ] {
+        let s = RenderSettings {
+            shadows,
+            shadow_samples: points,
+            ..modes()[0].clone()
+        };
+        assert_eq!(
+            Wavefront::new(&scene, &s, 64).lane_width(),
+            want,
+            "{shadows:?} {points}"
+        );
+        let auto = Wavefront::new(&scene, &s, 64).with_lane_width(LaneWidth::Auto);
+        assert_eq!(auto.lane_width(), want, "{shadows:?} {points}");
+        let forced = Wavefront::new(&scene, &s, 64).with_lane_width(LaneWidth::Sixteen);
+        assert_eq!(forced.lane_width(), LaneWidth::Sixteen);
+    }
 }

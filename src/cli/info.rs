@@ -7,7 +7,7 @@ use anyhow::Result;
 pub fn run() -> Result<()> {
     let b = raywave::build_info::current();
     raywave::terminal::print(&format!(
-        "raywave {}\ncommit  {}\nbuild   {} · {}\nrustflags {}\nfeatures {}\nsimd    {}\nlanes   {} by default (--lanes 8 or 16 forces a width; the same image either way)\nthreads {} (rayon default; --threads N to change)\n",
+        "raywave {}\ncommit  {}\nbuild   {} · {}\nrustflags {}\nfeatures {}\nsimd    {}\nlanes   {} by default, 8 for hard shadows and for 8 or fewer points per light (--lanes 8 or 16 forces a width; the same image either way)\nthreads {} (rayon default; --threads N to change)\n",
         env!("CARGO_PKG_VERSION"),
         match b.dirty {
             Some(true) => format!("{} (dirty)", b.commit),

@@ -69,8 +69,8 @@ pub struct RenderArgs {
     /// Which engine renders the image.
     #[arg(long, value_enum, default_value = "wavefront")]
     pub engine: EngineArg,
-    /// Lanes of the wavefront engine's kernels: auto (16 on an AVX-512 build, else 8), 8 or 16.
-    /// Speed only: the image is the same.
+    /// Lanes of the wavefront engine's kernels: auto (16 on an AVX-512 build, but 8 for hard
+    /// shadows and for 8 or fewer points per light), 8 or 16. Speed only: the image is the same.
     #[arg(long, value_enum, default_value = "auto")]
     pub lanes: LanesArg,
     /// Camera samples per wavefront tile: the unit of work and of memory.

@@ -47,6 +47,18 @@ pub struct TriangleShading {
     pub material: u32,
 }
 
+/// The width `LaneWidth::Auto` runs a render at: the build's native width, but 8 lanes where a
+/// 16-lane block would be mostly dead lanes: hard shadows (one point per light: equal speed,
+/// half the queue slots reserved per hit) and soft shadows of 8 points or fewer (the lab
+/// benchmark's frame at 16 lanes: 0.75× of 8 at 4 points, 0.88× at 8; docs/PERFORMANCE.md).
+pub fn auto_width(settings: &RenderSettings, points_per_light: u32) -> LaneWidth {
+    match settings.shadows {
+        ShadowMode::Hard => LaneWidth::Eight,
+        ShadowMode::Soft if points_per_light <= 8 => LaneWidth::Eight,
+        _ => LaneWidth::NATIVE,
+    }
+}
+
 /// Scene, settings and derived tables for one render.
 pub struct Context<'a> {
     /// The scene.
@@ -135,17 +147,20 @@ impl<'a> Context<'a> {
             materials,
             lights,
             points_per_light,
-            lane_width: LaneWidth::NATIVE,
+            lane_width: auto_width(settings, points_per_light),
             cell_x,
             cell_y,
             grid: (nx as f32, ny as f32),
         }
     }
 
-    /// The same context with the kernels run `width` lanes wide (`Auto`: the build's native
-    /// width). Speed only: every width gives the same image.
+    /// The same context with the kernels run `width` lanes wide (`Auto`: [`auto_width`]).
+    /// Speed only: every width gives the same image.
     pub fn with_lane_width(mut self, width: LaneWidth) -> Self {
-        self.lane_width = width.resolve();
+        self.lane_width = match width {
+            LaneWidth::Auto => auto_width(self.settings, self.points_per_light),
+            w => w,
+        };
         self
     }
 
