@@ -50,7 +50,8 @@ pub struct TriangleShading {
 /// The width `LaneWidth::Auto` runs a render at: the build's native width, but 8 lanes where a
 /// 16-lane block would be mostly dead lanes: hard shadows (one point per light: equal speed,
 /// half the queue slots reserved per hit) and soft shadows of 8 points or fewer (the lab
-/// benchmark's frame at 16 lanes: 0.75× of 8 at 4 points, 0.88× at 8; docs/PERFORMANCE.md).
+/// benchmark's frame at 16 lanes: 0.72–0.79× of 8 at 4 points, 0.83–0.88× at 8;
+/// docs/PERFORMANCE.md).
 pub fn auto_width(settings: &RenderSettings, points_per_light: u32) -> LaneWidth {
     match settings.shadows {
         ShadowMode::Hard => LaneWidth::Eight,
@@ -81,7 +82,7 @@ pub struct Context<'a> {
     /// Points per light (N).
     pub points_per_light: u32,
     /// The lane width of the brute-force, light and shading kernels, resolved (`Eight` or
-    /// `Sixteen`): the build's native width unless [`Context::with_lane_width`] says otherwise.
+    /// `Sixteen`): [`auto_width`]'s choice unless [`Context::with_lane_width`] says otherwise.
     pub lane_width: LaneWidth,
     /// Stratum column of every point index (padded to a multiple of 16), as floats.
     pub cell_x: Vec<f32>,
