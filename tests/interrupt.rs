@@ -51,6 +51,32 @@ fn temporaries(dir: &Path) -> Vec<String> {
         .collect()
 }
 
+/// Waits until the child catches `sig` (its handler is installed: `SigCgt` in
+/// /proc/PID/status), so that a delay counts from then and not from a start that a loaded
+/// machine may stretch past it (a signal before the handler kills the process outright).
+fn wait_until_caught(child: &Child, sig: i32) {
+    let start = Instant::now();
+    let status = format!("/proc/{}/status", child.id());
+    loop {
+        let caught = std::fs::read_to_string(&status)
+            .ok()
+            .and_then(|s| {
+                s.lines()
+                    .find_map(|l| l.strip_prefix("SigCgt:"))
+                    .and_then(|m| u64::from_str_radix(m.trim(), 16).ok())
+            })
+            .is_some_and(|mask| mask & (1 << (sig - 1)) != 0);
+        if caught {
+            return;
+        }
+        assert!(
+            start.elapsed() < Duration::from_secs(20),
+            "the child never installed its handler for signal {sig}"
+        );
+        std::thread::sleep(Duration::from_millis(1));
+    }
+}
+
 fn signal(child: &Child, sig: i32) {
     // SAFETY: kill with a pid we spawned and a valid signal number.
     assert_eq!(unsafe { libc::kill(child.id() as i32, sig) }, 0);
@@ -100,6 +126,7 @@ fn a_signal_while_rendering_exits_cleanly_and_keeps_the_old_outputs() {
         for delay_ms in [50, 300] {
             let dir = tempfile::tempdir().unwrap();
             let child = start(dir.path(), "2048", true);
+            wait_until_caught(&child, sig);
             std::thread::sleep(Duration::from_millis(delay_ms));
             signal(&child, sig);
             let (got, err) = finish(child);
