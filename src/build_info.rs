@@ -8,9 +8,10 @@ use serde::{Deserialize, Serialize};
 /// The build this binary is.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct BuildInfo {
-    /// `git rev-parse HEAD` at build time, or "unknown" (no git, e.g. a source tarball).
+    /// `git rev-parse HEAD` when the sources were compiled, or "unknown" (no git, e.g. a source
+    /// tarball). `build.rs` does not rerun on a commit alone.
     pub commit: String,
-    /// Whether tracked files differed from the commit at build time (None when unknown).
+    /// Whether the compiled files differed from the commit then (None when unknown).
     pub dirty: Option<bool>,
     /// Cargo profile ("release", "debug").
     pub profile: String,
