@@ -59,6 +59,7 @@ pub mod debug_view;
 pub mod engine;
 pub mod error;
 pub mod false_colour;
+#[path = "output/image_file.rs"]
 pub mod film;
 pub mod geometry;
 pub mod image_diff;
