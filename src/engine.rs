@@ -19,7 +19,8 @@ use crate::wavefront::stats::RenderStats;
 use serde::Serialize;
 
 /// The renderers.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, schemars::JsonSchema)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[cfg_attr(feature = "tools", derive(schemars::JsonSchema))]
 #[serde(rename_all = "lowercase")]
 pub enum Engine {
     /// Structure-of-arrays batches through 8-wide SIMD stages (the default).

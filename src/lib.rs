@@ -52,37 +52,56 @@
 //! ```
 #![warn(missing_docs)]
 
-pub mod bench;
-pub mod build_info;
+// The renderer: what a frame needs, with no tool's dependencies (`--no-default-features`
+// builds only this, as the instruction-count gate's child does).
 pub mod camera;
-pub mod debug_view;
 pub mod engine;
 pub mod error;
-pub mod false_colour;
-#[path = "output/image_file.rs"]
 pub mod film;
 pub mod geometry;
-pub mod image_diff;
-pub mod machine;
-pub mod meshgen;
-pub mod options;
-pub mod output;
-pub mod peer;
 pub mod quote;
 pub mod reference;
-pub mod report;
 pub mod sampling;
 pub mod scene;
 pub mod settings;
 pub mod shading;
 pub mod spawn;
-pub mod statistics;
 pub mod stats;
-pub mod terminal;
-pub mod trace;
-pub mod variance;
-pub mod view;
 pub mod wavefront;
+
+// Outputs, records and the tools built on the renderer (the default `tools` feature).
+#[cfg(feature = "tools")]
+pub mod bench;
+#[cfg(feature = "tools")]
+pub mod build_info;
+#[cfg(feature = "tools")]
+pub mod debug_view;
+#[cfg(feature = "tools")]
+pub mod false_colour;
+#[cfg(feature = "tools")]
+pub mod image_diff;
+#[cfg(feature = "tools")]
+pub mod machine;
+#[cfg(feature = "tools")]
+pub mod meshgen;
+#[cfg(feature = "tools")]
+pub mod options;
+#[cfg(feature = "tools")]
+pub mod output;
+#[cfg(feature = "tools")]
+pub mod peer;
+#[cfg(feature = "tools")]
+pub mod report;
+#[cfg(feature = "tools")]
+pub mod statistics;
+#[cfg(feature = "tools")]
+pub mod terminal;
+#[cfg(feature = "tools")]
+pub mod trace;
+#[cfg(feature = "tools")]
+pub mod variance;
+#[cfg(feature = "tools")]
+pub mod view;
 
 /// Which SIMD instructions this build's wavefront engine uses by default (`--lanes auto`),
 /// decided at compile time: `f32x16` on AVX-512 builds, else `f32x8` (from the `wide` crate).

@@ -200,7 +200,7 @@ impl RenderRecord {
     /// every object's keys alphabetically.
     pub fn write(&self, path: &Path) -> anyhow::Result<()> {
         let json = serde_json::to_value(self)?;
-        crate::film::write_atomically(path, |w| {
+        crate::output::image_file::write_atomically(path, |w| {
             serde_json::to_writer_pretty(&mut *w, &json)?;
             Ok(writeln!(w)?)
         })
@@ -216,7 +216,7 @@ impl RenderRecord {
     ) -> anyhow::Result<()> {
         let mut json = serde_json::to_value(self)?;
         json[key] = value;
-        crate::film::write_atomically(path, |w| {
+        crate::output::image_file::write_atomically(path, |w| {
             serde_json::to_writer_pretty(&mut *w, &json)?;
             Ok(writeln!(w)?)
         })

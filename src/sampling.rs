@@ -9,13 +9,12 @@
 
 use serde::{Deserialize, Serialize};
 
-pub mod rng;
-
 /// The `light` value used for the camera's own dimensions.
 pub const CAMERA_LIGHT: u32 = u32::MAX;
 
 /// How points are chosen on an area light.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "tools", derive(schemars::JsonSchema))]
 #[serde(rename_all = "lowercase")]
 pub enum LightSampler {
     /// N independent uniform points on the light.

@@ -5,7 +5,8 @@ use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
 /// How shadows are computed.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "tools", derive(schemars::JsonSchema))]
 #[serde(rename_all = "lowercase")]
 pub enum ShadowMode {
     /// The lab's starting point: every light counts as visible (no shadow rays).
@@ -17,9 +18,8 @@ pub enum ShadowMode {
 }
 
 /// How a light's colour reaches a shaded point.
-#[derive(
-    Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema,
-)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "tools", derive(schemars::JsonSchema))]
 #[serde(rename_all = "lowercase")]
 pub enum LightModel {
     /// The lab's: Lc = 0.2·ke·area, with no fall-off with distance.
@@ -31,7 +31,8 @@ pub enum LightModel {
 }
 
 /// Everything that decides the image, apart from the scene.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "tools", derive(schemars::JsonSchema))]
 pub struct RenderSettings {
     /// Image width in pixels.
     pub width: u32,

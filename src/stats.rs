@@ -6,9 +6,8 @@ use std::ops::{Add, AddAssign};
 use std::time::{Duration, Instant};
 
 /// Rays cast, by kind.
-#[derive(
-    Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema,
-)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "tools", derive(schemars::JsonSchema))]
 pub struct RayCounts {
     /// Primary rays from the camera.
     pub camera: u64,

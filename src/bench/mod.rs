@@ -142,7 +142,7 @@ pub fn run(args: &BenchOptions, hooks: &Hooks) -> Result<Outcome> {
         .into());
     }
     if let Some(p) = args.json.as_ref().filter(|p| p.as_os_str() != "-") {
-        crate::film::check_output_dir(p)?;
+        crate::output::image_file::check_output_dir(p)?;
     }
     let SceneFile { scene, bytes } =
         load_scene(args.scene.as_deref(), &args.image.parse_options())?;

@@ -427,7 +427,7 @@ pub fn save(path: &Path, record: &BenchRecord) -> Result<()> {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("cannot create directory {}", dir.display()))?;
     }
-    crate::film::write_atomically(path, |w| {
+    crate::output::image_file::write_atomically(path, |w| {
         serde_json::to_writer_pretty(&mut *w, record)?;
         Ok(writeln!(w)?)
     })

@@ -5,7 +5,7 @@
 use super::Command;
 use super::image::ImageArgs;
 use super::values::{EngineArg, ToneMapArg};
-use raywave::film::{OutputFormat, output_format};
+use raywave::output::image_file::{OutputFormat, output_format};
 use raywave::sampling::LightSampler;
 use raywave::settings::ShadowMode;
 

@@ -6,7 +6,7 @@ use super::values::DefaultsArg;
 use anyhow::{Result, bail};
 use clap::{Args, ValueEnum};
 use raywave::error::UsageError;
-use raywave::film::{ldr_format, write_atomically};
+use raywave::output::image_file::{ldr_format, write_atomically};
 use raywave::image_diff::{
     self, Comparison, EXIT_FAILED, FileInfo, Image, Metric, Region, read_image,
 };
@@ -238,7 +238,7 @@ pub fn run(args: &DiffArgs) -> Result<u8> {
             },
         );
         let fig = image_diff::figure(&errors, a.width, a.height, metric, &title)?;
-        raywave::film::write_rgb8(&fig, out)?;
+        raywave::output::image_file::write_rgb8(&fig, out)?;
         text.push_str(&format!("wrote    {}\n", out.display()));
     }
     if let Some(json) = &args.json {

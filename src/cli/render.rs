@@ -14,7 +14,7 @@ use raywave::debug_view::RayRecorder;
 use raywave::engine::{Engine, Prepared, thread_pool};
 use raywave::error::UsageError;
 use raywave::film::{Film, ToneMap};
-use raywave::film::{OutputFormat, check_hdr_path, output_format};
+use raywave::output::image_file::{OutputFormat, check_hdr_path, output_format};
 use raywave::image_diff::{self, Encoding, FileInfo, Image, Region, read_image};
 use raywave::machine::Machine;
 use raywave::options::{BackgroundSource, Effective};
@@ -227,7 +227,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         }
     }
     match &img {
-        Some(img) => raywave::film::write_rgb8(img, &args.output)?,
+        Some(img) => raywave::output::image_file::write_rgb8(img, &args.output)?,
         None => film.write_hdr(&args.output)?,
     }
     if let Some(hdr) = &args.hdr {

@@ -10,7 +10,7 @@ use clap::Args;
 use raywave::camera::CameraRays;
 use raywave::engine::{Engine, thread_pool};
 use raywave::error::UsageError;
-use raywave::film::ldr_format;
+use raywave::output::image_file::ldr_format;
 use raywave::output::{OutputPlan, write_output};
 use raywave::terminal::progress_bar;
 use raywave::trace::draw::{Overlay, depth_buffer};
@@ -198,7 +198,7 @@ pub fn run(args: &TracePixelArgs) -> Result<()> {
             settings.width as f32 / settings.height as f32,
             !args.no_rays,
         );
-        raywave::film::write_rgb8(&img, path)
+        raywave::output::image_file::write_rgb8(&img, path)
             .with_context(|| format!("cannot write --png {}", path.display()))?;
     }
     let wrote: Vec<String> = [

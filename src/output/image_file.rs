@@ -1,4 +1,5 @@
-//! The image being rendered (linear RGB floats) and how it is written.
+//! A film's files: PNG and PPM after tone mapping, PFM and EXR linear, the one table of image
+//! formats by extension, and the atomic writer every command's files go through.
 //!
 //! Every file is written whole or not at all: the bytes go to a temporary file in the same
 //! directory, which is renamed over the target only once it is complete (devices, FIFOs and
@@ -6,46 +7,11 @@
 
 use anyhow::{Context, Result, bail};
 use glam::Vec3;
-use serde::{Deserialize, Serialize};
+use crate::film::{Film, ToneMap};
 use std::io::{BufWriter, Write};
 use std::path::Path;
 
-/// Linear RGB pixels, row-major from the top-left.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Film {
-    /// Width in pixels.
-    pub width: u32,
-    /// Height in pixels.
-    pub height: u32,
-    /// `width × height` colours.
-    pub pixels: Vec<Vec3>,
-}
-
-/// How linear values become 8-bit pixels.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum ToneMap {
-    /// The lab's look: clamp to [0, 1], no gamma.
-    Clamp,
-    /// The lab's key 'h': 1 − exp(−3x).
-    Exp,
-}
-
 impl Film {
-    /// A black image.
-    pub fn new(width: u32, height: u32) -> Film {
-        Film {
-            width,
-            height,
-            pixels: vec![Vec3::ZERO; width as usize * height as usize],
-        }
-    }
-
-    /// How many pixels have a channel that is not finite.
-    pub fn non_finite_pixels(&self) -> usize {
-        self.pixels.iter().filter(|c| !c.is_finite()).count()
-    }
-
     /// 8-bit RGB after tone mapping.
     pub fn to_rgb8(&self, tone: ToneMap) -> image::RgbImage {
         let mut img = image::RgbImage::new(self.width, self.height);

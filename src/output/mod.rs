@@ -9,9 +9,10 @@
 //!   unusable directory   -> error naming the file and the directory (exit 1)
 //! ```
 //!
-//! `write.rs` writes the files (atomically for regular files, directly for devices, FIFOs and
-//! stdout) and removes temporary files on SIGINT/SIGTERM; `memory.rs` estimates a render's peak.
+//! `image_file.rs` turns a film into PNG, PPM, PFM or EXR bytes; `write.rs` writes the files
+//! (atomically for regular files, directly for devices, FIFOs and stdout) and removes temporary files on SIGINT/SIGTERM; `memory.rs` estimates a render's peak.
 
+pub mod image_file;
 pub mod memory;
 pub mod write;
 

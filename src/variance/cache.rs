@@ -169,7 +169,7 @@ impl Cache {
                 .flat_map(|c| c.to_array())
         };
         let sum = floats().fold(FNV_START, |h, x| fnv(h, &x.to_le_bytes()));
-        crate::film::write_atomically(&path, |w| {
+        crate::output::image_file::write_atomically(&path, |w| {
             w.write_all(MAGIC)?;
             for v in [CACHE_FORMAT, width, height] {
                 w.write_all(&v.to_le_bytes())?;

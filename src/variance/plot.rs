@@ -5,7 +5,7 @@
 
 use super::{Region, Row, StudyResult};
 use crate::false_colour::{self, Scale, figure, register_font};
-use crate::film::write_atomically;
+use crate::output::image_file::write_atomically;
 use crate::sampling::LightSampler;
 use anyhow::{Context, Result, anyhow};
 use plotters::coord::Shift;

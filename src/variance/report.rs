@@ -487,7 +487,7 @@ impl StudyResult {
         let mut written = Vec::new();
         let text = |name: &str, body: String, written: &mut Vec<PathBuf>| -> Result<()> {
             let path = dir.join(name);
-            crate::film::write_atomically(&path, |w| {
+            crate::output::image_file::write_atomically(&path, |w| {
                 std::io::Write::write_all(w, body.as_bytes())?;
                 Ok(())
             })?;

@@ -13,7 +13,7 @@
 
 use super::StudyResult;
 use crate::false_colour::register_font;
-use crate::film::write_atomically;
+use crate::output::image_file::write_atomically;
 use anyhow::{Result, anyhow};
 use image::RgbImage;
 use plotters::prelude::*;
