@@ -6,11 +6,11 @@ use super::values::DefaultsArg;
 use anyhow::{Result, bail};
 use clap::{Args, ValueEnum};
 use raywave::error::UsageError;
-use raywave::output::image_file::{ldr_format, write_atomically};
 use raywave::image_diff::{
     self, Comparison, EXIT_FAILED, FileInfo, Image, Metric, Region, read_image,
 };
 use raywave::options::ImageOptions;
+use raywave::output::image_file::{ldr_format, write_atomically};
 use raywave::output::{OutputPlan, is_stdio};
 use raywave::sampling::LightSampler;
 use raywave::scene::load_scene;

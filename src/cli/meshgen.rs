@@ -25,7 +25,9 @@ pub fn run(args: &MeshgenArgs) -> Result<()> {
     plan.check()?;
     let bands = bands_for(args.triangles as usize);
     let text = cornell_box_mesh_spheres(bands);
-    raywave::output::image_file::write_atomically(&args.output, |w| Ok(w.write_all(text.as_bytes())?))?;
+    raywave::output::image_file::write_atomically(&args.output, |w| {
+        Ok(w.write_all(text.as_bytes())?)
+    })?;
     let text = format!(
         "wrote   {}: {} triangles ({bands} latitude bands per sphere)\n",
         args.output.display(),

@@ -5,9 +5,9 @@
 //! directory, which is renamed over the target only once it is complete (devices, FIFOs and
 //! standard output are written directly: `output::write`).
 
+use crate::film::{Film, ToneMap};
 use anyhow::{Context, Result, bail};
 use glam::Vec3;
-use crate::film::{Film, ToneMap};
 use std::io::{BufWriter, Write};
 use std::path::Path;
 
