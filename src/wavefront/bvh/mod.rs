@@ -205,6 +205,9 @@ impl MeshBvh {
     /// Whether anything (spheres, then triangles through the tree) blocks every ray in
     /// (T_MIN, tmax), as `Accel::occluded`. Rays with tmax ≤ T_MIN cannot be blocked and are
     /// not traced (the shadow queue's dead lanes have tmax = 0).
+    ///
+    /// (An occluder cache, a ray after a blocked one testing the leaf that blocked that one
+    /// first, cost 6.6% more instructions on the gate's mesh tile: docs/PERFORMANCE.md, "What was tried".)
     pub fn occluded(&self, scene: &Scene, rays: &RayColumns, two_sided: bool, out: &mut [bool]) {
         let mut stack = Stack::new(self);
         let rays = cut(rays);
@@ -216,11 +219,15 @@ impl MeshBvh {
                 continue;
             }
             let ray = rays.ray(i);
-            *blocked = scene
+            if scene
                 .spheres
                 .iter()
                 .any(|s| crate::geometry::sphere_blocks(s, &ray, tmax))
-                || self.occluded_in(&ray, tmax, two_sided, &mut stack);
+            {
+                *blocked = true;
+                continue;
+            }
+            *blocked = self.blocker(&RayLanes::new(&ray), tmax, two_sided, &mut stack) != EMPTY;
         }
     }
 }

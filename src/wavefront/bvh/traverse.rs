@@ -6,7 +6,8 @@
 //!           one child hit: go on with it; two: push the far one; more: push far to near
 //!           leaf  → Möller–Trumbore against its 8 triangles, keep the least (t, id)
 //!           pop entries until one starts before the best t
-//! occluded: node → push every child hit; leaf → stop at the first blocker
+//! occluded: node → go on with the last child hit, push the others; leaf → stop at the first
+//!           blocker
 //! ```
 
 use super::{Block, EMPTY, LEAF, MeshBvh, Node, WIDTH, hit};
@@ -189,20 +190,21 @@ impl MeshBvh {
 
     /// True when a triangle blocks the ray in (T_MIN, tmax); stops at the first blocker.
     pub fn occluded_triangle(&self, ray: &Ray, tmax: f32, two_sided: bool) -> bool {
-        self.occluded_in(ray, tmax, two_sided, &mut Stack::new(self))
+        let r = RayLanes::new(ray);
+        self.blocker(&r, tmax, two_sided, &mut Stack::new(self)) != EMPTY
     }
 
-    /// [`Self::occluded_triangle`] with a stack from the caller.
+    /// The first leaf found that blocks the ray in (T_MIN, tmax), as a child reference
+    /// (`LEAF | block`), or `EMPTY` when none does; stops at that leaf.
     #[inline(always)]
-    pub(super) fn occluded_in(
+    pub(super) fn blocker(
         &self,
-        ray: &Ray,
+        r: &RayLanes,
         tmax: f32,
         two_sided: bool,
         stack: &mut Stack,
-    ) -> bool {
+    ) -> u32 {
         let stack = &mut stack.0[..];
-        let r = RayLanes::new(ray);
         let tmax8 = f32x8::splat(tmax);
         let mut sp = 0;
         let mut cur = self.root;
@@ -210,22 +212,41 @@ impl MeshBvh {
             if cur & LEAF == 0 {
                 let node = &self.nodes[cur as usize];
                 let (mask, _) = r.boxes(node, tmax);
-                for k in set_bits(mask) {
-                    self.prefetch(node.child[k]);
-                    stack[sp] = (node.child[k], 0.0);
-                    sp += 1;
+                if mask != 0 {
+                    // Go on with the last child entered and push the others, lowest first: the
+                    // order that pushing all of them and popping the last visits them in, so the
+                    // same leaves are tested in the same order, without the push, pop and
+                    // prefetch of the child taken at once (the only one, when one is entered).
+                    let last = 31 - mask.leading_zeros() as usize;
+                    for k in set_bits(mask & !(1 << last)) {
+                        self.prefetch(node.child[k]);
+                        stack[sp] = (node.child[k], 0.0);
+                        sp += 1;
+                    }
+                    cur = node.child[last];
+                    continue;
                 }
-            } else if cur != EMPTY
-                && triangles8_block(&self.blocks[(cur & !LEAF) as usize], &r, tmax8, two_sided)
-            {
-                return true;
+            } else if cur != EMPTY && self.leaf_blocks(cur, r, tmax8, two_sided) {
+                return cur;
             }
             if sp == 0 {
-                return false;
+                return EMPTY;
             }
             sp -= 1;
             cur = stack[sp].0;
         }
+    }
+
+    /// Whether a triangle of the leaf `leaf` (`LEAF | block`) blocks the ray before `tmax`.
+    #[inline(always)]
+    pub(super) fn leaf_blocks(
+        &self,
+        leaf: u32,
+        r: &RayLanes,
+        tmax: f32x8,
+        two_sided: bool,
+    ) -> bool {
+        triangles8_block(&self.blocks[(leaf & !LEAF) as usize], r, tmax, two_sided)
     }
 }
 
