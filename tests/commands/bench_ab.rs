@@ -3,7 +3,7 @@
 //! build that claims a microsecond per frame this build must be called a regression (exit 3),
 //! against one that claims a thousand seconds it must not.
 
-mod common;
+use crate::common;
 
 use common::bin::{raywave, stderr, stdout};
 use std::os::unix::fs::PermissionsExt;

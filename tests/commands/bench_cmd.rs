@@ -4,7 +4,7 @@
 //! 1); a missing record names its file and how to create it; sweeps write one record per
 //! point; the exports parse back. Tiny images: no timing is asserted.
 
-mod common;
+use crate::common;
 
 use common::bin::{stderr, stdout};
 use std::path::Path;

@@ -4,7 +4,7 @@
 //! is refused. Then `raywave bench compare A B` and `raywave bench list` on such files, good
 //! and bad.
 
-mod common;
+use crate::common;
 
 use common::bin::{raywave, stderr, stdout};
 use raywave::bench::compare::{Refusal, Verdict, compare};

@@ -2,7 +2,7 @@
 //! RPI flag, whose defaults apply, the no-argument run and the output formats. Its failures
 //! (usage errors, scene and output errors caught before the render) are in `cli_errors.rs`.
 
-mod common;
+use crate::common;
 
 use common::bin::{dir_with, files_in, raywave, stderr, stdout, words};
 use std::path::Path;

@@ -1,7 +1,7 @@
 //! The command line's failures: usage errors (exit 2, clap's message), and scene and output
 //! errors (exit 1, file:line), all caught before the render, with no output left behind.
 
-mod common;
+use crate::common;
 
 use common::bin::{dir_with, files_in, raywave, scenes, stderr, words};
 use std::time::{Duration, Instant};

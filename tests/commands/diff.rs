@@ -1,7 +1,7 @@
 //! `raywave diff` and `render --mse-reference` on tiny images this test writes itself (PFM and
 //! PPM by hand, PNG through `image`, EXR through `exr`), against figures worked out by hand.
 
-mod common;
+use crate::common;
 
 use common::bin::{raywave, stderr, stdout};
 use raywave::false_colour::{MIN_SIDE, inferno};

@@ -3,7 +3,7 @@
 //! docs/SAMPLING.md. (docs/TRACE.md and README's debug view are also run by tests/trace_pixel.rs,
 //! which checks what they wrote.)
 
-mod common;
+use crate::common;
 
 use common::docs::{
     Page, check_cargo, commands, nothing, run_in_page_order, shorten, stale_manual, uncovered,
@@ -20,7 +20,7 @@ const VIEW: &str =
 /// under a few seconds in a release build); the variance study is shortened.
 const README: Page = Page {
     path: "README.md",
-    text: include_str!("../README.md"),
+    text: include_str!("../../README.md"),
     quick: &[
         ("variance", "--size", &["16", "16"]),
         ("variance", "--seeds", &["2"]),
@@ -41,7 +41,7 @@ const README: Page = Page {
 /// this table.
 const BENCHMARKING: Page = Page {
     path: "docs/BENCHMARKING.md",
-    text: include_str!("../docs/BENCHMARKING.md"),
+    text: include_str!("../../docs/BENCHMARKING.md"),
     quick: &[
         ("bench", "--size", &["24", "24"]),
         ("bench", "--runs", &["6"]),
@@ -80,7 +80,7 @@ const BENCHMARKING: Page = Page {
 /// page's "Reproduce" says so); each must write its report.
 const SAMPLING: Page = Page {
     path: "docs/SAMPLING.md",
-    text: include_str!("../docs/SAMPLING.md"),
+    text: include_str!("../../docs/SAMPLING.md"),
     quick: &[
         ("variance", "--size", &["16", "16"]),
         ("variance", "--seeds", &["2"]),
@@ -223,6 +223,12 @@ fn the_checker_refuses_what_ci_does_not_run() {
         "cargo bench --features embree --bench mesh_rays",
         "cargo run --release -- bench",
         "cargo test --release --test no_such_test",
+        "cargo test --release --test no_such_test sample_streams::",
+        "cargo test --release --test sampling no_such_file::",
+        "cargo test --release --test sampling cli::",
+        "cargo test --release --test commands trace_demo::",
+        "cargo test --release --test commands main::",
+        "cargo test --release --test sampling sample_streams:: schema::",
         "cargo bench --bench wavefront -- --profile-time 5",
         "FOO=1 cargo bench --bench variance",
         "RAYWAVE_MESH=2M cargo bench --bench mesh_rays",
@@ -239,6 +245,10 @@ fn the_checker_refuses_what_ci_does_not_run() {
         "cargo bench --bench wavefront -- --save-baseline main stages/film",
         "RAYWAVE_RECORD=1 cargo bench --bench variance -- --test",
         "RAYWAVE_RECORD=1 cargo test --release --test icount",
+        "cargo test --release --test sampling sample_streams::",
+        "cargo test --release --test sampling sample_streams::light_points -- --nocapture",
+        "cargo test --release --test kernels mesh_bvh::mesh_occlusion::",
+        "cargo test --release --test icount -- --nocapture",
         "RAYWAVE_INTERLEAVE=20 RAYWAVE_MESH=12k cargo bench --bench mesh_rays",
         "RAYWAVE_ROUNDS=9 cargo bench --bench scaling",
     ] {

@@ -4,10 +4,10 @@
 //! engines) and `bench --json` / `--save` validates against the checked-in files, while
 //! doctored output does not.
 //!
-//! After changing the types: `RAYWAVE_UPDATE_SCHEMA=1 cargo test --release --test schema`
+//! After changing the types: `RAYWAVE_UPDATE_SCHEMA=1 cargo test --release --test commands schema::`
 //! rewrites docs/schema/, then review the diff (and bump `FORMAT` if the layout changed).
 
-mod common;
+use crate::common;
 
 use common::bin::{dir_with, raywave, stderr, words};
 use serde_json::{Value, json};
@@ -53,7 +53,7 @@ fn the_checked_in_schemas_are_the_generated_ones() {
         assert!(
             on_disk == generated,
             "docs/schema/{name} differs from the schema the types generate: after changing \
-             the record types run `RAYWAVE_UPDATE_SCHEMA=1 cargo test --release --test schema`, \
+             the record types run `RAYWAVE_UPDATE_SCHEMA=1 cargo test --release --test commands schema::`, \
              review the diff, bump FORMAT if the layout changed, and update docs/SCHEMA.md"
         );
     }

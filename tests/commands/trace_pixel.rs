@@ -4,8 +4,8 @@
 //! summary, the schema, bad input and the documented commands. The exports are tested in
 //! tests/trace_pixel_exports.rs.
 
-mod common;
-mod trace_demo;
+use crate::common;
+use crate::trace_demo;
 
 use common::bin::{dir_with, files_in, raywave, stderr, stdout};
 use glam::{DVec3, Vec3};
@@ -295,7 +295,7 @@ fn the_checked_in_schema_matches_the_types() {
     assert_eq!(
         serde_json::from_str::<serde_json::Value>(&checked_in).unwrap(),
         serde_json::from_str::<serde_json::Value>(&generated).unwrap(),
-        "docs/schema/ray-tree.schema.json is stale: run RAYWAVE_BLESS=1 cargo test --release --test trace_pixel"
+        "docs/schema/ray-tree.schema.json is stale: run RAYWAVE_BLESS=1 cargo test --release --test commands trace_pixel::"
     );
     // Every field the tree writes is in the schema.
     let tree = trace_pixel(&scene(), &settings(), PIXEL.0, PIXEL.1).unwrap();

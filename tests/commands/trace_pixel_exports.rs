@@ -2,8 +2,8 @@
 //! PLY parsed back against the tree, and the PNG against the same view without the rays and
 //! against the test's own projection and visibility.
 
-mod common;
-mod trace_demo;
+use crate::common;
+use crate::trace_demo;
 
 use common::bin::{dir_with, stderr};
 use glam::{DQuat, DVec3};

@@ -13,7 +13,7 @@
 //!
 //! RAYWAVE_VIEW_SCREENSHOT=FILE.png saves a screenshot of the page at the end.
 
-mod common;
+use crate::common;
 
 use common::view::ViewServer;
 use fantoccini::actions::{InputSource, MOUSE_BUTTON_LEFT, MouseActions, PointerAction};

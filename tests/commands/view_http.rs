@@ -6,7 +6,7 @@
 //! Cornell box has one area light (the face at z = 1), and the centre of the image looks at the
 //! back wall, so with hard shadows and no bounces its tree is one camera ray and one shadow ray.
 
-mod common;
+use crate::common;
 
 use common::view::{ViewServer, png_size};
 use std::time::Duration;

@@ -2,11 +2,11 @@
 //! dimension, seed), so the same seed gives the same bytes, and one thread or two give the
 //! same bytes, in the library and through the binary (both engines).
 
+use crate::common;
 use raywave::reference::Reference;
 use raywave::sampling::LightSampler;
 use raywave::scene::Scene;
 use raywave::settings::{RenderSettings, ShadowMode};
-mod common;
 
 use common::bin::{raywave, scenes, stderr, stdout};
 use std::path::{Path, PathBuf};

@@ -13,8 +13,8 @@
 // `!(d <= TOLERANCE)` is on purpose: a NaN difference counts as a difference.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-mod common;
-mod oracle;
+use crate::common;
+use crate::oracle;
 
 use common::bundled_scenes;
 

@@ -12,8 +12,8 @@
 //! against a midpoint-rule integral of the closed form. The lab's own N = 1 strategy (the
 //! light's centre) must miss the converged value by more than 50 such standard errors.
 
-mod common;
-mod oracle;
+use crate::common;
+use crate::oracle;
 
 use common::analytic::{KD, KE, SIZE, floor_point, scene, settings};
 use common::{PENTAGON, SQUARE};

@@ -5,7 +5,7 @@
 // `!(d <= 1e-4)` is on purpose: a NaN difference counts as a difference.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-mod common;
+use crate::common;
 
 use common::bundled_scenes;
 use glam::Vec3;

@@ -2,7 +2,7 @@
 //! `intersect_triangle`, lane by lane and bit for bit: on an edge-case table of rays and
 //! triangles for every leaf length up to the lane width, and on random input.
 
-mod common;
+use crate::common;
 
 use common::strategies::{any_f32, vec3};
 use common::{edge_rays, ray, triangle};

@@ -2,7 +2,7 @@
 //! diagonal, grazing rays, spheres from outside, inside and behind, NaN and infinite input,
 //! and the t > 1e-4 rule. Expected distances are worked out by hand in each test.
 
-mod common;
+use crate::common;
 
 use common::{TestRng, seeded};
 use glam::Vec3;

@@ -4,7 +4,7 @@
 //! width against the reference's `Accel`; its occlusion on adversarial shadow rays
 //! (`mesh_occlusion/`). The leaf kernels are in `bvh_leaves.rs`.
 
-mod common;
+use crate::common;
 mod mesh_occlusion;
 
 use common::{Draw, ray, scene_of, seeded, triangle};

@@ -30,7 +30,7 @@ fn mesh_scene() -> Scene {
 /// The lab's box as the peer table traces it: its 12 triangles without the light wall's two,
 /// and without its spheres (the peers trace triangles): raywave's brute-force path.
 fn lab_scene() -> Scene {
-    let text = include_str!("../scenes/cornell_box_reflective_spheres.obj");
+    let text = include_str!("../../scenes/cornell_box_reflective_spheres.obj");
     let scene = parse_scene_str(text, "cornell_box_reflective_spheres.obj");
     without_spheres(&without_emitters(&scene.expect("bundled scene parses")))
 }

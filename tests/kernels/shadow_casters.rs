@@ -3,7 +3,7 @@
 //! tests check the rule by hand on the lab's box and on two facing blockers, and check on random
 //! scenes that culling never changes whether a shadow ray is blocked.
 
-mod common;
+use crate::common;
 
 use common::{Draw, TestRng, seeded};
 use glam::Vec3;

@@ -3,7 +3,7 @@
 //! with the intersection kernels both use. The images themselves are held to an independent
 //! f64 oracle in tests/oracle_agreement.rs.
 
-mod common;
+use crate::common;
 
 use common::{Draw, TestRng, seeded, triangle};
 use glam::Vec3;

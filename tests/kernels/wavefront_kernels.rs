@@ -7,7 +7,7 @@
 // `!(x > 0.0)` is on purpose: it is true for NaN, like the kernels' tests.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-mod common;
+use crate::common;
 
 use common::strategies::{any_f32, vec3};
 use common::{edge_rays, ray, scene_of, triangle};

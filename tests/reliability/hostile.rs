@@ -2,7 +2,7 @@
 //! directory and checks its exit code, its message, that it neither panicked nor hung, and that
 //! no input or earlier output changed (`common::hostile`).
 
-mod common;
+use crate::common;
 
 use common::hostile::{Case, check, check_all, setup};
 

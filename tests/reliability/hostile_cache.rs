@@ -4,7 +4,7 @@
 //! message, no panic, no hang and that nothing changed but the files it names
 //! (`common::hostile`). Bench records and verdicts are in `tests/hostile_records.rs`.
 
-mod common;
+use crate::common;
 
 use common::hostile::{Case, TIMEOUT, check_all, run, setup};
 use std::path::{Path, PathBuf};

@@ -3,7 +3,7 @@
 //! the other flags make meaningless (exit 0 and one warning), across render, bench, variance
 //! and meshgen (`common::hostile` checks exit code, message, no panic, no hang, no stray file).
 
-mod common;
+use crate::common;
 
 use common::hostile::{case, check_all, setup};
 

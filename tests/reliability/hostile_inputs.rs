@@ -5,14 +5,14 @@
 //! code, a message fragment, no panic, no hang, and that no input changed
 //! (`common::hostile`).
 
-mod common;
+use crate::common;
 
 use common::hostile::setup_streams::{fifo_feeding, scaled, sparse};
 use common::hostile::{Case, TIMEOUT, case, check_all, run, setup};
 use std::path::Path;
 
 /// The lab's box, fed through FIFOs and standard input.
-const BOX: &[u8] = include_bytes!("../scenes/cornell_box.obj");
+const BOX: &[u8] = include_bytes!("../../scenes/cornell_box.obj");
 
 const DIR_MSG: &str = "found a directory";
 const DEV_MSG: &str = "found a character device";

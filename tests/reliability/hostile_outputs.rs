@@ -4,7 +4,7 @@
 //! message, no panic, no hang, and that no input or earlier output changed
 //! (`common::hostile`).
 
-mod common;
+use crate::common;
 
 use common::hostile::setup_outputs as out;
 use common::hostile::{Case, TIMEOUT, check_all, run, setup};

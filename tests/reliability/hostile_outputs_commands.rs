@@ -2,7 +2,7 @@
 //! hostile_outputs.rs): outputs that name an input or each other, devices, symlinks, standard
 //! output and unusable directories.
 
-mod common;
+use crate::common;
 
 use common::hostile::setup_outputs as out;
 use common::hostile::{Case, check_all, setup};

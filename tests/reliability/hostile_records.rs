@@ -5,7 +5,7 @@
 //! checks its exit code, a message, no panic, no hang and that nothing changed but the files it
 //! names (`common::hostile`). The variance cache's cases are in `tests/hostile_cache.rs`.
 
-mod common;
+use crate::common;
 
 use common::hostile::{Case, TIMEOUT, check_all, run, setup};
 use std::path::Path;

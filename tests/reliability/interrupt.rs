@@ -1,8 +1,6 @@
 //! SIGINT and SIGTERM at any phase (while rendering, while writing the output) leave no
 //! temporary file behind, keep the old output as it was, and exit 130 or 143.
 
-mod common;
-
 use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};

@@ -3,8 +3,8 @@
 //! light: lit for s = x + z > 1, umbra for s < −1, penumbra between); the study's budget
 //! matching.
 
-mod common;
-mod oracle;
+use crate::common;
+use crate::oracle;
 
 use common::SQUARE;
 use common::analytic::{self, SIZE, floor_point, settings};

@@ -5,8 +5,8 @@
 //! reference's N = 4 estimate must match I, and the f64 oracle's high-N estimate
 //! (tests/oracle/mod.rs), within ~5 standard errors of the mean taken from the sample variance. A pentagonal light checks the fan sampler the same way.
 
-mod common;
-mod oracle;
+use crate::common;
+use crate::oracle;
 
 use common::{PENTAGON, SQUARE};
 

@@ -4,7 +4,7 @@
 //! its flags: `--budgets` in both the comma form and the form its own --help shows, and a
 //! `--heatmap-n` that is not a budget (the nearest is drawn, with a note).
 
-mod common;
+use crate::common;
 
 use common::bin::{raywave, stderr, stdout};
 use raywave::false_colour::{MIN_SIDE, inferno};

@@ -6,7 +6,7 @@
 //! bound to a hand computation and make the study flag samplers whose bias is known. Also by
 //! hand: the converged reference's own noise estimate, and a zero MSE left out of the fit.
 
-mod common;
+use crate::common;
 
 use common::{Draw, seeded};
 use glam::Vec3;

@@ -1,7 +1,7 @@
 //! Scene errors: every parse error names `file:line` and says what was expected; a file that
 //! cannot be read is an error naming it, never an empty scene.
 
-mod common;
+use crate::common;
 
 use common::scenes::{WHITE_MATERIAL as MAT, error_at};
 use raywave::scene::{Scene, SceneError, parse_scene_str};

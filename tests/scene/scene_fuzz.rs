@@ -3,7 +3,7 @@
 //! scene parser. Never a panic; every error names a line of the input; no message carries a raw
 //! control character. Inputs that once crashed the fuzzer are kept below as regressions.
 
-mod common;
+use crate::common;
 
 use proptest::prelude::*;
 use raywave::scene::{ParseOptions, parse_scene_str_with};

@@ -2,7 +2,7 @@
 //! `scenes/`, and the extensions (comments, continuations, relative indices, polygons, the RPI
 //! camera block and materials). Parse errors are in `scene_errors.rs`.
 
-mod common;
+use crate::common;
 
 use common::scenes::{WHITE_MATERIAL as MAT, error_at};
 use glam::Vec3;
