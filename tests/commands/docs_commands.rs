@@ -1,7 +1,7 @@
 //! Every command the user-facing pages show is run or checked here (tests/common/docs.rs says
 //! how), so no page can drift from the code: README.md, docs/BENCHMARKING.md and
-//! docs/SAMPLING.md. (docs/TRACE.md and README's debug view are also run by tests/trace_pixel.rs,
-//! which checks what they wrote.)
+//! docs/SAMPLING.md. (docs/TRACE.md and README's debug view are also run by
+//! tests/commands/trace_pixel.rs, which checks what they wrote.)
 
 use crate::common;
 
@@ -12,9 +12,9 @@ use std::path::Path;
 
 const ROOT: &str = env!("CARGO_MANIFEST_DIR");
 
-/// `raywave view` serves until stopped; tests/view_http.rs and tests/view_browser.rs run it.
+/// `raywave view` serves until stopped; tests/commands/view_http.rs and view_browser.rs run it.
 const VIEW: &str =
-    "a server that runs until Ctrl-C; tests/view_http.rs and tests/view_browser.rs run it";
+    "a server that runs until Ctrl-C; tests/commands/view_http.rs and view_browser.rs run it";
 
 /// README.md: the set-up commands and the tour. Renders run at the page's sizes (each takes
 /// under a few seconds in a release build); the variance study is shortened.

@@ -1,8 +1,8 @@
-//! `raywave trace-pixel`'s tree on scenes/trace_demo.obj (tests/trace_demo/): the expected
+//! `raywave trace-pixel`'s tree on scenes/trace_demo.obj (tests/commands/trace_demo/): the expected
 //! segments come from the settings, the blocked flags from the test's own f64 geometry of the
 //! scene file, and the colours from both engines' whole-image renders; then the JSON, the
 //! summary, the schema, bad input and the documented commands. The exports are tested in
-//! tests/trace_pixel_exports.rs.
+//! tests/commands/trace_pixel_exports.rs.
 
 use crate::common;
 use crate::trace_demo;

@@ -1,5 +1,5 @@
-//! `raywave trace-pixel`'s exports on scenes/trace_demo.obj (tests/trace_demo/): the OBJ and
-//! PLY parsed back against the tree, and the PNG against the same view without the rays and
+//! `raywave trace-pixel`'s exports on scenes/trace_demo.obj (tests/commands/trace_demo/): the OBJ
+//! and PLY parsed back against the tree, and the PNG against the same view without the rays and
 //! against the test's own projection and visibility.
 
 use crate::common;

@@ -147,7 +147,7 @@ fn t_must_exceed_zero() {
     let on = ray([1.0, 0.5, 0.0], [0.0, 0.0, 1.0]);
     assert_eq!(quad_t(&s, &on, true), f32::INFINITY);
     // Any positive distance is: there is no absolute epsilon, which would be wrong at some
-    // scale (secondary rays start off their surface instead: tests/spawn.rs).
+    // scale (secondary rays start off their surface instead: tests/kernels/spawn.rs).
     let near = ray([1.0, 0.5, 1e-6], [0.0, 0.0, -1.0]);
     assert!((quad_t(&s, &near, false) - 1e-6).abs() < 1e-12);
     // A sphere: a ray from just outside the surface, going out, does not hit it; going in, it

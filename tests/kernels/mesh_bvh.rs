@@ -2,7 +2,7 @@
 //! every triangle (random rays through a generated mesh, a triangle soup, and a mesh full of
 //! coincident and degenerate triangles), and its batch entry points for lengths around the lane
 //! width against the reference's `Accel`; its occlusion on adversarial shadow rays
-//! (`mesh_occlusion/`). The leaf kernels are in `bvh_leaves.rs`.
+//! (`mesh_bvh/mesh_occlusion.rs`). The leaf kernels are in `bvh_leaves.rs`.
 
 use crate::common;
 mod mesh_occlusion;
@@ -447,7 +447,8 @@ fn packets_of_camera_rays_equal_brute_force() {
 /// the peer ray sets of the 12k-triangle box (128×128) through one engine, chosen by
 /// `PROBE=obvhs|wavefront|one_ray` (`one_ray`: the traversal one ray at a time, for closest-hit
 /// sets) and `SET=primary|shadow|incoherent|shadow_fan16|shadow_fan64`, 5 times:
-/// `valgrind --tool=callgrind --toggle-collect='*probe_trace*' <test binary> --ignored probe`.
+/// `valgrind --tool=callgrind --toggle-collect='*probe_trace*' <the kernels test binary> --ignored
+/// mesh_bvh::probe`.
 #[test]
 #[ignore]
 fn probe() {

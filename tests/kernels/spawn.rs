@@ -1,7 +1,7 @@
 //! Secondary rays never meet the surface they leave, at every scale: the property behind the
 //! speckle-free spheres, tested on the spawn functions both engines call (`raywave::spawn`)
 //! with the intersection kernels both use. The images themselves are held to an independent
-//! f64 oracle in tests/oracle_agreement.rs.
+//! f64 oracle in tests/images/oracle_agreement.rs.
 
 use crate::common;
 

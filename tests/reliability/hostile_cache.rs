@@ -2,7 +2,7 @@
 //! corrupt, foreign or special files where an entry belongs, `--no-cache`, `--clean-cache`, the
 //! size bound, and the command's usage errors (exit 2). Each case checks its exit code, a
 //! message, no panic, no hang and that nothing changed but the files it names
-//! (`common::hostile`). Bench records and verdicts are in `tests/hostile_records.rs`.
+//! (`common::hostile`). Bench records and verdicts are in `tests/reliability/hostile_records.rs`.
 
 use crate::common;
 
@@ -343,6 +343,6 @@ fn variance_option_conflicts_are_usage_errors() {
             outputs: &[],
         },
         // A --heatmap-n that is not a budget is not an error: the nearest budget is drawn
-        // (tests/variance_report.rs).
+        // (tests/sampling/variance_report.rs).
     ]);
 }

@@ -3,7 +3,8 @@
 //! format or not regular files; names that are paths; a regressing run that must not replace
 //! its baseline; and the command's exit codes (2 usage, 1 failure, 3 regression). Each case
 //! checks its exit code, a message, no panic, no hang and that nothing changed but the files it
-//! names (`common::hostile`). The variance cache's cases are in `tests/hostile_cache.rs`.
+//! names (`common::hostile`). The variance cache's cases are in
+//! `tests/reliability/hostile_cache.rs`.
 
 use crate::common;
 

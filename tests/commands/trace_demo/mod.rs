@@ -1,7 +1,7 @@
 //! The debug view's test scene, scenes/trace_demo.obj, and its chosen pixel: shared by
-//! tests/trace_pixel.rs (the tree) and tests/trace_pixel_exports.rs (OBJ, PLY, PNG). Pixel
-//! (26, 32) at 64×64: the camera ray hits the mirror sphere, its reflection the red wall, and
-//! the slab under the light blocks some of the wall's shadow rays.
+//! tests/commands/trace_pixel.rs (the tree) and tests/commands/trace_pixel_exports.rs (OBJ, PLY,
+//! PNG). Pixel (26, 32) at 64×64: the camera ray hits the mirror sphere, its reflection the red
+//! wall, and the slab under the light blocks some of the wall's shadow rays.
 #![allow(dead_code)]
 
 use glam::DVec3;
