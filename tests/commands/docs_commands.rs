@@ -237,6 +237,7 @@ fn the_checker_refuses_what_ci_does_not_run() {
         "RAYWAVE_INTERLEAVE=20 cargo test --release --all-targets",
         "RAYWAVE_ROUNDS=9 cargo bench --bench mesh_rays",
         "RAYWAVE_RECORD=1 cargo bench --bench wavefront",
+        "RAYWAVE_RECORD=1 cargo test --release --test sampling sample_streams::",
     ] {
         let words: Vec<&str> = bad.split_whitespace().collect();
         assert!(check_cargo(&words).is_err(), "`{bad}` passed the checker");

@@ -294,10 +294,18 @@ pub fn check_cargo(words: &[&str]) -> Result<(), String> {
             .copied()
     };
     let positive = |v: &str| v.parse::<u32>().is_ok_and(|n| n > 0);
+    // The icount gate: its own binary, or its file in a kind's binary (`--test KIND icount`).
+    let filter = words
+        .iter()
+        .position(|w| *w == "--test")
+        .and_then(|i| words.get(i + 2))
+        .filter(|w| !w.starts_with('-'));
+    let icount =
+        target("--test") == Some("icount") || filter.is_some_and(|f| f.starts_with("icount"));
     for w in &env {
-        let (bench, test) = (target("--bench"), target("--test"));
+        let bench = target("--bench");
         let known = match w.split_once('=') {
-            Some(("RAYWAVE_RECORD", "1")) => bench == Some("variance") || test == Some("icount"),
+            Some(("RAYWAVE_RECORD", "1")) => bench == Some("variance") || icount,
             Some(("RAYWAVE_INTERLEAVE", v)) => positive(v) && bench == Some("mesh_rays"),
             Some(("RAYWAVE_MESH", "12k" | "1M")) => bench == Some("mesh_rays"),
             Some(("RAYWAVE_ROUNDS", v)) => positive(v) && bench == Some("scaling"),
