@@ -410,8 +410,8 @@ pub fn build_cwbvh_scaled(scene: &Scene, scale: f32) -> CwBvh {
 /// A −0.0 direction component becomes +0.0 (x + 0.0 does exactly that and changes nothing
 /// else): obvhs inverts ±0 to ±1/ε by the sign bit but picks its CWBVH traversal octant by
 /// `x < 0.0`, which is false for −0.0, so the two disagreed and such rays missed boxes they
-/// lie in (half of the axis-aligned rays in tests/mesh_bvh.rs). Only the traversal sees this
-/// ray; the triangle tests use the caller's.
+/// lie in (half of the axis-aligned rays in tests/kernels/mesh_bvh.rs). Only the traversal sees
+/// this ray; the triangle tests use the caller's.
 pub fn obvhs_ray(ray: &Ray, tmax: f32) -> obvhs::ray::Ray {
     obvhs_ray_scaled(ray, tmax, 1.0)
 }

@@ -117,7 +117,7 @@ impl<'a> Reference<'a> {
 
     /// Pixels `first..first + out.len()` into `out`, without a trace log: the loop `render`
     /// runs for each row. Not generic, so it is compiled once, in this crate: the
-    /// instruction-count gate (`tests/icount.rs`) calls it to count the code the renderer
+    /// instruction-count gate (`tests/gates/icount.rs`) calls it to count the code the renderer
     /// runs, where a call to the generic `pixel` would count a copy compiled into the test.
     pub fn pixels(&self, first: u32, out: &mut [Vec3], counts: &mut RayCounts) {
         for (i, px) in out.iter_mut().enumerate() {

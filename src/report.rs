@@ -162,8 +162,8 @@ impl KindFigures {
 }
 
 /// The JSON Schemas of the `--stats-json` file and of a bench record, as (file name, pretty
-/// JSON with a final newline): docs/schema/ holds these, and tests/schema.rs checks that it
-/// still does.
+/// JSON with a final newline): docs/schema/ holds these, and tests/commands/schema.rs checks that
+/// it still does.
 pub fn schemas() -> [(&'static str, String); 2] {
     // The files as written: every field required (an absent value is written as null),
     // except the few left out when empty (a bench record's host name in `--stats-json`).

@@ -118,7 +118,7 @@ pub fn square_sample(sampler: LightSampler, key: &SampleKey, index: u32, count: 
             // One scramble seed per stream; the Sobol index is the sample number (< 2^16,
             // which the command line's limit on N guarantees).
             // `sample_4d` computes dimensions 0–3 together, with the index shuffle done once:
-            // the same values as `sample(index, 0 | 1, scramble)` (tests/sampling.rs), at
+            // the same values as `sample(index, 0 | 1, scramble)` (tests/sampling/sampling.rs), at
             // about half the cost.
             let scramble = hash(key, SOBOL_SEED_DIM);
             let [u, v, _, _] = sobol_burley::sample_4d(index, 0, scramble);

@@ -32,7 +32,7 @@
 //! but a ray that leaves the box's edge lies in the other wall's plane: the plain layout hits
 //! that wall at t = −0 (71 of 43,264 shadow rays of the mesh test scene at 256×256), which
 //! `peer::NEAR_ORIGIN_T` and `blocker_agreement` count as agreeing. Agreement with raywave is
-//! checked in `tests/peer_agreement.rs` and printed with every peer table.
+//! checked in `tests/kernels/peer_agreement.rs` and printed with every peer table.
 
 use super::{Hits, RaySet};
 use crate::scene::{NO_HIT, Scene};

@@ -11,7 +11,7 @@
 //! concrete `f32x8` and the free functions below.
 //!
 //! This is the only file of the crate that names the `wide` crate or `bytemuck`: the kernels
-//! (`simd/`, `shade.rs`, `bvh/`) take the lane types from here, and `tests/layering.rs` checks
+//! (`simd/`, `shade.rs`, `bvh/`) take the lane types from here, and `tests/gates/layering.rs` checks
 //! that nothing else reaches for them.
 
 use std::ops::{Add, BitAnd, BitOr, BitXor, Div, Mul, Neg, Not, Shl, Shr, Sub};

@@ -62,7 +62,7 @@ pub fn direct_light(
 
 /// [`direct_light`] at the lane width of `V`. Never inlined, so that the 8-lane stage is one
 /// function as it was before the 16-lane path, whatever codegen unit the dispatcher lands in
-/// (inlined, its instruction count in tests/icount.rs moved by 0.5–2.2% from build to build).
+/// (inlined, its instruction count in tests/gates/icount.rs moved by 0.5–2.2% from build to build).
 #[inline(never)]
 fn direct_light_lanes<V: Lanes>(
     ctx: &Context,

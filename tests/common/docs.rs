@@ -212,37 +212,65 @@ pub fn stale_manual(page: &Page) -> Vec<String> {
         .collect()
 }
 
-/// Names declared by `[[bench]]` in Cargo.toml.
-fn bench_targets() -> BTreeSet<String> {
+/// The targets of one kind (`bench` or `test`) declared in Cargo.toml: name and path (the path
+/// empty when the table gives none).
+fn targets(kind: &str) -> Vec<(String, String)> {
     let toml = std::fs::read_to_string(Path::new(ROOT).join("Cargo.toml")).unwrap();
-    let mut names = BTreeSet::new();
-    let mut in_bench = false;
+    let header = format!("[[{kind}]]");
+    let mut out: Vec<(String, String)> = Vec::new();
+    let mut inside = false;
     for line in toml.lines().map(str::trim) {
         if line.starts_with('[') {
-            in_bench = line == "[[bench]]";
-        } else if in_bench && let Some(v) = line.strip_prefix("name") {
-            names.insert(
-                v.trim_start_matches([' ', '='])
-                    .trim_matches('"')
-                    .to_string(),
-            );
+            inside = line == header;
+            if inside {
+                out.push((String::new(), String::new()));
+            }
+            continue;
+        }
+        let Some(last) = out.last_mut().filter(|_| inside) else {
+            continue;
+        };
+        let value = |v: &str| {
+            v.trim_start_matches([' ', '='])
+                .trim_matches('"')
+                .to_string()
+        };
+        if let Some(v) = line.strip_prefix("name") {
+            last.0 = value(v);
+        } else if let Some(v) = line.strip_prefix("path") {
+            last.1 = value(v);
         }
     }
-    names
+    out
 }
 
-/// Integration tests: the files of tests/.
-fn test_targets() -> BTreeSet<String> {
-    std::fs::read_dir(Path::new(ROOT).join("tests"))
-        .unwrap()
-        .filter_map(|e| {
-            let p = e.ok()?.path();
-            if p.extension()? != "rs" {
-                return None;
-            }
-            Some(p.file_stem()?.to_string_lossy().into_owned())
-        })
-        .collect()
+/// Names declared by `[[bench]]` in Cargo.toml.
+fn bench_targets() -> BTreeSet<String> {
+    targets("bench").into_iter().map(|(name, _)| name).collect()
+}
+
+/// Why `filter` (the test name filter after `--test NAME`) selects nothing that the docs can
+/// mean, or Ok. A kind's binary (`tests/KIND/main.rs`) holds one module per file, so its filter
+/// must start with one of them (`sample_streams::`, `sample_streams::light_points`); a
+/// one-file binary takes any filter.
+fn check_filter(test: &str, path: &str, filter: &str) -> Result<(), String> {
+    let Some(dir) = path.strip_suffix("/main.rs") else {
+        return Ok(());
+    };
+    let module = filter.split("::").next().unwrap_or("");
+    if !module.is_empty()
+        && module != "main"
+        && Path::new(ROOT)
+            .join(dir)
+            .join(format!("{module}.rs"))
+            .is_file()
+    {
+        return Ok(());
+    }
+    Err(format!(
+        "the filter {filter} names no file of the test binary {test} (a filter starts with \
+         one, as in `--test {test} FILE::`)"
+    ))
 }
 
 /// Why a `cargo` command is not covered by `.ci/run`, or Ok.
@@ -266,10 +294,18 @@ pub fn check_cargo(words: &[&str]) -> Result<(), String> {
             .copied()
     };
     let positive = |v: &str| v.parse::<u32>().is_ok_and(|n| n > 0);
+    // The icount gate: its file in the gates binary (`--test gates icount`).
+    let filter = words
+        .iter()
+        .position(|w| *w == "--test")
+        .and_then(|i| words.get(i + 2))
+        .filter(|w| !w.starts_with('-'));
+    let icount =
+        target("--test") == Some("gates") && filter.is_some_and(|f| f.starts_with("icount"));
     for w in &env {
-        let (bench, test) = (target("--bench"), target("--test"));
+        let bench = target("--bench");
         let known = match w.split_once('=') {
-            Some(("RAYWAVE_RECORD", "1")) => bench == Some("variance") || test == Some("icount"),
+            Some(("RAYWAVE_RECORD", "1")) => bench == Some("variance") || icount,
             Some(("RAYWAVE_INTERLEAVE", v)) => positive(v) && bench == Some("mesh_rays"),
             Some(("RAYWAVE_MESH", "12k" | "1M")) => bench == Some("mesh_rays"),
             Some(("RAYWAVE_ROUNDS", v)) => positive(v) && bench == Some("scaling"),
@@ -302,10 +338,16 @@ pub fn check_cargo(words: &[&str]) -> Result<(), String> {
                 i += 2;
             }
             ("--test", Some(name)) if *sub == "test" => {
-                if !test_targets().contains(*name) {
-                    return Err(format!("no tests/{name}.rs"));
-                }
+                let tests = targets("test");
+                let Some((_, path)) = tests.iter().find(|(n, _)| n == name) else {
+                    return Err(format!("no [[test]] named {name} in Cargo.toml"));
+                };
                 i += 2;
+                // An optional test name filter: `--test sampling sample_streams::`.
+                if let Some(filter) = rest.get(i).filter(|w| !w.starts_with('-')) {
+                    check_filter(name, path, filter)?;
+                    i += 1;
+                }
             }
             (flag, _) => {
                 return Err(format!(

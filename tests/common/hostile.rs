@@ -323,7 +323,7 @@ pub mod setup_streams {
     }
 }
 
-/// More setup helpers for the output cases (tests/hostile_outputs.rs).
+/// More setup helpers for the output cases (tests/reliability/hostile_outputs.rs).
 pub mod setup_outputs {
     use std::path::Path;
 

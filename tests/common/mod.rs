@@ -1,7 +1,7 @@
-//! Helpers shared by the integration tests (each test file that needs them declares
-//! `mod common;`), one file per idea: `rays` (constructors and the edge-case table),
-//! `scenes` (bare and bundled scenes, the bias tests' lights and settings), `analytic` (the
-//! closed-form penumbra scene), `strategies`
+//! Helpers shared by the integration tests (each kind's `tests/KIND/main.rs` declares it with
+//! `#[path = "../common/mod.rs"] mod common;`, and its files `use crate::common;`), one file per
+//! idea: `rays` (constructors and the edge-case table), `scenes` (bare and bundled scenes, the
+//! bias tests' lights and settings), `analytic` (the closed-form penumbra scene), `strategies`
 //! (proptest inputs), `random` (seeded inputs from `rand`), `bin` (running the binary in a
 //! scratch directory), `hostile` (the hostile-input catalogue's harness), `view` (`raywave view`
 //! on a free port, and raw HTTP requests to it).

@@ -8,7 +8,8 @@
 #   RAYWAVE_MUTANT_TESTS="sampling" tests/mutants/run.sh P.patch   other tests than the patch's
 #
 # A patch is `git diff` output after two header lines, "Mutant: what changed" and "Tests:
-# test-file names" (`lib` for the unit tests in src/), which `git apply` skips. Run it from a
+# test binaries" (the [[test]] names of Cargo.toml, one per kind, so `kernels` runs every file
+# of tests/kernels/; `lib` for the unit tests in src/), which `git apply` skips. Run it from a
 # clean work tree: it refuses to start when src/ has uncommitted changes, and it always reverts
 # what it applied. Each mutant rebuilds the library in release: about a minute on 2 cores.
 set -u

@@ -50,8 +50,8 @@
 //!    f32 error is amplified, and discontinuities within 1e-6 (edges, silhouettes, shadow
 //!    boundaries seen through mirrors). `Oracle::with_rounding` checks the claim: the oracle with
 //!    a 2e-7 error on every camera direction and hit point stays within 1e-4 on every pixel the
-//!    rule keeps (tests/oracle_agreement.rs); with 5e-7, 5 of the ~390,000 kept pixels of the
-//!    bundled scenes at scale 1 do not, so the margin is real but not large.
+//!    rule keeps (tests/images/oracle_agreement.rs); with 5e-7, 5 of the ~390,000 kept pixels of
+//!    the bundled scenes at scale 1 do not, so the margin is real but not large.
 //!
 //! Callers must cap how many pixels are excluded (the agreement test fails above 2%).
 #![allow(dead_code)]

@@ -40,7 +40,7 @@
 //!
 //! The one case where the tree's answer is not brute force's is a triangle the ray grazes: its
 //! computed t is off by about ε / sin θ and can lie before the entry of the box that holds it,
-//! which is then pruned by a hit found first. In `tests/mesh_bvh.rs`, 1 of 8,000 grazing
+//! which is then pruned by a hit found first. In `tests/kernels/mesh_bvh.rs`, 1 of 8,000 grazing
 //! queries differs (one ray at a time and in packets alike; 3 in an earlier tree; every
 //! difference measured was at |n·d| ≤ 1.5e-5), for a triangle with |n·d| ≈ 2e-6. The test
 //! holds every difference to that: brute force's hit grazes (|n·d| < 1e-3), and the tree's

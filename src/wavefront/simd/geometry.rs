@@ -251,7 +251,7 @@ pub fn closest_hits(
 ///
 /// The width is dispatched here, in a function of its own, not in `intersect::closest`: with
 /// the 16-lane loop inlined there, that stage's own per-hit loop took 1.1–1.75% more
-/// instructions at 8 lanes (tests/icount.rs).
+/// instructions at 8 lanes (tests/gates/icount.rs).
 #[inline(never)]
 pub fn closest_hits_at(
     width: LaneWidth,

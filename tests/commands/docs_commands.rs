@@ -1,0 +1,261 @@
+//! Every command the user-facing pages show is run or checked here (tests/common/docs.rs says
+//! how), so no page can drift from the code: README.md, docs/BENCHMARKING.md and
+//! docs/SAMPLING.md. (docs/TRACE.md and README's debug view are also run by
+//! tests/commands/trace_pixel.rs, which checks what they wrote.)
+
+use crate::common;
+
+use common::docs::{
+    Page, check_cargo, commands, nothing, run_in_page_order, shorten, stale_manual, uncovered,
+};
+use std::path::Path;
+
+const ROOT: &str = env!("CARGO_MANIFEST_DIR");
+
+/// `raywave view` serves until stopped; tests/commands/view_http.rs and view_browser.rs run it.
+const VIEW: &str =
+    "a server that runs until Ctrl-C; tests/commands/view_http.rs and view_browser.rs run it";
+
+/// README.md: the set-up commands and the tour. Renders run at the page's sizes (each takes
+/// under a few seconds in a release build); the variance study is shortened.
+const README: Page = Page {
+    path: "README.md",
+    text: include_str!("../../README.md"),
+    quick: &[
+        ("variance", "--size", &["16", "16"]),
+        ("variance", "--seeds", &["2"]),
+        ("variance", "--reference-samples", &["64"]),
+        ("variance", "--mask-samples", &["16"]),
+    ],
+    manual: &[
+        ("raywave view", VIEW),
+        (
+            "raywave view scenes/cornell_box_reflective_spheres.obj --size 256 256 --bounces 3 --port 8080",
+            VIEW,
+        ),
+    ],
+    after: nothing,
+};
+
+/// docs/BENCHMARKING.md, shortened so that the whole page runs in seconds; the page repeats
+/// this table.
+const BENCHMARKING: Page = Page {
+    path: "docs/BENCHMARKING.md",
+    text: include_str!("../../docs/BENCHMARKING.md"),
+    quick: &[
+        ("bench", "--size", &["24", "24"]),
+        ("bench", "--runs", &["6"]),
+        ("bench", "--shadow-samples", &["4"]),
+        ("render", "--size", &["24", "24"]),
+        ("render", "--shadow-samples", &["4"]),
+        ("variance", "--size", &["16", "16"]),
+        ("variance", "--seeds", &["2"]),
+        ("variance", "--reference-samples", &["64"]),
+        ("variance", "--mask-samples", &["16"]),
+        // The page's thresholds are for its 512×512 images; 24×24 ones with 4 points are noisier.
+        ("diff", "--fail-above", &["10"]),
+    ],
+    manual: &[
+        (
+            "sudo apt-get install libembree-dev",
+            "installs a system package",
+        ),
+        (
+            "cargo bench --features embree --bench mesh_rays",
+            "needs libembree3; .ci/run builds without the embree feature",
+        ),
+        (
+            "RAYWAVE_INTERLEAVE=20 cargo bench --features embree --bench mesh_rays",
+            "needs libembree3; .ci/run builds without the embree feature",
+        ),
+        (
+            "RAYWAVE_PEER_TABLE=9 cargo bench --bench mesh_rays --features embree,tinybvh",
+            "needs libembree3 and builds tinybvh's C++; .ci/run builds without either feature",
+        ),
+    ],
+    after: nothing,
+};
+
+/// docs/SAMPLING.md: every study at 16×16 with 2 seeds and a cheap reference and mask (the
+/// page's "Reproduce" says so); each must write its report.
+const SAMPLING: Page = Page {
+    path: "docs/SAMPLING.md",
+    text: include_str!("../../docs/SAMPLING.md"),
+    quick: &[
+        ("variance", "--size", &["16", "16"]),
+        ("variance", "--seeds", &["2"]),
+        ("variance", "--reference-samples", &["64"]),
+        ("variance", "--mask-samples", &["16"]),
+    ],
+    manual: &[],
+    after: study_wrote_its_report,
+};
+
+const PAGES: [&Page; 3] = [&README, &BENCHMARKING, &SAMPLING];
+
+/// A study (not `--clean-cache`) leaves its table, results, per-seed rows and contact sheet.
+fn study_wrote_its_report(dir: &Path, args: &[String]) {
+    if args.first().map(String::as_str) != Some("variance")
+        || args.iter().any(|a| a == "--clean-cache")
+    {
+        return;
+    }
+    let report = args
+        .iter()
+        .position(|w| w == "--out")
+        .map_or("variance-report", |i| args[i + 1].as_str());
+    for name in [
+        "table.txt",
+        "results.json",
+        "seeds.csv",
+        "contact_sheet.png",
+    ] {
+        assert!(
+            dir.join(report).join(name).is_file(),
+            "`raywave {}` left no {report}/{name}",
+            args.join(" ")
+        );
+    }
+}
+
+#[test]
+fn every_command_is_run_covered_by_ci_or_listed_as_manual() {
+    let mut problems = Vec::new();
+    for page in PAGES {
+        problems.extend(uncovered(page));
+        problems.extend(stale_manual(page));
+    }
+    assert!(
+        problems.is_empty(),
+        "commands that neither this test nor .ci/run covers (run them here, make them covered, \
+         or list them as manual with the page saying why):\n{}",
+        problems.join("\n")
+    );
+}
+
+#[test]
+fn readme_commands_run_in_page_order() {
+    let ran = run_in_page_order(&README);
+    assert!(ran >= 10, "ran only {ran} of README's commands");
+}
+
+#[test]
+fn benchmarking_commands_run_in_page_order() {
+    let ran = run_in_page_order(&BENCHMARKING);
+    assert!(ran >= 6, "ran only {ran} of BENCHMARKING.md's commands");
+}
+
+#[test]
+fn sampling_commands_run_in_page_order() {
+    let cmds = commands(SAMPLING.text);
+    assert!(
+        cmds.iter().all(|c| c.starts_with("raywave ")),
+        "docs/SAMPLING.md shows only raywave commands: {cmds:?}"
+    );
+    let ran = run_in_page_order(&SAMPLING);
+    assert!(ran >= 5, "ran only {ran} of SAMPLING.md's commands");
+}
+
+#[test]
+fn continued_lines_are_one_command() {
+    let page =
+        "```sh\nraywave trace-pixel 1 2 \\\n    --json t.json  # the tree\nraywave info\n```\n";
+    assert_eq!(
+        commands(page),
+        ["raywave trace-pixel 1 2 --json t.json", "raywave info"]
+    );
+}
+
+#[test]
+fn the_shortening_replaces_adds_and_keeps_sweep_points_apart() {
+    let quick = BENCHMARKING.quick;
+    let out = shorten(
+        &["bench", "--size", "512", "512", "--size", "256", "256"],
+        quick,
+    );
+    assert_eq!(
+        out.join(" "),
+        "bench --size 24 24 --size 32 24 --runs 6 --shadow-samples 4"
+    );
+    let out = shorten(&["variance", "--seeds", "16", "--out", "x"], SAMPLING.quick);
+    assert_eq!(
+        out.join(" "),
+        "variance --seeds 2 --out x --size 16 16 --reference-samples 64 --mask-samples 16"
+    );
+    for as_written in [
+        &["bench", "compare", "a", "b"][..],
+        &["bench", "list"],
+        &["variance", "--clean-cache"],
+    ] {
+        assert_eq!(shorten(as_written, quick), as_written);
+    }
+    // A scene path or a flag first: the default command, render.
+    let out = shorten(&["scenes/x.obj", "-o", "x.png"], quick);
+    assert_eq!(
+        out.join(" "),
+        "scenes/x.obj -o x.png --size 24 24 --shadow-samples 4"
+    );
+}
+
+#[test]
+fn ci_runs_the_readme_test_command() {
+    let run = std::fs::read_to_string(Path::new(ROOT).join(".ci/run")).unwrap();
+    let last = run
+        .lines()
+        .map(str::trim)
+        .rfind(|l| !l.is_empty() && !l.starts_with('#'))
+        .unwrap_or("");
+    assert_eq!(
+        last, "cargo test --release --all-targets",
+        ".ci/run changed"
+    );
+    assert!(
+        commands(README.text)
+            .iter()
+            .any(|c| c == "cargo test --release --all-targets")
+    );
+}
+
+#[test]
+fn the_checker_refuses_what_ci_does_not_run() {
+    for bad in [
+        "cargo bench --bench no_such_bench",
+        "cargo bench --features embree --bench mesh_rays",
+        "cargo run --release -- bench",
+        "cargo test --release --test no_such_test",
+        "cargo test --release --test no_such_test sample_streams::",
+        "cargo test --release --test sampling no_such_file::",
+        "cargo test --release --test sampling cli::",
+        "cargo test --release --test commands trace_demo::",
+        "cargo test --release --test commands main::",
+        "cargo test --release --test sampling sample_streams:: schema::",
+        "cargo bench --bench wavefront -- --profile-time 5",
+        "FOO=1 cargo bench --bench variance",
+        "RAYWAVE_MESH=2M cargo bench --bench mesh_rays",
+        "RAYWAVE_ROUNDS=many cargo bench --bench scaling",
+        "RAYWAVE_ROUNDS=0 cargo bench --bench scaling",
+        "RAYWAVE_INTERLEAVE=20 cargo test --release --all-targets",
+        "RAYWAVE_ROUNDS=9 cargo bench --bench mesh_rays",
+        "RAYWAVE_RECORD=1 cargo bench --bench wavefront",
+        "RAYWAVE_RECORD=1 cargo test --release --test sampling sample_streams::",
+        "RAYWAVE_RECORD=1 cargo test --release --test kernels icount",
+        "cargo test --release --test icount",
+    ] {
+        let words: Vec<&str> = bad.split_whitespace().collect();
+        assert!(check_cargo(&words).is_err(), "`{bad}` passed the checker");
+    }
+    for good in [
+        "cargo bench --bench wavefront -- --save-baseline main stages/film",
+        "RAYWAVE_RECORD=1 cargo bench --bench variance -- --test",
+        "RAYWAVE_RECORD=1 cargo test --release --test gates icount",
+        "cargo test --release --test sampling sample_streams::",
+        "cargo test --release --test sampling sample_streams::light_points -- --nocapture",
+        "cargo test --release --test kernels mesh_bvh::mesh_occlusion::",
+        "cargo test --release --test gates icount -- --nocapture",
+        "RAYWAVE_INTERLEAVE=20 RAYWAVE_MESH=12k cargo bench --bench mesh_rays",
+        "RAYWAVE_ROUNDS=9 cargo bench --bench scaling",
+    ] {
+        let words: Vec<&str> = good.split_whitespace().collect();
+        assert_eq!(check_cargo(&words), Ok(()), "`{good}`");
+    }
+}

@@ -1,0 +1,22 @@
+//! Command tests: the built binary run as a user runs it: the command line and its errors,
+//! `bench` (records, verdicts, A/B), `diff`, `trace-pixel` and its exports (on
+//! scenes/trace_demo.obj, `trace_demo/`), `view` over HTTP and in a browser, the JSON
+//! Schemas of its output, and every command the documentation shows. One test binary; each
+//! file is a module (docs/TESTING.md).
+
+#[path = "../common/mod.rs"]
+mod common;
+mod trace_demo;
+
+mod bench_ab;
+mod bench_cmd;
+mod bench_verdict;
+mod cli;
+mod cli_errors;
+mod diff;
+mod docs_commands;
+mod schema;
+mod trace_pixel;
+mod trace_pixel_exports;
+mod view_browser;
+mod view_http;

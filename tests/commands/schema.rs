@@ -1,0 +1,205 @@
+//! The JSON Schemas of `--stats-json` files and bench records (docs/schema/, described in
+//! docs/SCHEMA.md): the checked-in files are the ones the types generate, so a change to the
+//! types without a new schema fails here; and real output of `render --stats-json` (both
+//! engines) and `bench --json` / `--save` validates against the checked-in files, while
+//! doctored output does not.
+//!
+//! After changing the types: `RAYWAVE_UPDATE_SCHEMA=1 cargo test --release --test commands schema::`
+//! rewrites docs/schema/, then review the diff (and bump `FORMAT` if the layout changed).
+
+use crate::common;
+
+use common::bin::{dir_with, raywave, stderr, words};
+use serde_json::{Value, json};
+use std::path::{Path, PathBuf};
+
+fn schema_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/schema")
+}
+
+/// The checked-in schema `name`, parsed.
+fn checked_in(name: &str) -> Value {
+    let path = schema_dir().join(name);
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    serde_json::from_str(&text).unwrap()
+}
+
+/// Every way `instance` breaks the checked-in schema `name` (empty: it validates).
+fn violations(name: &str, instance: &Value) -> Vec<String> {
+    let validator = jsonschema::validator_for(&checked_in(name))
+        .unwrap_or_else(|e| panic!("docs/schema/{name} is not a usable JSON Schema: {e}"));
+    validator
+        .iter_errors(instance)
+        .map(|e| format!("{} at {}", e, e.instance_path()))
+        .collect()
+}
+
+fn assert_valid(name: &str, instance: &Value) {
+    let v = violations(name, instance);
+    assert!(v.is_empty(), "{name}:\n{}\n{instance:#}", v.join("\n"));
+}
+
+#[test]
+fn the_checked_in_schemas_are_the_generated_ones() {
+    let update = std::env::var_os("RAYWAVE_UPDATE_SCHEMA").is_some_and(|v| v == "1");
+    for (name, generated) in raywave::report::schemas() {
+        let path = schema_dir().join(name);
+        if update {
+            std::fs::create_dir_all(schema_dir()).unwrap();
+            std::fs::write(&path, &generated).unwrap();
+            continue;
+        }
+        let on_disk = std::fs::read_to_string(&path).unwrap_or_default();
+        assert!(
+            on_disk == generated,
+            "docs/schema/{name} differs from the schema the types generate: after changing \
+             the record types run `RAYWAVE_UPDATE_SCHEMA=1 cargo test --release --test commands schema::`, \
+             review the diff, bump FORMAT if the layout changed, and update docs/SCHEMA.md"
+        );
+    }
+}
+
+#[test]
+fn the_schemas_pin_the_format_and_name_every_top_level_field() {
+    for (name, fields) in [
+        (
+            "render-record.schema.json",
+            &[
+                "format",
+                "raywave",
+                "machine",
+                "engine",
+                "seconds",
+                "rays",
+                "kinds_timed_by",
+                "stages",
+            ][..],
+        ),
+        (
+            "bench-record.schema.json",
+            &["format", "raywave", "machine", "setup", "engines"][..],
+        ),
+    ] {
+        let schema = checked_in(name);
+        assert_eq!(
+            schema["properties"]["format"]["const"],
+            json!(raywave::bench::record::FORMAT),
+            "{name}"
+        );
+        for field in fields {
+            assert!(
+                schema["required"]
+                    .as_array()
+                    .is_some_and(|r| r.contains(&json!(field))),
+                "{name} does not require `{field}`"
+            );
+        }
+    }
+}
+
+/// `raywave render` with `--stats-json s.json` on a bundled scene, the file parsed.
+fn stats_json(engine: &str) -> Value {
+    let dir = dir_with(&["cornell_box_reflective_spheres.obj"]);
+    let line = format!(
+        "cornell_box_reflective_spheres.obj --size 16 12 --engine {engine} -q -o i.png \
+         --stats-json s.json"
+    );
+    let out = raywave(dir.path(), &words(&line));
+    assert!(out.status.success(), "{}", stderr(&out));
+    serde_json::from_slice(&std::fs::read(dir.path().join("s.json")).unwrap()).unwrap()
+}
+
+#[test]
+fn render_stats_json_validates_for_both_engines() {
+    for engine in ["wavefront", "reference"] {
+        let record = stats_json(engine);
+        assert_valid("render-record.schema.json", &record);
+        // The meaning, not only the shape: each kind's rate is its rays over its own
+        // thread-seconds, the total its rays over the wall clock.
+        let rays = &record["rays"];
+        for kind in ["camera", "shadow", "reflection"] {
+            let k = &rays[kind];
+            let (n, t) = (k["rays"].as_f64().unwrap(), k["thread_seconds"].as_f64());
+            let t = t.unwrap_or_else(|| panic!("{engine} {kind}: thread_seconds missing"));
+            assert!(n > 0.0 && t > 0.0, "{engine} {kind}: {k}");
+            let rate = k["rays_per_thread_second"].as_f64().unwrap();
+            assert!((rate - n / t).abs() <= 1e-9 * rate, "{engine} {kind}: {k}");
+        }
+        let total = &rays["total"];
+        let expected = total["rays"].as_f64().unwrap() / record["seconds"].as_f64().unwrap();
+        let got = total["rays_per_second"].as_f64().unwrap();
+        assert!(
+            (got - expected).abs() <= 1e-9 * expected,
+            "{engine}: {total}"
+        );
+        let timed_by = if engine == "reference" {
+            "instrumented pass"
+        } else {
+            "stage timers"
+        };
+        assert_eq!(record["kinds_timed_by"], timed_by);
+        assert_eq!(
+            record["instrumented_seconds"].is_null(),
+            engine == "wavefront"
+        );
+    }
+}
+
+#[test]
+fn bench_json_and_saved_records_validate() {
+    let dir = dir_with(&["cornell_box_reflective_spheres.obj"]);
+    let out = raywave(
+        dir.path(),
+        &words(
+            "bench cornell_box_reflective_spheres.obj --size 16 12 --runs 2 -q --json - \
+             --save s",
+        ),
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let printed: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_valid("bench-record.schema.json", &printed);
+    let saved: Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join(".raywave-bench/s.json")).unwrap())
+            .unwrap();
+    assert_valid("bench-record.schema.json", &saved);
+    // The wavefront engine's kinds are measured by its stage timers; the reference's are not
+    // (the bench times it without timers) and say so with null.
+    for (i, measured) in [(0, false), (1, true)] {
+        let rates = &printed["engines"][i]["median"]["rates"];
+        for kind in ["camera", "shadow", "reflection"] {
+            let rate = &rates[format!("{kind}_per_thread_second")];
+            assert_eq!(rate.is_number(), measured, "engine {i} {kind}: {rates}");
+        }
+        assert!(rates["total_per_second"].as_f64().unwrap() > 0.0);
+    }
+}
+
+#[test]
+fn doctored_records_do_not_validate() {
+    let record = stats_json("wavefront");
+    type Doctor = fn(&mut Value);
+    let doctored: [(&str, Doctor); 6] = [
+        ("an older format", |r| r["format"] = json!(1)),
+        ("no format", |r| {
+            r.as_object_mut().unwrap().remove("format");
+        }),
+        ("a rate that is text", |r| {
+            r["rays"]["total"]["rays_per_second"] = json!("fast")
+        }),
+        ("a negative ray count", |r| {
+            r["rays"]["camera"]["rays"] = json!(-1)
+        }),
+        ("an unknown engine", |r| r["engine"] = json!("gpu")),
+        ("kinds timed some other way", |r| {
+            r["kinds_timed_by"] = json!("guessed")
+        }),
+    ];
+    for (what, doctor) in doctored {
+        let mut r = record.clone();
+        doctor(&mut r);
+        assert!(
+            !violations("render-record.schema.json", &r).is_empty(),
+            "{what} validated"
+        );
+    }
+}

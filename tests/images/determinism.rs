@@ -1,0 +1,185 @@
+//! Determinism: every random number is a pure function of (pixel, sample, bounce, light,
+//! dimension, seed), so the same seed gives the same bytes, and one thread or two give the
+//! same bytes, in the library and through the binary (both engines).
+
+use crate::common;
+use raywave::reference::Reference;
+use raywave::sampling::LightSampler;
+use raywave::scene::Scene;
+use raywave::settings::{RenderSettings, ShadowMode};
+
+use common::bin::{raywave, scenes, stderr, stdout};
+use std::path::{Path, PathBuf};
+
+fn scene_path(name: &str) -> PathBuf {
+    scenes().join(name)
+}
+
+fn soft_settings(seed: u32) -> RenderSettings {
+    RenderSettings {
+        width: 40,
+        height: 30,
+        bounces: 3,
+        shadows: ShadowMode::Soft,
+        shadow_samples: 5,
+        sampler: LightSampler::Random,
+        aa_samples: 3,
+        background: [0.2, 0.1, 0.6],
+        seed,
+        two_sided: false,
+        ..RenderSettings::default()
+    }
+}
+
+fn render_on(threads: usize, scene: &Scene, settings: &RenderSettings) -> Vec<[u32; 3]> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    let (film, _) = pool.install(|| Reference::new(scene, settings).render(&|| {}));
+    // Compare bit patterns: -0.0 vs 0.0 or NaN payloads would count as differences.
+    film.pixels
+        .iter()
+        .map(|c| [c.x.to_bits(), c.y.to_bits(), c.z.to_bits()])
+        .collect()
+}
+
+#[test]
+fn reference_is_bit_identical_across_runs_and_thread_counts() {
+    let scene = Scene::load(&scene_path("cornell_box_reflective_spheres.obj")).unwrap();
+    for sampler in [LightSampler::Random, LightSampler::Stratified] {
+        let settings = RenderSettings {
+            sampler,
+            ..soft_settings(7)
+        };
+        let one = render_on(1, &scene, &settings);
+        assert_eq!(
+            one,
+            render_on(1, &scene, &settings),
+            "{sampler:?}: run to run"
+        );
+        assert_eq!(
+            one,
+            render_on(2, &scene, &settings),
+            "{sampler:?}: 1 vs 2 threads"
+        );
+        assert_eq!(
+            one,
+            render_on(3, &scene, &settings),
+            "{sampler:?}: 1 vs 3 threads"
+        );
+        // The seed matters: another seed changes the soft shadows.
+        let other = render_on(
+            2,
+            &scene,
+            &RenderSettings {
+                seed: 8,
+                ..settings
+            },
+        );
+        assert_ne!(one, other, "{sampler:?}: seed 7 and 8 gave the same image");
+    }
+}
+
+fn run(dir: &Path, args: &[&str]) -> Vec<u8> {
+    let out = raywave(dir, &[args, &["--quiet"]].concat());
+    assert!(
+        out.status.success(),
+        "raywave {args:?} failed: {}",
+        stderr(&out)
+    );
+    let name = args[args.iter().position(|a| *a == "-o").unwrap() + 1];
+    std::fs::read(dir.join(name)).unwrap()
+}
+
+/// The binary's engines, found from its help so the test follows the CLI.
+fn engines() -> Vec<Option<&'static str>> {
+    let help = raywave(&std::env::temp_dir(), &["render", "--help"]);
+    if stdout(&help).contains("--engine") {
+        vec![None, Some("reference"), Some("wavefront")]
+    } else {
+        vec![None]
+    }
+}
+
+#[test]
+fn binary_same_seed_same_bytes_and_threads_do_not_matter() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene_path("cornell_box_reflective_spheres.obj");
+    let scene = scene.to_str().unwrap();
+    for engine in engines() {
+        let mut base = vec![
+            scene,
+            "--size",
+            "37",
+            "29",
+            "--shadows",
+            "soft",
+            "--shadow-samples",
+            "6",
+            "--aa",
+            "2",
+        ];
+        if let Some(e) = engine {
+            base.extend(["--engine", e]);
+        }
+        let with = |extra: &[&'static str], out: &'static str| {
+            let mut a = base.clone();
+            a.extend(extra);
+            a.extend(["-o", out]);
+            run(dir.path(), &a)
+        };
+        let t1 = with(&["--threads", "1", "--seed", "11"], "t1.png");
+        let t1_again = with(&["--threads", "1", "--seed", "11"], "t1b.png");
+        let t2 = with(&["--threads", "2", "--seed", "11"], "t2.png");
+        let t4 = with(&["--threads", "4", "--seed", "11"], "t4.png");
+        assert_eq!(t1, t1_again, "{engine:?}: same seed, different bytes");
+        assert_eq!(t1, t2, "{engine:?}: --threads 1 and 2 differ");
+        assert_eq!(t1, t4, "{engine:?}: --threads 1 and 4 differ");
+        let other = with(&["--threads", "2", "--seed", "12"], "s12.png");
+        assert_ne!(t1, other, "{engine:?}: the seed has no effect");
+    }
+}
+
+#[test]
+fn binary_engines_agree_on_the_image() {
+    // The wavefront engine is the reference's twin: the 8-bit images may differ only where a
+    // value sits on a rounding boundary, by one level.
+    if engines().len() == 1 {
+        println!("skipped: this build has a single engine");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene_path("cornell_box_reflective_spheres.obj");
+    let scene = scene.to_str().unwrap();
+    let common = [
+        scene,
+        "--size",
+        "40",
+        "40",
+        "--shadows",
+        "soft",
+        "--shadow-samples",
+        "4",
+    ];
+    let mut a = common.to_vec();
+    a.extend(["--engine", "reference", "-o", "ref.png"]);
+    let mut b = common.to_vec();
+    b.extend(["--engine", "wavefront", "-o", "wf.png"]);
+    run(dir.path(), &a);
+    run(dir.path(), &b);
+    let ra = image::open(dir.path().join("ref.png")).unwrap().to_rgb8();
+    let rb = image::open(dir.path().join("wf.png")).unwrap().to_rgb8();
+    let mut off = 0;
+    for (pa, pb) in ra.pixels().zip(rb.pixels()) {
+        for c in 0..3 {
+            let d = (pa[c] as i32 - pb[c] as i32).abs();
+            assert!(d <= 1, "engines differ by {d} levels");
+            off += (d > 0) as usize;
+        }
+    }
+    assert!(
+        off <= 40 * 40 * 3 / 100,
+        "{off} channels differ by one level"
+    );
+}

@@ -1,0 +1,14 @@
+//! Whole-image tests: the wavefront engine against its whole-image twin, the reference renderer;
+//! determinism across seeds, threads and runs; and both engines against the independent f64
+//! oracle (`tests/oracle/`), pixel by pixel and in the mean over seeds. One test binary; each
+//! file is a module (docs/TESTING.md).
+
+#[path = "../common/mod.rs"]
+mod common;
+#[path = "../oracle/mod.rs"]
+mod oracle;
+
+mod determinism;
+mod oracle_agreement;
+mod oracle_bias;
+mod wavefront_images;

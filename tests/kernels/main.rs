@@ -1,0 +1,18 @@
+//! Kernel tests: the scalar kernels (intersection, shadow-caster culling, spawn offsets, shading,
+//! film) against values worked out by hand, and their twins (the wavefront engine's 8- and
+//! 16-lane kernels, the mesh BVH's leaves and traversal, the peer engines) against the scalar
+//! kernels or brute force, ray by ray and bit for bit. One test binary; each file is a module
+//! (docs/TESTING.md).
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod bvh_leaves;
+mod film;
+mod intersection;
+mod mesh_bvh;
+mod peer_agreement;
+mod shading_pixels;
+mod shadow_casters;
+mod spawn;
+mod wavefront_kernels;

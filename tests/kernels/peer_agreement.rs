@@ -1,0 +1,432 @@
+//! The peer comparison's engines find the same hits on the same rays: obvhs's one-ray CWBVH
+//! traversal equals an all-triangles brute force, raywave's wavefront stage equals obvhs, and
+//! the peers equal raywave: (with `--features embree`) Embree's single rays and 8-ray packets,
+//! (with `--features tinybvh`) tinybvh's plain BVH and BVH8_CPU, each on more than 99.99% of
+//! the rays of every set, on a small generated mesh and on the lab's box without its spheres
+//! (raywave's brute-force path), all two-sided like the peers.
+
+use raywave::meshgen::cornell_box_mesh_spheres;
+use raywave::peer::{
+    Agreement, FAN_SIZES, Hits, ObvhsMesh, RaySet, RaySets, blocker_agreement, brute_force_closest,
+    hit_agreement, occlusion_agreement, raywave_closest, wavefront_closest, wavefront_occluded,
+    without_emitters, without_spheres,
+};
+use raywave::scene::{NO_HIT, Scene, parse_scene_str};
+use raywave::settings::RenderSettings;
+use raywave::wavefront::batch::HitBatch;
+use raywave::wavefront::context::Context;
+
+const SIZE: u32 = 96;
+const SEED: u64 = 0x5eed;
+/// The bar: agreement on more than 99.99% of rays.
+const MIN_AGREEMENT: f64 = 0.9999;
+
+fn mesh_scene() -> Scene {
+    // 8 bands: 684 triangles, well above the BVH threshold of 64.
+    let scene = parse_scene_str(&cornell_box_mesh_spheres(8), "generated");
+    without_emitters(&scene.expect("generated scene parses"))
+}
+
+/// The lab's box as the peer table traces it: its 12 triangles without the light wall's two,
+/// and without its spheres (the peers trace triangles): raywave's brute-force path.
+fn lab_scene() -> Scene {
+    let text = include_str!("../../scenes/cornell_box_reflective_spheres.obj");
+    let scene = parse_scene_str(text, "cornell_box_reflective_spheres.obj");
+    without_spheres(&without_emitters(&scene.expect("bundled scene parses")))
+}
+
+fn settings() -> RenderSettings {
+    RenderSettings {
+        two_sided: true,
+        ..RenderSettings::preview()
+    }
+}
+
+fn check(what: &str, a: Agreement) {
+    assert!(
+        a.fraction() > MIN_AGREEMENT,
+        "{what}: {} of {} rays disagree",
+        a.disagree(),
+        a.rays
+    );
+}
+
+/// The occlusion sets: hard shadows and every fan.
+fn occlusion_sets(sets: &RaySets) -> Vec<&RaySet> {
+    let mut all = vec![&sets.shadow];
+    all.extend(&sets.fans);
+    all
+}
+
+#[test]
+fn ray_sets_are_what_they_claim() {
+    let scene = mesh_scene();
+    let bvh = ObvhsMesh::new(&scene);
+    let sets = RaySets::new(&scene, &bvh, SIZE, SIZE, SEED);
+    assert_eq!(sets.primary.len(), (SIZE * SIZE) as usize);
+    let mut hits = Hits::default();
+    bvh.closest(&scene, &sets.primary, &mut hits);
+    let primary_hits = hits.prim.iter().filter(|&&p| p != NO_HIT).count();
+    // Every primary hit spawns one shadow and one incoherent ray (none is closer than 2e-4 to
+    // the light here).
+    assert_eq!(sets.incoherent.len(), primary_hits);
+    assert_eq!(sets.shadow.len(), primary_hits);
+    assert!(primary_hits > sets.primary.len() / 2, "{primary_hits} hits");
+    // Shadow segments end short of the light; some are blocked (by the spheres), most are not.
+    let mut blocked = Vec::new();
+    bvh.occluded(&scene, &sets.shadow, &mut blocked);
+    let n_blocked = blocked.iter().filter(|&&b| b).count();
+    assert!(
+        n_blocked > 0 && n_blocked < blocked.len() / 2,
+        "{n_blocked} blocked"
+    );
+    for batch in &sets.shadow.batches {
+        assert!(batch.tmax.iter().all(|t| t.is_finite() && *t > 0.0));
+    }
+    // The fans: n segments from every n-th hit, one origin per aligned block of n, about one
+    // ray per primary hit.
+    for n in FAN_SIZES {
+        let fan = sets.fan(n);
+        assert_eq!(fan.len(), n as usize * primary_hits.div_ceil(n as usize));
+        for batch in &fan.batches {
+            assert!(batch.len().is_multiple_of(n as usize));
+            for block in (0..batch.len()).step_by(n as usize) {
+                let rays = block..block + n as usize;
+                assert!(rays.clone().all(|i| batch.origin(i) == batch.origin(block)));
+                assert!(
+                    rays.skip(1)
+                        .any(|i| batch.direction(i) != batch.direction(block))
+                );
+            }
+        }
+    }
+    // The table's order: camera, hard shadow, the fans, incoherent.
+    let names: Vec<String> = sets.all().iter().map(|s| s.kind.name()).collect();
+    assert_eq!(
+        names,
+        [
+            "primary",
+            "shadow",
+            "shadow_fan16",
+            "shadow_fan64",
+            "incoherent"
+        ]
+    );
+    // Same seed, same rays; another seed, other random rays.
+    let again = RaySets::new(&scene, &bvh, SIZE, SIZE, SEED);
+    assert_eq!(
+        again.incoherent.batches[0].direction_x,
+        sets.incoherent.batches[0].direction_x
+    );
+    assert_eq!(
+        again.fan(64).batches[0].direction_x,
+        sets.fan(64).batches[0].direction_x
+    );
+    let other = RaySets::new(&scene, &bvh, SIZE, SIZE, SEED + 1);
+    assert_ne!(
+        other.incoherent.batches[0].direction_x,
+        sets.incoherent.batches[0].direction_x
+    );
+}
+
+#[test]
+fn obvhs_one_ray_equals_brute_force() {
+    let scene = mesh_scene();
+    let bvh = ObvhsMesh::new(&scene);
+    let sets = RaySets::new(&scene, &bvh, SIZE, SIZE, SEED);
+    for set in [&sets.primary, &sets.incoherent] {
+        let (mut a, mut b) = (Hits::default(), Hits::default());
+        bvh.closest(&scene, set, &mut a);
+        brute_force_closest(&scene, set, &mut b);
+        check(&set.kind.name(), hit_agreement(&a, &b));
+    }
+    // Occlusion: blocked exactly when the brute-force closest hit lies inside the segment.
+    for set in occlusion_sets(&sets) {
+        let mut blocked = Vec::new();
+        bvh.occluded(&scene, set, &mut blocked);
+        let mut closest = Hits::default();
+        brute_force_closest(&scene, set, &mut closest);
+        let brute: Vec<bool> = closest.prim.iter().map(|&p| p != NO_HIT).collect();
+        check(&set.kind.name(), occlusion_agreement(&blocked, &brute));
+    }
+}
+
+#[test]
+fn wavefront_equals_obvhs_one_ray() {
+    let scene = mesh_scene();
+    let settings = settings();
+    let ctx = Context::new(&scene, &settings);
+    assert!(ctx.accel.is_some(), "the mesh must go through the BVH path");
+    let bvh = ObvhsMesh::new(&scene);
+    let sets = RaySets::new(&scene, &bvh, SIZE, SIZE, SEED);
+    let mut scratch = HitBatch::default();
+    for set in [&sets.primary, &sets.incoherent] {
+        let (mut a, mut b) = (Hits::default(), Hits::default());
+        bvh.closest(&scene, set, &mut a);
+        wavefront_closest(&ctx, set, &mut scratch, &mut b);
+        check(&set.kind.name(), hit_agreement(&a, &b));
+    }
+    for set in occlusion_sets(&sets) {
+        let (mut a, mut b) = (Vec::new(), Vec::new());
+        bvh.occluded(&scene, set, &mut a);
+        wavefront_occluded(&ctx, set, &mut b);
+        check(&set.kind.name(), occlusion_agreement(&a, &b));
+    }
+}
+
+/// The mesh's hit search as the peer table times it is the intersect stage's, bit for bit.
+#[test]
+fn raywave_closest_is_the_intersect_stage_hit_search() {
+    let settings = settings();
+    for scene in [mesh_scene(), lab_scene()] {
+        let ctx = Context::new(&scene, &settings);
+        let bvh = ObvhsMesh::new(&scene);
+        let sets = RaySets::new(&scene, &bvh, SIZE, SIZE, SEED);
+        let mut scratch = HitBatch::default();
+        for set in [&sets.primary, &sets.incoherent] {
+            let (mut a, mut b) = (Hits::default(), Hits::default());
+            wavefront_closest(&ctx, set, &mut scratch, &mut a);
+            raywave_closest(&ctx, set, &mut b);
+            assert_eq!(a, b, "{}", set.kind.name());
+        }
+    }
+}
+
+/// The lab's box has no BVH: `raywave_closest` and `wavefront_occluded` take the renderer's
+/// brute-force kernels there, and equal obvhs's CWBVH and an all-triangles brute force.
+#[test]
+fn raywave_brute_force_path_equals_obvhs_on_the_lab_box() {
+    let scene = lab_scene();
+    assert_eq!((scene.triangles.len(), scene.spheres.len()), (10, 0));
+    let settings = settings();
+    let ctx = Context::new(&scene, &settings);
+    assert!(
+        ctx.accel.is_none(),
+        "the lab box must take the brute-force path"
+    );
+    let bvh = ObvhsMesh::new(&scene);
+    let sets = RaySets::new(&scene, &bvh, SIZE, SIZE, SEED);
+    for set in [&sets.primary, &sets.incoherent] {
+        let (mut a, mut b, mut c) = (Hits::default(), Hits::default(), Hits::default());
+        bvh.closest(&scene, set, &mut a);
+        raywave_closest(&ctx, set, &mut b);
+        brute_force_closest(&scene, set, &mut c);
+        // The camera looks into the box, whose five walls are left: most camera rays hit one,
+        // and so do the random rays that do not leave through the open front.
+        let hits = b.prim.iter().filter(|&&p| p != NO_HIT).count();
+        assert!(4 * hits > set.len(), "{}: {hits} hits", set.kind.name());
+        check(&set.kind.name(), hit_agreement(&a, &b));
+        check(&set.kind.name(), hit_agreement(&c, &b));
+    }
+    for set in occlusion_sets(&sets) {
+        let (mut a, mut b) = (Vec::new(), Vec::new());
+        bvh.occluded(&scene, set, &mut a);
+        wavefront_occluded(&ctx, set, &mut b);
+        check(&set.kind.name(), occlusion_agreement(&a, &b));
+    }
+}
+
+#[test]
+fn agreement_counts_edges_and_real_differences() {
+    let a = Hits {
+        t: vec![
+            1.0,
+            2.0,
+            f32::INFINITY,
+            3.0,
+            4.0,
+            5.0,
+            1e-6,
+            1e-4,
+            2.0,
+            2e-5,
+        ],
+        prim: vec![0, 1, NO_HIT, 3, 4, 5, 6, 7, 8, 9],
+    };
+    let b = Hits {
+        // same; shared edge (other prim, same t); both miss; other prim far away;
+        // a hit against a miss; same prim; a miss against a hit at t ≈ 0 (a ray from an
+        // edge); a miss against a hit that is not near the origin; a hit at t = −0 (tinybvh's
+        // closed interval) against one farther on; a hit near, but not within 1e-5 of, the
+        // origin against another.
+        t: vec![
+            1.0,
+            2.0 + 1e-5,
+            f32::INFINITY,
+            3.5,
+            f32::INFINITY,
+            5.0,
+            f32::INFINITY,
+            f32::INFINITY,
+            -0.0,
+            1.0,
+        ],
+        prim: vec![0, 9, NO_HIT, 7, NO_HIT, 5, NO_HIT, NO_HIT, 2, 3],
+    };
+    let agreement = hit_agreement(&a, &b);
+    assert_eq!(agreement.rays, 10);
+    assert_eq!(agreement.agree, 6);
+    assert_eq!(agreement.same_t_other_prim, 1);
+    assert_eq!(agreement.near_origin, 2);
+    let o = occlusion_agreement(&[true, false, true], &[true, true, true]);
+    assert_eq!((o.rays, o.agree), (3, 2));
+    // Blockers of a closest-hit shadow query: one at t = −0 (the origin on a wall's plane), one
+    // well inside the segment where raywave saw none, one where raywave saw one, none.
+    let blockers = Hits {
+        t: vec![-0.0, 0.5, 0.3, f32::INFINITY],
+        prim: vec![2, 3, 4, NO_HIT],
+    };
+    let b = blocker_agreement(&[false, false, true, false], &blockers);
+    assert_eq!((b.rays, b.agree, b.near_origin), (4, 3, 1));
+}
+
+/// Every set's raywave answer (`raywave_closest`, `wavefront_occluded`) against a peer's, on
+/// `scene`. On meshes the shadow sets must hold both blocked and free rays, so that their
+/// agreement says something (in the lab's box without spheres nothing blocks a light).
+#[cfg(any(feature = "embree", feature = "tinybvh"))]
+fn check_peer_against_raywave(
+    what: &str,
+    scene: &Scene,
+    size: u32,
+    closest: &dyn Fn(&RaySet, &mut Hits),
+    occluded: &dyn Fn(&RaySet, &[bool]) -> Agreement,
+) {
+    let settings = settings();
+    let ctx = Context::new(scene, &settings);
+    let bvh = ObvhsMesh::new(scene);
+    let sets = RaySets::new(scene, &bvh, size, size, SEED);
+    for set in [&sets.primary, &sets.incoherent] {
+        let (mut ours, mut theirs) = (Hits::default(), Hits::default());
+        raywave_closest(&ctx, set, &mut ours);
+        closest(set, &mut theirs);
+        let what = format!("{what}, {}", set.kind.name());
+        let differ = (0..ours.t.len()).filter(|&i| {
+            let one = |h: &Hits| Hits {
+                t: vec![h.t[i]],
+                prim: vec![h.prim[i]],
+            };
+            hit_agreement(&one(&ours), &one(&theirs)).agree == 0
+        });
+        for i in differ.take(20) {
+            eprintln!(
+                "{what}: ray {i}: raywave t {} prim {}, peer t {} prim {}",
+                ours.t[i], ours.prim[i], theirs.t[i], theirs.prim[i]
+            );
+        }
+        check(&what, hit_agreement(&ours, &theirs));
+    }
+    for set in occlusion_sets(&sets) {
+        let mut ours = Vec::new();
+        wavefront_occluded(&ctx, set, &mut ours);
+        let what = format!("{what}, {}", set.kind.name());
+        if ctx.accel.is_some() {
+            let blocked = ours.iter().filter(|&&b| b).count();
+            assert!(
+                blocked > 0 && blocked < ours.len(),
+                "{what}: {blocked} of {} blocked",
+                ours.len()
+            );
+        }
+        check(&what, occluded(set, &ours));
+    }
+}
+
+#[cfg(feature = "embree")]
+#[test]
+fn embree_single_and_packet8_equal_raywave() {
+    use raywave::peer::embree::EmbreeMesh;
+    // The mesh at the benchmark's image size. (Before the kernels' edge slack, the two crack
+    // rays of the test below were 2 of 9216 at 96×96, under the 99.99% bar.)
+    for (scene, size) in [(mesh_scene(), 256), (lab_scene(), SIZE)] {
+        let embree = EmbreeMesh::new(&scene).expect("Embree builds the scene");
+        let n = scene.triangles.len();
+        check_peer_against_raywave(
+            &format!("Embree single, {n} triangles"),
+            &scene,
+            size,
+            &|set, out| embree.closest1(set, set.kind.is_coherent(), out),
+            &|set, ours| {
+                let mut theirs = Vec::new();
+                embree.occluded1(set, &mut theirs);
+                occlusion_agreement(ours, &theirs)
+            },
+        );
+        check_peer_against_raywave(
+            &format!("Embree packet8, {n} triangles"),
+            &scene,
+            size,
+            &|set, out| embree.closest8(set, set.kind.is_coherent(), out),
+            &|set, ours| {
+                let mut theirs = Vec::new();
+                embree.occluded8(set, &mut theirs);
+                occlusion_agreement(ours, &theirs)
+            },
+        );
+    }
+}
+
+/// tinybvh's layouts through tinybvh-rs; shadow rays by its closest hit limited to tmax (the
+/// crate binds no occlusion query).
+#[cfg(feature = "tinybvh")]
+#[test]
+fn tinybvh_layouts_equal_raywave() {
+    use raywave::peer::tinybvh::{TinybvhLayout, TinybvhMesh};
+    // BVH8_CPU is there wherever the build has AVX2 (the crate's condition for it).
+    #[cfg(target_feature = "avx2")]
+    assert!(TinybvhLayout::ALL.contains(&TinybvhLayout::Bvh8Cpu));
+    for (scene, size) in [(mesh_scene(), 256), (lab_scene(), SIZE)] {
+        let tinybvh = TinybvhMesh::new(&scene).expect("tinybvh builds the scene");
+        let n = scene.triangles.len();
+        for &layout in TinybvhLayout::ALL {
+            check_peer_against_raywave(
+                &format!("{}, {n} triangles", layout.title()),
+                &scene,
+                size,
+                &|set, out| tinybvh.closest(layout, set, out),
+                &|set, ours| {
+                    // The timed call's answer, and the blockers behind it: equal when blocked,
+                    // and agreeing with raywave's but for blockers at the origin.
+                    let (mut blocked, mut blockers) = (Vec::new(), Hits::default());
+                    tinybvh.occluded_by_closest(layout, set, &mut blocked);
+                    tinybvh.blockers(layout, set, &mut blockers);
+                    let found: Vec<bool> = blockers.prim.iter().map(|&p| p != NO_HIT).collect();
+                    assert_eq!(blocked, found);
+                    blocker_agreement(ours, &blockers)
+                },
+            );
+        }
+    }
+}
+
+/// Camera rays that enter the box through its open front (the light wall is removed) must hit
+/// one of its five closed walls or a sphere: the box is watertight, so a miss is a ray that
+/// fell through the crack between two triangles sharing an edge.
+///
+/// With u ≥ 0, v ≥ 0, u + v ≤ 1 on rounded values, Möller–Trumbore was not watertight: at
+/// 96×96 two camera rays crossed a wall's quad exactly on its split diagonal and missed both
+/// triangles (Embree's watertight test hit them). The kernels now allow `EDGE_EPSILON` of
+/// slack on those tests; this test fails without it. A watertight kernel (Woop et al. 2013)
+/// would be exact at any triangle size, where the slack is relative to the triangle.
+#[test]
+fn camera_rays_entering_the_closed_box_hit_it() {
+    let scene = mesh_scene();
+    let bvh = ObvhsMesh::new(&scene);
+    let sets = RaySets::new(&scene, &bvh, SIZE, SIZE, SEED);
+    let mut hits = Hits::default();
+    bvh.closest(&scene, &sets.primary, &mut hits);
+    let mut k = 0;
+    let mut leaks = Vec::new();
+    for batch in &sets.primary.batches {
+        for i in 0..batch.len() {
+            let (o, d) = (batch.origin(i), batch.direction(i));
+            // Where the ray crosses the open front z = 1, well inside the opening.
+            let t = (1.0 - o.z) / d.z;
+            let p = o + t * d;
+            if t > 0.0 && p.x.abs() < 0.999 && p.y.abs() < 0.999 && hits.prim[k] == NO_HIT {
+                leaks.push(k);
+            }
+            k += 1;
+        }
+    }
+    assert!(leaks.is_empty(), "camera rays through cracks: {leaks:?}");
+}

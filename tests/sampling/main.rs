@@ -1,0 +1,17 @@
+//! Statistical tests of sampling: the samples both renderers draw (uniform in their strata,
+//! independent across every key field), the samplers' placement and edges, unbiased soft
+//! shadows (against closed forms and the f64 oracle, `tests/oracle/`), and the variance study's
+//! statistics and report. One test binary; each file is a module (docs/TESTING.md).
+
+#[path = "../common/mod.rs"]
+mod common;
+#[path = "../oracle/mod.rs"]
+mod oracle;
+
+mod sample_streams;
+mod sampling;
+mod sampling_edges;
+mod sampling_study;
+mod soft_shadows;
+mod variance_report;
+mod variance_stats;
