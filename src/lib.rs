@@ -9,13 +9,8 @@
 //!   time, written to be obviously right: the twin every fast path is checked and timed
 //!   against.
 //!
-//! Callers choose one through [`engine::Engine`]. The pieces both share, in the order a frame
-//! uses them: [`scene`] (the lab's extended `.obj`), [`camera`] and [`sampling`] (where rays
-//! and light points go, as pure functions of (pixel, sample, bounce, light, dimension, seed)),
-//! [`geometry`] (scalar intersection kernels), [`spawn`] (where secondary rays start),
-//! [`shading`] (the lab's Shade) and [`film`] (the linear image and its files). Around them:
-//! [`variance`] (the light-sampling study), [`bench`](mod@bench) (both engines timed side by side) and
-//! [`peer`] (the same mesh rays through obvhs and Embree).
+//! Callers choose one through [`engine::Engine`]. What every module holds, and how they depend
+//! on each other, is in the module map of docs/ARCHITECTURE.md.
 //!
 //! A tiny render of a scene given as text, by both engines:
 //!

@@ -1,20 +1,7 @@
 //! The command line, which belongs to the binary: clap's types, one file per command, each
 //! turning its flags into the library's plain options (`ImageOptions`, `BenchOptions`,
-//! `VarianceOptions`) and running the command; `main` owns the exit code.
-//!
-//! ```text
-//! combos.rs    warnings for flags that other flags make meaningless
-//! foreign.rs   the lab's and RPI's spellings -> raywave's flags (FOREIGN_FLAGS)
-//! values.rs    clap spellings of the library's enums (engine, shadows, sampler, ...)
-//! image.rs     the image flags render and bench share -> raywave::options::ImageOptions
-//! render.rs    raywave render: summary, --stats, --stats-json, --debug-pixel
-//! bench.rs     raywave bench -> raywave::bench::BenchOptions
-//! variance.rs  raywave variance -> raywave::variance::command::VarianceOptions
-//! view.rs      raywave view -> raywave::view::ViewOptions (the browser debug window)
-//! trace_pixel.rs  raywave trace-pixel: one pixel's ray tree (JSON, OBJ, PLY, PNG)
-//! diff.rs      raywave diff -> raywave::image_diff
-//! meshgen.rs, info.rs
-//! ```
+//! `VarianceOptions`) and running the command; `main` owns the exit code. What each file holds
+//! is in the module map of docs/ARCHITECTURE.md (`cli/`).
 
 pub mod bench;
 pub mod combos;

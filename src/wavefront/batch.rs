@@ -222,7 +222,7 @@ impl HitBatch {
 /// `n_dot_l > 0`: the SIMD spawn writes whole 8-lane blocks and marks the lanes that cast no
 /// ray (the point not far enough above the surface, the hit not above the light's moved plane,
 /// or past the last point) dead with `n_dot_l = 0` and `tmax = 0`. The spawn is bound by its
-/// stores, so no column is kept that shading can do without (docs/PERFORMANCE.md).
+/// stores, so no column is kept that shading can do without (docs/TRIED.md).
 #[derive(Clone, Debug, Default)]
 pub struct ShadowQueue {
     /// Entries in use.

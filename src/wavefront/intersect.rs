@@ -8,7 +8,7 @@
 //! all other rays one at a time (one ray against 8 child boxes or 8 triangles). Its hits are
 //! brute force's (same t bits, ties to the lowest triangle id), as are the reference's
 //! (`Accel::closest` over obvhs's CWBVH), except for the few axis-parallel rays obvhs's box
-//! test misses (docs/PERFORMANCE.md, "Mesh rays").
+//! test misses (docs/ARCHITECTURE.md, "The mesh path").
 
 use super::batch::{HitBatch, RayBatch};
 use super::bvh::MeshBvh;
@@ -29,7 +29,7 @@ pub fn columns(rays: &RayBatch) -> RayColumns<'_> {
 
 /// t and primitive id of every ray's closest hit through the mesh BVH. Camera rays (depth 0:
 /// 8 consecutive rays are neighbouring pixels) go through the tree 8 at a time; mirror rays,
-/// which fan out, one at a time (docs/PERFORMANCE.md, "Mesh rays"). Both give brute force's
+/// which fan out, one at a time (docs/TRIED.md, "The mesh BVH"). Both give brute force's
 /// hits, except on the rare grazing triangle (`bvh` module docs).
 pub fn mesh_hits(
     bvh: &MeshBvh,

@@ -42,7 +42,7 @@ use rayon::prelude::*;
 use stats::{RenderStats, Stage};
 use std::sync::Mutex;
 
-/// Camera samples per tile unless told otherwise (measured in docs/PERFORMANCE.md).
+/// Camera samples per tile unless told otherwise (measured in docs/TRIED.md).
 pub const DEFAULT_BATCH_SIZE: usize = 4096;
 
 /// Buffers one worker reuses from tile to tile.

@@ -1,6 +1,6 @@
 //! Every command the user-facing pages show is run or checked here (tests/common/docs.rs says
-//! how), so no page can drift from the code: README.md, docs/BENCHMARKING.md and
-//! docs/SAMPLING.md. (docs/TRACE.md and README's debug view are also run by
+//! how), so no page can drift from the code: README.md, docs/BENCHMARKING.md, docs/DIFF.md
+//! and docs/SAMPLING.md. (docs/TRACE.md and README's debug view are also run by
 //! tests/commands/trace_pixel.rs, which checks what they wrote.)
 
 use crate::common;
@@ -52,8 +52,6 @@ const BENCHMARKING: Page = Page {
         ("variance", "--seeds", &["2"]),
         ("variance", "--reference-samples", &["64"]),
         ("variance", "--mask-samples", &["16"]),
-        // The page's thresholds are for its 512×512 images; 24×24 ones with 4 points are noisier.
-        ("diff", "--fail-above", &["10"]),
     ],
     manual: &[
         (
@@ -76,6 +74,21 @@ const BENCHMARKING: Page = Page {
     after: nothing,
 };
 
+/// docs/DIFF.md: its renders shortened as BENCHMARKING.md's are, so that the page runs in
+/// seconds; the page repeats this table.
+const DIFF: Page = Page {
+    path: "docs/DIFF.md",
+    text: include_str!("../../docs/DIFF.md"),
+    quick: &[
+        ("render", "--size", &["24", "24"]),
+        ("render", "--shadow-samples", &["4"]),
+        // The page's thresholds are for its 512×512 images; 24×24 ones with 4 points are noisier.
+        ("diff", "--fail-above", &["10"]),
+    ],
+    manual: &[],
+    after: nothing,
+};
+
 /// docs/SAMPLING.md: every study at 16×16 with 2 seeds and a cheap reference and mask (the
 /// page's "Reproduce" says so); each must write its report.
 const SAMPLING: Page = Page {
@@ -91,7 +104,7 @@ const SAMPLING: Page = Page {
     after: study_wrote_its_report,
 };
 
-const PAGES: [&Page; 3] = [&README, &BENCHMARKING, &SAMPLING];
+const PAGES: [&Page; 4] = [&README, &BENCHMARKING, &DIFF, &SAMPLING];
 
 /// A study (not `--clean-cache`) leaves its table, results, per-seed rows and contact sheet.
 fn study_wrote_its_report(dir: &Path, args: &[String]) {
@@ -143,6 +156,12 @@ fn readme_commands_run_in_page_order() {
 fn benchmarking_commands_run_in_page_order() {
     let ran = run_in_page_order(&BENCHMARKING);
     assert!(ran >= 6, "ran only {ran} of BENCHMARKING.md's commands");
+}
+
+#[test]
+fn diff_commands_run_in_page_order() {
+    let ran = run_in_page_order(&DIFF);
+    assert!(ran >= 6, "ran only {ran} of DIFF.md's commands");
 }
 
 #[test]

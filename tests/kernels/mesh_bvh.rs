@@ -443,7 +443,7 @@ fn packets_of_camera_rays_equal_brute_force() {
     assert!(2 * hits > queries, "{hits} hits of {queries}");
 }
 
-/// Not a test: the instruction-count probe behind docs/PERFORMANCE.md's mesh choices. Traces
+/// Not a test: the instruction-count probe behind docs/TRIED.md's mesh choices. Traces
 /// the peer ray sets of the 12k-triangle box (128×128) through one engine, chosen by
 /// `PROBE=obvhs|wavefront|one_ray` (`one_ray`: the traversal one ray at a time, for closest-hit
 /// sets) and `SET=primary|shadow|incoherent|shadow_fan16|shadow_fan64`, 5 times:

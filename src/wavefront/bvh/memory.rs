@@ -8,7 +8,7 @@
 /// With the kernel's THP mode at `madvise`, as on this machine, nothing else in raywave gets
 /// them. The advice is only a hint: where the kernel declines, the copy behaves as before.
 /// Measured in one process against a second tree without the advice: +2–4% on 1M-triangle
-/// rays (docs/PERFORMANCE.md, "What was tried").
+/// rays (docs/TRIED.md, "The mesh BVH").
 pub(super) fn huge_pages<T: Copy>(v: Vec<T>) -> Vec<T> {
     #[cfg(target_os = "linux")]
     {

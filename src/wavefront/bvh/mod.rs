@@ -20,7 +20,7 @@
 //! ```
 //!
 //! Node (`Node`, 224 bytes, 32-aligned; 64-aligned 256-byte nodes measured no clear win, see
-//! docs/PERFORMANCE.md): `bounds[axis][0]` = min, `bounds[axis][1]` = max of
+//! docs/TRIED.md): `bounds[axis][0]` = min, `bounds[axis][1]` = max of
 //! the 8 children, one f32x8 each; `child[k]` = a node index, or `LEAF | block`, or `EMPTY`
 //! (empty slots have min = +∞, max = −∞, which no ray enters). Block (`Block`, 320 bytes):
 //! v0, e1, e2 x/y/z columns of 8 triangles and their `Scene::triangles` ids; unused lanes are
@@ -207,7 +207,7 @@ impl MeshBvh {
     /// not traced (the shadow queue's dead lanes have tmax = 0).
     ///
     /// (An occluder cache, a ray after a blocked one testing the leaf that blocked that one
-    /// first, cost 6.6% more instructions on the gate's mesh tile: docs/PERFORMANCE.md, "What was tried".)
+    /// first, cost 6.6% more instructions on the gate's mesh tile: docs/TRIED.md, "The mesh BVH".)
     pub fn occluded(&self, scene: &Scene, rays: &RayColumns, two_sided: bool, out: &mut [bool]) {
         let mut stack = Stack::new(self);
         let rays = cut(rays);

@@ -31,7 +31,7 @@ use crate::wavefront::simd::{self, RayColumns, TriangleLanes};
 /// Embree's BVH8 traversal of 8-ray packets splits below 8 (its `switchThreshold`, 7). Here,
 /// against one ray at a time on the peer camera rays (interleaved, 30 rounds): splitting below
 /// 2 lanes 1.14–1.16× on 12k triangles, 0.96–0.98× on 1M; below 4, 1.12–1.13× and 1.01–1.04×;
-/// below 8, 1.02–1.08× and 1.02–1.03× (docs/PERFORMANCE.md, "What was tried").
+/// below 8, 1.02–1.08× and 1.02–1.03× (docs/TRIED.md, "The mesh BVH").
 const PACKET_MIN_LANES: u32 = 4;
 
 /// 8 rays in lanes (a packet of coherent rays: camera rays of neighbouring pixels), with what

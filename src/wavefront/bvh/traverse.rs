@@ -126,7 +126,7 @@ impl MeshBvh {
     /// The closest hit of one ray in the subtree `start`, given the best (t, triangle) found
     /// so far (`(tmax, NO_HIT)` for none): the better of the two, as a pair. Inlined into its
     /// callers: as a call per ray it ran the primary set at 15 Mrays/s instead of 22, and with
-    /// 12% more instructions (callgrind, incoherent rays; docs/PERFORMANCE.md).
+    /// 12% more instructions (callgrind, incoherent rays; docs/TRIED.md).
     #[inline(always)]
     pub(super) fn closest_from(
         &self,
