@@ -17,6 +17,20 @@ pub enum ShadowMode {
     Soft,
 }
 
+impl ShadowMode {
+    /// Every mode, in declaration order.
+    pub const ALL: [ShadowMode; 3] = [ShadowMode::Off, ShadowMode::Hard, ShadowMode::Soft];
+
+    /// The mode's name, as flags, records and summaries spell it ("off", "hard", "soft").
+    pub fn name(self) -> &'static str {
+        match self {
+            ShadowMode::Off => "off",
+            ShadowMode::Hard => "hard",
+            ShadowMode::Soft => "soft",
+        }
+    }
+}
+
 /// How a light's colour reaches a shaded point.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[cfg_attr(feature = "tools", derive(schemars::JsonSchema))]
@@ -28,6 +42,19 @@ pub enum LightModel {
     /// RPI's framework (`RayTracer::TraceRay`): Lc = ke·area / (π·d²), with no 0.2 factor, d
     /// the distance to the light point (docs/SHADING.md).
     Rpi,
+}
+
+impl LightModel {
+    /// Every model, in declaration order.
+    pub const ALL: [LightModel; 2] = [LightModel::Lab, LightModel::Rpi];
+
+    /// The model's name, as flags, records and summaries spell it ("lab", "rpi").
+    pub fn name(self) -> &'static str {
+        match self {
+            LightModel::Lab => "lab",
+            LightModel::Rpi => "rpi",
+        }
+    }
 }
 
 /// Everything that decides the image, apart from the scene.
@@ -125,6 +152,22 @@ impl RenderSettings {
         match self.shadows {
             ShadowMode::Soft => self.shadow_samples.max(1),
             _ => 1,
+        }
+    }
+}
+
+#[cfg(all(test, feature = "tools"))]
+mod tests {
+    use super::{LightModel, ShadowMode};
+
+    /// The names are the serialised spellings, so records and summaries say the same word.
+    #[test]
+    fn names_are_the_serialised_spellings() {
+        for m in ShadowMode::ALL {
+            assert_eq!(serde_json::to_value(m).unwrap(), m.name());
+        }
+        for m in LightModel::ALL {
+            assert_eq!(serde_json::to_value(m).unwrap(), m.name());
         }
     }
 }

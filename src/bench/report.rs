@@ -27,8 +27,7 @@ pub fn report(r: &BenchRecord) -> String {
     );
     let shadows = match s.shadows {
         ShadowMode::Soft => format!("soft, {} {} points", s.shadow_samples, s.sampler.name()),
-        ShadowMode::Hard => "hard".to_string(),
-        ShadowMode::Off => "off".to_string(),
+        mode => mode.name().to_string(),
     };
     // The lighting is named only when it is not the lab's.
     let lab = RenderSettings::default();
@@ -36,7 +35,10 @@ pub fn report(r: &BenchRecord) -> String {
         String::new()
     } else {
         let [r, g, b] = s.ambient;
-        format!(", light model {:?}, ambient {r} {g} {b}", s.light_model).to_lowercase()
+        format!(
+            ", light model {}, ambient {r} {g} {b}",
+            s.light_model.name()
+        )
     };
     let _ = writeln!(
         out,

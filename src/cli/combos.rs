@@ -49,11 +49,6 @@ pub fn meaningless(command: &Command, typed: &dyn Fn(&str) -> String) -> Vec<Str
 fn image(args: &ImageArgs, typed: &dyn Fn(&str) -> String, out: &mut Vec<String>) {
     let options = args.options();
     let shadows = options.resolve(None).settings.shadows;
-    let mode = |m: ShadowMode| match m {
-        ShadowMode::Off => "off",
-        ShadowMode::Hard => "hard",
-        ShadowMode::Soft => "soft",
-    };
     if let (Some(given @ (ShadowMode::Off | ShadowMode::Hard)), Some(n)) =
         (options.shadows, options.shadow_samples)
     {
@@ -61,13 +56,13 @@ fn image(args: &ImageArgs, typed: &dyn Fn(&str) -> String, out: &mut Vec<String>
             "{} {n} has no effect with {} {}: only soft shadows sample points on the lights",
             typed("--shadow-samples"),
             typed("--shadows"),
-            mode(given)
+            given.name()
         ));
     }
     if shadows != ShadowMode::Soft && options.sampler != LightSampler::Stratified {
         out.push(format!(
             "--sampler has no effect with {} shadows: only soft shadows sample points on the lights",
-            mode(shadows)
+            shadows.name()
         ));
     }
 }
