@@ -219,13 +219,13 @@ fn context(coherent: bool) -> sys::RTCIntersectContext {
 
 fn ray1(batch: &crate::wavefront::batch::RayBatch, i: usize) -> sys::RTCRay {
     sys::RTCRay {
-        org_x: batch.origin_x[i],
-        org_y: batch.origin_y[i],
-        org_z: batch.origin_z[i],
+        org_x: batch.origin.x[i],
+        org_y: batch.origin.y[i],
+        org_z: batch.origin.z[i],
         tnear: T_MIN,
-        dir_x: batch.direction_x[i],
-        dir_y: batch.direction_y[i],
-        dir_z: batch.direction_z[i],
+        dir_x: batch.direction.x[i],
+        dir_y: batch.direction.y[i],
+        dir_z: batch.direction.z[i],
         time: 0.0,
         tfar: batch.tmax[i],
         mask: u32::MAX,
@@ -260,13 +260,13 @@ fn ray8(
     let mut valid = [0i32; 8];
     valid[..lanes].fill(-1);
     let ray = sys::RTCRay8 {
-        org_x: fill(&batch.origin_x),
-        org_y: fill(&batch.origin_y),
-        org_z: fill(&batch.origin_z),
+        org_x: fill(&batch.origin.x),
+        org_y: fill(&batch.origin.y),
+        org_z: fill(&batch.origin.z),
         tnear: [T_MIN; 8],
-        dir_x: fill(&batch.direction_x),
-        dir_y: fill(&batch.direction_y),
-        dir_z: fill(&batch.direction_z),
+        dir_x: fill(&batch.direction.x),
+        dir_y: fill(&batch.direction.y),
+        dir_z: fill(&batch.direction.z),
         time: [0.0; 8],
         tfar: fill(&batch.tmax),
         mask: [u32::MAX; 8],

@@ -172,8 +172,8 @@ impl RaySet {
     pub fn ray(batch: &RayBatch, i: usize) -> (Ray, f32) {
         (
             Ray {
-                origin: batch.origin(i),
-                direction: batch.direction(i),
+                origin: batch.origin.get(i),
+                direction: batch.direction.get(i),
             },
             batch.tmax[i],
         )
@@ -230,8 +230,8 @@ impl RaySets {
                 continue;
             }
             let ray = Ray {
-                origin: batch.origin(i),
-                direction: batch.direction(i),
+                origin: batch.origin.get(i),
+                direction: batch.direction.get(i),
             };
             let hit = surface_hit(scene, prim, &ray, t, false);
             // Every ray leaves the surface on the side it goes to, as the renderers' do, but

@@ -214,12 +214,12 @@ struct RaySlot {
 /// engine to trace the same bits), with `hit.t` = tmax clamped to tinybvh's 1e30.
 fn ray(batch: &RayBatch, i: usize) -> Ray {
     let d = [
-        batch.direction_x[i],
-        batch.direction_y[i],
-        batch.direction_z[i],
+        batch.direction.x[i],
+        batch.direction.y[i],
+        batch.direction.z[i],
     ];
     Ray {
-        origin: [batch.origin_x[i], batch.origin_y[i], batch.origin_z[i]],
+        origin: [batch.origin.x[i], batch.origin.y[i], batch.origin.z[i]],
         // C++: `mask` = RAY_MASK_INTERSECT_ALL (only TLAS traversal reads it).
         padding_0: 0xffff,
         dir: d,

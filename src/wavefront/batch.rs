@@ -1,36 +1,103 @@
 //! Structure-of-arrays batches: one `Vec` per field, named like the scalar code's fields
-//! (`Ray::origin` → `origin_x/y/z`, `Hit::t`, `Hit::prim`, ...). A lane is index `i` across
-//! the columns of one batch; stages load 8 lanes at a time, compute, and store.
+//! (`Ray::origin` → `origin`, `Hit::t`, `Hit::prim`, ...); a vector field is a [`Vec3Column`]
+//! of three, so `rays.origin.x[i]` reads like `ray.origin.x`. A lane is index `i` across the
+//! columns of one batch; stages load 8 lanes at a time, compute, and store.
 //!
 //! Buffers are allocated once per worker and reused (`clear` keeps the capacity), so the memory
 //! of a render is bounded by the batch size, not by the image.
 
 use crate::spawn::{ShadowRay, SurfaceHit};
 use glam::Vec3;
+use std::ops::Range;
+
+/// A column of 3-vectors stored as three columns of f32: vector `i` is `(x[i], y[i], z[i])`
+/// (red, green, blue for a colour), so a stage loads 8 x, 8 y and 8 z at a time.
+#[derive(Clone, Debug, Default)]
+pub struct Vec3Column {
+    /// First components.
+    pub x: Vec<f32>,
+    /// Second components.
+    pub y: Vec<f32>,
+    /// Third components.
+    pub z: Vec<f32>,
+}
+
+impl Vec3Column {
+    /// Vector `i`.
+    #[inline]
+    pub fn get(&self, i: usize) -> Vec3 {
+        Vec3::new(self.x[i], self.y[i], self.z[i])
+    }
+
+    /// Sets vector `i`.
+    #[inline]
+    pub fn set(&mut self, i: usize, v: Vec3) {
+        (self.x[i], self.y[i], self.z[i]) = (v.x, v.y, v.z);
+    }
+
+    /// Appends a vector.
+    #[inline(always)]
+    pub fn push(&mut self, v: Vec3) {
+        self.x.push(v.x);
+        self.y.push(v.y);
+        self.z.push(v.z);
+    }
+
+    /// Drops every vector, keeping the capacity.
+    pub fn clear(&mut self) {
+        self.x.clear();
+        self.y.clear();
+        self.z.clear();
+    }
+
+    /// Resizes the three columns to `n`, new entries `value`.
+    pub fn resize(&mut self, n: usize, value: f32) {
+        self.x.resize(n, value);
+        self.y.resize(n, value);
+        self.z.resize(n, value);
+    }
+
+    /// Sets every vector in `range` to `v`.
+    #[inline]
+    pub fn fill(&mut self, range: Range<usize>, v: Vec3) {
+        self.x[range.clone()].fill(v.x);
+        self.y[range.clone()].fill(v.y);
+        self.z[range].fill(v.z);
+    }
+
+    /// The three columns over `range` (each cut to it, so that indexing below its length needs
+    /// no bounds checks).
+    #[inline]
+    pub fn slices(&self, range: Range<usize>) -> [&[f32]; 3] {
+        [
+            &self.x[range.clone()],
+            &self.y[range.clone()],
+            &self.z[range],
+        ]
+    }
+
+    /// [`Self::slices`], writable.
+    #[inline]
+    pub fn slices_mut(&mut self, range: Range<usize>) -> [&mut [f32]; 3] {
+        [
+            &mut self.x[range.clone()],
+            &mut self.y[range.clone()],
+            &mut self.z[range],
+        ]
+    }
+}
 
 /// Paths in flight at one depth: their current ray and what they carry.
 #[derive(Clone, Debug, Default)]
 pub struct RayBatch {
-    /// Ray origin x.
-    pub origin_x: Vec<f32>,
-    /// Ray origin y.
-    pub origin_y: Vec<f32>,
-    /// Ray origin z.
-    pub origin_z: Vec<f32>,
-    /// Unit direction x.
-    pub direction_x: Vec<f32>,
-    /// Unit direction y.
-    pub direction_y: Vec<f32>,
-    /// Unit direction z.
-    pub direction_z: Vec<f32>,
+    /// Ray origin.
+    pub origin: Vec3Column,
+    /// Unit direction.
+    pub direction: Vec3Column,
     /// End of the ray interval (T_MIN, tmax): infinity for camera and mirror rays.
     pub tmax: Vec<f32>,
-    /// Product of the mirror colours kr along the path, red.
-    pub throughput_r: Vec<f32>,
-    /// ... green.
-    pub throughput_g: Vec<f32>,
-    /// ... blue.
-    pub throughput_b: Vec<f32>,
+    /// Product of the mirror colours kr along the path (red, green, blue).
+    pub throughput: Vec3Column,
     /// Pixel index (row-major from the top-left), for the SampleKey.
     pub pixel: Vec<u32>,
     /// Antialiasing sample index, for the SampleKey.
@@ -54,16 +121,10 @@ impl RayBatch {
 
     /// Drops every ray, keeping the capacity.
     pub fn clear(&mut self, bounce: u32) {
-        self.origin_x.clear();
-        self.origin_y.clear();
-        self.origin_z.clear();
-        self.direction_x.clear();
-        self.direction_y.clear();
-        self.direction_z.clear();
+        self.origin.clear();
+        self.direction.clear();
         self.tmax.clear();
-        self.throughput_r.clear();
-        self.throughput_g.clear();
-        self.throughput_b.clear();
+        self.throughput.clear();
         self.pixel.clear();
         self.sample.clear();
         self.slot.clear();
@@ -73,45 +134,13 @@ impl RayBatch {
     /// Appends one ray.
     #[inline(always)]
     pub fn push(&mut self, origin: Vec3, direction: Vec3, throughput: Vec3, path: PathId) {
-        self.origin_x.push(origin.x);
-        self.origin_y.push(origin.y);
-        self.origin_z.push(origin.z);
-        self.direction_x.push(direction.x);
-        self.direction_y.push(direction.y);
-        self.direction_z.push(direction.z);
+        self.origin.push(origin);
+        self.direction.push(direction);
         self.tmax.push(f32::INFINITY);
-        self.throughput_r.push(throughput.x);
-        self.throughput_g.push(throughput.y);
-        self.throughput_b.push(throughput.z);
+        self.throughput.push(throughput);
         self.pixel.push(path.pixel);
         self.sample.push(path.sample);
         self.slot.push(path.slot);
-    }
-
-    /// Origin of ray `i`.
-    #[inline]
-    pub fn origin(&self, i: usize) -> Vec3 {
-        Vec3::new(self.origin_x[i], self.origin_y[i], self.origin_z[i])
-    }
-
-    /// Direction of ray `i`.
-    #[inline]
-    pub fn direction(&self, i: usize) -> Vec3 {
-        Vec3::new(
-            self.direction_x[i],
-            self.direction_y[i],
-            self.direction_z[i],
-        )
-    }
-
-    /// Throughput of ray `i`.
-    #[inline]
-    pub fn throughput(&self, i: usize) -> Vec3 {
-        Vec3::new(
-            self.throughput_r[i],
-            self.throughput_g[i],
-            self.throughput_b[i],
-        )
     }
 
     /// Which camera sample ray `i` belongs to.
@@ -143,28 +172,16 @@ pub struct HitBatch {
     pub t: Vec<f32>,
     /// Global primitive id; `NO_HIT` for a miss.
     pub prim: Vec<u32>,
-    /// Hit point x (origin + t·direction, put back on the surface: `spawn::surface_hit`).
-    pub point_x: Vec<f32>,
-    /// Hit point y.
-    pub point_y: Vec<f32>,
-    /// Hit point z.
-    pub point_z: Vec<f32>,
-    /// Unit shading normal x (flipped towards the ray for two-sided faces).
-    pub normal_x: Vec<f32>,
-    /// Normal y.
-    pub normal_y: Vec<f32>,
-    /// Normal z.
-    pub normal_z: Vec<f32>,
+    /// Hit point (origin + t·direction, put back on the surface: `spawn::surface_hit`).
+    pub point: Vec3Column,
+    /// Unit shading normal (flipped towards the ray for two-sided faces).
+    pub normal: Vec3Column,
     /// How far off the surface secondary rays start (`spawn::SurfaceHit::offset`).
     pub offset: Vec<f32>,
     /// Material index (0 for a miss, unused).
     pub material: Vec<u32>,
-    /// Σ lights Σ points Shade/N of the visible light points, red.
-    pub direct_r: Vec<f32>,
-    /// ... green.
-    pub direct_g: Vec<f32>,
-    /// ... blue.
-    pub direct_b: Vec<f32>,
+    /// Σ lights Σ points Shade/N of the visible light points (red, green, blue).
+    pub direct: Vec3Column,
 }
 
 impl HitBatch {
@@ -172,45 +189,21 @@ impl HitBatch {
     pub fn resize(&mut self, n: usize) {
         self.t.resize(n, f32::INFINITY);
         self.prim.resize(n, 0);
-        self.point_x.resize(n, 0.0);
-        self.point_y.resize(n, 0.0);
-        self.point_z.resize(n, 0.0);
-        self.normal_x.resize(n, 0.0);
-        self.normal_y.resize(n, 0.0);
-        self.normal_z.resize(n, 0.0);
+        self.point.resize(n, 0.0);
+        self.normal.resize(n, 0.0);
         self.offset.resize(n, 0.0);
         self.material.resize(n, 0);
-        self.direct_r.resize(n, 0.0);
-        self.direct_g.resize(n, 0.0);
-        self.direct_b.resize(n, 0.0);
-    }
-
-    /// Hit point of ray `i`.
-    #[inline]
-    pub fn point(&self, i: usize) -> Vec3 {
-        Vec3::new(self.point_x[i], self.point_y[i], self.point_z[i])
-    }
-
-    /// Shading normal at hit `i`.
-    #[inline]
-    pub fn normal(&self, i: usize) -> Vec3 {
-        Vec3::new(self.normal_x[i], self.normal_y[i], self.normal_z[i])
+        self.direct.resize(n, 0.0);
     }
 
     /// Hit `i` as the spawn functions take it.
     #[inline]
     pub fn surface(&self, i: usize) -> SurfaceHit {
         SurfaceHit {
-            point: self.point(i),
-            normal: self.normal(i),
+            point: self.point.get(i),
+            normal: self.normal.get(i),
             offset: self.offset[i],
         }
-    }
-
-    /// Direct light gathered at hit `i`.
-    #[inline]
-    pub fn direct(&self, i: usize) -> Vec3 {
-        Vec3::new(self.direct_r[i], self.direct_g[i], self.direct_b[i])
     }
 }
 
@@ -227,18 +220,10 @@ impl HitBatch {
 pub struct ShadowQueue {
     /// Entries in use.
     pub len: usize,
-    /// Origin x (the hit point, offset off its surface).
-    pub origin_x: Vec<f32>,
-    /// Origin y.
-    pub origin_y: Vec<f32>,
-    /// Origin z.
-    pub origin_z: Vec<f32>,
-    /// Unit direction to the light point x (the Shade formula's l, from the hit point itself).
-    pub direction_x: Vec<f32>,
-    /// Direction y.
-    pub direction_y: Vec<f32>,
-    /// Direction z.
-    pub direction_z: Vec<f32>,
+    /// Origin (the hit point, offset off its surface).
+    pub origin: Vec3Column,
+    /// Unit direction to the light point (the Shade formula's l, from the hit point itself).
+    pub direction: Vec3Column,
     /// Where the ray meets the light's moved plane (`spawn::ShadowRay::tmax`); 0 for a dead
     /// lane.
     pub tmax: Vec<f32>,
@@ -274,18 +259,10 @@ impl ShadowQueue {
         self.len = 0;
         self.dist.resize(if with_dist { capacity } else { 0 }, 0.0);
         if self.tmax.len() != capacity {
-            for c in [
-                &mut self.origin_x,
-                &mut self.origin_y,
-                &mut self.origin_z,
-                &mut self.direction_x,
-                &mut self.direction_y,
-                &mut self.direction_z,
-                &mut self.tmax,
-                &mut self.n_dot_l,
-            ] {
-                c.resize(capacity, 0.0);
-            }
+            self.origin.resize(capacity, 0.0);
+            self.direction.resize(capacity, 0.0);
+            self.tmax.resize(capacity, 0.0);
+            self.n_dot_l.resize(capacity, 0.0);
             self.path.resize(capacity, 0);
             self.light.resize(capacity, 0);
             self.blocked.resize(capacity, false);
@@ -301,12 +278,8 @@ impl ShadowQueue {
     #[inline]
     pub fn push(&mut self, ray: &ShadowRay, path: u32, light: u32) {
         let i = self.len;
-        self.origin_x[i] = ray.ray.origin.x;
-        self.origin_y[i] = ray.ray.origin.y;
-        self.origin_z[i] = ray.ray.origin.z;
-        self.direction_x[i] = ray.ray.direction.x;
-        self.direction_y[i] = ray.ray.direction.y;
-        self.direction_z[i] = ray.ray.direction.z;
+        self.origin.set(i, ray.ray.origin);
+        self.direction.set(i, ray.ray.direction);
         self.tmax[i] = ray.tmax;
         self.n_dot_l[i] = ray.n_dot_l;
         if let Some(d) = self.dist.get_mut(i) {
@@ -323,12 +296,15 @@ impl ShadowQueue {
     pub fn push_block<A: AsRef<[f32]>>(&mut self, block: &ShadowBlock<A>, path: u32, light: u32) {
         let width = block.tmax.as_ref().len();
         let r = self.len..self.len + width;
-        self.origin_x[r.clone()].fill(block.origin.x);
-        self.origin_y[r.clone()].fill(block.origin.y);
-        self.origin_z[r.clone()].fill(block.origin.z);
-        self.direction_x[r.clone()].copy_from_slice(block.l[0].as_ref());
-        self.direction_y[r.clone()].copy_from_slice(block.l[1].as_ref());
-        self.direction_z[r.clone()].copy_from_slice(block.l[2].as_ref());
+        self.origin.fill(r.clone(), block.origin);
+        for (column, l) in self
+            .direction
+            .slices_mut(r.clone())
+            .into_iter()
+            .zip(&block.l)
+        {
+            column.copy_from_slice(l.as_ref());
+        }
         self.tmax[r.clone()].copy_from_slice(block.tmax.as_ref());
         self.n_dot_l[r.clone()].copy_from_slice(block.n_dot_l.as_ref());
         if !self.dist.is_empty() {
@@ -337,16 +313,6 @@ impl ShadowQueue {
         self.path[r.clone()].fill(path);
         self.light[r].fill(light);
         self.len += width;
-    }
-
-    /// Direction (l) of ray `i`.
-    #[inline]
-    pub fn direction(&self, i: usize) -> Vec3 {
-        Vec3::new(
-            self.direction_x[i],
-            self.direction_y[i],
-            self.direction_z[i],
-        )
     }
 }
 
@@ -372,34 +338,28 @@ pub struct ShadowBlock<A = [f32; 8]> {
 /// Per camera sample of a tile: the radiance gathered so far.
 #[derive(Clone, Debug, Default)]
 pub struct Radiance {
-    /// Red.
-    pub r: Vec<f32>,
-    /// Green.
-    pub g: Vec<f32>,
-    /// Blue.
-    pub b: Vec<f32>,
+    /// Red, green, blue per slot.
+    pub sum: Vec3Column,
 }
 
 impl Radiance {
     /// `n` black slots.
     pub fn reset(&mut self, n: usize) {
-        for c in [&mut self.r, &mut self.g, &mut self.b] {
-            c.clear();
-            c.resize(n, 0.0);
-        }
+        self.sum.clear();
+        self.sum.resize(n, 0.0);
     }
 
     /// Adds `c` to slot `i`.
     #[inline]
     pub fn add(&mut self, i: usize, c: Vec3) {
-        self.r[i] += c.x;
-        self.g[i] += c.y;
-        self.b[i] += c.z;
+        self.sum.x[i] += c.x;
+        self.sum.y[i] += c.y;
+        self.sum.z[i] += c.z;
     }
 
     /// Slot `i`.
     #[inline]
     pub fn get(&self, i: usize) -> Vec3 {
-        Vec3::new(self.r[i], self.g[i], self.b[i])
+        self.sum.get(i)
     }
 }

@@ -21,8 +21,8 @@ use glam::Vec3;
 /// The ray columns of a batch.
 pub fn columns(rays: &RayBatch) -> RayColumns<'_> {
     RayColumns {
-        origin: [&rays.origin_x, &rays.origin_y, &rays.origin_z],
-        direction: [&rays.direction_x, &rays.direction_y, &rays.direction_z],
+        origin: [&rays.origin.x, &rays.origin.y, &rays.origin.z],
+        direction: [&rays.direction.x, &rays.direction.y, &rays.direction.z],
         tmax: &rays.tmax,
     }
 }
@@ -72,27 +72,11 @@ pub fn closest(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch) {
         ),
     }
     // Every column cut to n first, so that the loop's indexing needs no bounds checks.
-    let (ox, oy, oz) = (
-        &rays.origin_x[..n],
-        &rays.origin_y[..n],
-        &rays.origin_z[..n],
-    );
-    let (dx, dy, dz) = (
-        &rays.direction_x[..n],
-        &rays.direction_y[..n],
-        &rays.direction_z[..n],
-    );
+    let [ox, oy, oz] = rays.origin.slices(0..n);
+    let [dx, dy, dz] = rays.direction.slices(0..n);
     let (t, prims) = (&hits.t[..n], &hits.prim[..n]);
-    let (px, py, pz) = (
-        &mut hits.point_x[..n],
-        &mut hits.point_y[..n],
-        &mut hits.point_z[..n],
-    );
-    let (nx, ny, nz) = (
-        &mut hits.normal_x[..n],
-        &mut hits.normal_y[..n],
-        &mut hits.normal_z[..n],
-    );
+    let [px, py, pz] = hits.point.slices_mut(0..n);
+    let [nx, ny, nz] = hits.normal.slices_mut(0..n);
     let offset = &mut hits.offset[..n];
     let material = &mut hits.material[..n];
     for i in 0..n {

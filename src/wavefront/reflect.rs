@@ -20,11 +20,11 @@ pub fn mirror_rays(ctx: &Context, rays: &RayBatch, hits: &HitBatch, next: &mut R
         if !m.is_reflective {
             continue;
         }
-        let ray = mirror_ray(&hits.surface(i), rays.direction(i));
+        let ray = mirror_ray(&hits.surface(i), rays.direction.get(i));
         next.push(
             ray.origin,
             ray.direction,
-            rays.throughput(i) * m.reflective,
+            rays.throughput.get(i) * m.reflective,
             rays.path(i),
         );
     }

@@ -72,9 +72,7 @@ fn direct_light_lanes<V: Lanes>(
     capacity: usize,
 ) -> u64 {
     let n = rays.len();
-    for c in [&mut hits.direct_r, &mut hits.direct_g, &mut hits.direct_b] {
-        c[..n].fill(0.0);
-    }
+    hits.direct.fill(0..n, glam::Vec3::ZERO);
     // Room for one hit's rays at least, each light's points padded to whole N-lane blocks.
     let per_hit = ctx.lights.len() * (ctx.points_per_light as usize).div_ceil(V::N) * V::N;
     queue.reset(
@@ -171,16 +169,8 @@ fn occlude<V: Lanes>(ctx: &Context, queue: &mut ShadowQueue) {
     let two_sided = ctx.settings.two_sided;
     let n = queue.len;
     let cols = RayColumns {
-        origin: [
-            &queue.origin_x[..n],
-            &queue.origin_y[..n],
-            &queue.origin_z[..n],
-        ],
-        direction: [
-            &queue.direction_x[..n],
-            &queue.direction_y[..n],
-            &queue.direction_z[..n],
-        ],
+        origin: queue.origin.slices(0..n),
+        direction: queue.direction.slices(0..n),
         tmax: &queue.tmax[..n],
     };
     let blocked = &mut queue.blocked[..n];
@@ -233,13 +223,9 @@ fn shade<V: Lanes>(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch, queue: &
             });
             // In the order the kernel's operands were always evaluated: the hit, the rays, the
             // light (`shade8`'s instruction count moves with it).
-            let (normal, to_eye) = (hits.normal(i), -rays.direction(i));
+            let (normal, to_eye) = (hits.normal.get(i), -rays.direction.get(i));
             let lanes = ShadowLanes {
-                l: [
-                    &queue.direction_x[q..end],
-                    &queue.direction_y[q..end],
-                    &queue.direction_z[q..end],
-                ],
+                l: queue.direction.slices(q..end),
                 n_dot_l: &queue.n_dot_l[q..end],
                 blocked: &queue.blocked[q..end],
                 falloff: falloffs.as_ref().map(|f| f.as_ref()),
@@ -253,26 +239,26 @@ fn shade<V: Lanes>(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch, queue: &
             };
             let c = shade_lanes::<V>(&at, &lanes);
             // In lane order, like the reference's loop; lanes that add nothing hold −0.0.
-            let (mut r, mut g, mut b) = (hits.direct_r[i], hits.direct_g[i], hits.direct_b[i]);
+            let (mut r, mut g, mut b) = (hits.direct.x[i], hits.direct.y[i], hits.direct.z[i]);
             for ((cr, cg), cb) in c[0].as_ref().iter().zip(c[1].as_ref()).zip(c[2].as_ref()) {
                 r += cr;
                 g += cg;
                 b += cb;
             }
-            (hits.direct_r[i], hits.direct_g[i], hits.direct_b[i]) = (r, g, b);
+            (hits.direct.x[i], hits.direct.y[i], hits.direct.z[i]) = (r, g, b);
             q = end;
             continue;
         }
         if !queue.blocked[q] && queue.n_dot_l[q] > 0.0 {
             let i = queue.path[q] as usize;
-            let (n, l, n_dot_l) = (hits.normal(i), queue.direction(q), queue.n_dot_l[q]);
+            let (n, l, n_dot_l) = (hits.normal.get(i), queue.direction.get(q), queue.n_dot_l[q]);
             let m = &ctx.materials[hits.material[i] as usize];
             let fall = queue.dist.get(q).map_or(1.0, |&d| falloff(model, d));
             let light_color = ctx.lights[queue.light[q] as usize].color * fall;
-            let c = shade_terms(m, n, -rays.direction(i), l, n_dot_l, light_color) * weight;
-            hits.direct_r[i] += c.x;
-            hits.direct_g[i] += c.y;
-            hits.direct_b[i] += c.z;
+            let c = shade_terms(m, n, -rays.direction.get(i), l, n_dot_l, light_color) * weight;
+            hits.direct.x[i] += c.x;
+            hits.direct.y[i] += c.y;
+            hits.direct.z[i] += c.z;
         }
         q += 1;
     }

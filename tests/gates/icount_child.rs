@@ -175,8 +175,8 @@ fn workloads() {
     let accel = Accel::new(&scene);
     let scalar_rays: Vec<Ray> = (0..rays.len())
         .map(|i| Ray {
-            origin: rays.origin(i),
-            direction: rays.direction(i),
+            origin: rays.origin.get(i),
+            direction: rays.direction.get(i),
         })
         .collect();
     let mut prims = vec![0u32; scalar_rays.len()];

@@ -92,10 +92,13 @@ fn ray_sets_are_what_they_claim() {
             assert!(batch.len().is_multiple_of(n as usize));
             for block in (0..batch.len()).step_by(n as usize) {
                 let rays = block..block + n as usize;
-                assert!(rays.clone().all(|i| batch.origin(i) == batch.origin(block)));
+                assert!(
+                    rays.clone()
+                        .all(|i| batch.origin.get(i) == batch.origin.get(block))
+                );
                 assert!(
                     rays.skip(1)
-                        .any(|i| batch.direction(i) != batch.direction(block))
+                        .any(|i| batch.direction.get(i) != batch.direction.get(block))
                 );
             }
         }
@@ -115,17 +118,17 @@ fn ray_sets_are_what_they_claim() {
     // Same seed, same rays; another seed, other random rays.
     let again = RaySets::new(&scene, &bvh, SIZE, SIZE, SEED);
     assert_eq!(
-        again.incoherent.batches[0].direction_x,
-        sets.incoherent.batches[0].direction_x
+        again.incoherent.batches[0].direction.x,
+        sets.incoherent.batches[0].direction.x
     );
     assert_eq!(
-        again.fan(64).batches[0].direction_x,
-        sets.fan(64).batches[0].direction_x
+        again.fan(64).batches[0].direction.x,
+        sets.fan(64).batches[0].direction.x
     );
     let other = RaySets::new(&scene, &bvh, SIZE, SIZE, SEED + 1);
     assert_ne!(
-        other.incoherent.batches[0].direction_x,
-        sets.incoherent.batches[0].direction_x
+        other.incoherent.batches[0].direction.x,
+        sets.incoherent.batches[0].direction.x
     );
 }
 
@@ -418,7 +421,7 @@ fn camera_rays_entering_the_closed_box_hit_it() {
     let mut leaks = Vec::new();
     for batch in &sets.primary.batches {
         for i in 0..batch.len() {
-            let (o, d) = (batch.origin(i), batch.direction(i));
+            let (o, d) = (batch.origin.get(i), batch.direction.get(i));
             // Where the ray crosses the open front z = 1, well inside the opening.
             let t = (1.0 - o.z) / d.z;
             let p = o + t * d;

@@ -222,8 +222,8 @@ fn wavefront_draws(scene: &Scene, s: &RenderSettings) -> Drawn {
     generate::camera_rays(&ctx, 0, s.width * s.height, &mut rays);
     for i in 0..rays.len() {
         let ray = Ray {
-            origin: rays.origin(i),
-            direction: rays.direction(i),
+            origin: rays.origin.get(i),
+            direction: rays.direction.get(i),
         };
         drawn.camera.insert((rays.pixel[i], rays.sample[i]), ray);
     }
@@ -246,8 +246,13 @@ fn wavefront_draws(scene: &Scene, s: &RenderSettings) -> Drawn {
             // The light point is where the Shade formula's l, which runs from the hit point
             // itself, meets the light's plane (not read from the tested segment, so the test
             // does not depend on where the engine starts and ends that segment).
-            let origin = hits.point(i).as_dvec3();
-            let target = on_light_plane(scene, stream.light, origin, queue.direction(q).as_dvec3());
+            let origin = hits.point.get(i).as_dvec3();
+            let target = on_light_plane(
+                scene,
+                stream.light,
+                origin,
+                queue.direction.get(q).as_dvec3(),
+            );
             let uv = light_uv(scene, stream.light, target);
             drawn.points.entry(stream).or_default().push(uv);
         }
