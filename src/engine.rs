@@ -16,10 +16,10 @@ use crate::stats::RayCounts;
 use crate::wavefront::Wavefront;
 use crate::wavefront::lanes::LaneWidth;
 use crate::wavefront::stats::RenderStats;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// The renderers.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[cfg_attr(feature = "tools", derive(schemars::JsonSchema))]
 #[serde(rename_all = "lowercase")]
 pub enum Engine {

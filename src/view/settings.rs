@@ -22,34 +22,6 @@ pub const MAX_SHADOW_SAMPLES: u32 = 4096;
 /// The most mirror bounces (the command line's bound).
 pub const MAX_BOUNCES: u32 = 64;
 
-/// The engines, as the page spells them.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum EngineName {
-    /// The SIMD wavefront engine.
-    Wavefront,
-    /// The scalar reference renderer.
-    Reference,
-}
-
-impl From<EngineName> for Engine {
-    fn from(e: EngineName) -> Engine {
-        match e {
-            EngineName::Wavefront => Engine::Wavefront,
-            EngineName::Reference => Engine::Reference,
-        }
-    }
-}
-
-impl From<Engine> for EngineName {
-    fn from(e: Engine) -> EngineName {
-        match e {
-            Engine::Wavefront => EngineName::Wavefront,
-            Engine::Reference => EngineName::Reference,
-        }
-    }
-}
-
 /// A pinhole camera as the page sends it (degrees, not radians).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -137,7 +109,7 @@ pub struct ViewSettings {
     /// lab or rpi.
     pub light_model: Option<LightModel>,
     /// wavefront or reference.
-    pub engine: Option<EngineName>,
+    pub engine: Option<Engine>,
     /// Camera rays per pixel.
     pub aa: Option<u32>,
     /// The seed of every random number.
@@ -219,7 +191,7 @@ impl ViewSettings {
         };
         Ok(Resolved {
             settings: s,
-            engine: self.engine.map_or(base.engine, Engine::from),
+            engine: self.engine.unwrap_or(base.engine),
             camera,
         })
     }
@@ -237,7 +209,7 @@ impl Resolved {
             shadow_samples: Some(s.shadow_samples),
             sampler: Some(s.sampler),
             light_model: Some(s.light_model),
-            engine: Some(self.engine.into()),
+            engine: Some(self.engine),
             aa: Some(s.aa_samples),
             seed: Some(s.seed),
             camera: Some(CameraJson::from_camera(&self.camera)),
