@@ -30,6 +30,10 @@ pub struct ImageOptions {
     pub ring_segments: Option<u32>,
     /// Whose defaults fill what no option sets.
     pub defaults: Option<Defaults>,
+    /// Seed of every random number (`--seed`; 0 unless given).
+    pub seed: u32,
+    /// Whether faces are hit and lit from both sides (`--two-sided`).
+    pub two_sided: bool,
 }
 
 /// Whose defaults fill the settings that no flag sets.
@@ -225,7 +229,8 @@ impl ImageOptions {
                 background,
                 light_model,
                 ambient,
-                ..RenderSettings::default()
+                seed: self.seed,
+                two_sided: self.two_sided,
             },
             defaults,
             defaulted,

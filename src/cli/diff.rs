@@ -315,6 +315,8 @@ fn region(args: &DiffArgs, a: &Image) -> Result<Region> {
         light_model: None,
         ring_segments: args.ring_segments,
         defaults: args.defaults.map(Into::into),
+        seed: 0,
+        two_sided: args.two_sided,
     };
     let scene = load_scene(args.scene.as_deref(), &options.parse_options())?.scene;
     for w in &scene.warnings {
@@ -326,10 +328,9 @@ fn region(args: &DiffArgs, a: &Image) -> Result<Region> {
             scene.source
         );
     }
-    let mut settings = options
+    let settings = options
         .resolve(scene.background.map(|c| c.to_array()))
         .settings;
-    settings.two_sided = args.two_sided;
     let regions = raywave::variance::mask::penumbra_mask(&scene, &settings, args.mask_samples);
     Ok(Region {
         name: format!("penumbra of {}, {} bounces", scene.source, settings.bounces),

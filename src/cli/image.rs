@@ -67,6 +67,8 @@ impl ImageArgs {
             light_model: self.light_model.map(Into::into),
             ring_segments: self.ring_segments,
             defaults: self.defaults.map(Into::into),
+            seed: 0,
+            two_sided: false,
         }
     }
 }
@@ -131,14 +133,16 @@ pub fn scene_and_settings(
     seed: u32,
     two_sided: bool,
 ) -> anyhow::Result<(Scene, Effective)> {
-    let options = image.options();
+    let options = ImageOptions {
+        seed,
+        two_sided,
+        ..image.options()
+    };
     let scene = load_scene(path, &options.parse_options())?.scene;
     for w in &scene.warnings {
         eprintln!("{w}");
     }
-    let mut effective = options.resolve(scene.background.map(|c| c.to_array()));
-    effective.settings.seed = seed;
-    effective.settings.two_sided = two_sided;
+    let effective = options.resolve(scene.background.map(|c| c.to_array()));
     Ok((scene, effective))
 }
 
