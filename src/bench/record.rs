@@ -433,50 +433,37 @@ pub fn save(path: &Path, record: &BenchRecord) -> Result<()> {
     })
 }
 
-/// FNV-1a, hex: a stable hash of a scene's text.
+/// FNV-1a (64-bit, the `fnv` crate), hex: a stable hash of a scene's text.
 pub fn text_hash(bytes: &[u8]) -> String {
-    let mut h = 0xcbf2_9ce4_8422_2325u64;
-    for &b in bytes {
-        h ^= b as u64;
-        h = h.wrapping_mul(0x0000_0100_0000_01b3);
-    }
-    format!("{h:016x}")
+    use std::hash::Hasher;
+    let mut h = fnv::FnvHasher::default();
+    h.write(bytes);
+    format!("{:016x}", h.finish())
 }
 
-/// Seconds since the Unix epoch as RFC 3339 UTC (`2026-11-22T20:13:01Z`).
+/// Seconds since the Unix epoch as RFC 3339 UTC (`2026-11-22T20:13:01Z`), by `humantime`.
 pub fn rfc3339_utc(unix_seconds: u64) -> String {
-    let days = (unix_seconds / 86_400) as i64;
-    let secs = unix_seconds % 86_400;
-    // Howard Hinnant's days-to-civil.
-    let z = days + 719_468;
-    let era = z.div_euclid(146_097);
-    let doe = z - era * 146_097;
-    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
-    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
-    let mp = (5 * doy + 2) / 153;
-    let day = doy - (153 * mp + 2) / 5 + 1;
-    let month = if mp < 10 { mp + 3 } else { mp - 9 };
-    let year = yoe + era * 400 + i64::from(month <= 2);
-    format!(
-        "{year:04}-{month:02}-{day:02}T{:02}:{:02}:{:02}Z",
-        secs / 3600,
-        secs / 60 % 60,
-        secs % 60
-    )
+    let t = std::time::UNIX_EPOCH + std::time::Duration::from_secs(unix_seconds);
+    humantime::format_rfc3339_seconds(t).to_string()
 }
 
 /// Now, as [`rfc3339_utc`].
 pub fn now_utc() -> String {
-    let secs = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map(|d| d.as_secs())
-        .unwrap_or(0);
-    rfc3339_utc(secs)
+    humantime::format_rfc3339_seconds(std::time::SystemTime::now()).to_string()
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// FNV-1a's published 64-bit test vectors (the empty string, "a", "foobar"), so that the
+    /// hashes in saved records keep their meaning.
+    #[test]
+    fn text_hash_is_fnv1a_64() {
+        assert_eq!(text_hash(b""), "cbf29ce484222325");
+        assert_eq!(text_hash(b"a"), "af63dc4c8601ec8c");
+        assert_eq!(text_hash(b"foobar"), "85944171f73967e8");
+    }
 
     #[test]
     fn timestamps() {

@@ -61,15 +61,15 @@ pub enum Lookup {
     Invalid(String),
 }
 
-/// FNV-1a, 64-bit.
-fn fnv(mut h: u64, bytes: &[u8]) -> u64 {
-    for &b in bytes {
-        h ^= u64::from(b);
-        h = h.wrapping_mul(0x0000_0100_0000_01b3);
-    }
-    h
+/// FNV-1a, 64-bit (the `fnv` crate), continued from the state `h`.
+fn fnv(h: u64, bytes: &[u8]) -> u64 {
+    use std::hash::Hasher;
+    let mut hasher = fnv::FnvHasher::with_key(h);
+    hasher.write(bytes);
+    hasher.finish()
 }
 
+/// FNV-1a's starting state (the offset basis): `fnv::FnvHasher::default()`'s.
 const FNV_START: u64 = 0xcbf2_9ce4_8422_2325;
 
 /// The key of a reference: the cache format, the scene bytes that were parsed, every setting
