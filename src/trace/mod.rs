@@ -25,7 +25,9 @@ pub mod tracer;
 pub mod tree;
 pub mod view;
 
-pub use check::{PixelEngine, check_pixel, render_pixel, render_pixel_counted, tree_counts};
+pub use check::{
+    PixelEngine, check_pixel, contribution_sum, render_pixel, render_pixel_counted, tree_counts,
+};
 pub use scene_view::{
     LightView, MaterialView, SceneGeometry, SphereView, TriangleView, scene_bounds, scene_geometry,
 };

@@ -123,12 +123,7 @@ pub fn trace_pixel(
     };
     reference.pixel(pixel, &mut RayCounts::default(), &mut recorder);
     let segments = recorder.finish();
-    let mut sum = [0.0f64; 3];
-    for s in &segments {
-        for (acc, c) in sum.iter_mut().zip(s.contribution) {
-            *acc += f64::from(c);
-        }
-    }
+    let sum = super::check::contribution_sum(&segments);
     Ok(RayTree {
         schema: SCHEMA_ID.to_string(),
         scene: scene.source.clone(),
