@@ -70,8 +70,6 @@ pub mod bench;
 #[cfg(feature = "tools")]
 pub mod build_info;
 #[cfg(feature = "tools")]
-pub mod debug_view;
-#[cfg(feature = "tools")]
 pub mod false_colour;
 #[cfg(feature = "tools")]
 pub mod image_diff;

@@ -16,32 +16,67 @@ use crate::camera::CameraRays;
 use crate::film::Film;
 use crate::geometry::{Accel, Hit, Ray};
 use crate::sampling::{SampleKey, square_sample};
-use crate::scene::Scene;
+use crate::scene::{Material, Scene};
 use crate::settings::{RenderSettings, ShadowMode};
 use crate::shading::shade;
 use crate::spawn::{
-    SurfaceHit, falloff, light_end, light_offset, mirror_ray, shadow_ray, surface_hit,
+    ShadowRay, SurfaceHit, falloff, light_end, light_offset, mirror_ray, shadow_ray, surface_hit,
 };
 use crate::stats::{KindClock, KindTimes, RayCounts, RayKind};
 use glam::Vec3;
 use rayon::prelude::*;
 
-/// Receives every ray the tracer casts; `()` ignores them at no cost. Used by the one-pixel
-/// debug view.
+/// Receives every ray the tracer casts, with what the pixel gets from it; `()` ignores them at
+/// no cost. `trace::trace_pixel` records the one-pixel ray tree through it.
+///
+/// `key` is the path's: its sample and bounce (the light loop's own key, with the light's
+/// index, is not passed on, so a hook reads the bounce and light as the loop sees them, not as
+/// its random numbers are keyed). The calls come in the recursion's order: a hit, then the
+/// whole path of its mirror ray, then the hit's own light points.
 pub trait TraceLog {
-    /// A camera or reflection ray and what it hit.
-    fn path_ray(&mut self, _bounce: u32, _ray: &Ray, _hit: &Hit) {}
-    /// A shadow ray from `from` towards `to` on light `light`; `blocked` tells the outcome
-    /// (`None` when shadows are off and no ray was cast).
-    fn shadow_ray(
+    /// A camera ray (bounce 0) or mirror ray that hits nothing: the ray returns `background`.
+    fn path_miss(&mut self, _key: &SampleKey, _ray: &Ray, _background: Vec3) {}
+    /// A camera or mirror ray's closest hit, the surface there and its material, and the
+    /// hit's own term `ambient` = ambient ⊙ kd (the ray returns it plus kr ⊙ its mirror ray's
+    /// colour plus its light points' terms).
+    fn path_hit(
         &mut self,
-        _bounce: u32,
-        _light: u32,
-        _from: Vec3,
-        _to: Vec3,
-        _blocked: Option<bool>,
+        _key: &SampleKey,
+        _ray: &Ray,
+        _hit: &Hit,
+        _surface: &SurfaceHit,
+        _material: &Material,
+        _ambient: Vec3,
     ) {
     }
+    /// A light point not above the hit's tangent plane (or the light's own plane): no ray,
+    /// nothing added.
+    fn no_shadow_ray(&mut self, _key: &SampleKey, _target: &LightPoint) {}
+    /// A shadow ray towards `target`: `blocked` is the occlusion test's outcome (`None` when
+    /// shadows are off and no test runs) and `term` = Shade(l) / N what it adds to the hit's
+    /// colour (zero when blocked).
+    fn shadow_ray(
+        &mut self,
+        _key: &SampleKey,
+        _target: &LightPoint,
+        _shadow: &ShadowRay,
+        _blocked: Option<bool>,
+        _term: Vec3,
+    ) {
+    }
+}
+
+/// A point a hit's light loop aims a shadow ray at.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightPoint {
+    /// Index of the light.
+    pub light: u32,
+    /// Which of the light's points it is (0..points per light).
+    pub index: u32,
+    /// Its (u, v) on the light's square with soft shadows; none for the centroid.
+    pub uv: Option<[f32; 2]>,
+    /// The point.
+    pub point: Vec3,
 }
 
 impl TraceLog for () {}
@@ -66,6 +101,12 @@ impl<'a> Reference<'a> {
             camera: CameraRays::new(&scene.camera, settings.width, settings.height),
             light_offsets: scene.lights.iter().map(light_offset).collect(),
         }
+    }
+
+    /// The acceleration structure it traces with (`trace::trace_pixel` names the blocker of a
+    /// blocked shadow ray with it).
+    pub fn accel(&self) -> &Accel {
+        &self.accel
     }
 
     /// Renders the image on the current rayon pool; `on_row` is called after each row.
@@ -177,10 +218,11 @@ impl<'a> Reference<'a> {
         let hit = self
             .accel
             .closest(self.scene, ray, f32::INFINITY, self.settings.two_sided);
-        log.path_ray(key.bounce, ray, &hit);
         if !hit.is_hit() {
             clock.since(kind, start);
-            return self.settings.background();
+            let background = self.settings.background();
+            log.path_miss(&key, ray, background);
+            return background;
         }
         let surface = surface_hit(self.scene, hit.prim, ray, hit.t, self.settings.two_sided);
         // One reading ends this ray's work and starts what follows (the few operations of
@@ -188,6 +230,7 @@ impl<'a> Reference<'a> {
         let mut start = clock.since(kind, start);
         let material = self.scene.material_of(hit.prim);
         let mut color = Vec3::from_array(self.settings.ambient) * material.diffuse;
+        log.path_hit(&key, ray, &hit, &surface, material, color);
         if material.is_reflective() && key.bounce < self.settings.bounces {
             let next = mirror_ray(&surface, ray.direction);
             counts.reflection += 1;
@@ -209,7 +252,7 @@ impl<'a> Reference<'a> {
         &self,
         surface: &SurfaceHit,
         e: Vec3,
-        material: &crate::scene::Material,
+        material: &Material,
         key: SampleKey,
         counts: &mut RayCounts,
         log: &mut impl TraceLog,
@@ -226,22 +269,25 @@ impl<'a> Reference<'a> {
             let end_offset = self.light_offsets[li];
             let end = light_end(light, end_offset, surface);
             for j in 0..count {
-                let target = match settings.shadows {
+                let (uv, point) = match settings.shadows {
                     ShadowMode::Soft => {
                         let (u, v) = square_sample(settings.sampler, &light_key, j, count);
-                        light.point(u, v)
+                        (Some([u, v]), light.point(u, v))
                     }
-                    _ => light.centroid,
+                    _ => (None, light.centroid),
                 };
-                let Some(shadow) = shadow_ray(surface, target, &end) else {
+                let target = LightPoint {
+                    light: li as u32,
+                    index: j,
+                    uv,
+                    point,
+                };
+                let Some(shadow) = shadow_ray(surface, point, &end) else {
+                    log.no_shadow_ray(&key, &target);
                     continue;
                 };
-                let from = shadow.ray.origin;
-                let visible = match settings.shadows {
-                    ShadowMode::Off => {
-                        log.shadow_ray(key.bounce, li as u32, from, target, None);
-                        true
-                    }
+                let (blocked, visible) = match settings.shadows {
+                    ShadowMode::Off => (None, true),
                     _ => {
                         counts.shadow += 1;
                         let blocked = self.accel.occluded(
@@ -250,16 +296,18 @@ impl<'a> Reference<'a> {
                             shadow.tmax,
                             settings.two_sided,
                         );
-                        log.shadow_ray(key.bounce, li as u32, from, target, Some(blocked));
-                        !blocked
+                        (Some(blocked), !blocked)
                     }
                 };
+                let mut term = Vec3::ZERO;
                 if visible {
                     let light_color = light.color * falloff(settings.light_model, shadow.dist);
                     let l = shadow.ray.direction;
-                    sum +=
+                    term =
                         shade(material, surface.normal, e, l, shadow.n_dot_l, light_color) * weight;
+                    sum += term;
                 }
+                log.shadow_ray(&key, &target, &shadow, blocked, term);
             }
         }
         sum

@@ -10,7 +10,6 @@ use clap::Args;
 use image::RgbImage;
 use raywave::bench::record::StageFigure;
 use raywave::camera::CameraRays;
-use raywave::debug_view::RayRecorder;
 use raywave::engine::{Engine, Prepared, thread_pool};
 use raywave::error::UsageError;
 use raywave::film::{Film, ToneMap};
@@ -218,7 +217,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         match &mut img {
             Some(img) => {
                 let camera = CameraRays::new(&scene.camera, settings.width, settings.height);
-                RayRecorder::from_tree(&tree).draw(img, &camera);
+                raywave::trace::draw::draw_over_render(img, &tree, &camera);
             }
             None => eprintln!(
                 "note: the rays are drawn only over an 8-bit image; {} holds the linear image alone",

@@ -5,7 +5,7 @@
 //! `render_tile` on a tile of that one pixel (a pixel's value does not depend on the tile it is
 //! in: every lane is bit-equal to the scalar twins and each pixel is summed in sample order).
 
-use super::tree::{KindCounts, PixelCheck, RayCountCheck, RayTree, SegmentKind};
+use super::tree::{KindCounts, PixelCheck, RayCountCheck, RayTree, Segment, SegmentKind};
 use crate::reference::Reference;
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
@@ -86,9 +86,23 @@ pub fn tree_counts(tree: &RayTree) -> KindCounts {
     }
 }
 
-/// Renders the tree's pixel with both engines and compares it with the tree's sum.
+/// The sum of the segments' contributions, in f64, in tree order: the tree's `sum`.
+pub fn contribution_sum(segments: &[Segment]) -> [f64; 3] {
+    let mut sum = [0.0f64; 3];
+    for s in segments {
+        for (acc, c) in sum.iter_mut().zip(s.contribution) {
+            *acc += f64::from(c);
+        }
+    }
+    sum
+}
+
+/// Renders the tree's pixel with both engines and compares them with the sum of the tree's
+/// contributions (summed again here from the segments, not read from `tree.sum`) and their ray
+/// counters with the tree's segments.
 pub fn check_pixel(scene: &Scene, settings: &RenderSettings, tree: &RayTree) -> PixelCheck {
     let index = tree.pixel.index;
+    let sum = contribution_sum(&tree.segments);
     let (reference, reference_rays) =
         render_pixel_counted(PixelEngine::Reference, scene, settings, index);
     let (wavefront, wavefront_rays) =
@@ -100,14 +114,14 @@ pub fn check_pixel(scene: &Scene, settings: &RenderSettings, tree: &RayTree) -> 
     };
     let difference = |p: Vec3| {
         (0..3)
-            .map(|c| (tree.sum[c] - f64::from(p[c])).abs())
+            .map(|c| (sum[c] - f64::from(p[c])).abs())
             .fold(0.0f64, f64::max)
     };
     let magnitude = f64::from(reference.max_element().max(wavefront.max_element())).max(1.0);
     let tolerance = TOLERANCE * magnitude;
     let (rd, wd) = (difference(reference), difference(wavefront));
     PixelCheck {
-        sum: tree.sum,
+        sum,
         reference: reference.to_array(),
         wavefront: wavefront.to_array(),
         reference_difference: rd,

@@ -1,17 +1,26 @@
-//! The tree drawn over a render from the debug camera, as the lab's debug mode draws it: every
-//! segment twice, first a faint copy over everything (see-through), then in full colour where
-//! nothing in the scene is in front of it (depth-tested against the first hit through each
-//! pixel).
+//! The tree drawn over an image, two ways:
+//!
+//! - [`Overlay`] (`raywave trace-pixel --png`): over a render from the debug camera, as the
+//!   lab's debug mode draws it: every segment twice, first a faint copy over everything
+//!   (see-through), then in full colour where nothing in the scene is in front of it
+//!   (depth-tested against the first hit through each pixel);
+//! - [`draw_over_render`] (`raywave render --debug-pixel`): over the render itself, from its own
+//!   camera: every segment in full colour, no depth test, and a cross on each camera ray's end
+//!   (a camera ray runs along the line of sight and projects to a dot).
 //!
 //! ```text
+//! Overlay:
 //! depth[pixel] = distance to the first hit of the ray through the pixel's centre (∞: none)
 //! for each segment (clipped to the eye's near plane), sampled twice per pixel of its length:
 //!     faint:  pixel = 0.65·pixel + 0.35·colour   (once per pixel and segment)
 //!     solid:  pixel = colour   where |p − eye| ≤ depth + tolerance (and on the dash, if dashed)
+//! draw_over_render:
+//! for each segment, 2049 points evenly along it: pixel = colour (where in front of the eye)
+//! for each camera segment: a 9-pixel cross at its end
 //! ```
 
-use super::palette::{MAIN_CAMERA, Rgb, Style};
-use super::tree::RayTree;
+use super::palette::{CAMERA, MAIN_CAMERA, Rgb, Style};
+use super::tree::{RayTree, SegmentKind};
 use super::view::{camera_marker, project};
 use crate::camera::CameraRays;
 use crate::geometry::Accel;
@@ -152,5 +161,64 @@ impl Overlay<'_> {
                 plot(img, x as u32, y as u32, dist);
             }
         }
+    }
+}
+
+/// Draws the tree's segments over `img`, the render of `camera` (`raywave render
+/// --debug-pixel`): each in its colour (`Style`), in tree order, then a cross in the camera
+/// rays' colour on each camera segment's end (its hit, or `miss_length` out), drawn last so the
+/// rays leaving that hit do not cover it.
+pub fn draw_over_render(img: &mut RgbImage, tree: &RayTree, camera: &CameraRays) {
+    for s in &tree.segments {
+        let (a, b) = (Vec3::from_array(s.origin), Vec3::from_array(s.end));
+        let colour = Style::of(s).colour();
+        // Walk the 3D segment so the part in front of the eye is drawn even if an end is
+        // behind it.
+        let steps = 2048;
+        for k in 0..=steps {
+            let p = a.lerp(b, k as f32 / steps as f32);
+            if let Some((x, y)) = project_onto_render(camera, p) {
+                put(img, x.floor() as i64, y.floor() as i64, colour);
+            }
+        }
+    }
+    for s in tree
+        .segments
+        .iter()
+        .filter(|s| s.kind == SegmentKind::Camera)
+    {
+        if let Some((x, y)) = project_onto_render(camera, Vec3::from_array(s.end)) {
+            for d in -4..=4 {
+                put(img, x as i64 + d, y as i64, CAMERA);
+                put(img, x as i64, y as i64 + d, CAMERA);
+            }
+        }
+    }
+}
+
+/// Projects a world point to continuous pixel coordinates (x right, y down), or None within
+/// 1e-4 of the eye's plane or behind it: `view::project`'s mapping with another near limit and
+/// another order of f32 operations, kept so that `render --debug-pixel` draws on the same
+/// pixels as it always has.
+fn project_onto_render(camera: &CameraRays, p: Vec3) -> Option<(f32, f32)> {
+    let d = p - camera.origin;
+    let depth = d.dot(camera.forward);
+    if depth <= 1e-4 {
+        return None;
+    }
+    let half = camera.right.length();
+    let sx = d.dot(camera.right) / (half * half * depth);
+    let sy = d.dot(camera.up) / (half * half * depth);
+    let (w, h) = (camera.width as f32, camera.height as f32);
+    let m = w.max(h);
+    let x = ((sx + 1.0) * 0.5 - 0.5) * m + 0.5 * w;
+    let y = ((sy + 1.0) * 0.5 - 0.5) * m + 0.5 * h;
+    Some((x, h - y))
+}
+
+/// Sets a pixel if (x, y) lies inside the image.
+fn put(img: &mut RgbImage, x: i64, y: i64, colour: Rgb) {
+    if x >= 0 && y >= 0 && (x as u64) < img.width() as u64 && (y as u64) < img.height() as u64 {
+        img.put_pixel(x as u32, y as u32, image::Rgb(colour));
     }
 }

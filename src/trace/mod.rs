@@ -2,12 +2,12 @@
 //! each goes, what it hits or what blocks it, and the colour each adds to the pixel.
 //!
 //! ```text
-//! trace_pixel(scene, settings, x, y) -> RayTree       tracer.rs: the reference's recursion, recorded
-//! check_pixel(scene, settings, &tree) -> PixelCheck   check.rs: Σ contributions vs both engines
+//! trace_pixel(scene, settings, x, y) -> RayTree       tracer.rs: recorded from Reference::pixel
+//! check_pixel(scene, settings, &tree) -> PixelCheck   check.rs: Σ contributions, rays vs engines
 //! scene_geometry(scene) -> SceneGeometry              scene_view.rs: triangles, spheres, lights
 //! summary(&tree) -> String                            summary.rs: the readable tree
 //! mesh::groups(scene, &tree) -> obj.rs / ply.rs       the scene and the rays for 3D viewers
-//! view.rs (debug camera), draw.rs (rays over its render), palette.rs (the colours)
+//! view.rs (debug camera), draw.rs (rays over its render or render --debug-pixel's), palette.rs
 //! ```
 //!
 //! The types (tree.rs, scene_view.rs) are plain serde values with a JSON Schema
@@ -25,7 +25,9 @@ pub mod tracer;
 pub mod tree;
 pub mod view;
 
-pub use check::{PixelEngine, check_pixel, render_pixel, render_pixel_counted, tree_counts};
+pub use check::{
+    PixelEngine, check_pixel, contribution_sum, render_pixel, render_pixel_counted, tree_counts,
+};
 pub use scene_view::{
     LightView, MaterialView, SceneGeometry, SphereView, TriangleView, scene_bounds, scene_geometry,
 };

@@ -1,15 +1,21 @@
-//! Traces one pixel as its render does and records every ray: the reference's recursion
-//! (`crate::reference`), step for step, with the same camera rays, the same hashed random
-//! numbers, the same spawn offsets and occlusion tests, so the tree is the rays both engines
-//! trace for that pixel.
+//! Records one pixel's ray tree while the reference renderer traces it: `trace_pixel` runs
+//! `Reference::pixel` with a recorder as its `TraceLog`, so the tree's rays, hits, light points,
+//! occlusion outcomes and colour terms are the render's own. The recorder adds what the
+//! recursion does not keep: each segment's throughput and contribution, the tree's order, and
+//! which primitive blocks a blocked shadow ray.
 //!
 //! ```text
-//! for each aa sample s:  camera ray -> segment(path, throughput 1)
-//! segment(path, β):  closest hit
-//!     miss  -> contribution β ⊙ background / n_aa
-//!     hit   -> contribution β ⊙ ambient ⊙ kd / n_aa
-//!              for light l, point j:  shadow segment, contribution β ⊙ Shade / N / n_aa if visible
-//!              mirror with bounces left -> segment(reflection, β ⊙ kr)
+//! the recursion reports, for each aa sample (one camera ray):
+//!     P0, P1, ..., Pk (hits, the last maybe a miss), shadow rays of Pk, ..., of P1, of P0
+//! the recorder keeps that chain (one path segment per depth, with its shadow segments) and
+//! writes it in tree order when the sample ends:  P0, its shadow rays, P1, its shadow rays, ...
+//! throughput β: 1 for the camera ray, β ⊙ kr of the hit before for a mirror ray
+//! contribution, divided by the aa samples n_aa:
+//!     miss       β ⊙ background                   (what the ray returns)
+//!     hit        β ⊙ (ambient ⊙ kd)               (the hit's own term)
+//!     shadow     β ⊙ Shade / N, 0 if blocked      (what it adds to the hit)
+//! blocker of a blocked shadow ray: the nearest hit in (0, tmax), looked up here, not in the
+//! render; whether it is blocked is the render's own occlusion test
 //! ```
 //!
 //! The reference nests the same terms (kr ⊙ (a + b + ...)) in f32; the contributions here are
@@ -20,13 +26,13 @@ use super::tree::{
     BlockerInfo, PixelRef, PrimitiveRef, PrimitiveShape, RayTree, SCHEMA_ID, Segment, SegmentKind,
     ShadowInfo, SurfaceInfo, TraceSettings,
 };
-use crate::camera::CameraRays;
-use crate::geometry::{Accel, Ray};
-use crate::sampling::{SampleKey, square_sample};
-use crate::scene::Scene;
+use crate::geometry::{Accel, Hit, Ray};
+use crate::reference::{LightPoint, Reference, TraceLog};
+use crate::sampling::SampleKey;
+use crate::scene::{Material, Scene};
 use crate::settings::{LightModel, RenderSettings, ShadowMode};
-use crate::shading::shade;
-use crate::spawn::{falloff, light_end, light_offset, mirror_ray, shadow_ray, surface_hit};
+use crate::spawn::{ShadowRay, SurfaceHit};
+use crate::stats::RayCounts;
 use glam::Vec3;
 
 /// Why a pixel cannot be traced.
@@ -105,33 +111,19 @@ pub fn trace_pixel(
     } else {
         1.0
     };
-    let mut tracer = Tracer {
+    let reference = Reference::new(scene, settings);
+    let mut recorder = Recorder {
         scene,
-        settings,
-        accel: Accel::new(scene),
-        light_offsets: scene.lights.iter().map(light_offset).collect(),
-        samples: settings.aa_samples.max(1),
+        accel: reference.accel(),
+        two_sided: settings.two_sided,
+        per_sample: 1.0 / settings.aa_samples.max(1) as f32,
         miss_length,
+        chain: Vec::new(),
         segments: Vec::new(),
     };
-    let camera = CameraRays::new(&scene.camera, settings.width, settings.height);
-    for sample in 0..tracer.samples {
-        let key = SampleKey {
-            pixel,
-            sample,
-            bounce: 0,
-            light: 0,
-            seed: settings.seed,
-        };
-        let ray = camera.sample_ray(pixel, sample, tracer.samples, settings.seed);
-        tracer.path(&ray, key, None, Vec3::ONE);
-    }
-    let mut sum = [0.0f64; 3];
-    for s in &tracer.segments {
-        for (acc, c) in sum.iter_mut().zip(s.contribution) {
-            *acc += f64::from(c);
-        }
-    }
+    reference.pixel(pixel, &mut RayCounts::default(), &mut recorder);
+    let segments = recorder.finish();
+    let sum = super::check::contribution_sum(&segments);
     Ok(RayTree {
         schema: SCHEMA_ID.to_string(),
         scene: scene.source.clone(),
@@ -139,7 +131,7 @@ pub fn trace_pixel(
         settings: trace_settings(settings),
         camera: super::tree::CameraInfo::of(&scene.camera),
         miss_length,
-        segments: tracer.segments,
+        segments,
         sum,
         check: None,
     })
@@ -198,154 +190,194 @@ pub fn primitive_ref(scene: &Scene, prim: u32) -> PrimitiveRef {
     }
 }
 
-struct Tracer<'a> {
+/// Builds the tree from the reference's `TraceLog` calls for one pixel.
+struct Recorder<'a> {
     scene: &'a Scene,
-    settings: &'a RenderSettings,
-    accel: Accel,
-    light_offsets: Vec<f32>,
-    samples: u32,
+    /// The reference's own acceleration structure: names blockers.
+    accel: &'a Accel,
+    two_sided: bool,
+    /// 1 / the aa samples.
+    per_sample: f32,
     miss_length: f32,
+    /// The current aa sample's path segments so far, by depth.
+    chain: Vec<PathRecord>,
+    /// The finished samples' segments, in tree order.
     segments: Vec<Segment>,
 }
 
-impl Tracer<'_> {
-    /// A camera or reflection ray with path throughput `beta`: its segment, then its hit's
-    /// shadow rays, then its reflection.
-    fn path(&mut self, ray: &Ray, key: SampleKey, parent: Option<u32>, beta: Vec3) {
-        let (scene, settings) = (self.scene, self.settings);
-        let per_sample = 1.0 / self.samples as f32;
-        let hit = self
-            .accel
-            .closest(scene, ray, f32::INFINITY, settings.two_sided);
-        let id = self.segments.len() as u32;
+/// A camera or reflection segment of the current sample, and the shadow rays of its hit.
+struct PathRecord {
+    /// Its `id` and `parent` are set when the sample is written.
+    segment: Segment,
+    shadows: Vec<Segment>,
+    /// kr of its hit (zero for a miss): a mirror ray from it has throughput β ⊙ kr.
+    reflective: Vec3,
+}
+
+impl Recorder<'_> {
+    /// Starts the path segment for `ray` at `key.bounce`: the previous sample is written when
+    /// a camera ray starts a new one. Its end and contribution are those of a miss.
+    fn path(&mut self, key: &SampleKey, ray: &Ray, background: Vec3) -> &mut PathRecord {
+        if key.bounce == 0 {
+            self.write_sample();
+        }
+        debug_assert_eq!(
+            self.chain.len(),
+            key.bounce as usize,
+            "one path segment per depth"
+        );
+        let beta = match self.chain.last() {
+            Some(before) => Vec3::from_array(before.segment.throughput) * before.reflective,
+            None => Vec3::ONE,
+        };
         let kind = if key.bounce == 0 {
             SegmentKind::Camera
         } else {
             SegmentKind::Reflection
         };
-        let mut segment = Segment {
-            id,
-            parent,
-            sample: key.sample,
-            kind,
-            depth: key.bounce,
-            origin: ray.origin.to_array(),
-            direction: ray.direction.to_array(),
-            end: (ray.origin + self.miss_length * ray.direction).to_array(),
-            hit: None,
-            shadow: None,
-            throughput: beta.to_array(),
-            contribution: (beta * settings.background() * per_sample).to_array(),
-        };
-        if !hit.is_hit() {
-            self.segments.push(segment);
-            return;
+        self.chain.push(PathRecord {
+            segment: Segment {
+                id: 0,
+                parent: None,
+                sample: key.sample,
+                kind,
+                depth: key.bounce,
+                origin: ray.origin.to_array(),
+                direction: ray.direction.to_array(),
+                end: (ray.origin + self.miss_length * ray.direction).to_array(),
+                hit: None,
+                shadow: None,
+                throughput: beta.to_array(),
+                contribution: (beta * background * self.per_sample).to_array(),
+            },
+            shadows: Vec::new(),
+            reflective: Vec3::ZERO,
+        });
+        self.chain.last_mut().expect("just pushed")
+    }
+
+    /// Writes the current sample's chain in tree order: each path segment, then its shadow
+    /// segments; each path segment's parent is the one before it.
+    fn write_sample(&mut self) {
+        let mut parent = None;
+        for record in self.chain.drain(..) {
+            let id = self.segments.len() as u32;
+            self.segments.push(Segment {
+                id,
+                parent,
+                ..record.segment
+            });
+            for shadow in record.shadows {
+                let shadow_id = self.segments.len() as u32;
+                self.segments.push(Segment {
+                    id: shadow_id,
+                    parent: Some(id),
+                    ..shadow
+                });
+            }
+            parent = Some(id);
         }
-        let surface = surface_hit(scene, hit.prim, ray, hit.t, settings.two_sided);
-        let material = *scene.material_of(hit.prim);
-        segment.end = surface.point.to_array();
-        segment.contribution =
-            (beta * Vec3::from_array(settings.ambient) * material.diffuse * per_sample).to_array();
-        segment.hit = Some(SurfaceInfo {
-            primitive: primitive_ref(scene, hit.prim),
+    }
+
+    /// Every segment, in tree order.
+    fn finish(mut self) -> Vec<Segment> {
+        self.write_sample();
+        self.segments
+    }
+
+    /// The path segment of the hit whose light loop runs at `key.bounce`.
+    fn at(&mut self, key: &SampleKey) -> &mut PathRecord {
+        &mut self.chain[key.bounce as usize]
+    }
+}
+
+impl TraceLog for Recorder<'_> {
+    fn path_miss(&mut self, key: &SampleKey, ray: &Ray, background: Vec3) {
+        self.path(key, ray, background);
+    }
+
+    fn path_hit(
+        &mut self,
+        key: &SampleKey,
+        ray: &Ray,
+        hit: &Hit,
+        surface: &SurfaceHit,
+        material: &Material,
+        ambient: Vec3,
+    ) {
+        let primitive = primitive_ref(self.scene, hit.prim);
+        let per_sample = self.per_sample;
+        let record = self.path(key, ray, Vec3::ZERO);
+        let beta = Vec3::from_array(record.segment.throughput);
+        record.reflective = material.reflective;
+        record.segment.end = surface.point.to_array();
+        record.segment.contribution = (beta * ambient * per_sample).to_array();
+        record.segment.hit = Some(SurfaceInfo {
+            primitive,
             t: hit.t,
             point: surface.point.to_array(),
             normal: surface.normal.to_array(),
             shadow_points_not_cast: 0,
         });
-        self.segments.push(segment);
+    }
 
-        // Direct light, as `Reference::direct`.
-        let e = -ray.direction;
-        let count = settings.points_per_light();
-        let weight = 1.0 / count as f32;
-        let mut not_cast = 0;
-        for (li, light) in scene.lights.iter().enumerate() {
-            let light_key = SampleKey {
-                light: li as u32,
-                ..key
-            };
-            let end = light_end(light, self.light_offsets[li], &surface);
-            for j in 0..count {
-                let (uv, target) = match settings.shadows {
-                    ShadowMode::Soft => {
-                        let (u, v) = square_sample(settings.sampler, &light_key, j, count);
-                        (Some([u, v]), light.point(u, v))
-                    }
-                    _ => (None, light.centroid),
-                };
-                let Some(shadow) = shadow_ray(&surface, target, &end) else {
-                    not_cast += 1;
-                    continue;
-                };
-                let blocked = match settings.shadows {
-                    ShadowMode::Off => None,
-                    _ => Some(self.accel.occluded(
-                        scene,
-                        &shadow.ray,
-                        shadow.tmax,
-                        settings.two_sided,
-                    )),
-                };
-                // Which primitive blocks it: the nearest hit in (0, tmax). The flag above is
-                // the render's own test; this only names the blocker.
-                let blocker = (blocked == Some(true))
-                    .then(|| {
-                        let h =
-                            self.accel
-                                .closest(scene, &shadow.ray, shadow.tmax, settings.two_sided);
-                        h.is_hit().then(|| BlockerInfo {
-                            primitive: primitive_ref(scene, h.prim),
-                            t: h.t,
-                            point: (shadow.ray.origin + h.t * shadow.ray.direction).to_array(),
-                        })
-                    })
-                    .flatten();
-                let contribution = if blocked == Some(true) {
-                    Vec3::ZERO
-                } else {
-                    let light_color = light.color * falloff(settings.light_model, shadow.dist);
-                    let l = shadow.ray.direction;
-                    beta * (shade(&material, surface.normal, e, l, shadow.n_dot_l, light_color)
-                        * weight)
-                        * per_sample
-                };
-                let shadow_id = self.segments.len() as u32;
-                self.segments.push(Segment {
-                    id: shadow_id,
-                    parent: Some(id),
-                    sample: key.sample,
-                    kind: SegmentKind::Shadow,
-                    depth: key.bounce,
-                    origin: shadow.ray.origin.to_array(),
-                    direction: shadow.ray.direction.to_array(),
-                    end: target.to_array(),
-                    hit: None,
-                    shadow: Some(ShadowInfo {
-                        light: li as u32,
-                        sample_index: j,
-                        uv,
-                        light_point: target.to_array(),
-                        tmax: shadow.tmax,
-                        blocked,
-                        blocker,
-                    }),
-                    throughput: beta.to_array(),
-                    contribution: contribution.to_array(),
-                });
-            }
+    fn no_shadow_ray(&mut self, key: &SampleKey, _target: &LightPoint) {
+        if let Some(info) = self.at(key).segment.hit.as_mut() {
+            info.shadow_points_not_cast += 1;
         }
-        if let Some(info) = self.segments[id as usize].hit.as_mut() {
-            info.shadow_points_not_cast = not_cast;
-        }
+    }
 
-        if material.is_reflective() && key.bounce < settings.bounces {
-            let next = mirror_ray(&surface, ray.direction);
-            let bounced = SampleKey {
-                bounce: key.bounce + 1,
-                ..key
-            };
-            self.path(&next, bounced, Some(id), beta * material.reflective);
-        }
+    fn shadow_ray(
+        &mut self,
+        key: &SampleKey,
+        target: &LightPoint,
+        shadow: &ShadowRay,
+        blocked: Option<bool>,
+        term: Vec3,
+    ) {
+        // Which primitive blocks it: the nearest hit in (0, tmax). `blocked` is the render's
+        // own test; this only names the blocker.
+        let blocker = (blocked == Some(true))
+            .then(|| {
+                let h = self
+                    .accel
+                    .closest(self.scene, &shadow.ray, shadow.tmax, self.two_sided);
+                h.is_hit().then(|| BlockerInfo {
+                    primitive: primitive_ref(self.scene, h.prim),
+                    t: h.t,
+                    point: (shadow.ray.origin + h.t * shadow.ray.direction).to_array(),
+                })
+            })
+            .flatten();
+        let per_sample = self.per_sample;
+        let record = self.at(key);
+        let beta = Vec3::from_array(record.segment.throughput);
+        let contribution = if blocked == Some(true) {
+            Vec3::ZERO
+        } else {
+            beta * term * per_sample
+        };
+        record.shadows.push(Segment {
+            id: 0,
+            parent: None,
+            sample: key.sample,
+            kind: SegmentKind::Shadow,
+            depth: key.bounce,
+            origin: shadow.ray.origin.to_array(),
+            direction: shadow.ray.direction.to_array(),
+            end: target.point.to_array(),
+            hit: None,
+            shadow: Some(ShadowInfo {
+                light: target.light,
+                sample_index: target.index,
+                uv: target.uv,
+                light_point: target.point.to_array(),
+                tmax: shadow.tmax,
+                blocked,
+                blocker,
+            }),
+            throughput: beta.to_array(),
+            contribution: contribution.to_array(),
+        });
     }
 }

@@ -225,6 +225,69 @@ fn contributions_sum_to_the_pixel_both_engines_render() {
 }
 
 #[test]
+fn the_sum_check_fails_when_one_contribution_is_off_by_1e_4_of_the_pixel() {
+    let (scene, settings) = (scene(), settings());
+    let tree = trace_pixel(&scene, &settings, PIXEL.0, PIXEL.1).unwrap();
+    let check = raywave::trace::check_pixel(&scene, &settings, &tree);
+    assert!(check.agrees, "{check:?}");
+    // The demo pixel is reddest (the red wall seen in the mirror): nudge a visible shadow
+    // ray's red contribution by a fraction of the pixel's red. 1e-4 of it is about 3e-5, three
+    // times the tolerance (1e-5 for a pixel below 1); 1e-7 of it is well inside.
+    let red = f64::from(check.reference[0]);
+    let visible = tree
+        .segments
+        .iter()
+        .position(|s| s.shadow.as_ref().is_some_and(|i| i.blocked == Some(false)))
+        .expect("a visible shadow ray");
+    for (fraction, agrees) in [(1e-4, false), (1e-7, true)] {
+        let mut nudged = tree.clone();
+        nudged.segments[visible].contribution[0] += (fraction * red) as f32;
+        let check = raywave::trace::check_pixel(&scene, &settings, &nudged);
+        assert_eq!(
+            check.agrees, agrees,
+            "nudged by {fraction} of the pixel: {check:?}"
+        );
+        let over = |d: f64| d > check.tolerance;
+        assert_eq!(over(check.reference_difference), !agrees, "{check:?}");
+        assert_eq!(over(check.wavefront_difference), !agrees, "{check:?}");
+        // The rays are the same ones: the sum alone decides.
+        assert_eq!(check.rays.tree, check.rays.reference);
+        assert_eq!(check.rays.tree, check.rays.wavefront);
+    }
+}
+
+#[test]
+fn the_ray_count_check_fails_when_a_shadow_segment_is_missing_or_doubled() {
+    let (scene, settings) = (scene(), settings());
+    let tree = trace_pixel(&scene, &settings, PIXEL.0, PIXEL.1).unwrap();
+    // A blocked shadow ray adds nothing: without it, or with it twice, the sum is the same and
+    // only the count can tell.
+    let blocked = tree
+        .segments
+        .iter()
+        .position(|s| s.shadow.as_ref().is_some_and(|i| i.blocked == Some(true)))
+        .expect("a blocked shadow ray");
+    let mut dropped = tree.clone();
+    dropped.segments.remove(blocked);
+    let mut doubled = tree.clone();
+    doubled
+        .segments
+        .insert(blocked, tree.segments[blocked].clone());
+    for (changed, shadow) in [(&dropped, 31), (&doubled, 33)] {
+        let check = raywave::trace::check_pixel(&scene, &settings, changed);
+        assert_eq!(check.rays.tree.shadow, shadow, "{check:?}");
+        assert_eq!(check.rays.reference.shadow, 32, "{check:?}");
+        assert_eq!(check.rays.wavefront.shadow, 32, "{check:?}");
+        assert!(check.reference_difference <= check.tolerance, "{check:?}");
+        assert!(check.wavefront_difference <= check.tolerance, "{check:?}");
+        assert!(
+            !check.agrees,
+            "{shadow} shadow segments for 32 rays: {check:?}"
+        );
+    }
+}
+
+#[test]
 fn the_builtin_scene_sums_too() {
     // The lab's box: three mirror spheres, 5 bounces, soft shadows, 2×2 aa.
     let scene = Scene::builtin_default();

@@ -24,10 +24,11 @@
 use glam::{DVec2, DVec3};
 use raywave::camera::CameraRays;
 use raywave::geometry::{Hit, Ray};
-use raywave::reference::{Reference, TraceLog};
-use raywave::sampling::{LightSampler, strata_grid};
-use raywave::scene::{LightShape, Scene, parse_scene_str};
+use raywave::reference::{LightPoint, Reference, TraceLog};
+use raywave::sampling::{LightSampler, SampleKey, strata_grid};
+use raywave::scene::{LightShape, Material, Scene, parse_scene_str};
 use raywave::settings::{RenderSettings, ShadowMode};
+use raywave::spawn::{ShadowRay, SurfaceHit};
 use raywave::stats::RayCounts;
 use raywave::wavefront::batch::{HitBatch, RayBatch, ShadowQueue};
 use raywave::wavefront::context::Context;
@@ -164,33 +165,50 @@ fn reference_draws(scene: &Scene, s: &RenderSettings) -> Drawn {
     struct Log<'s> {
         scene: &'s Scene,
         pixel: u32,
-        /// The antialiasing sample being traced: path_ray at bounce 0 starts the next one.
+        /// The antialiasing sample being traced: a camera ray (a path hit or miss at bounce 0)
+        /// starts the next one.
         sample: Option<u32>,
         drawn: Drawn,
     }
-    impl TraceLog for Log<'_> {
-        fn path_ray(&mut self, bounce: u32, ray: &Ray, _hit: &Hit) {
-            if bounce == 0 {
+    impl Log<'_> {
+        fn path(&mut self, key: &SampleKey, ray: &Ray) {
+            if key.bounce == 0 {
                 let sample = self.sample.map_or(0, |s| s + 1);
                 self.sample = Some(sample);
                 self.drawn.camera.insert((self.pixel, sample), *ray);
             }
         }
+    }
+    impl TraceLog for Log<'_> {
+        fn path_miss(&mut self, key: &SampleKey, ray: &Ray, _background: glam::Vec3) {
+            self.path(key, ray);
+        }
+        fn path_hit(
+            &mut self,
+            key: &SampleKey,
+            ray: &Ray,
+            _hit: &Hit,
+            _surface: &SurfaceHit,
+            _material: &Material,
+            _ambient: glam::Vec3,
+        ) {
+            self.path(key, ray);
+        }
         fn shadow_ray(
             &mut self,
-            bounce: u32,
-            light: u32,
-            _from: glam::Vec3,
-            to: glam::Vec3,
+            key: &SampleKey,
+            target: &LightPoint,
+            _shadow: &ShadowRay,
             _blocked: Option<bool>,
+            _term: glam::Vec3,
         ) {
             let stream = Stream {
                 pixel: self.pixel,
                 sample: self.sample.expect("a camera ray comes first"),
-                bounce,
-                light,
+                bounce: key.bounce,
+                light: target.light,
             };
-            let uv = light_uv(self.scene, light, to.as_dvec3());
+            let uv = light_uv(self.scene, target.light, target.point.as_dvec3());
             self.drawn.points.entry(stream).or_default().push(uv);
         }
     }
