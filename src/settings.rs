@@ -129,7 +129,7 @@ impl RenderSettings {
     }
 
     /// The lab benchmark of docs/PERFORMANCE.md at `size`²: 5 bounces, soft shadows with 64
-    /// stratified points per light (the benches' frame; at 1024² the figure).
+    /// stratified points per light (the benches' frame; at 1024² the headline figure).
     pub fn lab_benchmark(size: u32) -> Self {
         RenderSettings {
             width: size,
