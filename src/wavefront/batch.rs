@@ -35,6 +35,14 @@ impl Vec3Column {
         (self.x[i], self.y[i], self.z[i]) = (v.x, v.y, v.z);
     }
 
+    /// Adds `v` to vector `i`, component by component.
+    #[inline]
+    pub fn add(&mut self, i: usize, v: Vec3) {
+        self.x[i] += v.x;
+        self.y[i] += v.y;
+        self.z[i] += v.z;
+    }
+
     /// Appends a vector.
     #[inline(always)]
     pub fn push(&mut self, v: Vec3) {
@@ -352,9 +360,7 @@ impl Radiance {
     /// Adds `c` to slot `i`.
     #[inline]
     pub fn add(&mut self, i: usize, c: Vec3) {
-        self.sum.x[i] += c.x;
-        self.sum.y[i] += c.y;
-        self.sum.z[i] += c.z;
+        self.sum.add(i, c);
     }
 
     /// Slot `i`.

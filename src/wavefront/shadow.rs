@@ -256,9 +256,7 @@ fn shade<V: Lanes>(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch, queue: &
             let fall = queue.dist.get(q).map_or(1.0, |&d| falloff(model, d));
             let light_color = ctx.lights[queue.light[q] as usize].color * fall;
             let c = shade_terms(m, n, -rays.direction.get(i), l, n_dot_l, light_color) * weight;
-            hits.direct.x[i] += c.x;
-            hits.direct.y[i] += c.y;
-            hits.direct.z[i] += c.z;
+            hits.direct.add(i, c);
         }
         q += 1;
     }
