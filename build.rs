@@ -1,5 +1,5 @@
 //! Embeds what the binary was built from, for bench records and `raywave info`
-//! (`raywave::build_info`): the git commit and whether the compiled files had uncommitted
+//! (`raywave::output::build_info`): the git commit and whether the compiled files had uncommitted
 //! changes, at build time ("unknown" without git, e.g. from a tarball), the cargo profile, the
 //! target triple, the target features and the RUSTFLAGS.
 //!

@@ -47,16 +47,16 @@ mod common;
 
 use criterion::{BenchmarkId, Criterion, Throughput};
 use raywave::bench::record::median;
-use raywave::meshgen::{bands_for, cornell_box_mesh_spheres, triangle_count};
 use raywave::peer::{
     Hits, ObvhsMesh, RayKind, RaySet, RaySets, hit_agreement, occlusion_agreement, raywave_closest,
     wavefront_bvh_closest, wavefront_bvh_closest_one_ray, wavefront_closest, wavefront_occluded,
     without_emitters, without_spheres,
 };
-use raywave::scene::{NO_HIT, Scene, parse_scene_str};
-use raywave::settings::RenderSettings;
-use raywave::wavefront::batch::HitBatch;
-use raywave::wavefront::context::Context;
+use raywave::render::scene::meshgen::{bands_for, cornell_box_mesh_spheres, triangle_count};
+use raywave::render::scene::{NO_HIT, Scene, parse_scene_str};
+use raywave::render::settings::RenderSettings;
+use raywave::render::wavefront::batch::HitBatch;
+use raywave::render::wavefront::context::Context;
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 
@@ -499,7 +499,7 @@ fn print_peer_table(rounds: usize, size: u32, rows: &[String], notes: &[String])
         "Mrays/s on one thread, median of {rounds} interleaved rounds (every engine once per \
          round, in rotating order); ratios are medians of the per-round ratios. {size}×{size} \
          camera rays; machine: {}, simd {}.\n",
-        raywave::machine::cpu_model(),
+        raywave::output::machine::cpu_model(),
         raywave::simd_path()
     );
     println!("{header} |");
@@ -576,7 +576,7 @@ fn main() {
     let mut c = common::criterion_for_frames(Duration::from_millis(300));
     eprintln!(
         "machine: {}, simd {}",
-        raywave::machine::cpu_model(),
+        raywave::output::machine::cpu_model(),
         raywave::simd_path()
     );
     let (mut rows, mut notes) = (Vec::new(), Vec::new());

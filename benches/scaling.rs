@@ -20,9 +20,9 @@
 mod common;
 
 use raywave::bench::record::median;
-use raywave::scene::Scene;
-use raywave::settings::RenderSettings;
-use raywave::wavefront::{DEFAULT_BATCH_SIZE, Wavefront};
+use raywave::render::scene::Scene;
+use raywave::render::settings::RenderSettings;
+use raywave::render::wavefront::{DEFAULT_BATCH_SIZE, Wavefront};
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 use wide::f32x8;

@@ -26,13 +26,13 @@
 mod common;
 
 use criterion::{BenchmarkId, Throughput};
-use raywave::engine::Engine;
-use raywave::film::Film;
-use raywave::sampling::LightSampler;
-use raywave::scene::Scene;
-use raywave::settings::RenderSettings;
-use raywave::statistics::{BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, bootstrap_interval};
-use raywave::stats::RayCounts;
+use raywave::bench::statistics::{BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, bootstrap_interval};
+use raywave::render::engine::Engine;
+use raywave::render::film::Film;
+use raywave::render::per_kind::RayCounts;
+use raywave::render::sampling::LightSampler;
+use raywave::render::scene::Scene;
+use raywave::render::settings::RenderSettings;
 use raywave::variance::{
     StudyConfig, converged_reference, error_stats, penumbra_mask, per_image_errors,
 };
@@ -178,7 +178,7 @@ fn measure(scene: &Scene, config: &StudyConfig) -> (usize, Vec<Measured>) {
     let start_time = std::time::SystemTime::now();
     let reference = converged_reference(
         scene,
-        raywave::scene::BUILTIN_CORNELL_BOX.as_bytes(),
+        raywave::render::scene::BUILTIN_CORNELL_BOX.as_bytes(),
         config,
         &render,
         cache_dir()

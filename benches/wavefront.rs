@@ -9,11 +9,11 @@
 mod common;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use raywave::scene::Scene;
-use raywave::settings::RenderSettings;
-use raywave::wavefront::batch::{HitBatch, Radiance, RayBatch, ShadowQueue};
-use raywave::wavefront::context::Context;
-use raywave::wavefront::{Wavefront, film, generate, intersect, reflect, shadow};
+use raywave::render::scene::Scene;
+use raywave::render::settings::RenderSettings;
+use raywave::render::wavefront::batch::{HitBatch, Radiance, RayBatch, ShadowQueue};
+use raywave::render::wavefront::context::Context;
+use raywave::render::wavefront::{Wavefront, film, generate, intersect, reflect, shadow};
 use std::hint::black_box;
 
 const TILE: u32 = 4096;

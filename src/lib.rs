@@ -2,22 +2,25 @@
 //!
 //! Two engines render the same image from the same samples:
 //!
-//! - the **wavefront** engine ([`wavefront`]) moves rays through stages in structure-of-arrays
-//!   batches, 8 or 16 lanes at a time (16 on AVX-512 builds): generate → intersect → shadow → film → reflect, tiles spread
-//!   over cores with rayon, meshes through its own 8-wide BVH;
-//! - the **reference** ([`reference`](mod@reference)) is the lab's recursive renderer, one scalar ray at a
-//!   time, written to be obviously right: the twin every fast path is checked and timed
-//!   against.
+//! - the **wavefront** engine ([`render::wavefront`]) moves rays through stages in
+//!   structure-of-arrays batches, 8 or 16 lanes at a time (16 on AVX-512 builds): generate →
+//!   intersect → shadow → film → reflect, tiles spread over cores with rayon, meshes through its
+//!   own 8-wide BVH;
+//! - the **reference** ([`render::reference`](mod@render::reference)) is the lab's recursive
+//!   renderer, one scalar ray at a time, written to be obviously right: the twin every fast path
+//!   is checked and timed against.
 //!
-//! Callers choose one through [`engine::Engine`]. What every module holds, and how they depend
-//! on each other, is in the module map of docs/ARCHITECTURE.md.
+//! Callers choose one through [`render::engine::Engine`]. The modules are in layers: the
+//! renderer ([`render`]), outputs and records (`output`), the tools built on both (`diff`,
+//! `trace`, `view`, `variance`, `bench`, `peer`), and the binary's `cli/`. What every module
+//! holds is in the module map of docs/ARCHITECTURE.md.
 //!
 //! A tiny render of a scene given as text, by both engines:
 //!
 //! ```
-//! use raywave::engine::Engine;
-//! use raywave::scene::parse_scene_str;
-//! use raywave::settings::{RenderSettings, ShadowMode};
+//! use raywave::render::engine::Engine;
+//! use raywave::render::scene::parse_scene_str;
+//! use raywave::render::settings::{RenderSettings, ShadowMode};
 //!
 //! // A white floor under a square light: materials first, then `m i` selects one for the
 //! // faces that follow (the lab's format, docs/SCENE_FORMAT.md).
@@ -47,48 +50,24 @@
 //! ```
 #![warn(missing_docs)]
 
+// The layers, each depending only on those above it; docs/ARCHITECTURE.md has the module map.
+//
 // The renderer: what a frame needs, with no tool's dependencies (`--no-default-features`
 // builds only this, as the instruction-count gate's child does).
-pub mod camera;
-pub mod engine;
-pub mod error;
-pub mod film;
-pub mod geometry;
-pub mod quote;
-pub mod reference;
-pub mod sampling;
-pub mod scene;
-pub mod settings;
-pub mod shading;
-pub mod spawn;
-pub mod stats;
-pub mod wavefront;
+pub mod render;
 
-// Outputs, records and the tools built on the renderer (the default `tools` feature).
+// Outputs and records: where a command's files go, the image formats, the render record, the
+// machine and build it describes, false-colour figures and the terminal.
+#[cfg(feature = "tools")]
+pub mod output;
+
+// The tools built on both, one folder per command.
 #[cfg(feature = "tools")]
 pub mod bench;
 #[cfg(feature = "tools")]
-pub mod build_info;
-#[cfg(feature = "tools")]
-pub mod false_colour;
-#[cfg(feature = "tools")]
-pub mod image_diff;
-#[cfg(feature = "tools")]
-pub mod machine;
-#[cfg(feature = "tools")]
-pub mod meshgen;
-#[cfg(feature = "tools")]
-pub mod options;
-#[cfg(feature = "tools")]
-pub mod output;
+pub mod diff;
 #[cfg(feature = "tools")]
 pub mod peer;
-#[cfg(feature = "tools")]
-pub mod report;
-#[cfg(feature = "tools")]
-pub mod statistics;
-#[cfg(feature = "tools")]
-pub mod terminal;
 #[cfg(feature = "tools")]
 pub mod trace;
 #[cfg(feature = "tools")]
@@ -99,13 +78,13 @@ pub mod view;
 /// Which SIMD instructions this build's wavefront engine uses by default (`--lanes auto`),
 /// decided at compile time: `f32x16` on AVX-512 builds, else `f32x8` (from the `wide` crate).
 pub fn simd_path() -> &'static str {
-    simd_path_for(wavefront::lanes::LaneWidth::Auto)
+    simd_path_for(render::wavefront::lanes::LaneWidth::Auto)
 }
 
 /// Which SIMD instructions the wavefront engine's kernels use at lane width `width`: the
 /// brute-force, light and shading kernels run that wide, the mesh BVH 8-wide.
-pub fn simd_path_for(width: wavefront::lanes::LaneWidth) -> &'static str {
-    use wavefront::lanes::LaneWidth;
+pub fn simd_path_for(width: render::wavefront::lanes::LaneWidth) -> &'static str {
+    use render::wavefront::lanes::LaneWidth;
     let avx2 = cfg!(all(target_feature = "avx2", target_feature = "fma"));
     match width.resolve() {
         LaneWidth::Sixteen => {

@@ -7,7 +7,7 @@
 mod cli;
 
 use cli::Command;
-use raywave::error::UsageError;
+use raywave::render::error::UsageError;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
@@ -57,7 +57,7 @@ fn main() -> ExitCode {
             Ok(code) => return ExitCode::from(code),
             Err(e) => Err(e),
         },
-        // Exit 3 when the figure is past --fail-above (raywave::image_diff::EXIT_FAILED).
+        // Exit 3 when the figure is past --fail-above (raywave::diff::EXIT_FAILED).
         Command::Diff(args) => match cli::diff::run(&args) {
             Ok(code) => return ExitCode::from(code),
             Err(e) => Err(e),

@@ -3,7 +3,7 @@
 //! command line tells which: clap's `ArgMatches::value_source`). A flag given explicitly that
 //! differs from the record makes the setups differ, and the comparison is refused.
 
-use crate::settings::RenderSettings;
+use crate::render::settings::RenderSettings;
 
 /// The settings fields each image flag sets (as named in the record's JSON). `--defaults`
 /// sets them all: given explicitly, nothing is adopted. Fields no flag names (the seed) are

@@ -97,7 +97,7 @@ pub fn list(dir: &Path) -> Result<(String, Vec<String>)> {
                 .and_then(|e| e.summary.iter().find(|f| f.figure == "total"))
                 .map_or("-".to_string(), |f| format!("{:.2}", f.median / 1e6))
         };
-        let source = crate::quote::escape(&r.setup.scene.source);
+        let source = crate::render::quote::escape(&r.setup.scene.source);
         let scene: String = if source.chars().count() > 28 {
             format!("{}…", source.chars().take(27).collect::<String>())
         } else {

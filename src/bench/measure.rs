@@ -11,12 +11,12 @@
 //! ```
 
 use super::record::{EngineRecord, KindRates, Measurement, StageFigure, summarise};
-use crate::engine::{Engine, Prepared};
-use crate::film::Film;
-use crate::scene::Scene;
-use crate::settings::RenderSettings;
-use crate::wavefront::DEFAULT_BATCH_SIZE;
-use crate::wavefront::lanes::LaneWidth;
+use crate::render::engine::{Engine, Prepared};
+use crate::render::film::Film;
+use crate::render::scene::Scene;
+use crate::render::settings::RenderSettings;
+use crate::render::wavefront::DEFAULT_BATCH_SIZE;
+use crate::render::wavefront::lanes::LaneWidth;
 use std::time::Instant;
 
 /// Warm-up and timed runs of `engines` on `pool`, the wavefront engine `lanes` wide; `tick` is

@@ -21,12 +21,13 @@ pub mod list;
 pub mod measure;
 pub mod record;
 pub mod report;
+pub mod statistics;
 pub mod sweep;
 
-use crate::engine::{Engine, thread_pool};
-use crate::options::ImageOptions;
-use crate::scene::{SceneFile, load_scene};
-use crate::wavefront::DEFAULT_BATCH_SIZE;
+use crate::render::engine::{Engine, thread_pool};
+use crate::render::scene::{SceneFile, load_scene};
+use crate::render::settings::options::ImageOptions;
+use crate::render::wavefront::DEFAULT_BATCH_SIZE;
 use anyhow::{Context, Result, bail};
 use record::{BenchRecord, Machine, SceneId, Setup};
 use std::path::PathBuf;
@@ -57,7 +58,7 @@ pub struct BenchOptions {
     /// The engines to time, in record order (reference, then wavefront).
     pub engines: Vec<Engine>,
     /// The wavefront engine's lane width (`--lanes`; speed only).
-    pub lanes: crate::wavefront::lanes::LaneWidth,
+    pub lanes: crate::render::wavefront::lanes::LaneWidth,
     /// Timed runs per engine.
     pub runs: u32,
     /// Untimed runs per engine before the timed ones.
@@ -117,7 +118,7 @@ pub struct Hooks<'a> {
 /// One point, ready to time: everything refusable was checked.
 struct Plan {
     point: sweep::Point,
-    settings: crate::settings::RenderSettings,
+    settings: crate::render::settings::RenderSettings,
     pool: rayon::ThreadPool,
     setup: Setup,
     engines: Vec<Engine>,
@@ -129,7 +130,7 @@ pub fn run(args: &BenchOptions, hooks: &Hooks) -> Result<Outcome> {
     // Everything that can fail cheaply happens before the timed part.
     let points = args.sweep.points();
     if points.len() > 1 && (args.compare.is_some() || args.json.is_some()) {
-        return Err(crate::error::UsageError(format!(
+        return Err(crate::render::error::UsageError(format!(
             "{} takes one point, but the sweep has {}: compare or write points one at a time \
              (`raywave bench compare A B` compares saved points; --export-json writes them all)",
             if args.compare.is_some() {
@@ -213,11 +214,11 @@ pub fn run(args: &BenchOptions, hooks: &Hooks) -> Result<Outcome> {
             if !problems.is_empty() {
                 bail!(incomparable(path, &problems));
             }
-            if args.runs < crate::statistics::MIN_FOR_INTERVAL as u32 {
-                return Err(crate::error::UsageError(format!(
+            if args.runs < crate::bench::statistics::MIN_FOR_INTERVAL as u32 {
+                return Err(crate::render::error::UsageError(format!(
                     "--compare needs --runs {} or more: with {} run(s) the median has no 95% \
                      interval, and the verdict needs one",
-                    crate::statistics::MIN_FOR_INTERVAL,
+                    crate::bench::statistics::MIN_FOR_INTERVAL,
                     args.runs
                 ))
                 .into());
@@ -253,7 +254,7 @@ pub fn run(args: &BenchOptions, hooks: &Hooks) -> Result<Outcome> {
         (hooks.progress)(n, total);
     };
     (hooks.progress)(0, total);
-    let build = crate::build_info::current();
+    let build = crate::output::build_info::current();
     let mut records = Vec::new();
     for plan in &plans {
         let engines = measure::measure(
@@ -274,9 +275,9 @@ pub fn run(args: &BenchOptions, hooks: &Hooks) -> Result<Outcome> {
             build: build.clone(),
             timestamp: record::now_utc(),
             machine: Machine {
-                hostname: crate::machine::hostname(),
-                cpu: crate::machine::cpu_model(),
-                logical_cpus: crate::machine::logical_cpus(),
+                hostname: crate::output::machine::hostname(),
+                cpu: crate::output::machine::cpu_model(),
+                logical_cpus: crate::output::machine::logical_cpus(),
                 os: std::env::consts::OS.to_string(),
                 arch: std::env::consts::ARCH.to_string(),
             },
@@ -383,5 +384,5 @@ fn incomparable(path: &std::path::Path, problems: &[String]) -> String {
 
 /// Writes to stdout; a closed pipe (`raywave bench | head`) is an error, not a panic.
 fn emit(text: &str) -> Result<()> {
-    crate::terminal::write_stdout(text).context("cannot write to stdout")
+    crate::output::terminal::write_stdout(text).context("cannot write to stdout")
 }

@@ -1,10 +1,10 @@
 //! A bench record: what was measured (medians and every run) and under which conditions
 //! (machine, build, scene, settings), as it is saved to `.raywave-bench/NAME.json`.
 
-pub use crate::machine::Machine;
-use crate::settings::RenderSettings;
-use crate::stats::RayCounts;
-use crate::wavefront::stats::{RenderStats, StageRow};
+pub use crate::output::machine::Machine;
+use crate::render::per_kind::RayCounts;
+use crate::render::settings::RenderSettings;
+use crate::render::wavefront::stats::{RenderStats, StageRow};
 use anyhow::{Context, Result, bail};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -32,7 +32,7 @@ pub struct BenchRecord {
     /// Whether tracked files had uncommitted changes at build time (None when unknown).
     pub git_dirty: Option<bool>,
     /// The build: commit, profile, target, target features, RUSTFLAGS (`build.rs`).
-    pub build: crate::build_info::BuildInfo,
+    pub build: crate::output::build_info::BuildInfo,
     /// When the bench ran, UTC, RFC 3339.
     pub timestamp: String,
     /// Where it ran.
@@ -119,7 +119,7 @@ pub struct FigureSummary {
 impl FigureSummary {
     /// The summary of `values`, one per run.
     pub fn of(figure: &str, unit: &str, values: &[f64]) -> FigureSummary {
-        let (median, low, high) = crate::statistics::median_with_interval(values);
+        let (median, low, high) = crate::bench::statistics::median_with_interval(values);
         let finite = |x: f64| x.is_finite().then_some(x);
         FigureSummary {
             figure: figure.to_string(),
@@ -130,7 +130,7 @@ impl FigureSummary {
             low: finite(low),
             high: finite(high),
             max: values.iter().copied().fold(f64::NEG_INFINITY, f64::max),
-            outliers: crate::statistics::outliers(values),
+            outliers: crate::bench::statistics::outliers(values),
         }
     }
 
@@ -149,7 +149,7 @@ impl FigureSummary {
             _ => format!(
                 "[none: {} run(s) < {}]",
                 self.runs,
-                crate::statistics::MIN_FOR_INTERVAL
+                crate::bench::statistics::MIN_FOR_INTERVAL
             ),
         }
     }
@@ -194,7 +194,7 @@ pub struct Measurement {
 }
 
 /// How fast each kind of ray was handled. A kind's rate is its rays per thread-second of
-/// that kind's own work ([`crate::stats::KindTimes`]: for the wavefront engine from its stage
+/// that kind's own work ([`crate::render::per_kind::KindTimes`]: for the wavefront engine from its stage
 /// timers), so it says how fast that work went whatever else the frame did; the total is all
 /// rays per wall-clock second of the frame, the headline figure. A kind is null (`None`) when
 /// its time was not measured (the reference in `raywave bench`, which times it without
@@ -303,7 +303,7 @@ impl From<&StageRow> for StageFigure {
     }
 }
 
-pub use crate::statistics::median;
+pub use crate::bench::statistics::median;
 
 impl Measurement {
     /// Each figure's median over `runs` (ray counts from the first run: they do not vary).
@@ -363,7 +363,7 @@ pub fn record_path(dir: &Path, name: &str) -> Result<std::path::PathBuf> {
             .chars()
             .all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.' | '+'));
     if !plain {
-        return Err(crate::error::UsageError(format!(
+        return Err(crate::render::error::UsageError(format!(
             "bench record name `{}` is not usable: expected a plain name like `before` \
              (letters, digits, - _ . +; no path separators, not starting with '.' or '-'); \
              use --dir to choose the directory",
@@ -481,7 +481,10 @@ mod tests {
         );
         for bad in ["", "../x", "a/b", ".hidden", "-x", "a\\b", "a\nb", "é"] {
             let e = record_path(dir, bad).unwrap_err();
-            assert!(e.downcast_ref::<crate::error::UsageError>().is_some());
+            assert!(
+                e.downcast_ref::<crate::render::error::UsageError>()
+                    .is_some()
+            );
             assert!(e.to_string().contains("not usable"), "{e}");
         }
     }

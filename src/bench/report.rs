@@ -3,7 +3,7 @@
 //! measurement deserves (outlier runs, wide intervals, a loaded machine).
 
 use super::record::{BenchRecord, FigureSummary};
-use crate::settings::{RenderSettings, ShadowMode};
+use crate::render::settings::{RenderSettings, ShadowMode};
 use std::fmt::Write as _;
 
 /// A median whose 95% interval is wider than this share of it, in percent, is called noisy.
@@ -178,7 +178,7 @@ pub fn warnings(r: &BenchRecord, point: &str) -> Vec<String> {
                     f.figure,
                     values.join(", "),
                     f.median / 1e6,
-                    crate::statistics::OUTLIER_Z
+                    crate::bench::statistics::OUTLIER_Z
                 ));
             }
             if let Some(w) = f.relative_width_pct().filter(|w| *w > NOISY_WIDTH_PCT) {
@@ -206,7 +206,7 @@ pub fn warnings(r: &BenchRecord, point: &str) -> Vec<String> {
 pub fn load_warning() -> Option<String> {
     let text = std::fs::read_to_string("/proc/loadavg").ok()?;
     let load: f64 = text.split_whitespace().next()?.parse().ok()?;
-    let cpus = crate::machine::logical_cpus();
+    let cpus = crate::output::machine::logical_cpus();
     (load > cpus as f64).then(|| {
         format!(
             "the load average is {load:.2} on {cpus} logical CPU(s) before the bench: other \

@@ -11,10 +11,10 @@ use raywave::bench::sweep::{Sweep, record_name};
 use raywave::bench::{
     BenchOptions, DEFAULT_RUNS, DEFAULT_THRESHOLD_PCT, EXIT_REGRESSION, Hooks, list,
 };
-use raywave::engine::Engine;
-use raywave::error::UsageError;
 use raywave::output::OutputPlan;
 use raywave::output::memory::{self, RenderFootprint};
+use raywave::render::engine::Engine;
+use raywave::render::error::UsageError;
 use std::path::PathBuf;
 
 /// Flags of `raywave bench`. A scene file literally named `compare` or `list` is given as
@@ -285,7 +285,7 @@ pub fn run(args: &BenchArgs, matches: Option<&ArgMatches>) -> Result<u8> {
     match &args.action {
         Some(BenchAction::Compare(c)) => {
             let (table, regressed) = list::compare_saved(&c.dir, &c.a, &c.b, c.threshold)?;
-            raywave::terminal::print(&table)?;
+            raywave::output::terminal::print(&table)?;
             return Ok(if regressed { EXIT_REGRESSION } else { 0 });
         }
         Some(BenchAction::List(l)) => {
@@ -293,7 +293,7 @@ pub fn run(args: &BenchArgs, matches: Option<&ArgMatches>) -> Result<u8> {
             for w in warnings {
                 eprintln!("warning: {w}");
             }
-            raywave::terminal::print(&table)?;
+            raywave::output::terminal::print(&table)?;
             return Ok(0);
         }
         None => {}
@@ -317,14 +317,14 @@ pub fn run(args: &BenchArgs, matches: Option<&ArgMatches>) -> Result<u8> {
             pixels: largest.unwrap_or(settings.width as u64 * settings.height as u64),
             primitives: 0,
             threads,
-            batch_size: raywave::wavefront::DEFAULT_BATCH_SIZE as u64,
+            batch_size: raywave::render::wavefront::DEFAULT_BATCH_SIZE as u64,
             rgb8: false,
             exr_in_memory: false,
         },
         None,
     )?;
     let Some(other) = &args.against else {
-        let bar = raywave::terminal::progress_bar(
+        let bar = raywave::output::terminal::progress_bar(
             0,
             "{elapsed_precise} [{bar:40}] {pos}/{len} runs (warm-up included), engines alternating",
             args.quiet,
@@ -366,7 +366,7 @@ pub fn run(args: &BenchArgs, matches: Option<&ArgMatches>) -> Result<u8> {
         threshold_pct: args.threshold.unwrap_or(AB_THRESHOLD_PCT),
         quiet: args.quiet,
     };
-    let bar = raywave::terminal::progress_bar(
+    let bar = raywave::output::terminal::progress_bar(
         0,
         "{elapsed_precise} [{bar:40}] {pos}/{len} runs, both builds alternating",
         args.quiet,
@@ -376,7 +376,7 @@ pub fn run(args: &BenchArgs, matches: Option<&ArgMatches>) -> Result<u8> {
         bar.set_position(done);
     })?;
     bar.finish_and_clear();
-    raywave::terminal::print(&ab::report(&options, &results))?;
+    raywave::output::terminal::print(&ab::report(&options, &results))?;
     Ok(if ab::regressed(&options, &results) {
         EXIT_REGRESSION
     } else {

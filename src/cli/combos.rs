@@ -6,8 +6,8 @@ use super::Command;
 use super::image::ImageArgs;
 use super::values::{EngineArg, ToneMapArg};
 use raywave::output::image_file::{OutputFormat, output_format};
-use raywave::sampling::LightSampler;
-use raywave::settings::ShadowMode;
+use raywave::render::sampling::LightSampler;
+use raywave::render::settings::ShadowMode;
 
 /// One line per meaningless flag in `command`; `typed` names a raywave flag as the user
 /// spelled it.
@@ -27,11 +27,11 @@ pub fn meaningless(command: &Command, typed: &dyn Fn(&str) -> String) -> Vec<Str
                     "{} has no effect: {} {} is a linear float image, not tone mapped",
                     "--tonemap exp",
                     typed("--output"),
-                    raywave::quote::quote(&args.output.display().to_string())
+                    raywave::render::quote::quote(&args.output.display().to_string())
                 ));
             }
             if args.engine == EngineArg::Reference
-                && args.batch_size != raywave::wavefront::DEFAULT_BATCH_SIZE as u32
+                && args.batch_size != raywave::render::wavefront::DEFAULT_BATCH_SIZE as u32
             {
                 out.push(
                     "--batch-size has no effect with --engine reference (it renders by rows)"

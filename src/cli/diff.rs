@@ -5,16 +5,14 @@
 use super::values::DefaultsArg;
 use anyhow::{Result, bail};
 use clap::{Args, ValueEnum};
-use raywave::error::UsageError;
-use raywave::image_diff::{
-    self, Comparison, EXIT_FAILED, FileInfo, Image, Metric, Region, read_image,
-};
-use raywave::options::ImageOptions;
+use raywave::diff::{self, Comparison, EXIT_FAILED, FileInfo, Image, Metric, Region, read_image};
 use raywave::output::image_file::{ldr_format, write_atomically};
+use raywave::output::terminal::print;
 use raywave::output::{OutputPlan, is_stdio};
-use raywave::sampling::LightSampler;
-use raywave::scene::load_scene;
-use raywave::terminal::print;
+use raywave::render::error::UsageError;
+use raywave::render::sampling::LightSampler;
+use raywave::render::scene::load_scene;
+use raywave::render::settings::options::ImageOptions;
 use serde::Serialize;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
@@ -130,7 +128,7 @@ struct Record<'a> {
 pub fn run(args: &DiffArgs) -> Result<u8> {
     let metric = Metric::from(args.metric);
     let want_flip = args.flip || metric == Metric::Flip;
-    if want_flip && !image_diff::FLIP_AVAILABLE {
+    if want_flip && !diff::FLIP_AVAILABLE {
         return Err(UsageError(
             "--flip and --metric flip need raywave built with the `flip` feature (on by default; it needs a C++ compiler)".into(),
         )
@@ -189,27 +187,26 @@ pub fn run(args: &DiffArgs) -> Result<u8> {
         format!("A {}", args.a.display()),
         format!("B {}", args.b.display()),
     );
-    image_diff::check_same_size(&a, &a_name, &b, &b_name)
-        .map_err(|e| UsageError::from_error(&e))?;
+    diff::check_same_size(&a, &a_name, &b, &b_name).map_err(|e| UsageError::from_error(&e))?;
     let (a_info, b_info) = (FileInfo::of(&args.a, &a), FileInfo::of(&args.b, &b));
     let mut text = format!(
         "A        {}\nB        {}, the reference\n",
         a_info.describe(),
         b_info.describe()
     );
-    if (a.encoding == image_diff::Encoding::Float) != (b.encoding == image_diff::Encoding::Float) {
+    if (a.encoding == diff::Encoding::Float) != (b.encoding == diff::Encoding::Float) {
         text.push_str(
             "note     one image holds linear floats and the other 8/16-bit values: the stored values are compared as they are\n",
         );
     }
     let region = region(args, &a)?;
-    let mut comparison = image_diff::compare(&a, &b, &region)?;
+    let mut comparison = diff::compare(&a, &b, &region)?;
     let flip_map = if want_flip {
-        Some(image_diff::add_flip(&mut comparison, &a, &b, &region)?)
+        Some(diff::add_flip(&mut comparison, &a, &b, &region)?)
     } else {
         None
     };
-    text.push_str(&image_diff::text::table(&comparison));
+    text.push_str(&diff::text::table(&comparison));
 
     let value = comparison.value(metric);
     let failed = match (args.fail_above, value) {
@@ -219,7 +216,7 @@ pub fn run(args: &DiffArgs) -> Result<u8> {
     if let Some(out) = &args.out {
         let errors = match (&flip_map, metric) {
             (Some(map), Metric::Flip) => map.clone(),
-            _ => image_diff::pixel_errors(&a, &b, &region, metric),
+            _ => diff::pixel_errors(&a, &b, &region, metric),
         };
         let within = match (args.penumbra(), args.mask_file()) {
             (true, _) => " in the penumbra (outside: black)".to_string(),
@@ -237,7 +234,7 @@ pub fn run(args: &DiffArgs) -> Result<u8> {
                 Metric::Flip => "FLIP error",
             },
         );
-        let fig = image_diff::figure(&errors, a.width, a.height, metric, &title)?;
+        let fig = diff::figure(&errors, a.width, a.height, metric, &title)?;
         raywave::output::image_file::write_rgb8(&fig, out)?;
         text.push_str(&format!("wrote    {}\n", out.display()));
     }
@@ -291,7 +288,7 @@ fn file_name(path: &Path) -> String {
 fn region(args: &DiffArgs, a: &Image) -> Result<Region> {
     if let Some(path) = args.mask_file() {
         let mask = read_image(path)?;
-        image_diff::check_same_size(
+        diff::check_same_size(
             &mask,
             &format!("--mask {}", path.display()),
             a,

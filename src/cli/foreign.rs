@@ -3,8 +3,8 @@
 //! and clap validates every spelling the same way.
 
 use super::values::DefaultsArg;
-use raywave::error::UsageError;
-use raywave::options::Defaults;
+use raywave::render::error::UsageError;
+use raywave::render::settings::options::Defaults;
 use std::ffi::OsString;
 
 /// What one value of a lab or RPI flag must look like.
@@ -176,7 +176,7 @@ impl Normalized {
             }
         }
         out.split('\n')
-            .map(raywave::quote::escape)
+            .map(raywave::render::quote::escape)
             .collect::<Vec<_>>()
             .join("\n")
     }

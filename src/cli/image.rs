@@ -2,9 +2,9 @@
 
 use super::values::{DefaultsArg, LightModelArg, SamplerArg, ShadowArg};
 use clap::Args;
-use raywave::options::{Effective, ImageOptions};
 use raywave::output::OutputPlan;
-use raywave::scene::{Scene, load_scene};
+use raywave::render::scene::{Scene, load_scene};
+use raywave::render::settings::options::{Effective, ImageOptions};
 use std::path::Path;
 
 /// The flags that shape the image, shared by `render` and `bench` so that both default alike
@@ -153,7 +153,7 @@ pub fn say(plan: &OutputPlan, text: &str) -> anyhow::Result<()> {
         eprint!("{text}");
         Ok(())
     } else {
-        raywave::terminal::print(text)
+        raywave::output::terminal::print(text)
     }
 }
 

@@ -5,8 +5,8 @@ use anyhow::Result;
 
 /// Prints the lines.
 pub fn run() -> Result<()> {
-    let b = raywave::build_info::current();
-    raywave::terminal::print(&format!(
+    let b = raywave::output::build_info::current();
+    raywave::output::terminal::print(&format!(
         "raywave {}\ncommit  {}\nbuild   {} · {}\nrustflags {}\nfeatures {}\nsimd    {}\nlanes   {} by default, 8 for hard shadows and for 8 or fewer points per light (--lanes 8 or 16 forces a width; the same image either way)\nthreads {} (rayon default; --threads N to change)\n",
         env!("CARGO_PKG_VERSION"),
         match b.dirty {
@@ -22,7 +22,7 @@ pub fn run() -> Result<()> {
         },
         b.target_features,
         raywave::simd_path(),
-        raywave::wavefront::lanes::LaneWidth::NATIVE.lanes(),
+        raywave::render::wavefront::lanes::LaneWidth::NATIVE.lanes(),
         rayon::current_num_threads()
     ))
 }

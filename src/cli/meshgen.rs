@@ -2,8 +2,8 @@
 
 use anyhow::Result;
 use clap::Args;
-use raywave::meshgen::{bands_for, cornell_box_mesh_spheres, triangle_count};
 use raywave::output::OutputPlan;
+use raywave::render::scene::meshgen::{bands_for, cornell_box_mesh_spheres, triangle_count};
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -37,6 +37,6 @@ pub fn run(args: &MeshgenArgs) -> Result<()> {
         eprint!("{text}");
         Ok(())
     } else {
-        raywave::terminal::print(&text)
+        raywave::output::terminal::print(&text)
     }
 }

@@ -9,21 +9,23 @@ use anyhow::Result;
 use clap::Args;
 use image::RgbImage;
 use raywave::bench::record::StageFigure;
-use raywave::camera::CameraRays;
-use raywave::engine::{Engine, Prepared, thread_pool};
-use raywave::error::UsageError;
-use raywave::film::{Film, ToneMap};
-use raywave::image_diff::{self, Encoding, FileInfo, Image, Region, read_image};
-use raywave::machine::Machine;
-use raywave::options::{BackgroundSource, Effective};
+use raywave::diff::{self, Encoding, FileInfo, Image, Region, read_image};
 use raywave::output::OutputPlan;
 use raywave::output::image_file::{OutputFormat, check_hdr_path, output_format};
+use raywave::output::machine::Machine;
 use raywave::output::memory::{self, RenderFootprint};
-use raywave::report::{DefaultsUsed, KindFigures, KindTiming, RenderRecord, SceneFigures};
-use raywave::scene::Scene;
-use raywave::settings::{LightModel, ShadowMode};
-use raywave::terminal::progress_bar;
-use raywave::wavefront::stats::RenderStats;
+use raywave::output::render_record::{
+    DefaultsUsed, KindFigures, KindTiming, RenderRecord, SceneFigures,
+};
+use raywave::output::terminal::progress_bar;
+use raywave::render::camera::CameraRays;
+use raywave::render::engine::{Engine, Prepared, thread_pool};
+use raywave::render::error::UsageError;
+use raywave::render::film::{Film, ToneMap};
+use raywave::render::scene::Scene;
+use raywave::render::settings::options::{BackgroundSource, Effective};
+use raywave::render::settings::{LightModel, ShadowMode};
+use raywave::render::wavefront::stats::RenderStats;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -73,7 +75,7 @@ pub struct RenderArgs {
     #[arg(long, value_enum, default_value = "auto")]
     pub lanes: LanesArg,
     /// Camera samples per wavefront tile: the unit of work and of memory.
-    #[arg(long, default_value_t = raywave::wavefront::DEFAULT_BATCH_SIZE as u32,
+    #[arg(long, default_value_t = raywave::render::wavefront::DEFAULT_BATCH_SIZE as u32,
           value_parser = clap::value_parser!(u32).range(1..=1 << 20))]
     pub batch_size: u32,
     /// Print rays and rays/s per kind, and per stage for the wavefront engine.
@@ -325,12 +327,12 @@ fn reference_error(
         (image, "the 8-bit image")
     };
     let region = Region::whole(render.width, render.height);
-    let comparison = image_diff::compare(&render, reference, &region)?;
+    let comparison = diff::compare(&render, reference, &region)?;
     let info = FileInfo::of(path, reference);
     let text = format!(
         "error of the render ({compared_as}) against --mse-reference {}\n{}",
         info.describe(),
-        image_diff::text::table(&comparison)
+        diff::text::table(&comparison)
     );
     let mut json = serde_json::to_value(&comparison)?;
     json["reference"] = serde_json::to_value(&info)?;

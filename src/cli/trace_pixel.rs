@@ -7,12 +7,12 @@ use super::image::scene_and_settings;
 use super::values::ToneMapArg;
 use anyhow::{Context, Result};
 use clap::Args;
-use raywave::camera::CameraRays;
-use raywave::engine::{Engine, thread_pool};
-use raywave::error::UsageError;
 use raywave::output::image_file::ldr_format;
+use raywave::output::terminal::progress_bar;
 use raywave::output::{OutputPlan, write_output};
-use raywave::terminal::progress_bar;
+use raywave::render::camera::CameraRays;
+use raywave::render::engine::{Engine, thread_pool};
+use raywave::render::error::UsageError;
 use raywave::trace::draw::{Overlay, depth_buffer};
 use raywave::trace::view::ViewPlacement;
 use raywave::trace::{check_pixel, mesh, obj, ply, scene_bounds, summary, trace_pixel};
@@ -161,7 +161,7 @@ pub fn run(args: &TracePixelArgs) -> Result<()> {
         };
         let mut view_scene = scene.clone();
         view_scene.camera = camera;
-        let view_settings = raywave::settings::RenderSettings {
+        let view_settings = raywave::render::settings::RenderSettings {
             width,
             height,
             ..settings.clone()
@@ -170,7 +170,7 @@ pub fn run(args: &TracePixelArgs) -> Result<()> {
         let engine = Engine::Wavefront.prepare(
             &view_scene,
             &view_settings,
-            raywave::wavefront::DEFAULT_BATCH_SIZE,
+            raywave::render::wavefront::DEFAULT_BATCH_SIZE,
         );
         let (units, unit) = engine.work_units(&view_settings);
         let progress = progress_bar(

@@ -3,12 +3,12 @@
 //! values), so that the library's types need no clap; `From` maps each to its twin, and a
 //! variant added to the library fails to compile here until it has a spelling.
 
-use raywave::engine::Engine;
-use raywave::film::ToneMap;
-use raywave::options::Defaults;
-use raywave::sampling::LightSampler;
-use raywave::settings::{LightModel, ShadowMode};
-use raywave::wavefront::lanes::LaneWidth;
+use raywave::render::engine::Engine;
+use raywave::render::film::ToneMap;
+use raywave::render::sampling::LightSampler;
+use raywave::render::settings::options::Defaults;
+use raywave::render::settings::{LightModel, ShadowMode};
+use raywave::render::wavefront::lanes::LaneWidth;
 
 /// Declares a clap value enum and its conversion into the library's enum of the same variants.
 macro_rules! mirror {

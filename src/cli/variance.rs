@@ -3,8 +3,8 @@
 use super::values::{EngineArg, LightModelArg, SamplerArg};
 use anyhow::Result;
 use clap::Args;
-use raywave::engine::thread_pool;
 use raywave::output::OutputPlan;
+use raywave::render::engine::thread_pool;
 use raywave::variance::command::VarianceOptions;
 use std::path::PathBuf;
 

@@ -5,9 +5,9 @@ use super::image::scene_and_settings;
 use super::values::EngineArg;
 use anyhow::Result;
 use clap::Args;
-use raywave::engine::Engine;
-use raywave::error::UsageError;
-use raywave::view::settings::{MAX_CAMERA_SAMPLES, MAX_SIDE, Resolved};
+use raywave::render::engine::Engine;
+use raywave::render::error::UsageError;
+use raywave::view::request::{MAX_CAMERA_SAMPLES, MAX_SIDE, Resolved};
 use raywave::view::{ViewOptions, run as serve};
 use std::path::PathBuf;
 
@@ -33,7 +33,7 @@ pub struct ViewArgs {
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
     pub threads: Option<u32>,
     /// Camera samples per wavefront tile.
-    #[arg(long, default_value_t = raywave::wavefront::DEFAULT_BATCH_SIZE as u32,
+    #[arg(long, default_value_t = raywave::render::wavefront::DEFAULT_BATCH_SIZE as u32,
           value_parser = clap::value_parser!(u32).range(1..=1 << 20))]
     pub batch_size: u32,
     /// Port on 127.0.0.1 [default: a free port the system chooses]; the URL is printed.
@@ -77,7 +77,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
             batch_size: args.batch_size as usize,
             port: args.port,
         },
-        &|text| raywave::terminal::print(text),
+        &|text| raywave::output::terminal::print(text),
     )?;
     eprintln!("raywave view: stopped by {signal}");
     Ok(())

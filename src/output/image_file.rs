@@ -5,7 +5,7 @@
 //! directory, which is renamed over the target only once it is complete (devices, FIFOs and
 //! standard output are written directly: `output::write`).
 
-use crate::film::{Film, ToneMap};
+use crate::render::film::{Film, ToneMap};
 use anyhow::{Context, Result, bail};
 use glam::Vec3;
 use std::io::{BufWriter, Write};

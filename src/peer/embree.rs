@@ -18,8 +18,8 @@
 //! ```
 
 use super::{Hits, RaySet};
-use crate::geometry::T_MIN;
-use crate::scene::{NO_HIT, Scene};
+use crate::render::geometry::T_MIN;
+use crate::render::scene::{NO_HIT, Scene};
 use embree::sys;
 use std::time::{Duration, Instant};
 
@@ -217,7 +217,7 @@ fn context(coherent: bool) -> sys::RTCIntersectContext {
     }
 }
 
-fn ray1(batch: &crate::wavefront::batch::RayBatch, i: usize) -> sys::RTCRay {
+fn ray1(batch: &crate::render::wavefront::batch::RayBatch, i: usize) -> sys::RTCRay {
     sys::RTCRay {
         org_x: batch.origin.x[i],
         org_y: batch.origin.y[i],
@@ -248,7 +248,7 @@ fn empty_hit1() -> sys::RTCHit {
 }
 
 fn ray8(
-    batch: &crate::wavefront::batch::RayBatch,
+    batch: &crate::render::wavefront::batch::RayBatch,
     start: usize,
     lanes: usize,
 ) -> (sys::RTCRay8, [i32; 8]) {

@@ -30,15 +30,15 @@ pub mod embree;
 #[cfg(feature = "tinybvh")]
 pub mod tinybvh;
 
-use crate::camera::CameraRays;
-use crate::geometry::{Ray, casters, intersect_triangle, obvhs_ray};
-use crate::scene::{NO_HIT, Scene};
-use crate::spawn::surface_hit;
-use crate::wavefront::batch::{HitBatch, PathId, RayBatch};
-use crate::wavefront::bvh::MeshBvh;
-use crate::wavefront::context::Context;
-use crate::wavefront::lanes::LaneWidth;
-use crate::wavefront::{DEFAULT_BATCH_SIZE, intersect, simd};
+use crate::render::camera::CameraRays;
+use crate::render::geometry::{Ray, casters, intersect_triangle, obvhs_ray};
+use crate::render::scene::{NO_HIT, Scene};
+use crate::render::spawn::surface_hit;
+use crate::render::wavefront::batch::{HitBatch, PathId, RayBatch};
+use crate::render::wavefront::bvh::MeshBvh;
+use crate::render::wavefront::context::Context;
+use crate::render::wavefront::lanes::LaneWidth;
+use crate::render::wavefront::{DEFAULT_BATCH_SIZE, intersect, simd};
 use glam::Vec3;
 use obvhs::{cwbvh::CwBvh, ray::RayHit};
 use std::time::{Duration, Instant};
@@ -378,7 +378,7 @@ impl ObvhsMesh {
     /// Builds the CWBVH with the same preset as raywave's `Accel` (`medium_build`).
     pub fn new(scene: &Scene) -> Self {
         let start = Instant::now();
-        let bvh = crate::geometry::build_cwbvh(scene);
+        let bvh = crate::render::geometry::build_cwbvh(scene);
         ObvhsMesh {
             bvh,
             build_time: start.elapsed(),

@@ -6,12 +6,12 @@
 //! in: every lane is bit-equal to the scalar twins and each pixel is summed in sample order).
 
 use super::tree::{KindCounts, PixelCheck, RayCountCheck, RayTree, Segment, SegmentKind};
-use crate::reference::Reference;
-use crate::scene::Scene;
-use crate::settings::RenderSettings;
-use crate::stats::RayCounts;
-use crate::wavefront::stats::RenderStats;
-use crate::wavefront::{Wavefront, Workspace};
+use crate::render::per_kind::RayCounts;
+use crate::render::reference::Reference;
+use crate::render::scene::Scene;
+use crate::render::settings::RenderSettings;
+use crate::render::wavefront::stats::RenderStats;
+use crate::render::wavefront::{Wavefront, Workspace};
 use glam::Vec3;
 
 /// The accepted difference between the tree's sum and a rendered pixel, relative to

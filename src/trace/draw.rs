@@ -22,9 +22,9 @@
 use super::palette::{CAMERA, MAIN_CAMERA, Rgb, Style};
 use super::tree::{RayTree, SegmentKind};
 use super::view::{camera_marker, project};
-use crate::camera::CameraRays;
-use crate::geometry::Accel;
-use crate::scene::{Camera, Scene};
+use crate::render::camera::CameraRays;
+use crate::render::geometry::Accel;
+use crate::render::scene::{Camera, Scene};
 use glam::Vec3;
 use image::RgbImage;
 use rayon::prelude::*;

@@ -17,7 +17,7 @@ use super::palette::{MAIN_CAMERA, Rgb, Style};
 use super::scene_view::scene_bounds;
 use super::tree::RayTree;
 use super::view::camera_marker;
-use crate::scene::Scene;
+use crate::render::scene::Scene;
 use glam::Vec3;
 use std::f32::consts::PI;
 

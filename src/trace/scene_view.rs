@@ -3,7 +3,7 @@
 //! and the camera.
 
 use super::tree::CameraInfo;
-use crate::scene::Scene;
+use crate::render::scene::Scene;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
@@ -84,7 +84,7 @@ pub struct LightView {
 
 impl CameraInfo {
     /// The scene camera as plain values.
-    pub fn of(camera: &crate::scene::Camera) -> CameraInfo {
+    pub fn of(camera: &crate::render::scene::Camera) -> CameraInfo {
         CameraInfo {
             position: camera.position.to_array(),
             look_at: camera.point_of_interest.to_array(),

@@ -26,13 +26,13 @@ use super::tree::{
     BlockerInfo, PixelRef, PrimitiveRef, PrimitiveShape, RayTree, SCHEMA_ID, Segment, SegmentKind,
     ShadowInfo, SurfaceInfo, TraceSettings,
 };
-use crate::geometry::{Accel, Hit, Ray};
-use crate::reference::{LightPoint, Reference, TraceLog};
-use crate::sampling::SampleKey;
-use crate::scene::{Material, Scene};
-use crate::settings::{LightModel, RenderSettings, ShadowMode};
-use crate::spawn::{ShadowRay, SurfaceHit};
-use crate::stats::RayCounts;
+use crate::render::geometry::{Accel, Hit, Ray};
+use crate::render::per_kind::RayCounts;
+use crate::render::reference::{LightPoint, Reference, TraceLog};
+use crate::render::sampling::SampleKey;
+use crate::render::scene::{Material, Scene};
+use crate::render::settings::{LightModel, RenderSettings, ShadowMode};
+use crate::render::spawn::{ShadowRay, SurfaceHit};
 use glam::Vec3;
 
 /// Why a pixel cannot be traced.

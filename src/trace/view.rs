@@ -7,8 +7,8 @@
 //! project(p): the inverse of CameraRays' pixel -> ray mapping (continuous pixel coordinates)
 //! ```
 
-use crate::camera::CameraRays;
-use crate::scene::Camera;
+use crate::render::camera::CameraRays;
+use crate::render::scene::Camera;
 use glam::{Quat, Vec3};
 
 /// The orbit angle about the up axis when neither `--view-from` nor `--orbit` is given, in

@@ -18,8 +18,8 @@
 //! the reference is rendered again. The least recently used entries are removed once the
 //! entries together exceed the size limit.
 
-use crate::film::Film;
-use crate::settings::RenderSettings;
+use crate::render::film::Film;
+use crate::render::settings::RenderSettings;
 use anyhow::{Context, Result, bail};
 use glam::Vec3;
 use std::io::{Read, Write};

@@ -2,12 +2,12 @@
 //! binary's.
 
 use super::{Cache, Region, StudyConfig, cache, run_study};
-use crate::engine::Engine;
-use crate::error::UsageError;
-use crate::sampling::LightSampler;
-use crate::scene::{ParseOptions, Scene, SceneFile, load_scene};
-use crate::settings::{LightModel, RenderSettings};
-use crate::terminal::{print, progress_bar};
+use crate::output::terminal::{print, progress_bar};
+use crate::render::engine::Engine;
+use crate::render::error::UsageError;
+use crate::render::sampling::LightSampler;
+use crate::render::scene::{ParseOptions, Scene, SceneFile, load_scene};
+use crate::render::settings::{LightModel, RenderSettings};
 use anyhow::{Context, Result, bail};
 use std::path::PathBuf;
 

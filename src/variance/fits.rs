@@ -12,8 +12,8 @@
 //! ```
 
 use super::{Region, Row, loglog_fit};
-use crate::sampling::LightSampler;
-use crate::statistics::{BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, bootstrap_interval, median};
+use crate::bench::statistics::{BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, bootstrap_interval, median};
+use crate::render::sampling::LightSampler;
 use crate::variance::LogLogFit;
 use serde::Serialize;
 

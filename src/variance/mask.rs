@@ -7,12 +7,12 @@
 //! - **lit** if every hit on its path sees every light fully (fraction = 1);
 //! - neither (umbra, lights seen edge-on, the background) otherwise.
 
-use crate::camera::CameraRays;
-use crate::geometry::Accel;
-use crate::sampling::{LightSampler, SampleKey, square_sample};
-use crate::scene::Scene;
-use crate::settings::RenderSettings;
-use crate::spawn::{light_end, light_offset, mirror_ray, shadow_ray, surface_hit};
+use crate::render::camera::CameraRays;
+use crate::render::geometry::Accel;
+use crate::render::sampling::{LightSampler, SampleKey, square_sample};
+use crate::render::scene::Scene;
+use crate::render::settings::RenderSettings;
+use crate::render::spawn::{light_end, light_offset, mirror_ray, shadow_ray, surface_hit};
 use rayon::prelude::*;
 
 /// Per-pixel region membership.

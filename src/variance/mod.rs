@@ -20,30 +20,30 @@
 
 pub mod cache;
 pub mod command;
+pub mod figures;
 pub mod fits;
 pub mod mask;
 pub mod plot;
 pub mod report;
 pub mod sheet;
-pub mod stats;
 
-use crate::film::Film;
-use crate::film::ToneMap;
-use crate::sampling::LightSampler;
-use crate::scene::Scene;
-use crate::settings::{RenderSettings, ShadowMode};
-use crate::stats::RayCounts;
+use crate::render::film::Film;
+use crate::render::film::ToneMap;
+use crate::render::per_kind::RayCounts;
+use crate::render::sampling::LightSampler;
+use crate::render::scene::Scene;
+use crate::render::settings::{RenderSettings, ShadowMode};
 use anyhow::{Result, bail};
 use glam::Vec3;
 use serde::Serialize;
 use std::time::Instant;
 
 pub use cache::Cache;
-pub use fits::{Matching, Slope, match_budget};
-pub use mask::{Regions, penumbra_mask};
-pub use stats::{
+pub use figures::{
     ErrorStats, LogLogFit, deterministic, error_stats, loglog_fit, per_image_errors, pixel_mse,
 };
+pub use fits::{Matching, Slope, match_budget};
+pub use mask::{Regions, penumbra_mask};
 
 /// Renders one image: the engine is the caller's choice (the fastest one, normally).
 pub type RenderFn<'a> = dyn Fn(&Scene, &RenderSettings) -> (Film, RayCounts) + Sync + 'a;
@@ -299,7 +299,7 @@ struct Measured<'a> {
 
 fn rows_of(m: &Measured, reference: &Converged, masks: &[Vec<bool>; 3]) -> Vec<Row> {
     let k = m.images.len();
-    let (seconds, lo, hi) = crate::statistics::median_with_interval(&m.times);
+    let (seconds, lo, hi) = crate::bench::statistics::median_with_interval(&m.times);
     let seconds_interval = (lo.is_finite() && hi.is_finite()).then_some([lo, hi]);
     let excluded_sampler = deterministic(m.sampler, m.n);
     Region::ALL
@@ -315,7 +315,7 @@ fn rows_of(m: &Measured, reference: &Converged, masks: &[Vec<bool>; 3]) -> Vec<R
             let efficiency_interval = fits::interval(k, |idx| {
                 let t: Vec<f64> = idx.iter().map(|&i| times[i]).collect();
                 1.0 / (fits::mean_at(&seed_mse, Some(idx))
-                    * crate::statistics::median(&t).max(1e-12))
+                    * crate::bench::statistics::median(&t).max(1e-12))
             });
             Row {
                 sampler: m.sampler.name(),
@@ -387,7 +387,7 @@ pub fn run_study(
             thumbnails.push((sampler, n, film.to_rgb8(ToneMap::Clamp)));
             progress(&format!("{} N={n} warm-up", sampler.name()));
         }
-        let mut films: Vec<Vec<crate::film::Film>> = vec![Vec::new(); samplers.len()];
+        let mut films: Vec<Vec<crate::render::film::Film>> = vec![Vec::new(); samplers.len()];
         let mut times = vec![Vec::new(); samplers.len()];
         let mut rays = vec![0u64; samplers.len()];
         for k in 0..config.seeds {

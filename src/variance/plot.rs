@@ -1,12 +1,12 @@
 //! Pictures of a study: MSE against N and MSE against time per image, on log-log axes (one
 //! panel per region, one line per sampler, 95% intervals as bars), and per-pixel error heat
-//! maps on one log scale shared by all samplers (`crate::false_colour`: title and colour bar).
+//! maps on one log scale shared by all samplers (`crate::output::false_colour`: title and colour bar).
 //! The font is embedded (DejaVu Sans, via the `dejavu` crate), so plots need no system fonts.
 
 use super::{Region, Row, StudyResult};
-use crate::false_colour::{self, Scale, figure, register_font};
+use crate::output::false_colour::{self, Scale, figure, register_font};
 use crate::output::image_file::write_atomically;
-use crate::sampling::LightSampler;
+use crate::render::sampling::LightSampler;
 use anyhow::{Context, Result, anyhow};
 use plotters::coord::Shift;
 use plotters::prelude::*;

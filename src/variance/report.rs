@@ -4,8 +4,8 @@
 //! per-seed rows), plus the plots, heat maps and contact sheet.
 
 use super::{Region, Row, StudyConfig, StudyResult, plot, sheet};
-use crate::machine::Machine;
-use crate::sampling::LightSampler;
+use crate::output::machine::Machine;
+use crate::render::sampling::LightSampler;
 use anyhow::{Context, Result};
 use serde::Serialize;
 use std::fmt::Write as _;
@@ -95,7 +95,7 @@ pub fn file_names(samplers: &[LightSampler], heatmap_n: u32) -> Vec<String> {
 
 /// The commit this binary was built from and whether its tree was dirty (embedded by build.rs).
 fn build_commit() -> (String, Option<bool>) {
-    let build = crate::build_info::current();
+    let build = crate::output::build_info::current();
     (build.commit, build.dirty)
 }
 
@@ -459,8 +459,8 @@ impl StudyResult {
                 threads: self.threads,
                 study: &self.config,
                 bootstrap: Bootstrap {
-                    resamples: crate::statistics::BOOTSTRAP_RESAMPLES,
-                    seed: crate::statistics::BOOTSTRAP_SEED,
+                    resamples: crate::bench::statistics::BOOTSTRAP_RESAMPLES,
+                    seed: crate::bench::statistics::BOOTSTRAP_SEED,
                     level: 0.95,
                     unit: "seed: one resample draws K seeds with replacement, the same for every sampler, budget and region",
                 },

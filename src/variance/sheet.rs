@@ -12,7 +12,7 @@
 //! (nearest neighbour: every pixel stays a visible square).
 
 use super::StudyResult;
-use crate::false_colour::register_font;
+use crate::output::false_colour::register_font;
 use crate::output::image_file::write_atomically;
 use anyhow::{Result, anyhow};
 use image::RgbImage;

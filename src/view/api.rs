@@ -4,12 +4,12 @@
 use super::compare::{CompareRequest, Comparisons};
 use super::http::{ApiError, Reply, number, query};
 use super::jobs::{ENGINES, Jobs};
+use super::request::{Resolved, ViewSettings};
 use super::scene_json::{CameraFrame, SceneJson};
-use super::settings::{Resolved, ViewSettings};
 use super::tree;
-use crate::quote::quote;
-use crate::sampling::LightSampler;
-use crate::scene::Scene;
+use crate::render::quote::quote;
+use crate::render::sampling::LightSampler;
+use crate::render::scene::Scene;
 use serde::Serialize;
 use std::sync::Arc;
 

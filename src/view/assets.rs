@@ -47,7 +47,7 @@ pub fn asset(name: &str) -> Result<Reply, ApiError> {
         .ok_or_else(|| {
             ApiError::not_found(format!(
                 "no asset `{}`: expected one of {}",
-                crate::quote::quote(name),
+                crate::render::quote::quote(name),
                 ASSETS.map(|a| a.0).join(", ")
             ))
         })

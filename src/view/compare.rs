@@ -11,12 +11,12 @@
 //! ```
 
 use super::http::ApiError;
-use super::settings::{Resolved, ViewSettings};
-use crate::engine::Engine;
-use crate::film::{Film, ToneMap};
-use crate::sampling::LightSampler;
-use crate::scene::Scene;
-use crate::statistics::median;
+use super::request::{Resolved, ViewSettings};
+use crate::bench::statistics::median;
+use crate::render::engine::Engine;
+use crate::render::film::{Film, ToneMap};
+use crate::render::sampling::LightSampler;
+use crate::render::scene::Scene;
 use crate::variance::{
     StudyConfig, converged_reference, error_stats, penumbra_mask, pixel_mse, plot::heat_images,
 };
@@ -83,7 +83,7 @@ impl CompareRequest {
         let r: CompareRequest = serde_json::from_slice(text).map_err(|e| {
             ApiError::bad(format!(
                 "comparison: {}",
-                crate::quote::quote(&e.to_string())
+                crate::render::quote::quote(&e.to_string())
             ))
         })?;
         let check = |name: &str, v: u32, lo: u32, hi: u32| {
@@ -224,7 +224,7 @@ impl Comparisons {
         let scene = super::jobs::with_camera(scene, &resolved.camera);
         let (w, h) = (resolved.settings.width, resolved.settings.height);
         let longer = w.max(h) as f32;
-        let base_settings = crate::settings::RenderSettings {
+        let base_settings = crate::render::settings::RenderSettings {
             width: ((w as f32 / longer * request.size as f32).round() as u32).max(1),
             height: ((h as f32 / longer * request.size as f32).round() as u32).max(1),
             ..resolved.settings.clone()
@@ -239,7 +239,7 @@ impl Comparisons {
             ..StudyConfig::standard(base_settings)
         };
         let engine: Engine = resolved.engine;
-        let render = |s: &Scene, settings: &crate::settings::RenderSettings| {
+        let render = |s: &Scene, settings: &crate::render::settings::RenderSettings| {
             pool.install(|| engine.image(s, settings))
         };
         let internal = |e: anyhow::Error| ApiError::status(500, format!("{e:#}"));

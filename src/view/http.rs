@@ -1,7 +1,7 @@
 //! The HTTP vocabulary the handlers share: the error every bad request becomes (a status and a
 //! message, sent as JSON), replies, request bodies read under a size limit, and query strings.
 
-use crate::quote::quote;
+use crate::render::quote::quote;
 use serde::Serialize;
 use std::io::Read;
 

@@ -10,11 +10,11 @@
 //!         -> PNG + ray counts and seconds -> JobState (read by GET /api/render/{id})
 //! ```
 
-use crate::engine::Engine;
-use crate::film::ToneMap;
-use crate::scene::Scene;
-use crate::stats::RayCounts;
-use crate::view::settings::{Resolved, ViewSettings};
+use crate::render::engine::Engine;
+use crate::render::film::ToneMap;
+use crate::render::per_kind::RayCounts;
+use crate::render::scene::Scene;
+use crate::view::request::{Resolved, ViewSettings};
 use serde::Serialize;
 use std::collections::VecDeque;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
@@ -277,7 +277,7 @@ fn render_thread(
 /// The scene seen through `camera`: a copy only when the camera differs from the file's.
 pub fn with_camera<'a>(
     scene: &'a Scene,
-    camera: &crate::scene::Camera,
+    camera: &crate::render::scene::Camera,
 ) -> std::borrow::Cow<'a, Scene> {
     if scene.camera == *camera {
         std::borrow::Cow::Borrowed(scene)
@@ -300,7 +300,7 @@ fn render_levels(
         if job.superseded.load(Ordering::Relaxed) {
             return Ok(false);
         }
-        let settings = crate::settings::RenderSettings {
+        let settings = crate::render::settings::RenderSettings {
             width,
             height,
             ..job.resolved.settings.clone()

@@ -7,7 +7,7 @@
 //! server.rs      binding, worker threads, the routing table, stopping on SIGINT/SIGTERM
 //! http.rs        errors as 4xx/5xx JSON, replies, bodies under a size limit, query strings
 //! api.rs         the handlers
-//! settings.rs    the settings a page sends (JSON) -> RenderSettings, checked
+//! request.rs     the settings a page sends (JSON) -> RenderSettings, checked
 //! jobs.rs        progressive render jobs on one render thread
 //! tree.rs        one pixel's ray tree
 //! compare.rs     two samplers side by side with their error heat maps
@@ -20,19 +20,19 @@ pub mod assets;
 pub mod compare;
 pub mod http;
 pub mod jobs;
+pub mod request;
 pub mod scene_json;
 pub mod server;
-pub mod settings;
 pub mod tree;
 
 use anyhow::Result;
-use settings::Resolved;
+use request::Resolved;
 use std::sync::Arc;
 
 /// What `raywave view` was started with.
 pub struct ViewOptions {
     /// The scene.
-    pub scene: crate::scene::Scene,
+    pub scene: crate::render::scene::Scene,
     /// The settings the page starts from (and every request's defaults).
     pub base: Resolved,
     /// Worker threads for renders (None: all cores).
@@ -47,7 +47,7 @@ pub struct ViewOptions {
 /// name.
 pub fn run(options: ViewOptions, say: &dyn Fn(&str) -> Result<()>) -> Result<&'static str> {
     let server = server::Server::bind(options.port)?;
-    let pool = Arc::new(crate::engine::thread_pool(options.threads)?);
+    let pool = Arc::new(crate::render::engine::thread_pool(options.threads)?);
     let scene = Arc::new(options.scene);
     let jobs = jobs::Jobs::start(scene.clone(), pool.clone(), options.batch_size)
         .map_err(|e| anyhow::anyhow!("cannot start the render thread: {e}"))?;

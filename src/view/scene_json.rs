@@ -2,8 +2,8 @@
 //! spheres as centre and radius (the page tessellates them), lights as outlines, the bounds
 //! (to place the orbit camera) and the render camera's frame (to draw it).
 
-use crate::camera::CameraRays;
-use crate::scene::{Camera, Material, Scene};
+use crate::render::camera::CameraRays;
+use crate::render::scene::{Camera, Material, Scene};
 use glam::Vec3;
 use serde::Serialize;
 

@@ -210,7 +210,7 @@ fn route(
         }
         _ => Err(ApiError::not_found(format!(
             "no such path: {} (the page is at /, the API under /api/)",
-            crate::quote::quote(path)
+            crate::render::quote::quote(path)
         ))),
     }
 }
@@ -229,7 +229,7 @@ fn check_host(host: Option<&str>, port: u16) -> Result<(), ApiError> {
             421,
             format!(
                 "unexpected Host `{}`: this server answers only to 127.0.0.1:{port} and localhost:{port}",
-                crate::quote::quote(host.unwrap_or(""))
+                crate::render::quote::quote(host.unwrap_or(""))
             ),
         ))
     }
@@ -251,7 +251,7 @@ fn check_origin(origin: Option<&str>, port: u16) -> Result<(), ApiError> {
             403,
             format!(
                 "requests from `{}` are refused: only the page at http://127.0.0.1:{port}/ may call this API",
-                crate::quote::quote(origin)
+                crate::render::quote::quote(origin)
             ),
         ))
     }

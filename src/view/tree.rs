@@ -3,8 +3,8 @@
 //! both engines' render of that pixel, and the palette the page draws it with.
 
 use super::http::ApiError;
-use crate::scene::Scene;
-use crate::settings::RenderSettings;
+use crate::render::scene::Scene;
+use crate::render::settings::RenderSettings;
 use crate::trace::palette::{self, Rgb};
 use crate::trace::{RayTree, TraceError, check_pixel, trace_pixel};
 use serde::Serialize;

@@ -4,7 +4,7 @@
 use crate::common;
 
 use common::bin::{raywave, stderr, stdout};
-use raywave::false_colour::{MIN_SIDE, inferno};
+use raywave::output::false_colour::{MIN_SIDE, inferno};
 use serde_json::Value;
 use std::path::Path;
 
@@ -386,13 +386,13 @@ fn the_penumbra_mask_is_variances() {
         ],
         0,
     );
-    let settings = raywave::settings::RenderSettings {
+    let settings = raywave::render::settings::RenderSettings {
         width: w as u32,
         height: h as u32,
         bounces: 2,
         ..Default::default()
     };
-    let scene = raywave::scene::Scene::builtin_default();
+    let scene = raywave::render::scene::Scene::builtin_default();
     let mask = raywave::variance::penumbra_mask(&scene, &settings, 16).penumbra;
     let inside: Vec<usize> = (0..w * h).filter(|&i| mask[i]).collect();
     assert!(!inside.is_empty() && inside.len() < w * h);

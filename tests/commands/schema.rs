@@ -42,7 +42,7 @@ fn assert_valid(name: &str, instance: &Value) {
 #[test]
 fn the_checked_in_schemas_are_the_generated_ones() {
     let update = std::env::var_os("RAYWAVE_UPDATE_SCHEMA").is_some_and(|v| v == "1");
-    for (name, generated) in raywave::report::schemas() {
+    for (name, generated) in raywave::output::render_record::schemas() {
         let path = schema_dir().join(name);
         if update {
             std::fs::create_dir_all(schema_dir()).unwrap();

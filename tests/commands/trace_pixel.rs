@@ -9,9 +9,9 @@ use crate::trace_demo;
 
 use common::bin::{dir_with, files_in, raywave, stderr, stdout};
 use glam::{DVec3, Vec3};
-use raywave::engine::Engine;
-use raywave::scene::Scene;
-use raywave::settings::{RenderSettings, ShadowMode};
+use raywave::render::engine::Engine;
+use raywave::render::scene::Scene;
+use raywave::render::settings::{RenderSettings, ShadowMode};
 use raywave::trace::{RayTree, SegmentKind, trace_pixel};
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -176,7 +176,7 @@ fn contributions_sum_to_the_pixel_both_engines_render() {
         base.clone(),
         RenderSettings {
             aa_samples: 4,
-            sampler: raywave::sampling::LightSampler::Sobol,
+            sampler: raywave::render::sampling::LightSampler::Sobol,
             seed: 3,
             ..base.clone()
         },

@@ -11,9 +11,9 @@
 //! pixels map to floor points in closed form (`floor_point`).
 
 use glam::DVec3;
-use raywave::sampling::LightSampler;
-use raywave::scene::{Scene, parse_scene_str};
-use raywave::settings::RenderSettings;
+use raywave::render::sampling::LightSampler;
+use raywave::render::scene::{Scene, parse_scene_str};
+use raywave::render::settings::RenderSettings;
 
 /// Image size.
 pub const SIZE: u32 = 64;

@@ -1,8 +1,8 @@
 //! Rays and triangles for the kernel tests: constructors from arrays and the edge-case table.
 
 use glam::Vec3;
-use raywave::geometry::Ray;
-use raywave::scene::Triangle;
+use raywave::render::geometry::Ray;
+use raywave::render::scene::Triangle;
 
 const NAN: f32 = f32::NAN;
 const INF: f32 = f32::INFINITY;

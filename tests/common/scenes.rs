@@ -1,7 +1,7 @@
 //! Scenes and settings shared by the tests: bare scenes from primitives, the bundled scenes,
 //! the bias tests' light shapes and soft-shadow settings.
 
-use raywave::scene::{Material, Scene, Sphere, Triangle, parse_scene_str};
+use raywave::render::scene::{Material, Scene, Sphere, Triangle, parse_scene_str};
 
 /// A white diffuse material block, every key spelled out, for scene texts built in tests.
 pub const WHITE_MATERIAL: &str =
@@ -77,18 +77,18 @@ pub const PENTAGON: &[(f64, f64)] = &[
 /// A `size`² image with soft shadows from `n` points of `sampler`, no bounces, seed `seed`.
 pub fn soft_settings(
     size: u32,
-    sampler: raywave::sampling::LightSampler,
+    sampler: raywave::render::sampling::LightSampler,
     n: u32,
     seed: u32,
-) -> raywave::settings::RenderSettings {
-    raywave::settings::RenderSettings {
+) -> raywave::render::settings::RenderSettings {
+    raywave::render::settings::RenderSettings {
         width: size,
         height: size,
         bounces: 0,
-        shadows: raywave::settings::ShadowMode::Soft,
+        shadows: raywave::render::settings::ShadowMode::Soft,
         shadow_samples: n,
         sampler,
         seed,
-        ..raywave::settings::RenderSettings::default()
+        ..raywave::render::settings::RenderSettings::default()
     }
 }

@@ -19,15 +19,15 @@
 //! Built only with the `icount-child` feature; the gate builds it (docs/BENCHMARKING.md, "The
 //! instruction-count gate").
 
-use raywave::geometry::{Accel, Ray};
-use raywave::reference::Reference;
-use raywave::sampling::LightSampler;
-use raywave::scene::Scene;
-use raywave::settings::{RenderSettings, ShadowMode};
-use raywave::stats::RayCounts;
-use raywave::wavefront::batch::{HitBatch, Radiance, RayBatch, ShadowQueue};
-use raywave::wavefront::context::Context;
-use raywave::wavefront::{film, generate, intersect, reflect, shadow};
+use raywave::render::geometry::{Accel, Ray};
+use raywave::render::per_kind::RayCounts;
+use raywave::render::reference::Reference;
+use raywave::render::sampling::LightSampler;
+use raywave::render::scene::Scene;
+use raywave::render::settings::{RenderSettings, ShadowMode};
+use raywave::render::wavefront::batch::{HitBatch, Radiance, RayBatch, ShadowQueue};
+use raywave::render::wavefront::context::Context;
+use raywave::render::wavefront::{film, generate, intersect, reflect, shadow};
 use std::hint::black_box;
 use std::path::Path;
 use std::process::Command;

@@ -1,6 +1,6 @@
-//! The lane layer stays one layer: `src/wavefront/lanes.rs` is the only source file that names
-//! the `wide` crate or `bytemuck`. Every other file, kernels included, takes lane types, loads,
-//! masks and bit casts from it, so that the lane width and its tricks live in one place.
+//! The lane layer stays one layer: `src/render/wavefront/lanes.rs` is the only source file that
+//! names the `wide` crate or `bytemuck`. Every other file, kernels included, takes lane types,
+//! loads, masks and bit casts from it, so that the lane width and its tricks live in one place.
 
 use std::path::{Path, PathBuf};
 
@@ -19,7 +19,7 @@ fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
 #[test]
 fn only_the_lane_layer_names_wide_or_bytemuck() {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
-    let lanes = src.join("wavefront").join("lanes.rs");
+    let lanes = src.join("render").join("wavefront").join("lanes.rs");
     let mut files = Vec::new();
     rust_files(&src, &mut files);
     assert!(files.contains(&lanes), "{} is missing", lanes.display());
@@ -37,7 +37,7 @@ fn only_the_lane_layer_names_wide_or_bytemuck() {
     }
     assert!(
         offenders.is_empty(),
-        "only src/wavefront/lanes.rs may name `wide` or `bytemuck`; take lane types, loads \
+        "only src/render/wavefront/lanes.rs may name `wide` or `bytemuck`; take lane types, loads \
          and casts from it instead:\n{}",
         offenders.join("\n")
     );

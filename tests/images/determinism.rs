@@ -3,10 +3,10 @@
 //! same bytes, in the library and through the binary (both engines).
 
 use crate::common;
-use raywave::reference::Reference;
-use raywave::sampling::LightSampler;
-use raywave::scene::Scene;
-use raywave::settings::{RenderSettings, ShadowMode};
+use raywave::render::reference::Reference;
+use raywave::render::sampling::LightSampler;
+use raywave::render::scene::Scene;
+use raywave::render::settings::{RenderSettings, ShadowMode};
 
 use common::bin::{raywave, scenes, stderr, stdout};
 use std::path::{Path, PathBuf};

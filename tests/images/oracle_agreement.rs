@@ -20,13 +20,13 @@ use common::bundled_scenes;
 
 use glam::{DVec3, Vec3};
 use oracle::{ILL_CONDITIONED, Oracle, OracleImage, TOLERANCE, scaled};
-use raywave::film::Film;
-use raywave::reference::Reference;
-use raywave::sampling::LightSampler;
-use raywave::scene::{LightShape, Scene, parse_scene_str};
-use raywave::settings::{LightModel, RenderSettings, ShadowMode};
-use raywave::stats::RayCounts;
-use raywave::wavefront::{DEFAULT_BATCH_SIZE, Wavefront};
+use raywave::render::film::Film;
+use raywave::render::per_kind::RayCounts;
+use raywave::render::reference::Reference;
+use raywave::render::sampling::LightSampler;
+use raywave::render::scene::{LightShape, Scene, parse_scene_str};
+use raywave::render::settings::{LightModel, RenderSettings, ShadowMode};
+use raywave::render::wavefront::{DEFAULT_BATCH_SIZE, Wavefront};
 use std::time::Instant;
 
 /// The scales of the matrix: three orders of magnitude either way.

@@ -20,10 +20,10 @@ use common::{PENTAGON, SQUARE};
 
 use glam::DVec3;
 use oracle::Oracle;
-use raywave::reference::Reference;
-use raywave::sampling::LightSampler;
-use raywave::scene::Scene;
-use raywave::stats::RayCounts;
+use raywave::render::per_kind::RayCounts;
+use raywave::render::reference::Reference;
+use raywave::render::sampling::LightSampler;
+use raywave::render::scene::Scene;
 
 /// Seeds averaged for the engine's N = 4 estimate.
 const SEEDS: u32 = 100_000;

@@ -9,13 +9,13 @@ use crate::common;
 
 use common::bundled_scenes;
 use glam::Vec3;
-use raywave::film::Film;
-use raywave::reference::Reference;
-use raywave::sampling::LightSampler;
-use raywave::scene::{Scene, parse_scene_str};
-use raywave::settings::{RenderSettings, ShadowMode};
-use raywave::stats::RayCounts;
-use raywave::wavefront::Wavefront;
+use raywave::render::film::Film;
+use raywave::render::per_kind::RayCounts;
+use raywave::render::reference::Reference;
+use raywave::render::sampling::LightSampler;
+use raywave::render::scene::{Scene, parse_scene_str};
+use raywave::render::settings::{RenderSettings, ShadowMode};
+use raywave::render::wavefront::Wavefront;
 
 /// The lab's modes, on a small image.
 fn modes() -> Vec<RenderSettings> {
@@ -121,9 +121,12 @@ fn every_scene_and_mode_matches_the_reference() {
 
 #[test]
 fn a_mesh_scene_through_the_bvh_matches_the_reference() {
-    let scene = parse_scene_str(&raywave::meshgen::cornell_box_mesh_spheres(4), "mesh")
-        .expect("generated scene parses");
-    assert!(scene.triangles.len() >= raywave::wavefront::context::BVH_MIN_TRIANGLES);
+    let scene = parse_scene_str(
+        &raywave::render::scene::meshgen::cornell_box_mesh_spheres(4),
+        "mesh",
+    )
+    .expect("generated scene parses");
+    assert!(scene.triangles.len() >= raywave::render::wavefront::context::BVH_MIN_TRIANGLES);
     let s = &modes()[4];
     assert!(Wavefront::new(&scene, s, 64).context().accel.is_some());
     assert_equivalent(&scene, s, 64);
@@ -186,7 +189,7 @@ fn film_bits(f: &Film) -> Vec<u32> {
 /// 16 lanes are two 256-bit halves.
 #[test]
 fn sixteen_and_eight_lanes_give_the_same_bytes_on_every_scene() {
-    use raywave::wavefront::lanes::LaneWidth;
+    use raywave::render::wavefront::lanes::LaneWidth;
     let mut settings = modes();
     let soft = |n, sampler| RenderSettings {
         shadows: ShadowMode::Soft,
@@ -236,7 +239,7 @@ fn sixteen_and_eight_lanes_give_the_same_bytes_on_every_scene() {
 /// `LaneWidth::Auto` is the build's native width: 16 lanes when built for AVX-512, else 8.
 #[test]
 fn auto_lanes_follow_the_build() {
-    use raywave::wavefront::lanes::LaneWidth;
+    use raywave::render::wavefront::lanes::LaneWidth;
     let scene = Scene::builtin_default();
     let native = if cfg!(target_feature = "avx512f") {
         LaneWidth::Sixteen

@@ -8,9 +8,9 @@ use common::strategies::{any_f32, vec3};
 use common::{edge_rays, ray, triangle};
 use glam::Vec3;
 use proptest::prelude::*;
-use raywave::geometry::{Ray, intersect_triangle};
-use raywave::scene::Triangle;
-use raywave::wavefront::bvh::arrays;
+use raywave::render::geometry::{Ray, intersect_triangle};
+use raywave::render::scene::Triangle;
+use raywave::render::wavefront::bvh::arrays;
 
 const NAN: f32 = f32::NAN;
 const INF: f32 = f32::INFINITY;

@@ -2,8 +2,8 @@
 //! files written whole or not at all.
 
 use glam::Vec3;
-use raywave::film::{Film, ToneMap};
 use raywave::output::image_file::{check_output_dir, ldr_format, write_atomically};
+use raywave::render::film::{Film, ToneMap};
 use std::io::Write;
 
 fn files_in(dir: &std::path::Path) -> Vec<String> {

@@ -7,8 +7,8 @@ use crate::common;
 use common::{TestRng, seeded};
 use glam::Vec3;
 use rand::RngExt;
-use raywave::geometry::{Accel, Ray, T_MIN, intersect_sphere, intersect_triangle};
-use raywave::scene::{NO_HIT, Scene, Sphere, parse_scene_str};
+use raywave::render::geometry::{Accel, Ray, T_MIN, intersect_sphere, intersect_triangle};
+use raywave::render::scene::{NO_HIT, Scene, Sphere, parse_scene_str};
 
 /// The unit square z = 0, x and y in [0, 2], wound counter-clockwise seen from +z: its front
 /// faces +z. Quad a b c d = (0,0) (2,0) (2,2) (0,2), split along a–c.
@@ -214,7 +214,7 @@ fn sphere_normal_is_outward_even_from_inside() {
     let hit = accel.closest(&s, &r, f32::INFINITY, false);
     assert_eq!(hit.prim, 0);
     assert!((hit.t - 2.0).abs() < 1e-6);
-    let n = raywave::spawn::surface_hit(&s, hit.prim, &r, hit.t, false).normal;
+    let n = raywave::render::spawn::surface_hit(&s, hit.prim, &r, hit.t, false).normal;
     assert!(n.distance(Vec3::Y) < 1e-6, "{n}");
 }
 
@@ -307,7 +307,7 @@ fn bvh_and_brute_force_agree_on_a_mesh() {
     assert!(accel.uses_bvh());
     let mut state = 12345u32;
     let mut rnd = || {
-        state = raywave::sampling::mix32(state.wrapping_add(0x9e37_79b9));
+        state = raywave::render::sampling::mix32(state.wrapping_add(0x9e37_79b9));
         (state >> 8) as f32 / 16_777_216.0
     };
     let mut hits = 0;
@@ -390,7 +390,7 @@ fn triangle_kernel_matches_an_independent_f64_plane_test() {
         if !(clearly_in || clearly_out) {
             continue;
         }
-        let tri = raywave::scene::Triangle {
+        let tri = raywave::render::scene::Triangle {
             v0: a.as_vec3(),
             e1: e1.as_vec3(),
             e2: e2.as_vec3(),
@@ -502,7 +502,7 @@ fn sphere_kernel_matches_an_independent_f64_root() {
 /// ambiguous cases left out: there the product and the quotient may round apart).
 #[test]
 fn sphere_blocks_agrees_with_the_closest_hit_and_an_f64_root() {
-    use raywave::geometry::sphere_blocks;
+    use raywave::render::geometry::sphere_blocks;
     let mut rng = seeded(11);
     let (mut blocked, mut clear) = (0, 0);
     for _ in 0..20000 {

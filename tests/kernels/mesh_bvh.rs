@@ -9,11 +9,11 @@ mod mesh_occlusion;
 
 use common::{Draw, ray, scene_of, seeded, triangle};
 use glam::Vec3;
-use raywave::geometry::{Accel, Ray, intersect_triangle};
-use raywave::meshgen::cornell_box_mesh_spheres;
-use raywave::scene::{NO_HIT, Scene, Sphere, Triangle, parse_scene_str};
-use raywave::wavefront::bvh::MeshBvh;
-use raywave::wavefront::simd::RayColumns;
+use raywave::render::geometry::{Accel, Ray, intersect_triangle};
+use raywave::render::scene::meshgen::cornell_box_mesh_spheres;
+use raywave::render::scene::{NO_HIT, Scene, Sphere, Triangle, parse_scene_str};
+use raywave::render::wavefront::bvh::MeshBvh;
+use raywave::render::wavefront::simd::RayColumns;
 
 const NAN: f32 = f32::NAN;
 const INF: f32 = f32::INFINITY;
@@ -100,7 +100,7 @@ fn brute_force_with_spheres(scene: &Scene, r: &Ray, tmax: f32, two_sided: bool) 
     let (mut t, mut prim) = brute_force(scene, r, tmax, two_sided);
     let mut best = if prim == NO_HIT { tmax } else { t };
     for (k, s) in scene.spheres.iter().enumerate() {
-        let ts = raywave::geometry::intersect_sphere(s, r, best);
+        let ts = raywave::render::geometry::intersect_sphere(s, r, best);
         if ts < best {
             best = ts;
             (t, prim) = (ts, base + k as u32);
@@ -380,7 +380,7 @@ fn batch_entry_points_equal_brute_force_for_lengths_around_the_lane_width() {
 fn packets_of_camera_rays_equal_brute_force() {
     let scene = mesh_scene_with_sphere(12, Vec3::new(0.3, -0.6, 0.2), 0.25);
     let bvh = MeshBvh::new(&scene);
-    let camera = raywave::camera::CameraRays::new(&scene.camera, 44, 40);
+    let camera = raywave::render::camera::CameraRays::new(&scene.camera, 44, 40);
     let mut rng = seeded(31);
     let mut rays: Vec<(Ray, f32)> = (0..44 * 40)
         .map(|pixel| {
@@ -453,16 +453,18 @@ fn packets_of_camera_rays_equal_brute_force() {
 #[ignore]
 fn probe() {
     use raywave::peer::{Hits, ObvhsMesh, RaySets, without_emitters};
-    let scene = without_emitters(&mesh_scene(raywave::meshgen::bands_for(12_000)));
+    let scene = without_emitters(&mesh_scene(raywave::render::scene::meshgen::bands_for(
+        12_000,
+    )));
     let obvhs = ObvhsMesh::new(&scene);
     let sets = RaySets::new(&scene, &obvhs, 128, 128, 2026);
-    let settings = raywave::settings::RenderSettings {
+    let settings = raywave::render::settings::RenderSettings {
         width: 128,
         height: 128,
         two_sided: true,
         ..Default::default()
     };
-    let ctx = raywave::wavefront::context::Context::new(&scene, &settings);
+    let ctx = raywave::render::wavefront::context::Context::new(&scene, &settings);
     let engine = std::env::var("PROBE").unwrap_or_else(|_| "wavefront".into());
     let set = std::env::var("SET").unwrap_or_else(|_| "primary".into());
     let set = sets

@@ -5,16 +5,16 @@
 //! the rays of every set, on a small generated mesh and on the lab's box without its spheres
 //! (raywave's brute-force path), all two-sided like the peers.
 
-use raywave::meshgen::cornell_box_mesh_spheres;
 use raywave::peer::{
     Agreement, FAN_SIZES, Hits, ObvhsMesh, RaySet, RaySets, blocker_agreement, brute_force_closest,
     hit_agreement, occlusion_agreement, raywave_closest, wavefront_closest, wavefront_occluded,
     without_emitters, without_spheres,
 };
-use raywave::scene::{NO_HIT, Scene, parse_scene_str};
-use raywave::settings::RenderSettings;
-use raywave::wavefront::batch::HitBatch;
-use raywave::wavefront::context::Context;
+use raywave::render::scene::meshgen::cornell_box_mesh_spheres;
+use raywave::render::scene::{NO_HIT, Scene, parse_scene_str};
+use raywave::render::settings::RenderSettings;
+use raywave::render::wavefront::batch::HitBatch;
+use raywave::render::wavefront::context::Context;
 
 const SIZE: u32 = 96;
 const SEED: u64 = 0x5eed;

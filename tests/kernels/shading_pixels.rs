@@ -1,18 +1,18 @@
 //! Pixels computed by hand from the lab's Shade formulas (docs/SHADING.md), compared with the
 //! reference renderer to 1e-5. Every expected value is built here from the formula, with this
-//! file's own vector arithmetic, never through `raywave::shading`.
+//! file's own vector arithmetic, never through `raywave::render::shading`.
 //!
 //! The scenes are small: a floor (y = 0, facing up), a 1 × 1 light at y = 2 facing down, and
 //! whatever the test adds. A 1 × 1 image sends its only ray from the camera position straight
 //! at the point of interest (x = y = 0.5), so the camera block picks the hit point.
 
 use glam::Vec3;
-use raywave::camera::CameraRays;
-use raywave::reference::Reference;
-use raywave::sampling::LightSampler;
-use raywave::scene::{Camera, Scene, parse_scene_str};
-use raywave::settings::{RenderSettings, ShadowMode};
-use raywave::stats::RayCounts;
+use raywave::render::camera::CameraRays;
+use raywave::render::per_kind::RayCounts;
+use raywave::render::reference::Reference;
+use raywave::render::sampling::LightSampler;
+use raywave::render::scene::{Camera, Scene, parse_scene_str};
+use raywave::render::settings::{RenderSettings, ShadowMode};
 
 const FLOOR_KD: Vec3 = Vec3::new(0.5, 0.6, 0.7);
 const LIGHT_KE: Vec3 = Vec3::new(1.0, 2.0, 3.0);

@@ -7,9 +7,9 @@ use crate::common;
 
 use common::{Draw, TestRng, seeded};
 use glam::Vec3;
-use raywave::geometry::{Accel, Ray, intersect_sphere, intersect_triangle, shadow_casters};
-use raywave::scene::{Scene, parse_scene_str};
-use raywave::spawn::{SurfaceHit, light_end, light_offset, shadow_ray};
+use raywave::render::geometry::{Accel, Ray, intersect_sphere, intersect_triangle, shadow_casters};
+use raywave::render::scene::{Scene, parse_scene_str};
+use raywave::render::spawn::{SurfaceHit, light_end, light_offset, shadow_ray};
 use std::fmt::Write;
 use std::path::Path;
 

@@ -1,5 +1,5 @@
 //! Secondary rays never meet the surface they leave, at every scale: the property behind the
-//! speckle-free spheres, tested on the spawn functions both engines call (`raywave::spawn`)
+//! speckle-free spheres, tested on the spawn functions both engines call (`raywave::render::spawn`)
 //! with the intersection kernels both use. The images themselves are held to an independent
 //! f64 oracle in tests/images/oracle_agreement.rs.
 
@@ -7,9 +7,9 @@ use crate::common;
 
 use common::{Draw, TestRng, seeded, triangle};
 use glam::Vec3;
-use raywave::geometry::{Accel, Ray, intersect_sphere};
-use raywave::scene::{Scene, Sphere};
-use raywave::spawn::{
+use raywave::render::geometry::{Accel, Ray, intersect_sphere};
+use raywave::render::scene::{Scene, Sphere};
+use raywave::render::spawn::{
     LightEnd, SurfaceHit, light_end, light_offset, mirror_ray, shadow_ray, sphere_offset,
     surface_hit,
 };
@@ -173,7 +173,7 @@ fn tessellated_light(s: f32, height: f32, k: usize) -> Scene {
             ));
         }
     }
-    raywave::scene::parse_scene_str(&text, "light.obj").expect("the light parses")
+    raywave::render::scene::parse_scene_str(&text, "light.obj").expect("the light parses")
 }
 
 #[test]
@@ -194,7 +194,7 @@ fn shadow_rays_end_before_the_light_even_at_grazing_angles() {
             let floor = SurfaceHit {
                 point: Vec3::new(p.x, p.y, -s),
                 normal: Vec3::Z,
-                offset: raywave::spawn::OFFSET_SCALE * s * spread,
+                offset: raywave::render::spawn::OFFSET_SCALE * s * spread,
             };
             let count = scene.lights.len();
             let light = &scene.lights[((rng.unit() * count as f32) as usize).min(count - 1)];

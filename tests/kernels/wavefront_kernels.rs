@@ -13,17 +13,19 @@ use common::strategies::{any_f32, vec3};
 use common::{edge_rays, ray, scene_of, triangle};
 use glam::Vec3;
 use proptest::prelude::*;
-use raywave::geometry::{self, Accel, Ray, intersect_sphere, intersect_triangle, shadow_casters};
-use raywave::sampling::{LightSampler, SampleKey, square_sample, strata_grid, uniform};
-use raywave::scene::{Light, LightShape, Material, NO_HIT, Scene, Sphere};
-use raywave::shading::shade;
-use raywave::spawn::{SurfaceHit, light_end, shadow_ray};
-use raywave::wavefront::lanes::{Lanes, f32x8, f32x16};
-use raywave::wavefront::shade::{
+use raywave::render::geometry::{
+    self, Accel, Ray, intersect_sphere, intersect_triangle, shadow_casters,
+};
+use raywave::render::sampling::{LightSampler, SampleKey, square_sample, strata_grid, uniform};
+use raywave::render::scene::{Light, LightShape, Material, NO_HIT, Scene, Sphere};
+use raywave::render::shading::shade;
+use raywave::render::spawn::{SurfaceHit, light_end, shadow_ray};
+use raywave::render::wavefront::lanes::{Lanes, f32x8, f32x16};
+use raywave::render::wavefront::shade::{
     HitLight, MaterialTerms, ShadowLanes, shade_lanes, shade_terms, shade8,
 };
-use raywave::wavefront::shadow::key_prefix;
-use raywave::wavefront::simd::{self, BlockSampler, LightBlock, RayColumns, arrays};
+use raywave::render::wavefront::shadow::key_prefix;
+use raywave::render::wavefront::simd::{self, BlockSampler, LightBlock, RayColumns, arrays};
 
 const NAN: f32 = f32::NAN;
 const INF: f32 = f32::INFINITY;
@@ -193,7 +195,7 @@ impl Columns {
 
 /// `closest_hits` and `occluded` over a whole batch against `Accel` without a BVH.
 fn check_batch(scene: &Scene, rays: &[(Ray, f32)], two_sided: bool) {
-    assert!(scene.triangles.len() < raywave::geometry::BVH_MIN_TRIANGLES);
+    assert!(scene.triangles.len() < raywave::render::geometry::BVH_MIN_TRIANGLES);
     let accel = Accel::new(scene);
     let cols = Columns::new(rays);
     let n = rays.len();
@@ -281,7 +283,7 @@ fn check_batch(scene: &Scene, rays: &[(Ray, f32)], two_sided: bool) {
 }
 
 fn lab_box() -> Scene {
-    raywave::scene::Scene::builtin_default()
+    raywave::render::scene::Scene::builtin_default()
 }
 
 /// Deterministic rays through the lab box, some with finite tmax.
@@ -421,7 +423,7 @@ proptest! {
         n in vec3(HALF), e in vec3(HALF), l in vec3(HALF), lc in vec3(HALF),
     ) {
         let m = Material { diffuse: kd.abs(), reflective: kr.abs(), emitted: ke.abs(), glossiness: g };
-        let terms = MaterialTerms::new(&m, Vec3::splat(raywave::shading::AMBIENT));
+        let terms = MaterialTerms::new(&m, Vec3::splat(raywave::render::shading::AMBIENT));
         let (n, e, l) = (n.normalize_or(Vec3::Z), e.normalize_or(Vec3::Z), l.normalize_or(Vec3::Z));
         let ndl = n.dot(l);
         prop_assume!(ndl > 0.0);
@@ -460,7 +462,7 @@ proptest! {
         let key = SampleKey { pixel, sample, bounce, light, seed };
         // The prefix trick: hash(key, dim) = mix32(prefix ^ dim).
         for dim in [0, 1, 2 * count - 1, 2 * count] {
-            let h = raywave::sampling::mix32(key_prefix(&key) ^ dim);
+            let h = raywave::render::sampling::mix32(key_prefix(&key) ^ dim);
             prop_assert_eq!((h >> 8) as f32 * (1.0 / 16_777_216.0), uniform(&key, dim));
         }
         // Every sampler with a SIMD twin (the lab's strategy only for N > 1).
@@ -499,7 +501,7 @@ fn check_shade(
     width: usize,
     kernel: impl Fn(&HitLight, &ShadowLanes) -> [Vec<f32>; 3],
 ) -> Result<(), TestCaseError> {
-    let terms = MaterialTerms::new(&case.m, Vec3::splat(raywave::shading::AMBIENT));
+    let terms = MaterialTerms::new(&case.m, Vec3::splat(raywave::render::shading::AMBIENT));
     let (n, e) = (case.n.normalize_or(Vec3::Z), case.e.normalize_or(Vec3::Z));
     let ls: Vec<Vec3> = case.ls[..width]
         .iter()
@@ -592,7 +594,7 @@ struct BlockOut {
 fn check_light_points<V: Lanes>(
     case: &LightCase,
     points: impl Fn(&LightBlock) -> [Vec<f32>; 3],
-    rays: impl Fn(&SurfaceHit, &[Vec<f32>; 3], &raywave::spawn::LightEnd, usize) -> BlockOut,
+    rays: impl Fn(&SurfaceHit, &[Vec<f32>; 3], &raywave::render::spawn::LightEnd, usize) -> BlockOut,
 ) -> Result<(), TestCaseError> {
     let LightCase {
         key,
@@ -635,7 +637,10 @@ fn check_light_points<V: Lanes>(
                     ny: ny as f32,
                 },
                 LightSampler::Sobol => BlockSampler::Sobol {
-                    scramble: raywave::sampling::hash(&key, raywave::sampling::SOBOL_SEED_DIM),
+                    scramble: raywave::render::sampling::hash(
+                        &key,
+                        raywave::render::sampling::SOBOL_SEED_DIM,
+                    ),
                 },
                 LightSampler::Random | LightSampler::Lab => BlockSampler::Random,
             },
@@ -729,7 +734,8 @@ fn simd_sobol_points_equal_scalar_up_to_the_largest_index() {
             light: 0,
             seed,
         };
-        let scramble = raywave::sampling::hash(&key, raywave::sampling::SOBOL_SEED_DIM);
+        let scramble =
+            raywave::render::sampling::hash(&key, raywave::render::sampling::SOBOL_SEED_DIM);
         for j0 in (0..count).step_by(8 * 61).chain([count - 16, count - 8]) {
             // The 16-lane kernel from the same index gives the same first 8 points and the
             // twins' next 8 (checked below for the 8-lane kernel from j0 + 8).

@@ -1,7 +1,7 @@
 //! An independent oracle for the lab's image: the model of docs/SHADING.md evaluated in f64, with
 //! its own camera, its own ray–sphere and ray–triangle tests, its own recursion and its own Shade.
 //! It reads the parsed `Scene` (input data) and draws the engines' random numbers through
-//! `raywave::sampling`, so its images compare pixel for pixel; nothing else of the engines is
+//! `raywave::render::sampling`, so its images compare pixel for pixel; nothing else of the engines is
 //! used. Slow (every ray tests every primitive of the clusters it can reach) and meant to be
 //! obviously right.
 //!
@@ -60,9 +60,9 @@
 
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
-use raywave::sampling::{CAMERA_LIGHT, SampleKey, pixel_offset, square_sample};
-use raywave::scene::{Camera, LightShape, Scene};
-use raywave::settings::{LightModel, RenderSettings, ShadowMode};
+use raywave::render::sampling::{CAMERA_LIGHT, SampleKey, pixel_offset, square_sample};
+use raywave::render::scene::{Camera, LightShape, Scene};
+use raywave::render::settings::{LightModel, RenderSettings, ShadowMode};
 
 /// Relative margin below which a discrete decision is called ambiguous.
 pub const DECISION_MARGIN: f64 = 1e-5;

@@ -520,7 +520,7 @@ fn adversarial_accepted_scenes_render_finite_pixels_with_both_engines() {
                 ];
                 let r = run(d, &args, None, TIMEOUT);
                 assert_eq!(r.code, Some(0), "{args:?}: {}", r.stderr);
-                let film = raywave::film::Film::read_pfm(&d.join("a.pfm")).unwrap();
+                let film = raywave::render::film::Film::read_pfm(&d.join("a.pfm")).unwrap();
                 let bad = film.pixels.iter().filter(|p| !p.is_finite()).count();
                 assert_eq!(bad, 0, "{args:?}: {bad} non-finite pixels");
                 checked += 1;
@@ -556,7 +556,7 @@ fn scales_1e_minus_6_and_1e6_render_the_same_image() {
             ];
             let r = run(d, &args, None, TIMEOUT);
             assert_eq!(r.code, Some(0), "{args:?}: {}", r.stderr);
-            raywave::film::Film::read_pfm(&d.join("a.pfm")).unwrap()
+            raywave::render::film::Film::read_pfm(&d.join("a.pfm")).unwrap()
         };
         let unit = image("cornell_box.obj");
         for scene in ["small.obj", "large.obj"] {

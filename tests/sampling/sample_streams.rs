@@ -22,17 +22,17 @@
 //! one of those hits sees all the points of both lights above its tangent plane.
 
 use glam::{DVec2, DVec3};
-use raywave::camera::CameraRays;
-use raywave::geometry::{Hit, Ray};
-use raywave::reference::{LightPoint, Reference, TraceLog};
-use raywave::sampling::{LightSampler, SampleKey, strata_grid};
-use raywave::scene::{LightShape, Material, Scene, parse_scene_str};
-use raywave::settings::{RenderSettings, ShadowMode};
-use raywave::spawn::{ShadowRay, SurfaceHit};
-use raywave::stats::RayCounts;
-use raywave::wavefront::batch::{HitBatch, RayBatch, ShadowQueue};
-use raywave::wavefront::context::Context;
-use raywave::wavefront::{generate, intersect, reflect, shadow};
+use raywave::render::camera::CameraRays;
+use raywave::render::geometry::{Hit, Ray};
+use raywave::render::per_kind::RayCounts;
+use raywave::render::reference::{LightPoint, Reference, TraceLog};
+use raywave::render::sampling::{LightSampler, SampleKey, strata_grid};
+use raywave::render::scene::{LightShape, Material, Scene, parse_scene_str};
+use raywave::render::settings::{RenderSettings, ShadowMode};
+use raywave::render::spawn::{ShadowRay, SurfaceHit};
+use raywave::render::wavefront::batch::{HitBatch, RayBatch, ShadowQueue};
+use raywave::render::wavefront::context::Context;
+use raywave::render::wavefront::{generate, intersect, reflect, shadow};
 use std::collections::BTreeMap;
 
 /// Upper 1e-6 point of χ² with 15 degrees of freedom (4 × 4 bins), from the regularised

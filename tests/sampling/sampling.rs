@@ -2,11 +2,13 @@
 //! more; uniform light points for both samplers; streams that depend on every key field.
 
 use glam::Vec3;
-use raywave::reference::Reference;
-use raywave::sampling::{LightSampler, SampleKey, pixel_offset, square_sample, strata_grid};
-use raywave::scene::parse_scene_str;
-use raywave::settings::{RenderSettings, ShadowMode};
-use raywave::stats::RayCounts;
+use raywave::render::per_kind::RayCounts;
+use raywave::render::reference::Reference;
+use raywave::render::sampling::{
+    LightSampler, SampleKey, pixel_offset, square_sample, strata_grid,
+};
+use raywave::render::scene::parse_scene_str;
+use raywave::render::settings::{RenderSettings, ShadowMode};
 
 fn key(pixel: u32, sample: u32) -> SampleKey {
     SampleKey {

@@ -1,7 +1,7 @@
 //! Sampling at its edges: the strata's upper border when the jitter rounds up, and the lab's
 //! strategy, which must equal `random` for every N but 1.
 
-use raywave::sampling::{
+use raywave::render::sampling::{
     CAMERA_LIGHT, LightSampler, SampleKey, pixel_offset, square_sample, strata_grid, uniform,
 };
 

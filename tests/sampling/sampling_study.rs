@@ -11,11 +11,11 @@ use common::analytic::{self, SIZE, floor_point, settings};
 
 use glam::{DVec3, Vec3};
 use oracle::Oracle;
-use raywave::reference::Reference;
-use raywave::sampling::{LightSampler, SampleKey, square_sample, strata_grid};
-use raywave::scene::{Scene, parse_scene_str};
-use raywave::settings::RenderSettings;
-use raywave::stats::RayCounts;
+use raywave::render::per_kind::RayCounts;
+use raywave::render::reference::Reference;
+use raywave::render::sampling::{LightSampler, SampleKey, square_sample, strata_grid};
+use raywave::render::scene::{Scene, parse_scene_str};
+use raywave::render::settings::RenderSettings;
 use raywave::variance::{Region, penumbra_mask};
 
 #[test]
@@ -274,7 +274,7 @@ fn matching_budget_inverts_the_fits() {
 /// Deterministic for fixed seeds, and it fails if stratification breaks (slope → −1).
 #[test]
 fn the_study_meets_its_floor_and_writes_its_outputs() {
-    use raywave::engine::Engine;
+    use raywave::render::engine::Engine;
     use raywave::variance::{StudyConfig, run_study};
     let scene = Scene::builtin_default();
     let base = RenderSettings {

@@ -12,11 +12,11 @@ use common::{PENTAGON, SQUARE};
 
 use glam::{DVec3, Vec3};
 use oracle::Oracle;
-use raywave::reference::Reference;
-use raywave::sampling::LightSampler;
-use raywave::scene::{Scene, parse_scene_str};
-use raywave::settings::{RenderSettings, ShadowMode};
-use raywave::stats::RayCounts;
+use raywave::render::per_kind::RayCounts;
+use raywave::render::reference::Reference;
+use raywave::render::sampling::LightSampler;
+use raywave::render::scene::{Scene, parse_scene_str};
+use raywave::render::settings::{RenderSettings, ShadowMode};
 
 const KD: f64 = 0.5;
 const KE: f64 = 1.0;

@@ -7,7 +7,7 @@
 use crate::common;
 
 use common::bin::{raywave, stderr, stdout};
-use raywave::false_colour::{MIN_SIDE, inferno};
+use raywave::output::false_colour::{MIN_SIDE, inferno};
 use raywave::variance::command::nearest_budget;
 use raywave::variance::sheet::{MIN_TILE, contact_sheet};
 use std::path::Path;

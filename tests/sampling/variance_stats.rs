@@ -10,13 +10,13 @@ use crate::common;
 
 use common::{Draw, seeded};
 use glam::Vec3;
-use raywave::film::Film;
-use raywave::sampling::LightSampler;
-use raywave::scene::Scene;
-use raywave::settings::RenderSettings;
-use raywave::stats::RayCounts;
+use raywave::render::film::Film;
+use raywave::render::per_kind::RayCounts;
+use raywave::render::sampling::LightSampler;
+use raywave::render::scene::Scene;
+use raywave::render::settings::RenderSettings;
+use raywave::render::wavefront::{DEFAULT_BATCH_SIZE, Wavefront};
 use raywave::variance::{ErrorStats, StudyConfig, error_stats, run_study};
-use raywave::wavefront::{DEFAULT_BATCH_SIZE, Wavefront};
 
 fn grey(values: &[f32]) -> Vec<Vec3> {
     values.iter().map(|&v| Vec3::splat(v)).collect()
@@ -272,7 +272,7 @@ fn normal(rng: &mut common::TestRng) -> f64 {
 /// How often the study's bootstrap interval of a mean of `k` normal units holds the true mean,
 /// over `trials` seeded experiments.
 fn mean_coverage(k: usize, trials: usize) -> f64 {
-    use raywave::statistics::{BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, bootstrap_interval};
+    use raywave::bench::statistics::{BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, bootstrap_interval};
     let mut rng = seeded(0xc0fe);
     let (mu, sigma) = (3.0, 0.7);
     let mut hits = 0;
@@ -305,7 +305,7 @@ fn bootstrap_intervals_cover_the_truth_at_about_the_nominal_rate() {
 /// (0.95 for a well-behaved statistic; the bound allows the small-sample shortfall above).
 #[test]
 fn bootstrap_slope_intervals_cover_the_true_slope() {
-    use raywave::statistics::{BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, bootstrap_interval};
+    use raywave::bench::statistics::{BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, bootstrap_interval};
     use raywave::variance::loglog_fit;
     let mut rng = seeded(0x51_09e);
     let (s, c, k) = (-1.5, 0.04, 16);

@@ -4,7 +4,7 @@
 use crate::common;
 
 use common::scenes::{WHITE_MATERIAL as MAT, error_at};
-use raywave::scene::{Scene, SceneError, parse_scene_str};
+use raywave::render::scene::{Scene, SceneError, parse_scene_str};
 use std::path::Path;
 
 #[test]
@@ -206,7 +206,9 @@ fn a_non_utf8_byte_is_an_error_naming_its_line() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("latin1.obj");
     std::fs::write(&path, b"material\ndiffuse 1 1 1\n# caf\xe9\nv 0 0 0\n").unwrap();
-    let err = raywave::scene::Scene::load(&path).unwrap_err().to_string();
+    let err = raywave::render::scene::Scene::load(&path)
+        .unwrap_err()
+        .to_string();
     assert!(err.contains("latin1.obj:3:"), "{err}");
     assert!(err.contains("expected UTF-8"), "{err}");
 }

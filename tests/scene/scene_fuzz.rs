@@ -6,7 +6,7 @@
 use crate::common;
 
 use proptest::prelude::*;
-use raywave::scene::{ParseOptions, parse_scene_str_with};
+use raywave::render::scene::{ParseOptions, parse_scene_str_with};
 
 /// Parses `bytes` as the loader would (UTF-8 first) and checks the error, if any.
 fn check(bytes: &[u8]) -> Result<(), TestCaseError> {

@@ -6,7 +6,7 @@ use crate::common;
 
 use common::scenes::{WHITE_MATERIAL as MAT, error_at};
 use glam::Vec3;
-use raywave::scene::{LightShape, Scene, parse_scene_str};
+use raywave::render::scene::{LightShape, Scene, parse_scene_str};
 use std::path::{Path, PathBuf};
 
 /// Counts read off the five files by hand: (file, materials, quads, spheres, lights).
@@ -474,7 +474,7 @@ fn camera_block_with_center_and_direction() {
 fn a_non_convex_polygon_is_loaded_with_a_warning() {
     // A dart (0,0) (2,1) (0,2) (1,1): fanned from (0,0), its second triangle (0,0) (0,2) (1,1)
     // winds the other way, so the fan overlaps itself. The square after it is convex.
-    let scene = raywave::scene::parse_scene_str(
+    let scene = raywave::render::scene::parse_scene_str(
         "material\ndiffuse 1 1 1\n\
          v 0 0 0\nv 2 1 0\nv 0 2 0\nv 1 1 0\n\
          v 3 0 0\nv 4 0 0\nv 4 1 0\nv 3 1 0\n\

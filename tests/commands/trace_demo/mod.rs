@@ -5,8 +5,8 @@
 #![allow(dead_code)]
 
 use glam::DVec3;
-use raywave::scene::Scene;
-use raywave::settings::{RenderSettings, ShadowMode};
+use raywave::render::scene::Scene;
+use raywave::render::settings::{RenderSettings, ShadowMode};
 use std::path::Path;
 
 pub const SCENE: &str = "trace_demo.obj";

@@ -4,7 +4,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use raywave::scene::{ParseOptions, parse_scene_str_with};
+use raywave::render::scene::{ParseOptions, parse_scene_str_with};
 
 fuzz_target!(|data: &[u8]| {
     let Ok(text) = std::str::from_utf8(data) else {

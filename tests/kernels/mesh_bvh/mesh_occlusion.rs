@@ -6,11 +6,11 @@
 
 use crate::common::{Draw, seeded};
 use glam::Vec3;
-use raywave::geometry::{Ray, T_MIN, intersect_triangle};
-use raywave::meshgen::cornell_box_mesh_spheres;
-use raywave::scene::{Scene, parse_scene_str};
-use raywave::wavefront::bvh::MeshBvh;
-use raywave::wavefront::simd::RayColumns;
+use raywave::render::geometry::{Ray, T_MIN, intersect_triangle};
+use raywave::render::scene::meshgen::cornell_box_mesh_spheres;
+use raywave::render::scene::{Scene, parse_scene_str};
+use raywave::render::wavefront::bvh::MeshBvh;
+use raywave::render::wavefront::simd::RayColumns;
 
 /// A ray with its tmax.
 type Segment = (Ray, f32);
@@ -115,7 +115,7 @@ fn hard_shadow_rays_from_neighbouring_points_equal_brute_force() {
     let scene = mesh_scene(10);
     let bvh = MeshBvh::new(&scene);
     let centroid = scene.lights[0].centroid;
-    let camera = raywave::camera::CameraRays::new(&scene.camera, 64, 48);
+    let camera = raywave::render::camera::CameraRays::new(&scene.camera, 64, 48);
     let mut segments = Vec::new();
     for pixel in 0..64 * 48 {
         let (x, y) = camera.screen(pixel, 0.5, 0.5);

@@ -1,0 +1,249 @@
+//! One entry point for both renderers: the command line, `raywave bench`, the variance study,
+//! the benches and the tests choose an [`Engine`] and call it, instead of each matching on the
+//! choice and calling `Wavefront` or `Reference` in its own way.
+//!
+//! ```text
+//! Engine::render(scene, settings, batch, progress)            one image
+//! Engine::prepare(scene, settings, batch) -> Prepared         set-up once (BVH, tables) ...
+//!     Prepared::render(progress) -> (Film, RenderStats)       ... then render as often as asked
+//! ```
+
+use crate::render::film::Film;
+use crate::render::per_kind::RayCounts;
+use crate::render::reference::Reference;
+use crate::render::scene::Scene;
+use crate::render::settings::RenderSettings;
+use crate::render::wavefront::Wavefront;
+use crate::render::wavefront::lanes::LaneWidth;
+use crate::render::wavefront::stats::RenderStats;
+use serde::{Deserialize, Serialize};
+
+/// The renderers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "tools", derive(schemars::JsonSchema))]
+#[serde(rename_all = "lowercase")]
+pub enum Engine {
+    /// Structure-of-arrays batches through 8-wide SIMD stages (the default).
+    Wavefront,
+    /// The scalar recursive renderer, one ray at a time: the whole-image twin.
+    Reference,
+}
+
+impl Engine {
+    /// The name used on the command line and in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Engine::Wavefront => "wavefront",
+            Engine::Reference => "reference",
+        }
+    }
+
+    /// Builds what the engine needs before its first ray (the BVH for meshes, the tables);
+    /// `batch_size` is the wavefront engine's camera samples per tile (the reference ignores it).
+    pub fn prepare<'a>(
+        self,
+        scene: &'a Scene,
+        settings: &'a RenderSettings,
+        batch_size: usize,
+    ) -> Prepared<'a> {
+        self.prepare_lanes(scene, settings, batch_size, LaneWidth::Auto)
+    }
+
+    /// [`Engine::prepare`] with the wavefront engine's kernels run `lanes` wide (the reference
+    /// ignores it). Speed only: the image is the same at every width.
+    pub fn prepare_lanes<'a>(
+        self,
+        scene: &'a Scene,
+        settings: &'a RenderSettings,
+        batch_size: usize,
+        lanes: LaneWidth,
+    ) -> Prepared<'a> {
+        match self {
+            Engine::Wavefront => Prepared::Wavefront(
+                Wavefront::new(scene, settings, batch_size).with_lane_width(lanes),
+            ),
+            Engine::Reference => Prepared::Reference(Reference::new(scene, settings)),
+        }
+    }
+
+    /// Renders one image on the current rayon pool; `progress` is called after each unit of
+    /// work (see [`Prepared::work_units`]). The reference has no stages: its `stage_time` is
+    /// zero.
+    pub fn render(
+        self,
+        scene: &Scene,
+        settings: &RenderSettings,
+        batch_size: usize,
+        progress: &(dyn Fn() + Sync),
+    ) -> (Film, RenderStats) {
+        self.prepare(scene, settings, batch_size).render(progress)
+    }
+
+    /// One image at the default batch size, without progress, as the variance study's
+    /// `RenderFn` takes it.
+    pub fn image(self, scene: &Scene, settings: &RenderSettings) -> (Film, RayCounts) {
+        let (film, stats) = self.render(
+            scene,
+            settings,
+            crate::render::wavefront::DEFAULT_BATCH_SIZE,
+            &|| {},
+        );
+        (film, stats.counts)
+    }
+}
+
+/// An engine set up for one scene and one set of settings.
+pub enum Prepared<'a> {
+    /// The wavefront engine.
+    Wavefront(Wavefront<'a>),
+    /// The reference renderer.
+    Reference(Reference<'a>),
+}
+
+impl Prepared<'_> {
+    /// Which engine this is.
+    pub fn engine(&self) -> Engine {
+        match self {
+            Prepared::Wavefront(_) => Engine::Wavefront,
+            Prepared::Reference(_) => Engine::Reference,
+        }
+    }
+
+    /// The SIMD path this engine's kernels run on (`raywave::simd_path_for` its lane width; the
+    /// build's default path for the scalar reference, as records have always said).
+    pub fn simd_path(&self) -> &'static str {
+        match self {
+            Prepared::Wavefront(w) => crate::simd_path_for(w.lane_width()),
+            Prepared::Reference(_) => crate::simd_path(),
+        }
+    }
+
+    /// How many times `render` calls `progress`, and what one call stands for ("tiles" or
+    /// "rows").
+    pub fn work_units(&self, settings: &RenderSettings) -> (u64, &'static str) {
+        match self {
+            Prepared::Wavefront(w) => (w.tile_count() as u64, "tiles"),
+            Prepared::Reference(_) => (settings.height as u64, "rows"),
+        }
+    }
+
+    /// Seconds spent building the wavefront engine's mesh BVH: `None` for the reference, and
+    /// `Some(None)` when the scene needs no BVH.
+    pub fn bvh_build_seconds(&self) -> Option<Option<f64>> {
+        match self {
+            Prepared::Wavefront(w) => Some(
+                w.context()
+                    .accel
+                    .as_ref()
+                    .map(|bvh| bvh.build_time.as_secs_f64()),
+            ),
+            Prepared::Reference(_) => None,
+        }
+    }
+
+    /// Renders the image on the current rayon pool, calling `progress` after each work unit.
+    ///
+    /// Every pixel comes out finite: a scene's numbers are bounded by the parser, but a mirror
+    /// that reflects more than it receives, over many bounces, or a bright light next to a
+    /// surface can still overflow f32; such pixels are clamped (see [`clamp_to_finite`]) with
+    /// one warning on stderr.
+    pub fn render(&self, progress: &(dyn Fn() + Sync)) -> (Film, RenderStats) {
+        let (mut film, stats) = self.render_raw(progress);
+        let clamped = clamp_to_finite(&mut film);
+        if clamped > 0 {
+            eprintln!(
+                "warning: {clamped} pixel(s) overflowed f32 and were clamped to finite values \
+                 (the scene's colours or mirrors amplify light past 3.4e38)"
+            );
+        }
+        (film, stats)
+    }
+
+    fn render_raw(&self, progress: &(dyn Fn() + Sync)) -> (Film, RenderStats) {
+        match self {
+            Prepared::Wavefront(w) => w.render(progress),
+            Prepared::Reference(r) => {
+                let (film, counts) = r.render(progress);
+                (
+                    film,
+                    RenderStats {
+                        counts,
+                        ..RenderStats::default()
+                    },
+                )
+            }
+        }
+    }
+}
+
+/// Makes every channel of every pixel finite: +inf becomes `f32::MAX`, NaN (infinity times
+/// zero) becomes 0. Returns how many pixels changed; finite images are left untouched.
+pub fn clamp_to_finite(film: &mut Film) -> usize {
+    let mut changed = 0;
+    for p in &mut film.pixels {
+        if !p.is_finite() {
+            changed += 1;
+            *p = glam::Vec3::from_array(p.to_array().map(|c| {
+                if c.is_nan() {
+                    0.0
+                } else {
+                    c.clamp(-f32::MAX, f32::MAX)
+                }
+            }));
+        }
+    }
+    changed
+}
+
+/// The worker threads the engines render on: `threads`, or rayon's default (all cores).
+pub fn thread_pool(threads: Option<u32>) -> anyhow::Result<rayon::ThreadPool> {
+    let mut builder = rayon::ThreadPoolBuilder::new();
+    if let Some(n) = threads {
+        builder = builder.num_threads(n as usize);
+    }
+    anyhow::Context::context(builder.build(), "cannot start the worker threads")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn both_engines_render_the_same_rays_through_the_facade() {
+        let scene = Scene::builtin_default();
+        let settings = RenderSettings {
+            width: 12,
+            height: 8,
+            shadow_samples: 2,
+            ..RenderSettings::default()
+        };
+        let calls = std::sync::atomic::AtomicU64::new(0);
+        let count = || {
+            calls.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        };
+        for engine in [Engine::Wavefront, Engine::Reference] {
+            calls.store(0, std::sync::atomic::Ordering::Relaxed);
+            let prepared = engine.prepare(&scene, &settings, 16);
+            assert_eq!(prepared.engine(), engine);
+            let (units, _) = prepared.work_units(&settings);
+            let (film, stats) = prepared.render(&count);
+            assert_eq!(calls.load(std::sync::atomic::Ordering::Relaxed), units);
+            assert_eq!((film.width, film.height), (12, 8));
+            assert_eq!(stats.counts.camera, 96);
+            assert_eq!(engine.image(&scene, &settings).1, stats.counts);
+        }
+        assert_eq!(
+            Engine::Reference
+                .prepare(&scene, &settings, 16)
+                .bvh_build_seconds(),
+            None
+        );
+        assert_eq!(
+            Engine::Reference
+                .render(&scene, &settings, 16, &|| {})
+                .1
+                .stage_time,
+            RenderStats::default().stage_time
+        );
+    }
+}

@@ -1,0 +1,200 @@
+//! The wavefront engine: rays in structure-of-arrays batches flowing through stages, 8 lanes
+//! at a time, tiles spread over cores.
+//!
+//! ```text
+//! for each tile (rayon; a fixed range of pixels, independent of the thread count):
+//!     generate   camera rays, one per (pixel, aa sample)          generate.rs
+//!     for bounce in 0..=max bounces, while rays are left:
+//!         intersect  closest hit of every ray                      intersect.rs
+//!         shadow     shadow rays, occlusion, Shade sums             shadow.rs
+//!         film       radiance += throughput · (0.2·kd + direct)     film.rs
+//!         reflect    mirror rays into the next batch                reflect.rs
+//!         swap the two ray batches
+//!     film       pixel = mean of its samples, in sample order        film.rs
+//! ```
+//!
+//! Every random number comes from `sampling`'s pure hash of (pixel, sample, bounce, light,
+//! dimension, seed), and each pixel is summed inside one tile in a fixed order, so the image
+//! does not depend on scheduling: `--threads 1` and `--threads 2` give the same bytes. Memory
+//! is the film plus one `Workspace` per worker, bounded by the batch size.
+
+pub mod batch;
+pub mod bvh;
+pub mod context;
+pub mod film;
+pub mod generate;
+pub mod intersect;
+pub mod lanes;
+pub mod reflect;
+pub mod shade;
+pub mod shadow;
+pub mod simd;
+pub mod stats;
+
+use crate::render::film::Film;
+use crate::render::per_kind::RayKind;
+use crate::render::scene::Scene;
+use crate::render::settings::RenderSettings;
+use batch::{HitBatch, Radiance, RayBatch, ShadowQueue};
+use context::Context;
+use glam::Vec3;
+use rayon::prelude::*;
+use stats::{RenderStats, Stage};
+use std::sync::Mutex;
+
+/// Camera samples per tile unless told otherwise (measured in docs/TRIED.md).
+pub const DEFAULT_BATCH_SIZE: usize = 4096;
+
+/// Buffers one worker reuses from tile to tile.
+#[derive(Default)]
+pub struct Workspace {
+    rays: RayBatch,
+    next: RayBatch,
+    hits: HitBatch,
+    shadow: ShadowQueue,
+    radiance: Radiance,
+}
+
+/// The wavefront renderer for one scene and one set of settings.
+pub struct Wavefront<'a> {
+    ctx: Context<'a>,
+    /// Pixels per tile: the batch size divided by the antialiasing samples.
+    tile_pixels: usize,
+    /// Shadow rays queued before an occlusion pass.
+    queue_capacity: usize,
+    /// Workspaces between rayon jobs and between renders. rayon asks for a fresh one per job
+    /// (23 per 1024² frame on 2 threads, 2 on one), and a fresh one grows its buffers again
+    /// from empty, page faults included.
+    pool: Mutex<Vec<Workspace>>,
+}
+
+/// A workspace borrowed from the pool for one rayon job, returned when the job ends.
+struct Pooled<'p> {
+    ws: Workspace,
+    pool: &'p Mutex<Vec<Workspace>>,
+}
+
+impl Drop for Pooled<'_> {
+    fn drop(&mut self) {
+        let ws = std::mem::take(&mut self.ws);
+        // A poisoned pool only means another job panicked; the panic propagates anyway.
+        if let Ok(mut pool) = self.pool.lock() {
+            pool.push(ws);
+        }
+    }
+}
+
+impl<'a> Wavefront<'a> {
+    /// Prepares the tables (and the BVH for meshes); `batch_size` is camera samples per tile.
+    pub fn new(scene: &'a Scene, settings: &'a RenderSettings, batch_size: usize) -> Self {
+        let ctx = Context::new(scene, settings);
+        let batch_size = batch_size.max(1);
+        Wavefront {
+            tile_pixels: (batch_size / settings.aa_samples.max(1) as usize).max(1),
+            queue_capacity: batch_size.max(16),
+            ctx,
+            pool: Mutex::new(Vec::new()),
+        }
+    }
+
+    /// The same engine with its brute-force, light and shading kernels run `width` lanes wide
+    /// (`LaneWidth::Auto`, the default: 16 on AVX-512 builds, else 8). Speed only: the image,
+    /// the counts and the records' figures other than times are the same at every width.
+    pub fn with_lane_width(mut self, width: lanes::LaneWidth) -> Self {
+        self.ctx = self.ctx.with_lane_width(width);
+        self.queue_capacity = self.queue_capacity.max(self.ctx.lane_width.lanes());
+        self
+    }
+
+    /// The lane width the kernels run at (resolved: `Eight` or `Sixteen`).
+    pub fn lane_width(&self) -> lanes::LaneWidth {
+        self.ctx.lane_width
+    }
+
+    /// The derived tables, BVH included.
+    pub fn context(&self) -> &Context<'a> {
+        &self.ctx
+    }
+
+    /// Number of tiles (for progress reporting).
+    pub fn tile_count(&self) -> usize {
+        self.pixel_count().div_ceil(self.tile_pixels)
+    }
+
+    fn pixel_count(&self) -> usize {
+        self.ctx.settings.width as usize * self.ctx.settings.height as usize
+    }
+
+    /// Renders on the current rayon pool; `on_tile` is called after each tile.
+    pub fn render(&self, on_tile: &(dyn Fn() + Sync)) -> (Film, RenderStats) {
+        let s = self.ctx.settings;
+        let mut film = Film::new(s.width, s.height);
+        let stats = film
+            .pixels
+            .par_chunks_mut(self.tile_pixels)
+            .enumerate()
+            .map_init(
+                || Pooled {
+                    ws: self
+                        .pool
+                        .lock()
+                        .map(|mut p| p.pop())
+                        .ok()
+                        .flatten()
+                        .unwrap_or_default(),
+                    pool: &self.pool,
+                },
+                |pooled, (tile, out)| {
+                    let mut stats = RenderStats::default();
+                    self.render_tile(
+                        (tile * self.tile_pixels) as u32,
+                        out,
+                        &mut pooled.ws,
+                        &mut stats,
+                    );
+                    on_tile();
+                    stats
+                },
+            )
+            .reduce(RenderStats::default, |a, b| a + b);
+        (film, stats)
+    }
+
+    /// Renders pixels `first..first + out.len()` into `out`: the architecture diagram.
+    pub fn render_tile(
+        &self,
+        first: u32,
+        out: &mut [Vec3],
+        ws: &mut Workspace,
+        st: &mut RenderStats,
+    ) {
+        let ctx = &self.ctx;
+        st.time_kind(Stage::Generate, RayKind::Camera, || {
+            generate::camera_rays(ctx, first, out.len() as u32, &mut ws.rays);
+            ws.radiance.reset(ws.rays.len());
+        });
+        st.counts.camera += ws.rays.len() as u64;
+        // The first batch holds the camera rays, every later one mirror rays.
+        let mut traced = RayKind::Camera;
+        while !ws.rays.is_empty() {
+            st.time_kind(Stage::Intersect, traced, || {
+                intersect::closest(ctx, &ws.rays, &mut ws.hits);
+            });
+            st.counts.shadow += st.time_kind(Stage::Shadow, RayKind::Shadow, || {
+                let capacity = self.queue_capacity;
+                shadow::direct_light(ctx, &ws.rays, &mut ws.hits, &mut ws.shadow, capacity)
+            });
+            st.time(Stage::Film, || {
+                film::accumulate(ctx, &ws.rays, &ws.hits, &mut ws.radiance);
+            });
+            st.counts.reflection += st.time_kind(Stage::Reflect, RayKind::Reflection, || {
+                reflect::mirror_rays(ctx, &ws.rays, &ws.hits, &mut ws.next)
+            });
+            std::mem::swap(&mut ws.rays, &mut ws.next);
+            traced = RayKind::Reflection;
+        }
+        st.time(Stage::Film, || {
+            film::resolve(&ws.radiance, ctx.settings.aa_samples, out);
+        });
+    }
+}

@@ -1,0 +1,263 @@
+//! Stage 3, shadow: direct light at every hit.
+//!
+//! ```text
+//! for each group of hits whose shadow rays fit the queue:
+//!     spawn:   for hit, for light, for point j < N:  the shadow ray of `spawn::shadow_ray`
+//!              (origin, l, tmax), queued when it has one (the point far enough above the
+//!              tangent plane, the hit above the light's moved plane)
+//!     occlude: N queued rays at a time (8 or 16), stop at the first blocker; small scenes
+//!              test only the triangles that can shadow a light (`geometry::shadow_casters`),
+//!              meshes go one ray at a time through `bvh::MeshBvh`, 8 boxes or 8 triangles per
+//!              test
+//!     shade:   in queue order, direct[hit] += Shade(l) / N for the rays not blocked
+//! ```
+//!
+//! Queue order is the reference's loop order, so each hit's sum is added in the same order and
+//! comes out bit-identical. Soft shadows on a parallelogram light (every lab light) go N points
+//! at a time, every sampler with a SIMD twin (`simd::light_points`); hard shadows and other
+//! light shapes call the scalar sampling code one point at a time.
+//!
+//! N is the engine's lane width (`lanes::LaneWidth`, 8 or 16): the stage is generic over the
+//! lane type, and with 16 lanes the queue holds aligned blocks of 16 points per (hit, light).
+//! Dead lanes add −0.0 and each hit's sum is still added in point order, so both widths give
+//! the same bits.
+
+use super::batch::{HitBatch, RayBatch, ShadowQueue};
+use super::context::Context;
+use super::lanes::{LaneWidth, Lanes, f32x8, f32x16};
+use super::shade::{HitLight, ShadowLanes, shade_lanes, shade_terms};
+use super::simd::{self, LightBlock, RayColumns};
+use crate::render::geometry::casters;
+use crate::render::sampling::{SampleKey, mix32, square_sample};
+use crate::render::scene::NO_HIT;
+use crate::render::settings::LightModel;
+use crate::render::spawn::{falloff, light_end, shadow_ray};
+
+/// The hash state of a SampleKey before its dimension is mixed in: `sampling::hash(key, dim)`
+/// is `mix32(key_prefix(key) ^ dim)`, so a (hit, light) stream is hashed once, not once per
+/// point. Tested against `sampling::uniform`.
+#[inline]
+pub fn key_prefix(key: &SampleKey) -> u32 {
+    let mut h = mix32(key.seed ^ 0x9e37_79b9);
+    h = mix32(h ^ key.pixel);
+    h = mix32(h ^ key.sample);
+    h = mix32(h ^ key.bounce);
+    mix32(h ^ key.light)
+}
+
+/// Fills every hit's `direct` column; returns the number of shadow rays cast (queued rays: a
+/// point behind the surface casts none, and no ray is cast with shadows off).
+pub fn direct_light(
+    ctx: &Context,
+    rays: &RayBatch,
+    hits: &mut HitBatch,
+    queue: &mut ShadowQueue,
+    capacity: usize,
+) -> u64 {
+    match ctx.lane_width {
+        LaneWidth::Sixteen => direct_light_lanes::<f32x16>(ctx, rays, hits, queue, capacity),
+        _ => direct_light_lanes::<f32x8>(ctx, rays, hits, queue, capacity),
+    }
+}
+
+/// [`direct_light`] at the lane width of `V`. Never inlined, so that the 8-lane stage is one
+/// function as it was before the 16-lane path, whatever codegen unit the dispatcher lands in
+/// (inlined, its instruction count in tests/gates/icount.rs moved by 0.5–2.2% from build to build).
+#[inline(never)]
+fn direct_light_lanes<V: Lanes>(
+    ctx: &Context,
+    rays: &RayBatch,
+    hits: &mut HitBatch,
+    queue: &mut ShadowQueue,
+    capacity: usize,
+) -> u64 {
+    let n = rays.len();
+    hits.direct.fill(0..n, glam::Vec3::ZERO);
+    // Room for one hit's rays at least, each light's points padded to whole N-lane blocks.
+    let per_hit = ctx.lights.len() * (ctx.points_per_light as usize).div_ceil(V::N) * V::N;
+    queue.reset(
+        capacity.max(per_hit),
+        ctx.settings.light_model != LightModel::Lab,
+    );
+    let mut cast = 0;
+    let mut next = 0;
+    while next < n {
+        queue.len = 0;
+        while next < n && queue.room() >= per_hit {
+            cast += spawn::<V>(ctx, rays, hits, next, queue);
+            next += 1;
+        }
+        if ctx.casts_shadow_rays() {
+            occlude::<V>(ctx, queue); // writes every entry
+        } else {
+            queue.blocked[..queue.len].fill(false);
+        }
+        shade::<V>(ctx, rays, hits, queue);
+    }
+    if ctx.casts_shadow_rays() { cast } else { 0 }
+}
+
+/// Queues the shadow rays of hit `i`, in (light, point) order.
+/// Returns the number of live rays queued.
+fn spawn<V: Lanes>(
+    ctx: &Context,
+    rays: &RayBatch,
+    hits: &HitBatch,
+    i: usize,
+    queue: &mut ShadowQueue,
+) -> u64 {
+    if hits.prim[i] == NO_HIT {
+        return 0;
+    }
+    let mut cast = 0;
+    let hit = hits.surface(i);
+    let count = ctx.points_per_light;
+    for (li, light) in ctx.lights.iter().enumerate() {
+        let key = SampleKey {
+            pixel: rays.pixel[i],
+            sample: rays.sample[i],
+            bounce: rays.bounce,
+            light: li as u32,
+            seed: ctx.settings.seed,
+        };
+        let end = light_end(&ctx.scene.lights[li], light.end_offset, &hit);
+        match (
+            ctx.samples_lights() && ctx.simd_light_sampling(),
+            light.parallelogram,
+        ) {
+            (true, Some((origin, edge_u, edge_v))) => {
+                let block = LightBlock {
+                    prefix: key_prefix(&key),
+                    j0: 0,
+                    sampler: ctx.block_sampler(&key),
+                    origin,
+                    edge_u,
+                    edge_v,
+                };
+                for j0 in (0..count).step_by(V::N) {
+                    let target = simd::light_points::<V>(&LightBlock { j0, ..block });
+                    let lanes = ((count - j0) as usize).min(V::N);
+                    let block = simd::shadow_rays::<V>(&hit, &target, &end, lanes);
+                    if block.live != 0 {
+                        queue.push_block(&block, i as u32, li as u32);
+                        cast += block.live.count_ones() as u64;
+                    }
+                }
+            }
+            _ => {
+                for j in 0..count {
+                    let target = if ctx.samples_lights() {
+                        let (u, v) = square_sample(ctx.settings.sampler, &key, j, count);
+                        ctx.scene.lights[li].point(u, v)
+                    } else {
+                        light.centroid
+                    };
+                    if let Some(s) = shadow_ray(&hit, target, &end) {
+                        queue.push(&s, i as u32, li as u32);
+                        cast += 1;
+                    }
+                }
+            }
+        }
+    }
+    cast
+}
+
+/// Sets `queue.blocked` for every queued ray (both kernels write every entry).
+fn occlude<V: Lanes>(ctx: &Context, queue: &mut ShadowQueue) {
+    let scene = ctx.scene;
+    let two_sided = ctx.settings.two_sided;
+    let n = queue.len;
+    let cols = RayColumns {
+        origin: queue.origin.slices(0..n),
+        direction: queue.direction.slices(0..n),
+        tmax: &queue.tmax[..n],
+    };
+    let blocked = &mut queue.blocked[..n];
+    match &ctx.accel {
+        // At 8 lanes the 8-lane entry point, a function of its own as it always was (`V::N` is a
+        // constant, so only one arm is compiled in each instantiation).
+        None if V::N == 8 => simd::occluded(
+            casters(scene, &ctx.shadow_casters, two_sided),
+            &scene.spheres,
+            &cols,
+            two_sided,
+            blocked,
+        ),
+        None => simd::occluded_lanes::<V>(
+            casters(scene, &ctx.shadow_casters, two_sided),
+            &scene.spheres,
+            &cols,
+            two_sided,
+            blocked,
+        ),
+        // Dead entries (no ray: `spawn::shadow_ray` gave none) carry tmax = 0, which
+        // `MeshBvh::occluded` skips.
+        Some(bvh) => bvh.occluded(scene, &cols, two_sided, blocked),
+    }
+}
+
+/// Adds Shade / N of every unblocked queued ray to its hit, in queue order. Aligned blocks of
+/// N rays (the lane width) from one hit to one light (soft shadows) are shaded N lanes at a
+/// time, then added lane by lane in order.
+fn shade<V: Lanes>(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch, queue: &ShadowQueue) {
+    let weight = 1.0 / ctx.points_per_light as f32;
+    let model = ctx.settings.light_model;
+    let mut q = 0;
+    while q < queue.len {
+        let end = q + V::N;
+        // The queue is sorted by (hit, light): equal ends mean one hit and one light.
+        if end <= queue.len
+            && queue.path[q] == queue.path[end - 1]
+            && queue.light[q] == queue.light[end - 1]
+        {
+            let i = queue.path[q] as usize;
+            let m = &ctx.materials[hits.material[i] as usize];
+            // Distances are kept only under a light model with fall-off (`ShadowQueue::dist`).
+            let falloffs: Option<V::Array> = (!queue.dist.is_empty()).then(|| {
+                let mut f = V::Array::default();
+                for (f, &d) in f.as_mut().iter_mut().zip(&queue.dist[q..end]) {
+                    *f = falloff(model, d);
+                }
+                f
+            });
+            // In the order the kernel's operands were always evaluated: the hit, the rays, the
+            // light (`shade8`'s instruction count moves with it).
+            let (normal, to_eye) = (hits.normal.get(i), -rays.direction.get(i));
+            let lanes = ShadowLanes {
+                l: queue.direction.slices(q..end),
+                n_dot_l: &queue.n_dot_l[q..end],
+                blocked: &queue.blocked[q..end],
+                falloff: falloffs.as_ref().map(|f| f.as_ref()),
+            };
+            let at = HitLight {
+                material: m,
+                normal,
+                to_eye,
+                light_color: ctx.lights[queue.light[q] as usize].color,
+                weight,
+            };
+            let c = shade_lanes::<V>(&at, &lanes);
+            // In lane order, like the reference's loop; lanes that add nothing hold −0.0.
+            let (mut r, mut g, mut b) = (hits.direct.x[i], hits.direct.y[i], hits.direct.z[i]);
+            for ((cr, cg), cb) in c[0].as_ref().iter().zip(c[1].as_ref()).zip(c[2].as_ref()) {
+                r += cr;
+                g += cg;
+                b += cb;
+            }
+            (hits.direct.x[i], hits.direct.y[i], hits.direct.z[i]) = (r, g, b);
+            q = end;
+            continue;
+        }
+        if !queue.blocked[q] && queue.n_dot_l[q] > 0.0 {
+            let i = queue.path[q] as usize;
+            let (n, l, n_dot_l) = (hits.normal.get(i), queue.direction.get(q), queue.n_dot_l[q]);
+            let m = &ctx.materials[hits.material[i] as usize];
+            let fall = queue.dist.get(q).map_or(1.0, |&d| falloff(model, d));
+            let light_color = ctx.lights[queue.light[q] as usize].color * fall;
+            let c = shade_terms(m, n, -rays.direction.get(i), l, n_dot_l, light_color) * weight;
+            hits.direct.add(i, c);
+        }
+        q += 1;
+    }
+}

@@ -1,0 +1,166 @@
+//! The SIMD kernels of the stages, by idea: ray–primitive tests (`geometry.rs`) and light
+//! sampling with shadow-ray spawning (`light.rs`); the shading kernel sits with its scalar twin
+//! in `wavefront/shade.rs`, and the mesh BVH's node and leaf tests in `wavefront/bvh/`. Lanes,
+//! loads and masks come from `wavefront/lanes.rs`.
+//!
+//! The brute-force, light and shading kernels are written once, generic over the lane type
+//! (`lanes::Lanes`), and run 8 or 16 lanes wide (`lanes::LaneWidth`). `closest_hits`,
+//! `occluded`, `light_points8`, `shadow_rays8` and `shade8` are their 8-lane entry points,
+//! `closest_hits_lanes`, `occluded_lanes`, `light_points`, `shadow_rays` and
+//! `shade::shade_lanes` take the width as a type parameter, and `triangle8`, `sphere8` and
+//! `moller_trumbore8` (names from the 8-wide days) take it from their operands. The mesh BVH's
+//! kernels stay 8-wide.
+//!
+//! Every kernel is a lane-by-lane copy of a scalar twin, with the same operations in the
+//! same order, so that with IEEE arithmetic (no FMA contraction: Rust never fuses `a * b + c`,
+//! and neither does `wide`) each lane gives the same bits as the twin:
+//!
+//! | kernel               | scalar twin                                              |
+//! |----------------------|----------------------------------------------------------|
+//! | `moller_trumbore8` | `geometry::intersect_triangle` (8 rays × 1 triangle in [`triangle8`], 1 ray × 8 triangles in `bvh/`) |
+//! | [`sphere8`]          | `geometry::intersect_sphere`                             |
+//! | [`closest_hits`]     | `Accel::closest` without a BVH                           |
+//! | [`occluded`]         | `Accel::occluded` without a BVH                          |
+//! | [`light_points8`]    | `sampling::square_sample` then `Light::point`            |
+//! | [`shadow_rays8`]     | the start of `Reference::direct` (l, dist, n·l)          |
+//! | `shade::shade8`      | `shade::shade_terms`, twin of `shading::shade`           |
+//!
+//! Branches become masks: a lane that misses gets `f32::INFINITY`, exactly like the twins'
+//! sentinel. Batches whose length is not a multiple of the width are padded with lanes that
+//! cannot hit (tmax = 0, NaN directions), and the padding is never stored back.
+
+mod geometry;
+mod light;
+
+pub(crate) use geometry::{TriangleLanes, moller_trumbore8, moller_trumbore8_blocks};
+pub use geometry::{
+    closest_hits, closest_hits_at, closest_hits_lanes, occluded, occluded_at, occluded_lanes,
+    sphere8, triangle8,
+};
+pub use light::{BlockSampler, LightBlock, light_points, light_points8, shadow_rays, shadow_rays8};
+
+use super::lanes::{LANES, Lanes, f32x8};
+use crate::render::geometry::Ray;
+use crate::render::scene::{Sphere, Triangle};
+use glam::Vec3;
+
+/// Ray columns of a batch, borrowed: origin, direction and tmax.
+#[derive(Clone, Copy)]
+pub struct RayColumns<'a> {
+    /// origin x, y, z.
+    pub origin: [&'a [f32]; 3],
+    /// direction x, y, z.
+    pub direction: [&'a [f32]; 3],
+    /// End of the interval (T_MIN, tmax).
+    pub tmax: &'a [f32],
+}
+
+impl RayColumns<'_> {
+    /// Number of rays.
+    pub fn len(&self) -> usize {
+        self.tmax.len()
+    }
+    /// True without rays.
+    pub fn is_empty(&self) -> bool {
+        self.tmax.is_empty()
+    }
+    /// Ray `i`.
+    #[inline(always)]
+    pub fn ray(&self, i: usize) -> Ray {
+        let (o, d) = (self.origin, self.direction);
+        Ray {
+            origin: Vec3::new(o[0][i], o[1][i], o[2][i]),
+            direction: Vec3::new(d[0][i], d[1][i], d[2][i]),
+        }
+    }
+}
+
+/// N rays in registers (8 or 16, the width of `V`).
+#[derive(Clone, Copy)]
+pub struct Rays<V = f32x8> {
+    ox: V,
+    oy: V,
+    oz: V,
+    dx: V,
+    dy: V,
+    dz: V,
+}
+
+/// Eight rays in registers.
+pub type Rays8 = Rays<f32x8>;
+
+impl<V: Lanes> Rays<V> {
+    /// Loads rays `i..i + N` (padding past the end with NaN directions).
+    #[inline(always)]
+    fn load(r: &RayColumns, i: usize) -> Rays<V> {
+        Rays {
+            ox: V::load(r.origin[0], i, 0.0),
+            oy: V::load(r.origin[1], i, 0.0),
+            oz: V::load(r.origin[2], i, 0.0),
+            dx: V::load(r.direction[0], i, f32::NAN),
+            dy: V::load(r.direction[1], i, f32::NAN),
+            dz: V::load(r.direction[2], i, f32::NAN),
+        }
+    }
+
+    /// N rays given as a slice of `N` rays.
+    fn from_rays(rays: &[Ray]) -> Rays<V> {
+        let col = |f: fn(&Ray) -> f32| V::from_fn(|k| f(&rays[k]));
+        Rays {
+            ox: col(|r| r.origin.x),
+            oy: col(|r| r.origin.y),
+            oz: col(|r| r.origin.z),
+            dx: col(|r| r.direction.x),
+            dy: col(|r| r.direction.y),
+            dz: col(|r| r.direction.z),
+        }
+    }
+}
+
+/// Lane-level entry points for tests: 8 (or N) rays given as arrays, the kernels' answers as
+/// arrays.
+pub mod arrays {
+    use super::*;
+
+    fn rays8(rays: &[Ray; LANES]) -> Rays8 {
+        Rays::from_rays(rays)
+    }
+
+    /// [`triangle8`] at the width of `V`, on `V::N` rays and tmaxes.
+    pub fn triangle_lanes<V: Lanes>(
+        tri: &Triangle,
+        rays: &[Ray],
+        tmax: &[f32],
+        two_sided: bool,
+    ) -> V::Array {
+        assert!(rays.len() == V::N && tmax.len() == V::N);
+        triangle8(
+            tri,
+            &Rays::<V>::from_rays(rays),
+            V::load(tmax, 0, 0.0),
+            two_sided,
+        )
+        .to_array()
+    }
+
+    /// [`sphere8`] at the width of `V`, on `V::N` rays and tmaxes.
+    pub fn sphere_lanes<V: Lanes>(s: &Sphere, rays: &[Ray], tmax: &[f32]) -> V::Array {
+        assert!(rays.len() == V::N && tmax.len() == V::N);
+        sphere8(s, &Rays::<V>::from_rays(rays), V::load(tmax, 0, 0.0)).to_array()
+    }
+
+    /// [`triangle8`] on arrays.
+    pub fn triangle(
+        tri: &Triangle,
+        rays: &[Ray; LANES],
+        tmax: [f32; LANES],
+        two_sided: bool,
+    ) -> [f32; LANES] {
+        triangle8(tri, &rays8(rays), f32x8::new(tmax), two_sided).to_array()
+    }
+
+    /// [`sphere8`] on arrays.
+    pub fn sphere(s: &Sphere, rays: &[Ray; LANES], tmax: [f32; LANES]) -> [f32; LANES] {
+        sphere8(s, &rays8(rays), f32x8::new(tmax)).to_array()
+    }
+}

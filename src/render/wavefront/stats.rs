@@ -1,0 +1,142 @@
+//! Per-stage timing, per-kind timing and ray counts of a wavefront render.
+
+use crate::render::per_kind::{KindTimes, RayCounts, RayKind};
+use serde::Serialize;
+use std::ops::Add;
+use std::time::{Duration, Instant};
+
+/// The stages, in pipeline order.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stage {
+    /// Camera rays.
+    Generate,
+    /// Closest hits and surface data.
+    Intersect,
+    /// Shadow rays: spawn, occlusion, Shade.
+    Shadow,
+    /// Mirror rays.
+    Reflect,
+    /// Radiance accumulation and pixel resolve.
+    Film,
+}
+
+impl Stage {
+    /// Every stage, in order.
+    pub const ALL: [Stage; 5] = [
+        Stage::Generate,
+        Stage::Intersect,
+        Stage::Shadow,
+        Stage::Reflect,
+        Stage::Film,
+    ];
+
+    /// Lower-case name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Stage::Generate => "generate",
+            Stage::Intersect => "intersect",
+            Stage::Shadow => "shadow",
+            Stage::Reflect => "reflect",
+            Stage::Film => "film",
+        }
+    }
+}
+
+/// Rays by kind, thread-time by stage and by kind, summed over tiles.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RenderStats {
+    /// Rays cast, by kind (live lanes only).
+    pub counts: RayCounts,
+    /// Thread-time spent in each stage, in `Stage::ALL` order (zero for the reference).
+    pub stage_time: [Duration; 5],
+    /// Thread-time spent on each kind's work; `None` when it was not measured (the reference
+    /// unless asked, see `Reference::render_timed`). The wavefront engine's comes from the
+    /// stage timers: camera = generate + intersect of the camera rays; reflection = reflect +
+    /// intersect of the mirror rays; shadow = the shadow stage; film belongs to no kind.
+    pub kind_time: Option<KindTimes>,
+}
+
+impl RenderStats {
+    /// Runs `f`, adding its duration to `stage`.
+    #[inline]
+    pub fn time<T>(&mut self, stage: Stage, f: impl FnOnce() -> T) -> T {
+        let start = Instant::now();
+        let out = f();
+        self.stage_time[stage as usize] += start.elapsed();
+        out
+    }
+
+    /// Runs `f`, adding its duration to `stage` and to `kind`'s work (the same reading of
+    /// the clock: no timer more than [`RenderStats::time`]).
+    #[inline]
+    pub fn time_kind<T>(&mut self, stage: Stage, kind: RayKind, f: impl FnOnce() -> T) -> T {
+        let start = Instant::now();
+        let out = f();
+        let d = start.elapsed();
+        self.stage_time[stage as usize] += d;
+        self.kind_time.get_or_insert_default().add(kind, d);
+        out
+    }
+
+    /// The rays a stage handles: generate makes camera rays, intersect traces camera and
+    /// mirror rays, shadow casts shadow rays, reflect makes mirror rays, film resolves camera
+    /// samples.
+    pub fn stage_rays(&self, stage: Stage) -> u64 {
+        let c = &self.counts;
+        match stage {
+            Stage::Generate | Stage::Film => c.camera,
+            Stage::Intersect => c.camera + c.reflection,
+            Stage::Shadow => c.shadow,
+            Stage::Reflect => c.reflection,
+        }
+    }
+
+    /// One row per stage for reports.
+    pub fn stage_rows(&self) -> Vec<StageRow> {
+        Stage::ALL
+            .iter()
+            .map(|&s| {
+                let seconds = self.stage_time[s as usize].as_secs_f64();
+                let rays = self.stage_rays(s);
+                StageRow {
+                    stage: s.name(),
+                    rays,
+                    thread_seconds: seconds,
+                    rays_per_thread_second: if seconds > 0.0 {
+                        rays as f64 / seconds
+                    } else {
+                        0.0
+                    },
+                }
+            })
+            .collect()
+    }
+}
+
+/// One stage's figures.
+#[derive(Clone, Debug, Serialize)]
+pub struct StageRow {
+    /// Stage name.
+    pub stage: &'static str,
+    /// Rays the stage handled.
+    pub rays: u64,
+    /// Thread-time spent in it (summed over worker threads).
+    pub thread_seconds: f64,
+    /// rays / thread_seconds.
+    pub rays_per_thread_second: f64,
+}
+
+impl Add for RenderStats {
+    type Output = RenderStats;
+    fn add(mut self, o: RenderStats) -> RenderStats {
+        self.counts += o.counts;
+        for (a, b) in self.stage_time.iter_mut().zip(o.stage_time) {
+            *a += b;
+        }
+        self.kind_time = match (self.kind_time, o.kind_time) {
+            (Some(a), Some(b)) => Some(a + b),
+            (a, b) => a.or(b),
+        };
+        self
+    }
+}

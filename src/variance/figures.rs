@@ -1,0 +1,227 @@
+//! The numbers of a variance study, as pure functions of images: error against the converged
+//! reference over a region, and the log-log slope of MSE against N. Tested on synthetic data,
+//! where the right answers are known in closed form.
+
+use crate::render::sampling::LightSampler;
+use glam::Vec3;
+use serde::Serialize;
+
+/// Error statistics of K images of one (sampler, N) over one region.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct ErrorStats {
+    /// Mean squared error against the reference, over images, pixels and channels.
+    pub mse: f64,
+    /// Mean signed error (image − reference).
+    pub bias: f64,
+    /// Four standard errors of `bias` under the hypothesis of no bias: a larger |bias| means
+    /// the sampler (or the reference) is biased.
+    pub bias_bound: f64,
+    /// Per-pixel variance across the K images (K − 1 denominator), averaged over the region.
+    pub variance: f64,
+    /// Pixels in the region.
+    pub pixels: usize,
+}
+
+/// Statistics of `images` (each `pixels` long) against `reference` over the pixels where
+/// `region` is true. `reference_noise` is the per-pixel error variance of the reference
+/// itself (added to the bias bound, since the reference's own noise moves the mean error).
+pub fn error_stats(
+    images: &[&[Vec3]],
+    reference: &[Vec3],
+    reference_noise: &[f32],
+    region: &[bool],
+) -> ErrorStats {
+    let k = images.len();
+    let mut sum_sq = 0.0f64;
+    let mut sum = 0.0f64;
+    let mut sum_var = 0.0f64;
+    let mut ref_var = 0.0f64;
+    let mut pixels = 0usize;
+    for p in (0..reference.len()).filter(|&p| region[p]) {
+        pixels += 1;
+        ref_var += reference_noise[p] as f64;
+        for c in 0..3 {
+            let r = reference[p][c] as f64;
+            let mut m = 0.0;
+            for img in images {
+                let e = img[p][c] as f64 - r;
+                sum += e;
+                sum_sq += e * e;
+                m += e;
+            }
+            if k > 1 {
+                m /= k as f64;
+                let v: f64 = images
+                    .iter()
+                    .map(|img| (img[p][c] as f64 - r - m).powi(2))
+                    .sum();
+                sum_var += v / (k - 1) as f64;
+            }
+        }
+    }
+    if pixels == 0 || k == 0 {
+        return ErrorStats::default();
+    }
+    let samples = (pixels * 3 * k) as f64;
+    let variance = sum_var / (pixels * 3) as f64;
+    let ref_variance = ref_var / pixels as f64;
+    // Channels of one pixel are strongly correlated (grey lights), so count pixels, not
+    // channels, as the independent samples: a conservative bound.
+    let bias_bound = 4.0 * (variance / (pixels * k) as f64 + ref_variance / pixels as f64).sqrt();
+    ErrorStats {
+        mse: sum_sq / samples,
+        bias: sum / samples,
+        bias_bound,
+        variance,
+        pixels,
+    }
+}
+
+/// The squared error of each pixel against `reference`, averaged over channels and `images`:
+/// the heat maps' values.
+pub fn pixel_mse(images: &[&[Vec3]], reference: &[Vec3]) -> Vec<f32> {
+    (0..reference.len())
+        .map(|p| {
+            let sq: f32 = images
+                .iter()
+                .map(|img| (img[p] - reference[p]).length_squared())
+                .sum();
+            sq / (3 * images.len().max(1)) as f32
+        })
+        .collect()
+}
+
+/// Mean squared error and mean signed error of each image of `images` against `reference`
+/// over the pixels where `region` is true (the per-seed figures that [`error_stats`] pools):
+/// one `(mse, bias)` per image, `(0, 0)` for an empty region.
+pub fn per_image_errors(
+    images: &[&[Vec3]],
+    reference: &[Vec3],
+    region: &[bool],
+) -> Vec<(f64, f64)> {
+    images
+        .iter()
+        .map(|img| {
+            let (mut sum_sq, mut sum, mut count) = (0.0f64, 0.0f64, 0usize);
+            for p in (0..reference.len()).filter(|&p| region[p]) {
+                for c in 0..3 {
+                    let e = img[p][c] as f64 - reference[p][c] as f64;
+                    sum_sq += e * e;
+                    sum += e;
+                    count += 1;
+                }
+            }
+            if count == 0 {
+                (0.0, 0.0)
+            } else {
+                (sum_sq / count as f64, sum / count as f64)
+            }
+        })
+        .collect()
+}
+
+/// True when `sampler` draws the same points at budget `n` whatever the seed, so that its
+/// error there is bias, not noise, and does not lie on the N^-slope line of its noisy points:
+/// the lab's strategy at N = 1 (the light's centre). Such points are left out of the fits.
+pub fn deterministic(sampler: LightSampler, n: u32) -> bool {
+    matches!((sampler, n), (LightSampler::Lab, 1))
+}
+
+/// A least-squares line through (log10 x, log10 y).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct LogLogFit {
+    /// d log y / d log x: −1 for error ∝ 1/N.
+    pub slope: f64,
+    /// log10 y at x = 1.
+    pub intercept: f64,
+}
+
+/// Fits log10(y) = intercept + slope·log10(x) by least squares; points with y ≤ 0 are skipped.
+/// Returns None with fewer than two usable points.
+pub fn loglog_fit(points: &[(f64, f64)]) -> Option<LogLogFit> {
+    let pts: Vec<(f64, f64)> = points
+        .iter()
+        .filter(|(x, y)| *x > 0.0 && *y > 0.0)
+        .map(|(x, y)| (x.log10(), y.log10()))
+        .collect();
+    if pts.len() < 2 {
+        return None;
+    }
+    let n = pts.len() as f64;
+    let mx = pts.iter().map(|p| p.0).sum::<f64>() / n;
+    let my = pts.iter().map(|p| p.1).sum::<f64>() / n;
+    let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
+    if sxx == 0.0 {
+        return None;
+    }
+    let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+    let slope = sxy / sxx;
+    Some(LogLogFit {
+        slope,
+        intercept: my - slope * mx,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fit_recovers_a_power_law() {
+        let pts: Vec<(f64, f64)> = [1.0, 4.0, 16.0, 64.0, 256.0]
+            .iter()
+            .map(|&n: &f64| (n, 0.3 * n.powf(-1.5)))
+            .collect();
+        let fit = loglog_fit(&pts).unwrap();
+        assert!((fit.slope + 1.5).abs() < 1e-12, "{fit:?}");
+        assert!((fit.intercept - 0.3f64.log10()).abs() < 1e-12);
+        assert!(loglog_fit(&pts[..1]).is_none());
+        assert!(loglog_fit(&[(4.0, 1.0), (4.0, 2.0)]).is_none());
+    }
+
+    #[test]
+    fn stats_of_known_errors() {
+        // Reference 0.5 everywhere; two images with errors +0.1 and −0.1 on region pixels.
+        let reference = vec![Vec3::splat(0.5); 4];
+        let a: Vec<Vec3> = vec![Vec3::splat(0.6); 4];
+        let b: Vec<Vec3> = vec![Vec3::splat(0.4); 4];
+        let region = [true, true, false, true];
+        let noise = vec![0.0f32; 4];
+        let s = error_stats(&[&a, &b], &reference, &noise, &region);
+        assert_eq!(s.pixels, 3);
+        // The images are f32 (0.6 is 0.60000002...), so compare at f32 precision.
+        assert!((s.mse - 0.01).abs() < 1e-6, "{s:?}");
+        assert!(s.bias.abs() < 1e-6);
+        // Per pixel: values 0.6, 0.4 -> sample variance 0.02.
+        assert!((s.variance - 0.02).abs() < 1e-6);
+        // A constant offset is bias, and it exceeds its bound.
+        let c: Vec<Vec3> = vec![Vec3::splat(0.55); 4];
+        let d: Vec<Vec3> = vec![Vec3::splat(0.57); 4];
+        let s = error_stats(&[&c, &d], &reference, &noise, &region);
+        assert!((s.bias - 0.06).abs() < 1e-6);
+        assert!(s.bias.abs() > s.bias_bound, "{s:?}");
+    }
+
+    #[test]
+    fn per_image_errors_pool_to_the_study_mse() {
+        let reference = vec![Vec3::splat(0.5); 3];
+        let a = vec![Vec3::splat(0.75); 3];
+        let b = vec![Vec3::new(0.5, 0.5, 0.25); 3];
+        let region = [true, false, true];
+        let e = per_image_errors(&[&a, &b], &reference, &region);
+        assert_eq!(e, vec![(0.0625, 0.25), (0.0625 / 3.0, -0.25 / 3.0)]);
+        assert_eq!(
+            per_image_errors(&[&a], &reference, &[false; 3]),
+            vec![(0.0, 0.0)]
+        );
+        assert!(deterministic(LightSampler::Lab, 1));
+        assert!(!deterministic(LightSampler::Lab, 4) && !deterministic(LightSampler::Random, 1));
+    }
+
+    #[test]
+    fn empty_region_gives_zeros() {
+        let reference = vec![Vec3::ZERO; 2];
+        let s = error_stats(&[&reference], &reference, &[0.0, 0.0], &[false, false]);
+        assert_eq!(s, ErrorStats::default());
+    }
+}
