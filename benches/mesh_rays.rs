@@ -48,9 +48,9 @@ mod common;
 use criterion::{BenchmarkId, Criterion, Throughput};
 use raywave::bench::record::median;
 use raywave::peer::{
-    Hits, ObvhsMesh, RayKind, RaySet, RaySets, hit_agreement, occlusion_agreement, raywave_closest,
-    wavefront_bvh_closest, wavefront_bvh_closest_one_ray, wavefront_closest, wavefront_occluded,
-    without_emitters, without_spheres,
+    Hits, ObvhsMesh, RaySet, RaySetKind, RaySets, hit_agreement, occlusion_agreement,
+    raywave_closest, wavefront_bvh_closest, wavefront_bvh_closest_one_ray, wavefront_closest,
+    wavefront_occluded, without_emitters, without_spheres,
 };
 use raywave::render::scene::meshgen::{bands_for, cornell_box_mesh_spheres, triangle_count};
 use raywave::render::scene::{NO_HIT, Scene, parse_scene_str};
@@ -350,7 +350,7 @@ fn engines(ctx: &Context, set: &RaySet) -> Vec<&'static str> {
     if mesh && !shadow {
         engines.push("wavefront_bvh");
     }
-    if mesh && set.kind == RayKind::Primary {
+    if mesh && set.kind == RaySetKind::Primary {
         engines.push("wavefront_one_ray");
     }
     engines.extend(peers().into_iter().map(|(engine, _)| engine));

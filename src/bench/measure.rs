@@ -10,7 +10,7 @@
 //! per engine: medians of every figure, and the summary of the headline figures
 //! ```
 
-use super::record::{EngineRecord, KindRates, Measurement, StageFigure, summarise};
+use super::record::{EngineRecord, KindRates, Measurement, summarise};
 use crate::render::engine::{Engine, Prepared};
 use crate::render::film::Film;
 use crate::render::scene::Scene;
@@ -56,7 +56,7 @@ fn timed(
         let seconds = start.elapsed().as_secs_f64();
         drop::<Film>(film);
         let stages = match engine.engine() {
-            Engine::Wavefront => stats.stage_rows().iter().map(StageFigure::from).collect(),
+            Engine::Wavefront => stats.stage_figures(),
             Engine::Reference => Vec::new(),
         };
         Measurement {

@@ -2,9 +2,9 @@
 //! (machine, build, scene, settings), as it is saved to `.raywave-bench/NAME.json`.
 
 pub use crate::output::machine::Machine;
-use crate::render::per_kind::RayCounts;
+use crate::render::per_kind::{PerKind, RayCounts};
 use crate::render::settings::RenderSettings;
-use crate::render::wavefront::stats::{RenderStats, StageRow};
+use crate::render::wavefront::stats::{RenderStats, StageFigure};
 use anyhow::{Context, Result, bail};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -194,34 +194,63 @@ pub struct Measurement {
 }
 
 /// How fast each kind of ray was handled. A kind's rate is its rays per thread-second of
-/// that kind's own work ([`crate::render::per_kind::KindTimes`]: for the wavefront engine from its stage
+/// that kind's own work (`RenderStats::kind_time`: for the wavefront engine from its stage
 /// timers), so it says how fast that work went whatever else the frame did; the total is all
 /// rays per wall-clock second of the frame, the headline figure. A kind is null (`None`) when
 /// its time was not measured (the reference in `raywave bench`, which times it without
 /// timers) or it cast no rays.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(from = "RatesRecord", into = "RatesRecord")]
 pub struct KindRates {
-    /// Camera rays per thread-second of camera work.
-    #[serde(rename = "camera_per_thread_second")]
-    pub camera: Option<f64>,
-    /// Shadow rays per thread-second of shadow work.
-    #[serde(rename = "shadow_per_thread_second")]
-    pub shadow: Option<f64>,
-    /// Mirror rays per thread-second of mirror work.
-    #[serde(rename = "reflection_per_thread_second")]
-    pub reflection: Option<f64>,
+    /// Each kind's rays per thread-second of its own work.
+    pub kinds: PerKind<Option<f64>>,
     /// All rays per wall-clock second: the headline figure.
-    #[serde(rename = "total_per_second")]
     pub total: f64,
+}
+
+/// [`KindRates`] as records spell it: one flat object whose keys name their units.
+#[derive(Clone, Copy, Serialize, Deserialize, JsonSchema)]
+#[schemars(rename = "KindRates")]
+struct RatesRecord {
+    /// Camera rays per thread-second of camera work.
+    camera_per_thread_second: Option<f64>,
+    /// Shadow rays per thread-second of shadow work.
+    shadow_per_thread_second: Option<f64>,
+    /// Mirror rays per thread-second of mirror work.
+    reflection_per_thread_second: Option<f64>,
+    /// All rays per wall-clock second: the headline figure.
+    total_per_second: f64,
+}
+
+impl From<RatesRecord> for KindRates {
+    fn from(r: RatesRecord) -> KindRates {
+        KindRates {
+            kinds: PerKind {
+                camera: r.camera_per_thread_second,
+                shadow: r.shadow_per_thread_second,
+                reflection: r.reflection_per_thread_second,
+            },
+            total: r.total_per_second,
+        }
+    }
+}
+
+impl From<KindRates> for RatesRecord {
+    fn from(r: KindRates) -> RatesRecord {
+        RatesRecord {
+            camera_per_thread_second: r.kinds.camera,
+            shadow_per_thread_second: r.kinds.shadow,
+            reflection_per_thread_second: r.kinds.reflection,
+            total_per_second: r.total,
+        }
+    }
 }
 
 impl KindRates {
     /// The total rate alone: `rays.total()` per wall-clock `seconds`, no kind measured.
     pub fn new(rays: &RayCounts, seconds: f64) -> KindRates {
         KindRates {
-            camera: None,
-            shadow: None,
-            reflection: None,
+            kinds: PerKind::default(),
             total: rays.total() as f64 / seconds.max(1e-9),
         }
     }
@@ -229,45 +258,35 @@ impl KindRates {
     /// The total per wall-clock `seconds`, and each kind per thread-second of its work when
     /// `stats` measured it.
     pub fn measured(stats: &RenderStats, seconds: f64) -> KindRates {
-        let total = KindRates::new(&stats.counts, seconds);
-        match &stats.kind_time {
-            Some(times) => KindRates {
-                camera: per_thread_second(stats.counts.camera, times.camera),
-                shadow: per_thread_second(stats.counts.shadow, times.shadow),
-                reflection: per_thread_second(stats.counts.reflection, times.reflection),
-                ..total
+        KindRates {
+            kinds: match &stats.kind_time {
+                Some(times) => PerKind::from_fn(|k| per_thread_second(stats.counts[k], times[k])),
+                None => PerKind::default(),
             },
-            None => total,
+            ..KindRates::new(&stats.counts, seconds)
         }
     }
 
     /// (kind, rate) in report order, for the kinds that have one, then the total.
     pub fn rows(&self) -> Vec<(&'static str, f64)> {
-        [
-            ("camera", self.camera),
-            ("shadow", self.shadow),
-            ("reflection", self.reflection),
-            ("total", Some(self.total)),
-        ]
-        .into_iter()
-        .filter_map(|(kind, rate)| Some((kind, rate?)))
-        .collect()
+        self.kinds
+            .iter()
+            .filter_map(|(kind, rate)| Some((kind.name(), (*rate)?)))
+            .chain([("total", self.total)])
+            .collect()
     }
 
     /// Each rate's median over `rates` (a kind only when every run measured it).
     pub fn median_of(rates: &[KindRates]) -> KindRates {
-        let kind = |f: fn(&KindRates) -> Option<f64>| {
-            rates
-                .iter()
-                .map(f)
-                .collect::<Option<Vec<f64>>>()
-                .filter(|v| !v.is_empty())
-                .map(|v| median(&v))
-        };
         KindRates {
-            camera: kind(|r| r.camera),
-            shadow: kind(|r| r.shadow),
-            reflection: kind(|r| r.reflection),
+            kinds: PerKind::from_fn(|kind| {
+                rates
+                    .iter()
+                    .map(|r| r.kinds[kind])
+                    .collect::<Option<Vec<f64>>>()
+                    .filter(|v| !v.is_empty())
+                    .map(|v| median(&v))
+            }),
             total: median(&rates.iter().map(|r| r.total).collect::<Vec<_>>()),
         }
     }
@@ -277,30 +296,6 @@ impl KindRates {
 pub fn per_thread_second(rays: u64, time: std::time::Duration) -> Option<f64> {
     let seconds = time.as_secs_f64();
     (rays > 0 && seconds > 0.0).then(|| rays as f64 / seconds)
-}
-
-/// One wavefront stage's figures.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
-pub struct StageFigure {
-    /// Stage name (generate, intersect, shadow, reflect, film).
-    pub stage: String,
-    /// Rays the stage handled.
-    pub rays: u64,
-    /// Thread-seconds spent in it.
-    pub thread_seconds: f64,
-    /// rays / thread_seconds: the stage's headline figure.
-    pub rays_per_thread_second: f64,
-}
-
-impl From<&StageRow> for StageFigure {
-    fn from(row: &StageRow) -> StageFigure {
-        StageFigure {
-            stage: row.stage.to_string(),
-            rays: row.rays,
-            thread_seconds: row.thread_seconds,
-            rays_per_thread_second: row.rays_per_thread_second,
-        }
-    }
 }
 
 pub use crate::bench::statistics::median;

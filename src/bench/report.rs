@@ -60,16 +60,14 @@ pub fn report(r: &BenchRecord) -> String {
     for e in &r.engines {
         let m = &e.median;
         let k = &m.rays_per_second;
-        for (kind, rays, rate) in [
-            ("camera", m.rays.camera, k.camera),
-            ("shadow", m.rays.shadow, k.shadow),
-            ("reflection", m.rays.reflection, k.reflection),
-        ] {
-            let rate = rate.map_or("-".to_string(), |r| format!("{:.2}", r / 1e6));
+        for (kind, rays) in m.rays.iter() {
+            let rate = k.kinds[kind].map_or("-".to_string(), |r| format!("{:.2}", r / 1e6));
             let _ = writeln!(
                 out,
-                "{:<10} {kind:<12} {rays:>12} {:>10} {rate:>16}",
-                e.engine, ""
+                "{:<10} {:<12} {rays:>12} {:>10} {rate:>16}",
+                e.engine,
+                kind.name(),
+                ""
             );
         }
         let _ = writeln!(

@@ -8,7 +8,7 @@ use super::values::{EngineArg, LanesArg, ToneMapArg};
 use anyhow::Result;
 use clap::Args;
 use image::RgbImage;
-use raywave::bench::record::StageFigure;
+
 use raywave::diff::{self, Encoding, FileInfo, Image, Region, read_image};
 use raywave::output::OutputPlan;
 use raywave::output::image_file::{OutputFormat, check_hdr_path, output_format};
@@ -509,10 +509,11 @@ fn stats_table(report: &Report) -> String {
     let or_dash = |x: Option<f64>, scale: f64, digits: usize| {
         x.map_or("-".to_string(), |x| format!("{:.digits$}", x * scale))
     };
-    for (kind, figure) in kinds.kinds() {
+    for (kind, figure) in kinds.kinds.iter() {
         let _ = writeln!(
             out,
-            "{kind:<12} {:>14} {:>14} {:>20}",
+            "{:<12} {:>14} {:>14} {:>20}",
+            kind.name(),
             figure.rays,
             or_dash(figure.thread_seconds, 1.0, 4),
             or_dash(figure.rays_per_thread_second, 1e-6, 2)
@@ -559,7 +560,7 @@ fn stats_table(report: &Report) -> String {
             "{:<12} {:>14} {:>14} {:>20}",
             "stage", "rays", "thread-s", "Mrays/thread-s"
         );
-        for row in stats.stage_rows() {
+        for row in stats.stage_figures() {
             let _ = writeln!(
                 out,
                 "{:<12} {:>14} {:>14.4} {:>20.2}",
@@ -576,10 +577,7 @@ fn stats_table(report: &Report) -> String {
 /// The `--stats-json` record of a render.
 fn record(scene: &Scene, effective: &Effective, run: &RunInfo, report: &Report) -> RenderRecord {
     let (stages, bvh) = match &report.stages {
-        Some((stats, bvh)) => (
-            Some(stats.stage_rows().iter().map(StageFigure::from).collect()),
-            Some(*bvh),
-        ),
+        Some((stats, bvh)) => (Some(stats.stage_figures()), Some(*bvh)),
         None => (None, None),
     };
     RenderRecord {

@@ -4,11 +4,13 @@
 //! kind and a stage alike; docs/SCHEMA.md describes both and docs/schema/ holds their JSON
 //! Schemas, generated from these types by [`schemas`].
 
-use crate::bench::record::{BenchRecord, KindRates, StageFigure};
+use crate::bench::record::{BenchRecord, KindRates};
 use crate::output::machine::Machine;
 use crate::render::engine::Engine;
+use crate::render::per_kind::PerKind;
 use crate::render::settings::RenderSettings;
 use crate::render::wavefront::stats::RenderStats;
+use crate::render::wavefront::stats::StageFigure;
 use schemars::JsonSchema;
 use serde::Serialize;
 use std::io::Write;
@@ -117,12 +119,11 @@ pub struct TotalFigure {
 /// [`KindFigure`] for each kind, and the total.
 #[derive(Clone, Copy, Debug, Serialize, JsonSchema)]
 pub struct KindFigures {
-    /// Camera rays: making them and their closest hits.
-    pub camera: KindFigure,
-    /// Shadow rays: spawning them, the occlusion tests and the Shade sums.
-    pub shadow: KindFigure,
-    /// Mirror rays: making them and their closest hits.
-    pub reflection: KindFigure,
+    /// Each kind: camera rays (making them and their closest hits), shadow rays (spawning
+    /// them, the occlusion tests and the Shade sums), mirror rays (making them and their
+    /// closest hits).
+    #[serde(flatten)]
+    pub kinds: PerKind<KindFigure>,
     /// All rays per wall-clock second.
     pub total: TotalFigure,
 }
@@ -131,33 +132,19 @@ impl KindFigures {
     /// The counts of `stats`, each kind over its thread-time when `stats` measured it
     /// ([`KindRates::measured`], as bench records do it), the total over wall-clock `seconds`.
     pub fn new(stats: &RenderStats, seconds: f64) -> KindFigures {
-        let counts = &stats.counts;
         let rates = KindRates::measured(stats, seconds);
-        let times = stats.kind_time.map(|t| [t.camera, t.shadow, t.reflection]);
-        let figure = |i: usize, rays, rate| KindFigure {
-            rays,
-            thread_seconds: times.map(|t: [std::time::Duration; 3]| t[i].as_secs_f64()),
-            rays_per_thread_second: rate,
-        };
         KindFigures {
-            camera: figure(0, counts.camera, rates.camera),
-            shadow: figure(1, counts.shadow, rates.shadow),
-            reflection: figure(2, counts.reflection, rates.reflection),
+            kinds: PerKind::from_fn(|kind| KindFigure {
+                rays: stats.counts[kind],
+                thread_seconds: stats.kind_time.map(|t| t[kind].as_secs_f64()),
+                rays_per_thread_second: rates.kinds[kind],
+            }),
             total: TotalFigure {
-                rays: counts.total(),
+                rays: stats.counts.total(),
                 seconds,
                 rays_per_second: rates.total,
             },
         }
-    }
-
-    /// (kind, figure) for camera, shadow and reflection, in report order.
-    pub fn kinds(&self) -> [(&'static str, KindFigure); 3] {
-        [
-            ("camera", self.camera),
-            ("shadow", self.shadow),
-            ("reflection", self.reflection),
-        ]
     }
 }
 
@@ -236,7 +223,7 @@ mod tests {
                 shadow: 6,
                 reflection: 2,
             },
-            kind_time: Some(crate::render::per_kind::KindTimes {
+            kind_time: Some(crate::render::per_kind::PerKind {
                 camera: std::time::Duration::from_millis(500),
                 shadow: std::time::Duration::from_millis(1500),
                 reflection: std::time::Duration::ZERO,

@@ -71,7 +71,7 @@ pub const BATCH: usize = DEFAULT_BATCH_SIZE;
 
 /// Which ray set.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum RayKind {
+pub enum RaySetKind {
     /// Camera rays through pixel centres: coherent, closest hit.
     Primary,
     /// Segments from primary hits to light points: coherent, any hit (occlusion).
@@ -88,35 +88,35 @@ pub enum RayKind {
 /// lab benchmark's 64.
 pub const FAN_SIZES: [u32; 2] = [16, 64];
 
-impl RayKind {
+impl RaySetKind {
     /// Lower-case name, for benchmark ids: `primary`, `shadow`, `incoherent`, `shadow_fan16`.
     pub fn name(self) -> String {
         match self {
-            RayKind::Primary => "primary".into(),
-            RayKind::Shadow => "shadow".into(),
-            RayKind::Incoherent => "incoherent".into(),
-            RayKind::ShadowFan(n) => format!("shadow_fan{n}"),
+            RaySetKind::Primary => "primary".into(),
+            RaySetKind::Shadow => "shadow".into(),
+            RaySetKind::Incoherent => "incoherent".into(),
+            RaySetKind::ShadowFan(n) => format!("shadow_fan{n}"),
         }
     }
 
     /// What the rays are, for table rows: `camera`, `hard shadow`, `soft shadow ×16`, ...
     pub fn title(self) -> String {
         match self {
-            RayKind::Primary => "camera".into(),
-            RayKind::Shadow => "hard shadow".into(),
-            RayKind::Incoherent => "incoherent".into(),
-            RayKind::ShadowFan(n) => format!("soft shadow ×{n}"),
+            RaySetKind::Primary => "camera".into(),
+            RaySetKind::Shadow => "hard shadow".into(),
+            RaySetKind::Incoherent => "incoherent".into(),
+            RaySetKind::ShadowFan(n) => format!("soft shadow ×{n}"),
         }
     }
 
     /// True for occlusion (any-hit) sets, false for closest-hit sets.
     pub fn is_occlusion(self) -> bool {
-        matches!(self, RayKind::Shadow | RayKind::ShadowFan(_))
+        matches!(self, RaySetKind::Shadow | RaySetKind::ShadowFan(_))
     }
 
     /// Whether the rays are coherent (Embree's context hint): every set but the incoherent one.
     pub fn is_coherent(self) -> bool {
-        self != RayKind::Incoherent
+        self != RaySetKind::Incoherent
     }
 }
 
@@ -124,13 +124,13 @@ impl RayKind {
 #[derive(Clone, Debug)]
 pub struct RaySet {
     /// What the rays are.
-    pub kind: RayKind,
+    pub kind: RaySetKind,
     /// The rays; `tmax` is infinity except for shadow segments.
     pub batches: Vec<RayBatch>,
 }
 
 impl RaySet {
-    fn new(kind: RayKind) -> Self {
+    fn new(kind: RaySetKind) -> Self {
         RaySet {
             kind,
             batches: Vec::new(),
@@ -152,7 +152,7 @@ impl RaySet {
             // Camera rays are depth 0, the rest as if from a first bounce: the intersect
             // stage traces depth-0 batches as coherent packets.
             self.batches.push(RayBatch {
-                bounce: u32::from(self.kind != RayKind::Primary),
+                bounce: u32::from(self.kind != RaySetKind::Primary),
                 ..RayBatch::default()
             });
         }
@@ -199,7 +199,7 @@ impl RaySets {
     /// come from `bvh`, the random numbers from `seed` alone.
     pub fn new(scene: &Scene, bvh: &ObvhsMesh, width: u32, height: u32, seed: u64) -> Self {
         let camera = CameraRays::new(&scene.camera, width, height);
-        let mut primary = RaySet::new(RayKind::Primary);
+        let mut primary = RaySet::new(RaySetKind::Primary);
         for pixel in 0..width * height {
             let (x, y) = camera.screen(pixel, 0.5, 0.5);
             let ray = camera.ray(x, y);
@@ -209,11 +209,11 @@ impl RaySets {
         bvh.closest(scene, &primary, &mut hits);
 
         let mut rng = SplitMix64(seed);
-        let mut shadow = RaySet::new(RayKind::Shadow);
-        let mut incoherent = RaySet::new(RayKind::Incoherent);
+        let mut shadow = RaySet::new(RaySetKind::Shadow);
+        let mut incoherent = RaySet::new(RaySetKind::Incoherent);
         let mut fans: Vec<RaySet> = FAN_SIZES
             .iter()
-            .map(|&n| RaySet::new(RayKind::ShadowFan(n)))
+            .map(|&n| RaySet::new(RaySetKind::ShadowFan(n)))
             .collect();
         // Their own streams, so adding the fan sets left the other sets unchanged.
         let mut fan_rngs: Vec<SplitMix64> = FAN_SIZES
@@ -264,7 +264,7 @@ impl RaySets {
             let direction = Vec3::new(r * phi.cos(), r * phi.sin(), z);
             incoherent.push(leave(direction), direction, f32::INFINITY);
             for (fan, fan_rng) in fans.iter_mut().zip(&mut fan_rngs) {
-                let RayKind::ShadowFan(n) = fan.kind else {
+                let RaySetKind::ShadowFan(n) = fan.kind else {
                     unreachable!("fans are fan sets")
                 };
                 if !hit_index.is_multiple_of(n as usize) || scene.lights.is_empty() {
@@ -301,7 +301,7 @@ impl RaySets {
     pub fn fan(&self, n: u32) -> &RaySet {
         self.fans
             .iter()
-            .find(|s| s.kind == RayKind::ShadowFan(n))
+            .find(|s| s.kind == RaySetKind::ShadowFan(n))
             .unwrap_or_else(|| panic!("no fan of {n}: the sizes are {FAN_SIZES:?}"))
     }
 

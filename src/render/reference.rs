@@ -15,7 +15,7 @@
 use crate::render::camera::CameraRays;
 use crate::render::film::Film;
 use crate::render::geometry::{Accel, Hit, Ray};
-use crate::render::per_kind::{KindClock, KindTimes, RayCounts, RayKind};
+use crate::render::per_kind::{KindClock, PerKind, RayCounts, RayKind};
 use crate::render::sampling::{SampleKey, square_sample};
 use crate::render::scene::{Material, Scene};
 use crate::render::settings::{RenderSettings, ShadowMode};
@@ -25,6 +25,7 @@ use crate::render::spawn::{
 };
 use glam::Vec3;
 use rayon::prelude::*;
+use std::time::Duration;
 
 /// Receives every ray the tracer casts, with what the pixel gets from it; `()` ignores them at
 /// no cost. `trace::trace_pixel` records the one-pixel ray tree through it.
@@ -135,7 +136,7 @@ impl<'a> Reference<'a> {
     /// two or three times per path segment (a reading that ends one interval starts the
     /// next), which costs time: docs/SCHEMA.md gives the measured overhead. Same image, same
     /// counts.
-    pub fn render_timed(&self, on_row: &(dyn Fn() + Sync)) -> (Film, RayCounts, KindTimes) {
+    pub fn render_timed(&self, on_row: &(dyn Fn() + Sync)) -> (Film, RayCounts, PerKind<Duration>) {
         let w = self.settings.width as usize;
         let mut film = Film::new(self.settings.width, self.settings.height);
         let (counts, times) = film
@@ -144,7 +145,7 @@ impl<'a> Reference<'a> {
             .enumerate()
             .map(|(row, out)| {
                 let mut counts = RayCounts::default();
-                let mut times = KindTimes::default();
+                let mut times = PerKind::<Duration>::default();
                 let first = (row * w) as u32;
                 for (i, px) in out.iter_mut().enumerate() {
                     *px = self.pixel_clocked(first + i as u32, &mut counts, &mut (), &mut times);

@@ -5,7 +5,7 @@
 //! `render_tile` on a tile of that one pixel (a pixel's value does not depend on the tile it is
 //! in: every lane is bit-equal to the scalar twins and each pixel is summed in sample order).
 
-use super::tree::{KindCounts, PixelCheck, RayCountCheck, RayTree, Segment, SegmentKind};
+use super::tree::{PixelCheck, RayCountCheck, RayTree, Segment, SegmentKind};
 use crate::render::per_kind::RayCounts;
 use crate::render::reference::Reference;
 use crate::render::scene::Scene;
@@ -63,19 +63,11 @@ pub fn render_pixel_counted(
     }
 }
 
-fn kinds(counts: &RayCounts) -> KindCounts {
-    KindCounts {
-        camera: counts.camera,
-        reflection: counts.reflection,
-        shadow: counts.shadow,
-    }
-}
-
 /// The tree's rays by kind, shadow rays counted where the occlusion test ran (as the engines
 /// count them).
-pub fn tree_counts(tree: &RayTree) -> KindCounts {
+pub fn tree_counts(tree: &RayTree) -> RayCounts {
     let of = |k: SegmentKind| tree.segments.iter().filter(|s| s.kind == k).count() as u64;
-    KindCounts {
+    RayCounts {
         camera: of(SegmentKind::Camera),
         reflection: of(SegmentKind::Reflection),
         shadow: tree
@@ -109,8 +101,8 @@ pub fn check_pixel(scene: &Scene, settings: &RenderSettings, tree: &RayTree) -> 
         render_pixel_counted(PixelEngine::Wavefront, scene, settings, index);
     let rays = RayCountCheck {
         tree: tree_counts(tree),
-        reference: kinds(&reference_rays),
-        wavefront: kinds(&wavefront_rays),
+        reference: reference_rays,
+        wavefront: wavefront_rays,
     };
     let difference = |p: Vec3| {
         (0..3)

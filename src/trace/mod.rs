@@ -34,7 +34,6 @@ pub use scene_view::{
 pub use summary::summary;
 pub use tracer::{TraceError, primitive_ref, trace_pixel, trace_settings};
 pub use tree::{
-    BlockerInfo, CameraInfo, KindCounts, PixelCheck, PixelRef, PrimitiveRef, PrimitiveShape,
-    RayCountCheck, RayTree, SCHEMA_ID, Segment, SegmentKind, ShadowInfo, SurfaceInfo,
-    TraceSettings,
+    BlockerInfo, CameraInfo, PixelCheck, PixelRef, PrimitiveRef, PrimitiveShape, RayCountCheck,
+    RayTree, SCHEMA_ID, Segment, SegmentKind, ShadowInfo, SurfaceInfo, TraceSettings,
 };

@@ -143,7 +143,7 @@ pub fn summary(tree: &RayTree) -> String {
                 "MISMATCH: the tree does not add up to the rendered pixel"
             }
         );
-        let k = |n: &super::tree::KindCounts| {
+        let k = |n: &crate::render::per_kind::RayCounts| {
             format!(
                 "{} camera, {} reflection, {} shadow",
                 n.camera, n.reflection, n.shadow

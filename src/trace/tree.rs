@@ -5,6 +5,7 @@
 //! Coordinates are world space in the scene file's units (the frame of its `v` and `s` lines);
 //! colours are linear RGB, the render's own values before tone mapping. Vectors are `[x, y, z]`.
 
+use crate::render::per_kind::RayCounts;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
@@ -253,20 +254,9 @@ pub struct PixelCheck {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 pub struct RayCountCheck {
     /// The tree's segments (shadow segments only where the occlusion test ran).
-    pub tree: KindCounts,
+    pub tree: RayCounts,
     /// The reference's counters for the pixel.
-    pub reference: KindCounts,
+    pub reference: RayCounts,
     /// The wavefront engine's counters for the pixel.
-    pub wavefront: KindCounts,
-}
-
-/// Rays of each kind.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
-pub struct KindCounts {
-    /// Camera rays.
-    pub camera: u64,
-    /// Reflection rays.
-    pub reflection: u64,
-    /// Shadow rays tested for occlusion.
-    pub shadow: u64,
+    pub wavefront: RayCounts,
 }

@@ -10,6 +10,7 @@
 //!         -> PNG + ray counts and seconds -> JobState (read by GET /api/render/{id})
 //! ```
 
+use crate::bench::record::KindRates;
 use crate::render::engine::Engine;
 use crate::render::film::ToneMap;
 use crate::render::per_kind::RayCounts;
@@ -44,32 +45,6 @@ pub enum Status {
     Failed(String),
 }
 
-/// Rays per second by kind, over one level.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
-pub struct RaysPerSecond {
-    /// Camera rays.
-    pub camera: f64,
-    /// Shadow rays.
-    pub shadow: f64,
-    /// Mirror rays.
-    pub reflection: f64,
-    /// All kinds.
-    pub total: f64,
-}
-
-impl RaysPerSecond {
-    /// Counts over `seconds` (one render: a single measurement, not a benchmark).
-    pub fn of(counts: &RayCounts, seconds: f64) -> Self {
-        let s = seconds.max(1e-9);
-        RaysPerSecond {
-            camera: counts.camera as f64 / s,
-            shadow: counts.shadow as f64 / s,
-            reflection: counts.reflection as f64 / s,
-            total: counts.total() as f64 / s,
-        }
-    }
-}
-
 /// One rendered level.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Level {
@@ -81,8 +56,9 @@ pub struct Level {
     pub seconds: f64,
     /// Rays cast, by kind.
     pub rays: RayCounts,
-    /// Rays per second, by kind.
-    pub rays_per_second: RaysPerSecond,
+    /// Each kind's rays per thread-second of its own work (null when not measured: the
+    /// reference renders without kind timers), and all rays per wall-clock second.
+    pub rays_per_second: KindRates,
 }
 
 /// What the page polls.
@@ -323,7 +299,7 @@ fn render_levels(
             height,
             seconds,
             rays: stats.counts,
-            rays_per_second: RaysPerSecond::of(&stats.counts, seconds),
+            rays_per_second: KindRates::measured(&stats, seconds),
         });
         state.pngs.push(Arc::new(png));
     }

@@ -54,7 +54,7 @@ fn the_chosen_pixel_has_the_segments_the_settings_give() {
     assert_eq!(count(SegmentKind::Reflection), 1);
     assert_eq!(count(SegmentKind::Shadow), 2 * 16);
     let rays = raywave::trace::check_pixel(&scene, &settings, &tree).rays;
-    let expected = raywave::trace::KindCounts {
+    let expected = raywave::render::per_kind::RayCounts {
         camera: 1,
         reflection: 1,
         shadow: 32,

@@ -70,7 +70,12 @@ fn every_endpoint_answers() {
         let shadow = level["rays"]["shadow"].as_u64().unwrap();
         assert!(shadow > 0 && shadow <= w * h, "{level}");
         assert_eq!(level["rays"]["reflection"], 0);
-        assert!(level["rays_per_second"]["total"].as_f64().unwrap() > 0.0);
+        assert!(
+            level["rays_per_second"]["total_per_second"]
+                .as_f64()
+                .unwrap()
+                > 0.0
+        );
     }
     for (k, size) in [(0, (4, 2)), (3, (32, 16))] {
         let png = server.get(&format!("/api/render/{job}/{k}.png"));

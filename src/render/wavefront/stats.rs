@@ -1,7 +1,7 @@
 //! Per-stage timing, per-kind timing and ray counts of a wavefront render.
 
-use crate::render::per_kind::{KindTimes, RayCounts, RayKind};
-use serde::Serialize;
+use crate::render::per_kind::{PerKind, RayCounts, RayKind};
+use serde::{Deserialize, Serialize};
 use std::ops::Add;
 use std::time::{Duration, Instant};
 
@@ -53,7 +53,7 @@ pub struct RenderStats {
     /// unless asked, see `Reference::render_timed`). The wavefront engine's comes from the
     /// stage timers: camera = generate + intersect of the camera rays; reflection = reflect +
     /// intersect of the mirror rays; shadow = the shadow stage; film belongs to no kind.
-    pub kind_time: Option<KindTimes>,
+    pub kind_time: Option<PerKind<Duration>>,
 }
 
 impl RenderStats {
@@ -74,7 +74,7 @@ impl RenderStats {
         let out = f();
         let d = start.elapsed();
         self.stage_time[stage as usize] += d;
-        self.kind_time.get_or_insert_default().add(kind, d);
+        self.kind_time.get_or_insert_default()[kind] += d;
         out
     }
 
@@ -91,15 +91,15 @@ impl RenderStats {
         }
     }
 
-    /// One row per stage for reports.
-    pub fn stage_rows(&self) -> Vec<StageRow> {
+    /// Each stage's figures, in pipeline order.
+    pub fn stage_figures(&self) -> Vec<StageFigure> {
         Stage::ALL
             .iter()
             .map(|&s| {
                 let seconds = self.stage_time[s as usize].as_secs_f64();
                 let rays = self.stage_rays(s);
-                StageRow {
-                    stage: s.name(),
+                StageFigure {
+                    stage: s.name().to_string(),
                     rays,
                     thread_seconds: seconds,
                     rays_per_thread_second: if seconds > 0.0 {
@@ -113,16 +113,17 @@ impl RenderStats {
     }
 }
 
-/// One stage's figures.
-#[derive(Clone, Debug, Serialize)]
-pub struct StageRow {
-    /// Stage name.
-    pub stage: &'static str,
+/// One wavefront stage's figures, as reports print them and records store them.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "tools", derive(schemars::JsonSchema))]
+pub struct StageFigure {
+    /// Stage name (generate, intersect, shadow, reflect, film).
+    pub stage: String,
     /// Rays the stage handled.
     pub rays: u64,
-    /// Thread-time spent in it (summed over worker threads).
+    /// Thread-seconds spent in it, summed over worker threads.
     pub thread_seconds: f64,
-    /// rays / thread_seconds.
+    /// rays / thread_seconds: the stage's headline figure (0 when the stage took no time).
     pub rays_per_thread_second: f64,
 }
 

@@ -46,7 +46,8 @@ function options(select, names) {
   for (const n of names) { const o = document.createElement('option'); o.textContent = n; select.appendChild(o); }
 }
 
-const mega = x => (x / 1e6).toFixed(2);
+// Rates in millions; a kind the engine did not time (the reference) is null and shows '-'.
+const mega = x => (x === null || x === undefined ? '-' : (x / 1e6).toFixed(2));
 
 function showStats(status) {
   const body = $('stats').querySelector('tbody');
@@ -54,7 +55,7 @@ function showStats(status) {
   status.levels.forEach((l, k) => {
     const r = l.rays_per_second;
     const tr = document.createElement('tr');
-    for (const v of [k, `${l.width}×${l.height}`, l.seconds.toFixed(3), mega(r.camera), mega(r.shadow), mega(r.reflection), mega(r.total)]) {
+    for (const v of [k, `${l.width}×${l.height}`, l.seconds.toFixed(3), mega(r.camera_per_thread_second), mega(r.shadow_per_thread_second), mega(r.reflection_per_thread_second), mega(r.total_per_second)]) {
       const td = document.createElement('td'); td.textContent = v; tr.appendChild(td);
     }
     body.appendChild(tr);
