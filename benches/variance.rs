@@ -26,7 +26,7 @@
 mod common;
 
 use criterion::{BenchmarkId, Throughput};
-use raywave::bench::statistics::{BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, bootstrap_interval};
+use raywave::output::statistics::{BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, bootstrap_interval};
 use raywave::render::engine::Engine;
 use raywave::render::film::Film;
 use raywave::render::per_kind::RayCounts;

@@ -24,7 +24,7 @@
 //! sorted, the median lies between the k-th and the (n − k + 1)-th with probability ≥ 95%, k the
 //! largest with P(Binomial(n, ½) < k) ≤ 2.5%. It needs n ≥ 6.
 
-use crate::bench::statistics::{MIN_FOR_INTERVAL, median, median_with_interval};
+use crate::output::statistics::{MIN_FOR_INTERVAL, median, median_with_interval};
 use crate::render::engine::Engine;
 use crate::render::error::UsageError;
 use anyhow::{Context, Result, bail};

@@ -14,7 +14,7 @@
 //! not enough: a large change with overlapping intervals is noise a few runs could produce, a
 //! small change with separate intervals is real but below what the threshold says matters.
 
-use super::record::{BenchRecord, FigureSummary, Setup};
+use crate::output::bench_record::{BenchRecord, FigureSummary, Setup};
 use std::fmt::Write;
 
 /// The fields in which two setups differ, as `path: X in the record, Y now` lines (empty if
@@ -331,7 +331,7 @@ pub fn record_problems(record: &BenchRecord, engines: &[&str]) -> Vec<String> {
                     e.engine,
                     f.figure,
                     f.runs,
-                    crate::bench::statistics::MIN_FOR_INTERVAL
+                    crate::output::statistics::MIN_FOR_INTERVAL
                 )),
             }
         }
@@ -376,7 +376,7 @@ pub fn compare(
                     a.engine,
                     fa.figure,
                     fa.runs,
-                    crate::bench::statistics::MIN_FOR_INTERVAL
+                    crate::output::statistics::MIN_FOR_INTERVAL
                 ));
                 continue;
             }

@@ -2,7 +2,7 @@
 //! (median, its 95% interval, min, max) in a file for scripts, spreadsheets or a pull request.
 //! JSON holds the whole records; CSV and Markdown one row per point, engine and figure.
 
-use super::record::BenchRecord;
+use crate::output::bench_record::BenchRecord;
 use anyhow::Result;
 use std::io::Write;
 use std::path::Path;

@@ -1,7 +1,7 @@
 //! `raywave bench list` and `raywave bench compare A B`: the saved records, read offline.
 
 use super::compare::{Refusal, compare};
-use super::record::{self, BenchRecord};
+use crate::output::bench_record::{self as record, BenchRecord};
 use anyhow::{Context, Result, bail};
 use std::path::{Path, PathBuf};
 

@@ -10,7 +10,7 @@
 //! per engine: medians of every figure, and the summary of the headline figures
 //! ```
 
-use super::record::{EngineRecord, KindRates, Measurement, summarise};
+use crate::output::bench_record::{EngineRecord, KindRates, Measurement, summarise};
 use crate::render::engine::{Engine, Prepared};
 use crate::render::film::Film;
 use crate::render::scene::Scene;

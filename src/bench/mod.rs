@@ -19,17 +19,15 @@ pub mod compare;
 pub mod export;
 pub mod list;
 pub mod measure;
-pub mod record;
 pub mod report;
-pub mod statistics;
 pub mod sweep;
 
+use crate::output::bench_record::{self as record, BenchRecord, Machine, SceneId, Setup};
 use crate::render::engine::{Engine, thread_pool};
 use crate::render::scene::{SceneFile, load_scene};
 use crate::render::settings::options::ImageOptions;
 use crate::render::wavefront::DEFAULT_BATCH_SIZE;
 use anyhow::{Context, Result, bail};
-use record::{BenchRecord, Machine, SceneId, Setup};
 use std::path::PathBuf;
 
 pub use report::report;
@@ -214,11 +212,11 @@ pub fn run(args: &BenchOptions, hooks: &Hooks) -> Result<Outcome> {
             if !problems.is_empty() {
                 bail!(incomparable(path, &problems));
             }
-            if args.runs < crate::bench::statistics::MIN_FOR_INTERVAL as u32 {
+            if args.runs < crate::output::statistics::MIN_FOR_INTERVAL as u32 {
                 return Err(crate::render::error::UsageError(format!(
                     "--compare needs --runs {} or more: with {} run(s) the median has no 95% \
                      interval, and the verdict needs one",
-                    crate::bench::statistics::MIN_FOR_INTERVAL,
+                    crate::output::statistics::MIN_FOR_INTERVAL,
                     args.runs
                 ))
                 .into());

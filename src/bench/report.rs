@@ -2,7 +2,7 @@
 //! the headline figures with min, median, 95% interval and max; and the warnings a noisy
 //! measurement deserves (outlier runs, wide intervals, a loaded machine).
 
-use super::record::{BenchRecord, FigureSummary};
+use crate::output::bench_record::{BenchRecord, FigureSummary};
 use crate::render::settings::{RenderSettings, ShadowMode};
 use std::fmt::Write as _;
 
@@ -176,7 +176,7 @@ pub fn warnings(r: &BenchRecord, point: &str) -> Vec<String> {
                     f.figure,
                     values.join(", "),
                     f.median / 1e6,
-                    crate::bench::statistics::OUTLIER_Z
+                    crate::output::statistics::OUTLIER_Z
                 ));
             }
             if let Some(w) = f.relative_width_pct().filter(|w| *w > NOISY_WIDTH_PCT) {

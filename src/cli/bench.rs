@@ -6,12 +6,12 @@ use anyhow::Result;
 use clap::parser::ValueSource;
 use clap::{ArgAction, ArgMatches, Args, Subcommand, ValueEnum};
 use raywave::bench::ab::{self, AbOptions, MIN_ROUNDS};
-use raywave::bench::record::record_path;
 use raywave::bench::sweep::{Sweep, record_name};
 use raywave::bench::{
     BenchOptions, DEFAULT_RUNS, DEFAULT_THRESHOLD_PCT, EXIT_REGRESSION, Hooks, list,
 };
 use raywave::output::OutputPlan;
+use raywave::output::bench_record::record_path;
 use raywave::output::memory::{self, RenderFootprint};
 use raywave::render::engine::Engine;
 use raywave::render::error::UsageError;

@@ -581,7 +581,7 @@ fn record(scene: &Scene, effective: &Effective, run: &RunInfo, report: &Report) 
         None => (None, None),
     };
     RenderRecord {
-        format: raywave::bench::record::FORMAT,
+        format: raywave::output::bench_record::FORMAT,
         raywave: env!("CARGO_PKG_VERSION"),
         // The record has never named the host.
         machine: Machine {

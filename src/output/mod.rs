@@ -12,12 +12,14 @@
 //! `image_file.rs` turns a film into PNG, PPM, PFM or EXR bytes; `write.rs` writes the files
 //! (atomically for regular files, directly for devices, FIFOs and stdout) and removes temporary files on SIGINT/SIGTERM; `memory.rs` estimates a render's peak.
 
+pub mod bench_record;
 pub mod build_info;
 pub mod false_colour;
 pub mod image_file;
 pub mod machine;
 pub mod memory;
 pub mod render_record;
+pub mod statistics;
 pub mod terminal;
 pub mod write;
 

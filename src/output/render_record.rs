@@ -1,10 +1,10 @@
 //! The `--stats-json` file of `raywave render`: one render's figures, with the machine, the
 //! build and the settings. It shares [`Machine`], [`KindRates`], [`StageFigure`] and the
-//! layout version ([`FORMAT`](crate::bench::record::FORMAT)) with `raywave bench`'s records, so both describe a machine, a
+//! layout version ([`FORMAT`](crate::output::bench_record::FORMAT)) with `raywave bench`'s records, so both describe a machine, a
 //! kind and a stage alike; docs/SCHEMA.md describes both and docs/schema/ holds their JSON
 //! Schemas, generated from these types by [`schemas`].
 
-use crate::bench::record::{BenchRecord, KindRates};
+use crate::output::bench_record::{BenchRecord, KindRates};
 use crate::output::machine::Machine;
 use crate::render::engine::Engine;
 use crate::render::per_kind::PerKind;
@@ -19,8 +19,8 @@ use std::path::Path;
 /// Everything `--stats-json` writes.
 #[derive(Clone, Debug, Serialize, JsonSchema)]
 pub struct RenderRecord {
-    /// Layout version, shared with bench records (`raywave::bench::record::FORMAT`).
-    #[schemars(extend("const" = crate::bench::record::FORMAT))]
+    /// Layout version, shared with bench records (`raywave::output::bench_record::FORMAT`).
+    #[schemars(extend("const" = crate::output::bench_record::FORMAT))]
     pub format: u32,
     /// raywave's version.
     pub raywave: &'static str,
@@ -213,7 +213,7 @@ impl RenderRecord {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bench::record::FORMAT;
+    use crate::output::bench_record::FORMAT;
 
     #[test]
     fn the_file_keeps_its_keys_sorted_and_names_no_host() {

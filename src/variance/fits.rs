@@ -12,7 +12,7 @@
 //! ```
 
 use super::{Region, Row, loglog_fit};
-use crate::bench::statistics::{BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, bootstrap_interval, median};
+use crate::output::statistics::{BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, bootstrap_interval, median};
 use crate::render::sampling::LightSampler;
 use crate::variance::LogLogFit;
 use serde::Serialize;

@@ -299,7 +299,7 @@ struct Measured<'a> {
 
 fn rows_of(m: &Measured, reference: &Converged, masks: &[Vec<bool>; 3]) -> Vec<Row> {
     let k = m.images.len();
-    let (seconds, lo, hi) = crate::bench::statistics::median_with_interval(&m.times);
+    let (seconds, lo, hi) = crate::output::statistics::median_with_interval(&m.times);
     let seconds_interval = (lo.is_finite() && hi.is_finite()).then_some([lo, hi]);
     let excluded_sampler = deterministic(m.sampler, m.n);
     Region::ALL
@@ -315,7 +315,7 @@ fn rows_of(m: &Measured, reference: &Converged, masks: &[Vec<bool>; 3]) -> Vec<R
             let efficiency_interval = fits::interval(k, |idx| {
                 let t: Vec<f64> = idx.iter().map(|&i| times[i]).collect();
                 1.0 / (fits::mean_at(&seed_mse, Some(idx))
-                    * crate::bench::statistics::median(&t).max(1e-12))
+                    * crate::output::statistics::median(&t).max(1e-12))
             });
             Row {
                 sampler: m.sampler.name(),

@@ -451,7 +451,7 @@ impl StudyResult {
             raywave_version: env!("CARGO_PKG_VERSION"),
             commit,
             commit_dirty,
-            created: crate::bench::record::now_utc(),
+            created: crate::output::bench_record::now_utc(),
             machine: Machine::current(),
             settings: Settings {
                 scene: &self.scene,
@@ -459,8 +459,8 @@ impl StudyResult {
                 threads: self.threads,
                 study: &self.config,
                 bootstrap: Bootstrap {
-                    resamples: crate::bench::statistics::BOOTSTRAP_RESAMPLES,
-                    seed: crate::bench::statistics::BOOTSTRAP_SEED,
+                    resamples: crate::output::statistics::BOOTSTRAP_RESAMPLES,
+                    seed: crate::output::statistics::BOOTSTRAP_SEED,
                     level: 0.95,
                     unit: "seed: one resample draws K seeds with replacement, the same for every sampler, budget and region",
                 },

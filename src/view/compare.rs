@@ -12,7 +12,7 @@
 
 use super::http::ApiError;
 use super::request::{Resolved, ViewSettings};
-use crate::bench::statistics::median;
+use crate::output::statistics::median;
 use crate::render::engine::Engine;
 use crate::render::film::{Film, ToneMap};
 use crate::render::sampling::LightSampler;

@@ -10,7 +10,7 @@
 //!         -> PNG + ray counts and seconds -> JobState (read by GET /api/render/{id})
 //! ```
 
-use crate::bench::record::KindRates;
+use crate::output::bench_record::KindRates;
 use crate::render::engine::Engine;
 use crate::render::film::ToneMap;
 use crate::render::per_kind::RayCounts;

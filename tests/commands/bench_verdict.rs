@@ -8,7 +8,7 @@ use crate::common;
 
 use common::bin::{raywave, stderr, stdout};
 use raywave::bench::compare::{Refusal, Verdict, compare};
-use raywave::bench::record::BenchRecord;
+use raywave::output::bench_record::BenchRecord;
 use serde_json::{Value, json};
 use std::path::Path;
 

@@ -83,7 +83,7 @@ fn the_schemas_pin_the_format_and_name_every_top_level_field() {
         let schema = checked_in(name);
         assert_eq!(
             schema["properties"]["format"]["const"],
-            json!(raywave::bench::record::FORMAT),
+            json!(raywave::output::bench_record::FORMAT),
             "{name}"
         );
         for field in fields {

@@ -1,6 +1,8 @@
-//! The lane layer stays one layer: `src/render/wavefront/lanes.rs` is the only source file that
-//! names the `wide` crate or `bytemuck`. Every other file, kernels included, takes lane types,
-//! loads, masks and bit casts from it, so that the lane width and its tricks live in one place.
+//! The layers stay layers. The lane layer: `src/render/wavefront/lanes.rs` is the only source
+//! file that names the `wide` crate or `bytemuck`; every other file, kernels included, takes
+//! lane types, loads, masks and bit casts from it, so that the lane width and its tricks live
+//! in one place. The module layers: the renderer names neither the outputs nor a tool, and the
+//! outputs name no tool.
 
 use std::path::{Path, PathBuf};
 
@@ -41,4 +43,51 @@ fn only_the_lane_layer_names_wide_or_bytemuck() {
          and casts from it instead:\n{}",
         offenders.join("\n")
     );
+}
+
+/// `crate::<module>` paths named in the non-comment lines of the files under `dir`, for the
+/// given modules: (file:line, module).
+fn uses_of(dir: &Path, modules: &[&str]) -> Vec<String> {
+    let mut files = Vec::new();
+    rust_files(dir, &mut files);
+    let mut found = Vec::new();
+    for path in files {
+        let text = std::fs::read_to_string(&path).expect("read a source file");
+        for (n, line) in text.lines().enumerate() {
+            let code = line.trim_start();
+            if code.starts_with("//") {
+                continue;
+            }
+            for m in modules {
+                if code.contains(&format!("crate::{m}::")) || code.contains(&format!("crate::{m};"))
+                {
+                    found.push(format!("{}:{}: {}", path.display(), n + 1, code));
+                }
+            }
+        }
+    }
+    found
+}
+
+const TOOLS: [&str; 6] = ["bench", "diff", "peer", "trace", "variance", "view"];
+
+/// The layers of docs/ARCHITECTURE.md, each depending only on those above it: the renderer
+/// names neither the outputs nor a tool (its `--no-default-features` build would fail
+/// anyway), and the outputs and records name no tool.
+#[test]
+fn each_layer_names_only_the_layers_above_it() {
+    let src = Path::new("src");
+    let mut offenders = uses_of(&src.join("render"), &[&["output"][..], &TOOLS].concat());
+    offenders.extend(uses_of(&src.join("output"), &TOOLS));
+    assert!(
+        offenders.is_empty(),
+        "a layer names one below it (render/ < output/ < the tools, docs/ARCHITECTURE.md):\n{}",
+        offenders.join("\n")
+    );
+}
+
+/// The check sees a use: the view names the trace module.
+#[test]
+fn a_use_across_layers_is_seen() {
+    assert!(!uses_of(&Path::new("src").join("view"), &["trace"]).is_empty());
 }

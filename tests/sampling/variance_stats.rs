@@ -272,7 +272,7 @@ fn normal(rng: &mut common::TestRng) -> f64 {
 /// How often the study's bootstrap interval of a mean of `k` normal units holds the true mean,
 /// over `trials` seeded experiments.
 fn mean_coverage(k: usize, trials: usize) -> f64 {
-    use raywave::bench::statistics::{BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, bootstrap_interval};
+    use raywave::output::statistics::{BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, bootstrap_interval};
     let mut rng = seeded(0xc0fe);
     let (mu, sigma) = (3.0, 0.7);
     let mut hits = 0;
@@ -305,7 +305,7 @@ fn bootstrap_intervals_cover_the_truth_at_about_the_nominal_rate() {
 /// (0.95 for a well-behaved statistic; the bound allows the small-sample shortfall above).
 #[test]
 fn bootstrap_slope_intervals_cover_the_true_slope() {
-    use raywave::bench::statistics::{BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, bootstrap_interval};
+    use raywave::output::statistics::{BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, bootstrap_interval};
     use raywave::variance::loglog_fit;
     let mut rng = seeded(0x51_09e);
     let (s, c, k) = (-1.5, 0.04, 16);

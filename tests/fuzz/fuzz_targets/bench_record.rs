@@ -1,4 +1,4 @@
-//! Any bytes as a saved bench record (`raywave::bench::record::load`): an error or a record,
+//! Any bytes as a saved bench record (`raywave::output::bench_record::load`): an error or a record,
 //! never a panic.
 #![no_main]
 
@@ -9,5 +9,5 @@ fuzz_target!(|data: &[u8]| {
     let _ = std::fs::create_dir_all(&dir);
     let path = dir.join("record.json");
     std::fs::write(&path, data).unwrap();
-    let _ = raywave::bench::record::load(&path, "record");
+    let _ = raywave::output::bench_record::load(&path, "record");
 });
