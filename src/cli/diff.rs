@@ -234,7 +234,7 @@ pub fn run(args: &DiffArgs) -> Result<u8> {
                 Metric::Flip => "FLIP error",
             },
         );
-        let fig = diff::figure(&errors, a.width, a.height, metric, &title)?;
+        let fig = diff::figure(&errors, a.film.width, a.film.height, metric, &title)?;
         raywave::output::image_file::write_rgb8(&fig, out)?;
         text.push_str(&format!("wrote    {}\n", out.display()));
     }
@@ -298,10 +298,10 @@ fn region(args: &DiffArgs, a: &Image) -> Result<Region> {
         return Ok(Region::from_mask_image(&mask, path.display().to_string()));
     }
     if !args.penumbra() {
-        return Ok(Region::whole(a.width, a.height));
+        return Ok(Region::whole(a.film.width, a.film.height));
     }
     let options = ImageOptions {
-        size: Some([a.width, a.height]),
+        size: Some([a.film.width, a.film.height]),
         bounces: args.bounces,
         shadows: None,
         shadow_samples: None,

@@ -138,12 +138,12 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let reference = match &args.mse_reference {
         Some(path) => {
             let image = read_image(path)?;
-            if (image.width, image.height) != (settings.width, settings.height) {
+            if (image.film.width, image.film.height) != (settings.width, settings.height) {
                 return Err(UsageError(format!(
                     "--mse-reference {} is {}×{} but the render is {}×{}: expected a reference of the render's size",
                     path.display(),
-                    image.width,
-                    image.height,
+                    image.film.width,
+                    image.film.height,
                     settings.width,
                     settings.height
                 ))
@@ -318,7 +318,7 @@ fn reference_error(
     tone: ToneMap,
 ) -> Result<(String, serde_json::Value)> {
     let (render, compared_as) = if reference.encoding == Encoding::Float {
-        (Image::from_film(film, "render"), "linear floats")
+        (Image::from_film(film.clone(), "render"), "linear floats")
     } else {
         let image = match rgb8 {
             Some(img) => Image::from_rgb8(img, "render"),
@@ -326,7 +326,7 @@ fn reference_error(
         };
         (image, "the 8-bit image")
     };
-    let region = Region::whole(render.width, render.height);
+    let region = Region::whole(render.film.width, render.film.height);
     let comparison = diff::compare(&render, reference, &region)?;
     let info = FileInfo::of(path, reference);
     let text = format!(

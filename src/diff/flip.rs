@@ -10,13 +10,17 @@
 use super::{FlipFigures, Image, Region, to_byte};
 
 fn bytes(img: &Image) -> Vec<u8> {
-    img.pixels.iter().flat_map(|p| p.map(to_byte)).collect()
+    img.film
+        .pixels
+        .iter()
+        .flat_map(|p| p.to_array().map(to_byte))
+        .collect()
 }
 
 /// FLIP of A against the reference B: the figures over the region, and the per-pixel map
 /// (NaN outside the region and where a value is not finite).
 pub fn flip(a: &Image, b: &Image, region: &Region) -> (FlipFigures, Vec<f32>) {
-    let (w, h) = (a.width, a.height);
+    let (w, h) = (a.film.width, a.film.height);
     let reference = nv_flip::FlipImageRgb8::with_data(w, h, &bytes(b));
     let test = nv_flip::FlipImageRgb8::with_data(w, h, &bytes(a));
     let errors = nv_flip::flip(reference, test, nv_flip::DEFAULT_PIXELS_PER_DEGREE).to_vec();
@@ -27,9 +31,8 @@ pub fn flip(a: &Image, b: &Image, region: &Region) -> (FlipFigures, Vec<f32>) {
         .iter()
         .enumerate()
         .map(|(i, &e)| {
-            let used = region.inside[i]
-                && a.pixels[i].iter().all(|v| v.is_finite())
-                && b.pixels[i].iter().all(|v| v.is_finite());
+            let used =
+                region.inside[i] && a.film.pixels[i].is_finite() && b.film.pixels[i].is_finite();
             if used {
                 sum += e as f64;
                 max = max.max(e as f64);

@@ -26,7 +26,9 @@ mod flip;
 pub use read::read_image;
 
 use crate::output::false_colour::{self, Scale};
+use crate::render::film::Film;
 use anyhow::{Result, bail};
+use glam::Vec3;
 use serde::Serialize;
 
 /// relMSE's denominator is (b + RELATIVE_EPSILON)², as in pbrt-v4.
@@ -63,15 +65,12 @@ impl Encoding {
     }
 }
 
-/// An image to compare: RGB values, row-major from the top-left.
+/// An image to compare: its values as a [`Film`] (the one linear image type, which both engines
+/// fill), and how they were stored.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Image {
-    /// Width in pixels.
-    pub width: u32,
-    /// Height in pixels.
-    pub height: u32,
-    /// `width × height` RGB values.
-    pub pixels: Vec<[f32; 3]>,
+    /// The RGB values, row-major from the top-left.
+    pub film: Film,
     /// How the values were stored.
     pub encoding: Encoding,
     /// The file format ("PNG", "PPM", "PFM", "EXR").
@@ -98,7 +97,7 @@ impl FileInfo {
             path: path.display().to_string(),
             format: img.format,
             encoding: img.encoding,
-            size: [img.width, img.height],
+            size: [img.film.width, img.film.height],
         }
     }
 
@@ -176,11 +175,7 @@ impl Region {
     pub fn from_mask_image(mask: &Image, name: String) -> Region {
         Region {
             name,
-            inside: mask
-                .pixels
-                .iter()
-                .map(|p| p.iter().any(|&v| v != 0.0))
-                .collect(),
+            inside: mask.film.pixels.iter().map(|&p| p != Vec3::ZERO).collect(),
         }
     }
 
@@ -256,6 +251,7 @@ impl Comparison {
 
 /// Refuses two images of different sizes, naming both files.
 pub fn check_same_size(a: &Image, a_name: &str, b: &Image, b_name: &str) -> Result<()> {
+    let (a, b) = (&a.film, &b.film);
     if (a.width, a.height) != (b.width, b.height) {
         bail!(
             "{a_name} is {}×{} but {b_name} is {}×{}: expected two images of the same size",
@@ -268,8 +264,8 @@ pub fn check_same_size(a: &Image, a_name: &str, b: &Image, b_name: &str) -> Resu
     Ok(())
 }
 
-fn finite(p: &[f32; 3]) -> bool {
-    p.iter().all(|v| v.is_finite())
+fn finite(p: &Vec3) -> bool {
+    p.is_finite()
 }
 
 /// PSNR in dB of an MSE against [`PSNR_PEAK`]: infinite for 0.
@@ -280,6 +276,7 @@ pub fn psnr(mse: f64) -> f64 {
 /// Compares A with the reference B over `region`. The images must have the same size and the
 /// region must hold one flag per pixel with some pixel compared (errors otherwise).
 pub fn compare(a: &Image, b: &Image, region: &Region) -> Result<Comparison> {
+    let (a, b) = (&a.film, &b.film);
     let n_pixels = a.pixels.len();
     if b.pixels.len() != n_pixels || region.inside.len() != n_pixels {
         bail!("compare: images and region of different sizes");
@@ -388,9 +385,10 @@ pub fn to_byte(v: f32) -> u8 {
 /// the relative squared error, or the largest |a − b| over channels; NaN outside the region
 /// and where a value is not finite. FLIP's map comes from [`add_flip`].
 pub fn pixel_errors(a: &Image, b: &Image, region: &Region, metric: Metric) -> Vec<f32> {
-    a.pixels
+    a.film
+        .pixels
         .iter()
-        .zip(&b.pixels)
+        .zip(&b.film.pixels)
         .zip(&region.inside)
         .map(|((pa, pb), &inside)| {
             if !inside || !finite(pa) || !finite(pb) {
@@ -460,9 +458,11 @@ mod tests {
 
     fn image(pixels: Vec<[f32; 3]>, width: u32) -> Image {
         Image {
-            width,
-            height: pixels.len() as u32 / width,
-            pixels,
+            film: Film {
+                width,
+                height: pixels.len() as u32 / width,
+                pixels: pixels.into_iter().map(Vec3::from_array).collect(),
+            },
             encoding: Encoding::Float,
             format: "PFM",
         }

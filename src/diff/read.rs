@@ -6,6 +6,7 @@
 use super::{Encoding, Image};
 use crate::render::film::Film;
 use anyhow::{Context, Result, bail};
+use glam::Vec3;
 use image::{ColorType, ImageFormat, ImageReader};
 use std::io::Read;
 use std::os::unix::fs::FileTypeExt;
@@ -34,7 +35,7 @@ pub fn read_image(path: &Path) -> Result<Image> {
         .with_context(|| format!("cannot read {}", path.display()))?;
     if n >= 3 && magic[0] == b'P' && magic[1] == b'F' && magic[2].is_ascii_whitespace() {
         let film = Film::read_pfm(path)?;
-        return Ok(Image::from_film(&film, "PFM"));
+        return Ok(Image::from_film(film, "PFM"));
     }
     let reader = ImageReader::open(path)
         .and_then(|r| r.with_guessed_format())
@@ -71,12 +72,14 @@ pub fn read_image(path: &Path) -> Result<Image> {
     let pixels = rgb
         .as_raw()
         .chunks_exact(3)
-        .map(|c| [c[0], c[1], c[2]])
+        .map(|c| Vec3::new(c[0], c[1], c[2]))
         .collect();
     Ok(Image {
-        width,
-        height,
-        pixels,
+        film: Film {
+            width,
+            height,
+            pixels,
+        },
         encoding,
         format: name,
     })
@@ -84,11 +87,9 @@ pub fn read_image(path: &Path) -> Result<Image> {
 
 impl Image {
     /// A render's linear floats, as a float image named `format`.
-    pub fn from_film(film: &Film, format: &'static str) -> Image {
+    pub fn from_film(film: Film, format: &'static str) -> Image {
         Image {
-            width: film.width,
-            height: film.height,
-            pixels: film.pixels.iter().map(|c| c.to_array()).collect(),
+            film,
             encoding: Encoding::Float,
             format,
         }
@@ -97,12 +98,14 @@ impl Image {
     /// An 8-bit image's values divided by 255, as reading its PNG gives them.
     pub fn from_rgb8(img: &image::RgbImage, format: &'static str) -> Image {
         Image {
-            width: img.width(),
-            height: img.height(),
-            pixels: img
-                .pixels()
-                .map(|p| p.0.map(|v| v as f32 / 255.0))
-                .collect(),
+            film: Film {
+                width: img.width(),
+                height: img.height(),
+                pixels: img
+                    .pixels()
+                    .map(|p| Vec3::from_array(p.0.map(|v| v as f32 / 255.0)))
+                    .collect(),
+            },
             encoding: Encoding::Bits8,
             format,
         }
