@@ -2,6 +2,7 @@
 //! A B` and `raywave bench list` for saved records.
 
 use super::image::ImageArgs;
+use super::values::float;
 use anyhow::Result;
 use clap::parser::ValueSource;
 use clap::{ArgAction, ArgMatches, Args, Subcommand, ValueEnum};
@@ -72,7 +73,7 @@ pub struct BenchArgs {
     /// by more and whose 95% interval lies wholly below the record's regressed; with
     /// --against, a ratio whose whole 95% interval lies above 1 + PCT% [default: 40; 5 with
     /// --against].
-    #[arg(long, value_name = "PCT", value_parser = parse_threshold)]
+    #[arg(long, value_name = "PCT", value_parser = float("a percentage between 0 and 1000", |x: f64| (0.0..1000.0).contains(&x)))]
     pub threshold: Option<f64>,
     /// Time this build against another raywave binary on the same flags: the two alternate,
     /// round after round, and each engine's time ratio (this / OTHER) gets a median and a 95%
@@ -143,7 +144,7 @@ pub struct CompareArgs {
     #[arg(long, default_value = ".raywave-bench")]
     pub dir: PathBuf,
     /// Regression threshold in percent (the rule of --compare).
-    #[arg(long, value_name = "PCT", value_parser = parse_threshold, default_value_t = DEFAULT_THRESHOLD_PCT)]
+    #[arg(long, value_name = "PCT", value_parser = float("a percentage between 0 and 1000", |x: f64| (0.0..1000.0).contains(&x)), default_value_t = DEFAULT_THRESHOLD_PCT)]
     pub threshold: f64,
 }
 
@@ -153,15 +154,6 @@ pub struct ListArgs {
     /// Directory of saved records.
     #[arg(long, default_value = ".raywave-bench")]
     pub dir: PathBuf,
-}
-
-fn parse_threshold(s: &str) -> Result<f64, String> {
-    match s.parse::<f64>() {
-        Ok(x) if x.is_finite() && (0.0..1000.0).contains(&x) => Ok(x),
-        _ => Err(format!(
-            "expected a percentage between 0 and 1000, found `{s}`"
-        )),
-    }
 }
 
 /// The flags whose values `--compare` must not replace with the record's: those given on the

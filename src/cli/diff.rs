@@ -2,7 +2,7 @@
 //! or a mask, prints the figures (and writes them as JSON), draws the per-pixel error, and
 //! exits 3 when `--fail-above` is passed.
 
-use super::values::DefaultsArg;
+use super::values::{DefaultsArg, float};
 use anyhow::{Result, bail};
 use clap::{Args, ValueEnum};
 use raywave::diff::{self, Comparison, EXIT_FAILED, FileInfo, Image, Metric, Region, read_image};
@@ -63,7 +63,7 @@ pub struct DiffArgs {
     #[arg(long, value_enum, default_value = "mse")]
     pub metric: MetricArg,
     /// Exit 3 when the overall --metric figure is above X (for psnr: below X).
-    #[arg(long, value_name = "X", value_parser = parse_threshold, allow_negative_numbers = true)]
+    #[arg(long, value_name = "X", value_parser = float("a finite number", f64::is_finite), allow_negative_numbers = true)]
     pub fail_above: Option<f64>,
     /// Also compute FLIP, NVIDIA's perceptual error (implied by --metric flip).
     #[arg(long)]
@@ -89,14 +89,6 @@ pub struct DiffArgs {
     /// Points per light per hit for the penumbra test.
     #[arg(long, default_value_t = 1024, help_heading = "With --mask penumbra", value_parser = clap::value_parser!(u32).range(1..=65536))]
     pub mask_samples: u32,
-}
-
-fn parse_threshold(s: &str) -> Result<f64, String> {
-    match s.parse::<f64>() {
-        Ok(x) if x.is_finite() => Ok(x),
-        Ok(_) => Err(format!("expected a finite number, found `{s}`")),
-        Err(_) => Err(format!("expected a number, found `{s}`")),
-    }
 }
 
 const PENUMBRA: &str = "penumbra";

@@ -1,6 +1,6 @@
 //! The flags that shape the image, shared by `raywave render` and `raywave bench`.
 
-use super::values::{DefaultsArg, LightModelArg, SamplerArg, ShadowArg};
+use super::values::{DefaultsArg, LightModelArg, SamplerArg, ShadowArg, float};
 use clap::Args;
 use raywave::output::OutputPlan;
 use raywave::render::scene::{Scene, load_scene};
@@ -34,10 +34,10 @@ pub struct ImageArgs {
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub aa: Option<u32>,
     /// Background colour for rays that hit nothing [default: the scene's, else white].
-    #[arg(long, num_args = 3, value_names = ["R", "G", "B"], value_parser = parse_colour_component)]
+    #[arg(long, num_args = 3, value_names = ["R", "G", "B"], value_parser = float("a finite non-negative colour component", |x: f32| x.is_finite() && x >= 0.0))]
     pub background: Option<Vec<f32>>,
     /// Ambient light: every hit gets ambient ⊙ kd [default: 0.2 grey; RPI's 0.1].
-    #[arg(long, num_args = 3, value_names = ["R", "G", "B"], value_parser = parse_colour_component)]
+    #[arg(long, num_args = 3, value_names = ["R", "G", "B"], value_parser = float("a finite non-negative colour component", |x: f32| x.is_finite() && x >= 0.0))]
     pub ambient: Option<Vec<f32>>,
     /// How a light's colour reaches a point: lab (no fall-off) or rpi (divided by π·d², as
     /// RPI's framework does) [default: lab; RPI's rpi].
@@ -124,18 +124,44 @@ impl ImageArgs {
     }
 }
 
+/// The seed and the facing: what shapes a render besides the image flags (`render`,
+/// `trace-pixel` and `view` take them; `bench` renders with their defaults).
+#[derive(Args, Debug, Clone)]
+pub struct SeedArgs {
+    /// Seed of every random number.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u32,
+    /// Let faces be hit from behind too.
+    #[arg(long)]
+    pub two_sided: bool,
+}
+
+/// The worker threads of every command that renders on one pool.
+#[derive(Args, Debug, Clone)]
+pub struct ThreadsArg {
+    /// Worker threads [default: all cores]; 1 runs serially.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub threads: Option<u32>,
+}
+
+impl ThreadsArg {
+    /// The pool the flag asks for.
+    pub fn pool(&self) -> anyhow::Result<rayon::ThreadPool> {
+        raywave::render::engine::thread_pool(self.threads)
+    }
+}
+
 /// Loads the scene at `path` (the built-in one for `None`; its warnings go to stderr) and
 /// resolves `image` against it, with the seed and the facing that the image flags do not hold:
 /// the one way `render`, `trace-pixel` and `view` turn their flags into a scene and settings.
 pub fn scene_and_settings(
     path: Option<&Path>,
     image: &ImageArgs,
-    seed: u32,
-    two_sided: bool,
+    seed: &SeedArgs,
 ) -> anyhow::Result<(Scene, Effective)> {
     let options = ImageOptions {
-        seed,
-        two_sided,
+        seed: seed.seed,
+        two_sided: seed.two_sided,
         ..image.options()
     };
     let scene = load_scene(path, &options.parse_options())?.scene;
@@ -154,15 +180,5 @@ pub fn say(plan: &OutputPlan, text: &str) -> anyhow::Result<()> {
         Ok(())
     } else {
         raywave::output::terminal::print(text)
-    }
-}
-
-fn parse_colour_component(s: &str) -> Result<f32, String> {
-    match s.parse::<f32>() {
-        Ok(x) if x.is_finite() && x >= 0.0 => Ok(x),
-        Ok(_) => Err(format!(
-            "expected a finite non-negative colour component, found `{s}`"
-        )),
-        Err(_) => Err(format!("expected a number, found `{s}`")),
     }
 }

@@ -1,8 +1,8 @@
 //! `raywave render`: checks what can fail cheaply, renders with the chosen engine, writes the
 //! image (and the linear floats, and the `--stats-json` record), then prints the summary.
 
-use super::image::ImageArgs;
 use super::image::scene_and_settings;
+use super::image::{ImageArgs, SeedArgs, ThreadsArg};
 use super::phases::Phases;
 use super::values::{EngineArg, LanesArg, ToneMapArg};
 use anyhow::Result;
@@ -19,7 +19,7 @@ use raywave::output::render_record::{
 };
 use raywave::output::terminal::progress_bar;
 use raywave::render::camera::CameraRays;
-use raywave::render::engine::{Engine, Prepared, thread_pool};
+use raywave::render::engine::{Engine, Prepared};
 use raywave::render::error::UsageError;
 use raywave::render::film::{Film, ToneMap};
 use raywave::render::scene::Scene;
@@ -46,21 +46,16 @@ pub struct RenderArgs {
     /// Size, bounces, shadows, lighting and sampling (shared with `raywave bench`).
     #[command(flatten)]
     pub image: ImageArgs,
-    /// Seed of every random number.
-    #[arg(long, default_value_t = 0)]
-    pub seed: u32,
-    /// Worker threads [default: all cores]; 1 runs serially.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
-    pub threads: Option<u32>,
+    #[command(flatten)]
+    pub seed: SeedArgs,
+    #[command(flatten)]
+    pub workers: ThreadsArg,
     /// Also write linear floats to this file (.pfm or .exr; `-` or a device: PFM).
     #[arg(long)]
     pub hdr: Option<PathBuf>,
     /// Tone mapping of the 8-bit image: clamp (the lab's look) or exp (1 − e^(−3x)).
     #[arg(long, value_enum, default_value = "clamp")]
     pub tonemap: ToneMapArg,
-    /// Let faces be hit from behind too.
-    #[arg(long)]
-    pub two_sided: bool,
     /// Print the rays traced for pixel X Y (from the top-left) and draw them over the image.
     #[arg(long, num_args = 2, value_names = ["X", "Y"])]
     pub debug_pixel: Option<Vec<u32>>,
@@ -120,8 +115,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let (scene, effective) = scene_and_settings(
         args.scene_path().map(PathBuf::as_path),
         &args.image,
-        args.seed,
-        args.two_sided,
+        &args.seed,
     )?;
     let settings = effective.settings.clone();
     phases.mark("outputs, scene, settings");
@@ -153,7 +147,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         }
         None => None,
     };
-    let pool = thread_pool(args.threads)?;
+    let pool = args.workers.pool()?;
     let threads = pool.current_num_threads();
     phases.mark("thread pool");
     let engine_choice = Engine::from(args.engine);

@@ -2,16 +2,16 @@
 //! render of that pixel, written as JSON, OBJ, PLY and a PNG from a debug camera, or printed
 //! as a readable summary when no output is asked for.
 
-use super::image::ImageArgs;
 use super::image::scene_and_settings;
-use super::values::ToneMapArg;
+use super::image::{ImageArgs, SeedArgs, ThreadsArg};
+use super::values::{ToneMapArg, float};
 use anyhow::{Context, Result};
 use clap::Args;
 use raywave::output::image_file::ldr_format;
 use raywave::output::terminal::progress_bar;
 use raywave::output::{OutputPlan, write_output};
 use raywave::render::camera::CameraRays;
-use raywave::render::engine::{Engine, thread_pool};
+use raywave::render::engine::Engine;
 use raywave::render::error::UsageError;
 use raywave::trace::draw::{Overlay, depth_buffer};
 use raywave::trace::view::ViewPlacement;
@@ -32,12 +32,8 @@ pub struct TracePixelArgs {
     /// render's pixel.
     #[command(flatten)]
     pub image: ImageArgs,
-    /// Seed of every random number.
-    #[arg(long, default_value_t = 0)]
-    pub seed: u32,
-    /// Let faces be hit from behind too.
-    #[arg(long)]
-    pub two_sided: bool,
+    #[command(flatten)]
+    pub seed: SeedArgs,
     /// Write the tree as JSON (docs/TRACE.md; `-`: standard output).
     #[arg(long, value_name = "FILE")]
     pub json: Option<PathBuf>,
@@ -56,15 +52,15 @@ pub struct TracePixelArgs {
     /// point of interest [default: the render camera's eye].
     #[arg(long, num_args = 3, action = clap::ArgAction::Set, value_names = ["X", "Y", "Z"],
           allow_negative_numbers = true,
-          value_parser = parse_finite)]
+          value_parser = float("a finite number", f32::is_finite))]
     pub view_from: Option<Vec<f32>>,
     /// Turn the debug camera this many degrees about the scene's up axis, around the point of
     /// interest [default: 30, or 0 with --view-from].
-    #[arg(long, value_name = "DEG", allow_negative_numbers = true, value_parser = parse_finite)]
+    #[arg(long, value_name = "DEG", allow_negative_numbers = true, value_parser = float("a finite number", f32::is_finite))]
     pub orbit: Option<f32>,
     /// Multiply the debug camera's distance from the point of interest by F (above 1 backs
     /// away to show more around the tree).
-    #[arg(long, value_name = "F", default_value_t = 1.0, value_parser = parse_positive)]
+    #[arg(long, value_name = "F", default_value_t = 1.0, value_parser = float("a positive number", |x: f32| x.is_finite() && x > 0.0))]
     pub view_distance: f32,
     /// Size of the debug camera's image [default: the render's size].
     #[arg(long, num_args = 2, action = clap::ArgAction::Set, value_names = ["W", "H"],
@@ -76,24 +72,8 @@ pub struct TracePixelArgs {
     /// Tone mapping of the PNG: clamp (the lab's look) or exp (1 − e^(−3x)).
     #[arg(long, value_enum, default_value = "clamp")]
     pub tonemap: ToneMapArg,
-    /// Worker threads for the PNG's render [default: all cores].
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
-    pub threads: Option<u32>,
-}
-
-fn parse_positive(s: &str) -> Result<f32, String> {
-    match parse_finite(s)? {
-        x if x > 0.0 => Ok(x),
-        _ => Err(format!("expected a positive number, found `{s}`")),
-    }
-}
-
-fn parse_finite(s: &str) -> Result<f32, String> {
-    match s.parse::<f32>() {
-        Ok(x) if x.is_finite() => Ok(x),
-        Ok(_) => Err(format!("expected a finite number, found `{s}`")),
-        Err(_) => Err(format!("expected a number, found `{s}`")),
-    }
+    #[command(flatten)]
+    pub workers: ThreadsArg,
 }
 
 /// Traces, checks and writes as the flags say.
@@ -105,12 +85,7 @@ pub fn run(args: &TracePixelArgs) -> Result<()> {
     plan.check()?;
     plan.refuse_binary_on_terminal(&["--png"])?;
 
-    let (scene, effective) = scene_and_settings(
-        args.scene.as_deref(),
-        &args.image,
-        args.seed,
-        args.two_sided,
-    )?;
+    let (scene, effective) = scene_and_settings(args.scene.as_deref(), &args.image, &args.seed)?;
     let settings = effective.settings;
     let mut tree =
         trace_pixel(&scene, &settings, args.x, args.y).map_err(|e| UsageError(e.to_string()))?;
@@ -166,7 +141,7 @@ pub fn run(args: &TracePixelArgs) -> Result<()> {
             height,
             ..settings.clone()
         };
-        let pool = thread_pool(args.threads)?;
+        let pool = args.workers.pool()?;
         let engine = Engine::Wavefront.prepare(
             &view_scene,
             &view_settings,
@@ -246,7 +221,7 @@ pub fn meaningless(args: &TracePixelArgs) -> Vec<String> {
         ("--view-size", args.view_size.is_some()),
         ("--no-rays", args.no_rays),
         ("--tonemap", args.tonemap != ToneMapArg::Clamp),
-        ("--threads", args.threads.is_some()),
+        ("--threads", args.workers.threads.is_some()),
     ];
     given
         .iter()

@@ -1,14 +1,30 @@
-//! The command line's spellings of the library's choices. Each enum mirrors one of the
-//! library's, variant for variant and with the same docs (clap prints them as the possible
-//! values), so that the library's types need no clap; `From` maps each to its twin, and a
-//! variant added to the library fails to compile here until it has a spelling.
+//! The command line's spellings of the library's choices, and its number parsers.
+//!
+//! Each enum mirrors one of the library's, variant for variant and with the same docs (clap
+//! prints them as the possible values), so that the library's types need no clap; `From` maps
+//! each to its twin, and a variant added to the library fails to compile here until it has a
+//! spelling. Integers use clap's own ranged parsers (`value_parser!(u32).range(..)`); clap has
+//! none for floats, so [`float`] is clap's string parser mapped through a check.
 
+use clap::builder::{StringValueParser, TypedValueParser};
 use raywave::render::engine::Engine;
 use raywave::render::film::ToneMap;
 use raywave::render::sampling::LightSampler;
 use raywave::render::settings::options::Defaults;
 use raywave::render::settings::{LightModel, ShadowMode};
 use raywave::render::wavefront::lanes::LaneWidth;
+
+/// A float that `ok` accepts, refused otherwise with "expected {what}, found `text`" (clap
+/// names the flag).
+pub fn float<T>(what: &'static str, ok: fn(T) -> bool) -> impl TypedValueParser<Value = T>
+where
+    T: std::str::FromStr + Copy + Send + Sync + 'static,
+{
+    StringValueParser::new().try_map(move |text| match text.parse::<T>() {
+        Ok(x) if ok(x) => Ok(x),
+        _ => Err(format!("expected {what}, found `{text}`")),
+    })
+}
 
 /// Declares a clap value enum and its conversion into the library's enum of the same variants.
 macro_rules! mirror {

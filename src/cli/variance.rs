@@ -1,10 +1,10 @@
 //! `raywave variance` flags, turned into `raywave::variance::command::VarianceOptions`.
 
+use super::image::ThreadsArg;
 use super::values::{EngineArg, LightModelArg, SamplerArg};
 use anyhow::Result;
 use clap::Args;
 use raywave::output::OutputPlan;
-use raywave::render::engine::thread_pool;
 use raywave::variance::command::VarianceOptions;
 use std::path::PathBuf;
 
@@ -68,9 +68,8 @@ pub struct VarianceArgs {
     /// The engine that renders the images (both draw the same samples).
     #[arg(long, value_enum, default_value = "wavefront")]
     pub engine: EngineArg,
-    /// Worker threads [default: all cores].
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
-    pub threads: Option<u32>,
+    #[command(flatten)]
+    pub workers: ThreadsArg,
     /// No progress bar.
     #[arg(short, long)]
     pub quiet: bool,
@@ -120,6 +119,6 @@ pub fn run(args: &VarianceArgs) -> Result<()> {
     // The flags' own errors first, with their own messages; then the outputs.
     options.validate()?;
     output_plan(&options).check()?;
-    let pool = thread_pool(args.threads)?;
+    let pool = args.workers.pool()?;
     pool.install(|| raywave::variance::command::run(&options))
 }

@@ -1,7 +1,7 @@
 //! `raywave view` flags, turned into `raywave::view::ViewOptions`.
 
-use super::image::ImageArgs;
 use super::image::scene_and_settings;
+use super::image::{ImageArgs, SeedArgs, ThreadsArg};
 use super::values::EngineArg;
 use anyhow::Result;
 use clap::Args;
@@ -23,15 +23,10 @@ pub struct ViewArgs {
     /// The engine the page starts with.
     #[arg(long, value_enum, default_value = "wavefront")]
     pub engine: EngineArg,
-    /// Seed of every random number.
-    #[arg(long, default_value_t = 0)]
-    pub seed: u32,
-    /// Let faces be hit from behind too.
-    #[arg(long)]
-    pub two_sided: bool,
-    /// Worker threads for renders [default: all cores].
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
-    pub threads: Option<u32>,
+    #[command(flatten)]
+    pub seed: SeedArgs,
+    #[command(flatten)]
+    pub workers: ThreadsArg,
     /// Camera samples per wavefront tile.
     #[arg(long, default_value_t = raywave::render::wavefront::DEFAULT_BATCH_SIZE as u32,
           value_parser = clap::value_parser!(u32).range(1..=1 << 20))]
@@ -43,12 +38,7 @@ pub struct ViewArgs {
 
 /// Serves the page until Ctrl-C.
 pub fn run(args: &ViewArgs) -> Result<()> {
-    let (scene, effective) = scene_and_settings(
-        args.scene.as_deref(),
-        &args.image,
-        args.seed,
-        args.two_sided,
-    )?;
+    let (scene, effective) = scene_and_settings(args.scene.as_deref(), &args.image, &args.seed)?;
     let settings = effective.settings;
     if settings.width > MAX_SIDE || settings.height > MAX_SIDE {
         return Err(UsageError(format!(
@@ -73,7 +63,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
         ViewOptions {
             scene,
             base,
-            threads: args.threads,
+            threads: args.workers.threads,
             batch_size: args.batch_size as usize,
             port: args.port,
         },
