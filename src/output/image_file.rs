@@ -147,11 +147,40 @@ pub enum LdrFormat {
     Ppm,
 }
 
+/// A linear float format raywave writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum HdrFormat {
+    /// Portable float map, written here.
+    Pfm,
+    /// OpenEXR, through the `exr` crate.
+    Exr,
+}
+
+/// Every image format raywave writes, by its file extension (lower case): the one table that
+/// `-o`, `--hdr` and every figure consult.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Format {
+    Ldr(LdrFormat),
+    Hdr(HdrFormat),
+}
+
+const FORMATS: [(&str, Format); 4] = [
+    ("png", Format::Ldr(LdrFormat::Png)),
+    ("ppm", Format::Ldr(LdrFormat::Ppm)),
+    ("pfm", Format::Hdr(HdrFormat::Pfm)),
+    ("exr", Format::Hdr(HdrFormat::Exr)),
+];
+
+/// The format `path`'s extension names, if any.
+fn format_of(path: &Path) -> Option<Format> {
+    let ext = extension(path)?;
+    FORMATS.iter().find(|(e, _)| *e == ext).map(|&(_, f)| f)
+}
+
 /// The 8-bit format for an output path, or an error naming what is accepted.
 pub fn ldr_format(path: &Path) -> Result<LdrFormat> {
-    match extension(path).as_deref() {
-        Some("png") => Ok(LdrFormat::Png),
-        Some("ppm") => Ok(LdrFormat::Ppm),
+    match format_of(path) {
+        Some(Format::Ldr(f)) => Ok(f),
         _ if is_stream_or_device(path) => Ok(LdrFormat::Png),
         _ => bail!(
             "cannot write {}: expected an output file ending in .png or .ppm (use --hdr for .pfm or .exr)",
@@ -171,10 +200,9 @@ pub enum OutputFormat {
 
 /// The format of an `-o` path, or an error naming the extensions accepted.
 pub fn output_format(path: &Path) -> Result<OutputFormat> {
-    match extension(path).as_deref() {
-        Some("png") => Ok(OutputFormat::Ldr(LdrFormat::Png)),
-        Some("ppm") => Ok(OutputFormat::Ldr(LdrFormat::Ppm)),
-        Some("pfm" | "exr") => Ok(OutputFormat::Linear),
+    match format_of(path) {
+        Some(Format::Ldr(f)) => Ok(OutputFormat::Ldr(f)),
+        Some(Format::Hdr(_)) => Ok(OutputFormat::Linear),
         _ if is_stream_or_device(path) => Ok(OutputFormat::Ldr(LdrFormat::Png)),
         _ => bail!(
             "cannot write {}: expected an output file ending in .png or .ppm (8-bit), or .pfm or .exr (linear floats only)",
@@ -183,13 +211,21 @@ pub fn output_format(path: &Path) -> Result<OutputFormat> {
     }
 }
 
+/// An 8-bit image as PNG bytes: the one PNG encoder of every output (files, figures and the
+/// viewer's levels).
+pub fn png_bytes(img: &image::RgbImage) -> Result<Vec<u8>> {
+    let mut out = std::io::Cursor::new(Vec::new());
+    img.write_to(&mut out, image::ImageFormat::Png)?;
+    Ok(out.into_inner())
+}
+
 /// Writes an 8-bit image whole or not at all; the format follows the extension (png, ppm).
 pub fn write_rgb8(img: &image::RgbImage, path: &Path) -> Result<()> {
     match ldr_format(path)? {
-        LdrFormat::Png => write_atomically(path, |w| {
-            img.write_to(w, image::ImageFormat::Png)
-                .map_err(anyhow::Error::from)
-        }),
+        LdrFormat::Png => {
+            let bytes = png_bytes(img)?;
+            write_atomically(path, |w| Ok(w.write_all(&bytes)?))
+        }
         LdrFormat::Ppm => write_atomically(path, |w| {
             // Netpbm's binary pixmap: magic, width, height, maxval, one whitespace byte, then
             // the RGB bytes row by row from the top.
@@ -200,20 +236,14 @@ pub fn write_rgb8(img: &image::RgbImage, path: &Path) -> Result<()> {
     }
 }
 
-enum HdrFormat {
-    Pfm,
-    Exr,
-}
-
 /// Checks that an `--hdr` path has a float format's extension.
 pub fn check_hdr_path(path: &Path) -> Result<()> {
     hdr_extension(path).map(|_| ())
 }
 
 fn hdr_extension(path: &Path) -> Result<HdrFormat> {
-    match extension(path).as_deref() {
-        Some("pfm") => Ok(HdrFormat::Pfm),
-        Some("exr") => Ok(HdrFormat::Exr),
+    match format_of(path) {
+        Some(Format::Hdr(f)) => Ok(f),
         _ if is_stream_or_device(path) => Ok(HdrFormat::Pfm),
         _ => bail!(
             "cannot write {}: expected an --hdr file ending in .pfm or .exr",

@@ -5,7 +5,7 @@
 
 use super::{Region, Row, StudyResult};
 use crate::output::false_colour::{self, Scale, figure, register_font};
-use crate::output::image_file::write_atomically;
+use crate::output::image_file::write_rgb8;
 use crate::render::sampling::LightSampler;
 use anyhow::{Context, Result, anyhow};
 use plotters::coord::Shift;
@@ -205,10 +205,7 @@ pub fn mse_plot(result: &StudyResult, path: &Path) -> Result<()> {
         root.present().map_err(|e| anyhow!("plot: {e}"))?;
     }
     let img = image::RgbImage::from_raw(w, h, buffer).context("plot buffer")?;
-    write_atomically(path, |out| {
-        img.write_to(out, image::ImageFormat::Png)
-            .map_err(anyhow::Error::from)
-    })
+    write_rgb8(&img, path)
 }
 
 /// Writes `heat_<sampler>_N<n>.png` for every sampler: per-pixel MSE over the seeds on one log
@@ -236,10 +233,7 @@ pub fn heatmaps(result: &StudyResult, dir: &Path) -> Result<Vec<PathBuf>> {
             "MSE per pixel, mean of R, G, B; one scale for all samplers",
         )?;
         let path = dir.join(format!("heat_{}_N{n}.png", sampler.name()));
-        write_atomically(&path, |out| {
-            img.write_to(out, image::ImageFormat::Png)
-                .map_err(anyhow::Error::from)
-        })?;
+        write_rgb8(&img, &path)?;
         written.push(path);
     }
     Ok(written)

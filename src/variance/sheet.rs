@@ -13,7 +13,7 @@
 
 use super::StudyResult;
 use crate::output::false_colour::register_font;
-use crate::output::image_file::write_atomically;
+use crate::output::image_file::write_rgb8;
 use anyhow::{Result, anyhow};
 use image::RgbImage;
 use plotters::prelude::*;
@@ -128,9 +128,6 @@ pub fn write(result: &StudyResult, path: &Path) -> Result<bool> {
     let rows: Vec<String> = samplers.iter().map(|s| s.name().to_string()).collect();
     let cols: Vec<String> = budgets.iter().map(|n| format!("N = {n}")).collect();
     let img = contact_sheet(&title, &rows, &cols, &images)?;
-    write_atomically(path, |out| {
-        img.write_to(out, image::ImageFormat::Png)
-            .map_err(anyhow::Error::from)
-    })?;
+    write_rgb8(&img, path)?;
     Ok(true)
 }

@@ -12,6 +12,7 @@
 
 use super::http::ApiError;
 use super::request::{Resolved, ViewSettings};
+use crate::output::image_file::png_bytes;
 use crate::output::statistics::median;
 use crate::render::engine::Engine;
 use crate::render::film::{Film, ToneMap};
@@ -304,7 +305,7 @@ impl Comparisons {
         for (img, name) in heat_imgs.iter().zip(["heat-a", "heat-b"]) {
             pngs.push((
                 name.to_string(),
-                Arc::new(super::jobs::encode_png(img).map_err(internal)?),
+                Arc::new(png_bytes(img).map_err(internal)?),
             ));
         }
         let noise = reference.noise.iter().map(|&v| v as f64).sum::<f64>()
@@ -332,7 +333,7 @@ impl Comparisons {
 }
 
 fn png(film: &Film) -> anyhow::Result<Vec<u8>> {
-    super::jobs::encode_png(&film.to_rgb8(ToneMap::Clamp))
+    png_bytes(&film.to_rgb8(ToneMap::Clamp))
 }
 
 #[cfg(test)]

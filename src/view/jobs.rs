@@ -11,6 +11,7 @@
 //! ```
 
 use crate::output::bench_record::KindRates;
+use crate::output::image_file::png_bytes;
 use crate::render::engine::Engine;
 use crate::render::film::ToneMap;
 use crate::render::per_kind::RayCounts;
@@ -292,7 +293,7 @@ fn render_levels(
             })
         });
         let seconds = start.elapsed().as_secs_f64();
-        let png = encode_png(&film.to_rgb8(ToneMap::Clamp))?;
+        let png = png_bytes(&film.to_rgb8(ToneMap::Clamp))?;
         let mut state = job.state.lock().unwrap_or_else(|e| e.into_inner());
         state.levels.push(Level {
             width,
@@ -304,13 +305,6 @@ fn render_levels(
         state.pngs.push(Arc::new(png));
     }
     Ok(true)
-}
-
-/// An 8-bit image as PNG bytes.
-pub fn encode_png(img: &image::RgbImage) -> anyhow::Result<Vec<u8>> {
-    let mut out = std::io::Cursor::new(Vec::new());
-    img.write_to(&mut out, image::ImageFormat::Png)?;
-    Ok(out.into_inner())
 }
 
 /// Engines by name, for the page's menu.
