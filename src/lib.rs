@@ -48,7 +48,7 @@
 //! assert_eq!(wavefront, reference);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
-#![warn(missing_docs)]
+#![warn(missing_docs, unreachable_pub)]
 
 // The layers, each depending only on those above it; docs/ARCHITECTURE.md has the module map.
 //

@@ -8,7 +8,7 @@ use crate::render::settings::RenderSettings;
 /// The settings fields each image flag sets (as named in the record's JSON). `--defaults`
 /// sets them all: given explicitly, nothing is adopted. Fields no flag names (the seed) are
 /// always adopted.
-pub const FLAG_FIELDS: [(&str, &[&str]); 10] = [
+pub(crate) const FLAG_FIELDS: [(&str, &[&str]); 10] = [
     ("size", &["width", "height"]),
     ("bounces", &["bounces"]),
     ("shadows", &["shadows"]),
@@ -24,7 +24,7 @@ pub const FLAG_FIELDS: [(&str, &[&str]); 10] = [
 
 /// `ours` with every field that no flag in `explicit` (clap ids: `size`, `shadow_samples`,
 /// ...) set taken from `record`.
-pub fn adopt_settings(
+pub(crate) fn adopt_settings(
     ours: &RenderSettings,
     record: &RenderSettings,
     explicit: &[String],

@@ -8,11 +8,11 @@ use std::io::Write;
 use std::path::Path;
 
 /// The CSV header (one row per point, engine and figure follows).
-pub const CSV_HEADER: &str = "point,scene,width,height,bounces,shadow_samples,threads,engine,\
+pub(crate) const CSV_HEADER: &str = "point,scene,width,height,bounces,shadow_samples,threads,engine,\
                               figure,unit,runs,min,median,low,high,max,outliers";
 
 /// The records as a JSON array, one record per point.
-pub fn json(records: &[BenchRecord]) -> Result<String> {
+pub(crate) fn json(records: &[BenchRecord]) -> Result<String> {
     Ok(format!("{}\n", serde_json::to_string_pretty(records)?))
 }
 
@@ -32,7 +32,7 @@ fn opt(x: Option<f64>) -> String {
 /// One row per point, engine and headline figure; rates in rays/s or rays/thread-s (`unit`),
 /// `low` and `high` empty without an interval, `outliers` the outlier runs (1-based) joined by
 /// spaces. `labels[i]` names point i (empty for a single point).
-pub fn csv(records: &[BenchRecord], labels: &[String]) -> String {
+pub(crate) fn csv(records: &[BenchRecord], labels: &[String]) -> String {
     let mut out = format!("{CSV_HEADER}\n");
     for (r, label) in records.iter().zip(labels) {
         let s = &r.setup.settings;
@@ -69,7 +69,7 @@ pub fn csv(records: &[BenchRecord], labels: &[String]) -> String {
 
 /// A Markdown table to paste into a pull request: per point, engine and figure, the median,
 /// its 95% interval, min and max in Mrays/s (total) or Mrays/thread-s (stages).
-pub fn markdown(records: &[BenchRecord], labels: &[String]) -> String {
+pub(crate) fn markdown(records: &[BenchRecord], labels: &[String]) -> String {
     let mut out = String::from(
         "| point | engine | figure | median | 95% interval | min | max | unit |\n\
          |---|---|---|---:|---:|---:|---:|---|\n",
@@ -108,6 +108,6 @@ pub fn markdown(records: &[BenchRecord], labels: &[String]) -> String {
 }
 
 /// Writes `text` to `path` through `crate::output` (atomically; `-` is standard output).
-pub fn write(path: &Path, text: &str) -> Result<()> {
+pub(crate) fn write(path: &Path, text: &str) -> Result<()> {
     crate::output::write_output(path, |w| Ok(w.write_all(text.as_bytes())?))
 }

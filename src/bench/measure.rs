@@ -24,7 +24,7 @@ use std::time::Instant;
 // One more than clippy's 7: the lane width joined the point's settings, which are the
 // arguments' natural split (a struct for them would only be unpacked again below).
 #[allow(clippy::too_many_arguments)]
-pub fn measure(
+pub(crate) fn measure(
     pool: &rayon::ThreadPool,
     scene: &Scene,
     settings: &RenderSettings,
@@ -93,7 +93,7 @@ fn timed(
 
 /// The order in which round `round` runs `n` engines: 0..n rotated by `round`, so each engine
 /// goes first in turn.
-pub fn round_order(n: usize, round: usize) -> Vec<usize> {
+pub(crate) fn round_order(n: usize, round: usize) -> Vec<usize> {
     (0..n).map(|i| (i + round) % n.max(1)).collect()
 }
 

@@ -14,12 +14,12 @@
 //! ```
 
 pub mod ab;
-pub mod adopt;
+pub(crate) mod adopt;
 pub mod compare;
-pub mod export;
+pub(crate) mod export;
 pub mod list;
-pub mod measure;
-pub mod report;
+pub(crate) mod measure;
+pub(crate) mod report;
 pub mod sweep;
 
 use crate::output::bench_record::{self as record, BenchRecord, Machine, SceneId, Setup};

@@ -7,7 +7,7 @@ use crate::render::settings::{RenderSettings, ShadowMode};
 use std::fmt::Write as _;
 
 /// A median whose 95% interval is wider than this share of it, in percent, is called noisy.
-pub const NOISY_WIDTH_PCT: f64 = 10.0;
+pub(crate) const NOISY_WIDTH_PCT: f64 = 10.0;
 
 /// The printed report of one record: header, then per engine its kinds and stages, then the
 /// headline figures.
@@ -141,7 +141,7 @@ fn outlier_text(f: &FigureSummary) -> String {
 
 /// The warnings for one record: each figure with outlier runs (by the modified Z-score) and
 /// each whose interval is wider than [`NOISY_WIDTH_PCT`] of its median, named.
-pub fn warnings(r: &BenchRecord, point: &str) -> Vec<String> {
+pub(crate) fn warnings(r: &BenchRecord, point: &str) -> Vec<String> {
     let at = if point.is_empty() {
         String::new()
     } else {
@@ -201,7 +201,7 @@ pub fn warnings(r: &BenchRecord, point: &str) -> Vec<String> {
 
 /// A warning when the machine's 1-minute load average exceeds its logical CPUs (read from
 /// /proc/loadavg before the bench starts): other processes then compete for every core.
-pub fn load_warning() -> Option<String> {
+pub(crate) fn load_warning() -> Option<String> {
     let text = std::fs::read_to_string("/proc/loadavg").ok()?;
     let load: f64 = text.split_whitespace().next()?.parse().ok()?;
     let cpus = crate::output::machine::logical_cpus();

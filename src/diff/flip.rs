@@ -19,7 +19,7 @@ fn bytes(img: &Image) -> Vec<u8> {
 
 /// FLIP of A against the reference B: the figures over the region, and the per-pixel map
 /// (NaN outside the region and where a value is not finite).
-pub fn flip(a: &Image, b: &Image, region: &Region) -> (FlipFigures, Vec<f32>) {
+pub(super) fn flip(a: &Image, b: &Image, region: &Region) -> (FlipFigures, Vec<f32>) {
     let (w, h) = (a.film.width, a.film.height);
     let reference = nv_flip::FlipImageRgb8::with_data(w, h, &bytes(b));
     let test = nv_flip::FlipImageRgb8::with_data(w, h, &bytes(a));

@@ -17,7 +17,7 @@
 //! not estimates: they carry no sampling error. The images themselves may be Monte Carlo
 //! renders, so an error against a noisy reference includes the reference's own noise.
 
-pub mod read;
+pub(crate) mod read;
 pub mod text;
 
 #[cfg(feature = "flip")]

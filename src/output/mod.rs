@@ -21,7 +21,7 @@ pub mod memory;
 pub mod render_record;
 pub mod statistics;
 pub mod terminal;
-pub mod write;
+pub(crate) mod write;
 
 pub use write::{Target, install_signal_cleanup, target, write_output};
 

@@ -18,7 +18,7 @@ use glam::Vec3;
 /// max(1, the pixel's largest channel): the engines add the same f32 terms in other orders
 /// (nested kr ⊙ (...) instead of distributed over the path), a few ulps per term; 1e-5 is
 /// about 80 ulps at 1.
-pub const TOLERANCE: f64 = 1e-5;
+pub(crate) const TOLERANCE: f64 = 1e-5;
 
 /// Which renderer computes a pixel.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

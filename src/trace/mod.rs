@@ -13,16 +13,16 @@
 //! The types (tree.rs, scene_view.rs) are plain serde values with a JSON Schema
 //! (docs/schema/ray-tree.schema.json, docs/TRACE.md).
 
-pub mod check;
+pub(crate) mod check;
 pub mod draw;
 pub mod mesh;
 pub mod obj;
 pub mod palette;
 pub mod ply;
-pub mod scene_view;
+pub(crate) mod scene_view;
 pub mod summary;
-pub mod tracer;
-pub mod tree;
+pub(crate) mod tracer;
+pub(crate) mod tree;
 pub mod view;
 
 pub use check::{

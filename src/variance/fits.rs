@@ -18,7 +18,7 @@ use crate::variance::LogLogFit;
 use serde::Serialize;
 
 /// The lab's budget of random points that [`Matching`] is about.
-pub const LAB_RANDOM_POINTS: f64 = 150.0;
+pub(crate) const LAB_RANDOM_POINTS: f64 = 150.0;
 
 /// The fitted slope for a (sampler, region).
 #[derive(Clone, Debug, Serialize)]
@@ -109,7 +109,7 @@ fn fitted(rows: &[Row], sampler: LightSampler, region: Region) -> Vec<&Row> {
 }
 
 /// One slope per (sampler, region), with its interval over `k` seeds.
-pub fn slopes(rows: &[Row], samplers: &[LightSampler], k: usize) -> Vec<Slope> {
+pub(crate) fn slopes(rows: &[Row], samplers: &[LightSampler], k: usize) -> Vec<Slope> {
     let mut out = Vec::new();
     for &sampler in samplers {
         for region in Region::ALL {
@@ -140,7 +140,7 @@ pub fn slopes(rows: &[Row], samplers: &[LightSampler], k: usize) -> Vec<Slope> {
 }
 
 /// One matching budget per (sampler other than random, region), when random was studied.
-pub fn matching(rows: &[Row], samplers: &[LightSampler], k: usize) -> Vec<Matching> {
+pub(crate) fn matching(rows: &[Row], samplers: &[LightSampler], k: usize) -> Vec<Matching> {
     let mut out = Vec::new();
     if !samplers.contains(&LightSampler::Random) {
         return out;
@@ -183,7 +183,7 @@ fn efficiency_at(row: &Row, idx: &[usize]) -> f64 {
 /// Fills every row's error reduction (random's MSE over its own) and efficiency relative to
 /// random's, at the same N and region, with their intervals (the same seeds resampled for
 /// both: seed k of every sampler ran in round k, so a slow round slows both).
-pub fn ratios_to_random(rows: &mut [Row], k: usize) {
+pub(crate) fn ratios_to_random(rows: &mut [Row], k: usize) {
     let random: Vec<Row> = rows
         .iter()
         .filter(|r| r.sampler == LightSampler::Random.name())

@@ -20,10 +20,10 @@
 
 pub mod cache;
 pub mod command;
-pub mod figures;
-pub mod fits;
+pub(crate) mod figures;
+pub(crate) mod fits;
 pub mod mask;
-pub mod plot;
+pub(crate) mod plot;
 pub mod report;
 pub mod sheet;
 

@@ -190,7 +190,7 @@ fn panel(
 
 /// Draws `mse.png`: MSE against N (top row) and against median time per image (bottom row),
 /// one log-log panel per region (whole, penumbra, lit), 95% intervals as bars.
-pub fn mse_plot(result: &StudyResult, path: &Path) -> Result<()> {
+pub(crate) fn mse_plot(result: &StudyResult, path: &Path) -> Result<()> {
     register_font();
     let (w, h) = (1500u32, 1040u32);
     let mut buffer = vec![0u8; (w * h * 3) as usize];
@@ -211,7 +211,7 @@ pub fn mse_plot(result: &StudyResult, path: &Path) -> Result<()> {
 /// Writes `heat_<sampler>_N<n>.png` for every sampler: per-pixel MSE over the seeds on one log
 /// scale shared by all samplers (dark = low error, bright = high), with a title and a
 /// labelled colour bar, so the maps compare directly and each reads on its own.
-pub fn heatmaps(result: &StudyResult, dir: &Path) -> Result<Vec<PathBuf>> {
+pub(crate) fn heatmaps(result: &StudyResult, dir: &Path) -> Result<Vec<PathBuf>> {
     let Some(scale) = Scale::from_values(result.heatmaps.iter().flat_map(|(_, m)| m), true) else {
         return Ok(Vec::new());
     };
@@ -243,7 +243,11 @@ pub fn heatmaps(result: &StudyResult, dir: &Path) -> Result<Vec<PathBuf>> {
 /// ([`false_colour::Scale::from_values`]: the 1st to the 99.9th percentile of all maps' positive
 /// values; dark = low error, bright = high), so that the maps compare directly; also returns
 /// that scale as (lo, hi) in log10. `None` when no map has a positive value.
-pub fn heat_images(maps: &[&[f32]], w: u32, h: u32) -> Option<(Vec<image::RgbImage>, [f32; 2])> {
+pub(crate) fn heat_images(
+    maps: &[&[f32]],
+    w: u32,
+    h: u32,
+) -> Option<(Vec<image::RgbImage>, [f32; 2])> {
     let scale = false_colour::Scale::from_values(maps.iter().flat_map(|m| m.iter()), true)?;
     let images = maps
         .iter()

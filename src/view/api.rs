@@ -14,7 +14,7 @@ use serde::Serialize;
 use std::sync::Arc;
 
 /// Everything the handlers share.
-pub struct State {
+pub(crate) struct State {
     /// The scene, read once at start.
     pub scene: Arc<Scene>,
     /// The settings the command line gave: what a request leaves out.
@@ -32,12 +32,12 @@ pub struct State {
 }
 
 /// `GET /api/scene`.
-pub fn scene(state: &State) -> Reply {
+pub(crate) fn scene(state: &State) -> Reply {
     Reply::bytes("application/json", state.scene_json.clone())
 }
 
 /// The JSON of `GET /api/scene`, made once at start.
-pub fn scene_json(scene: &Scene, base: &Resolved) -> Vec<u8> {
+pub(crate) fn scene_json(scene: &Scene, base: &Resolved) -> Vec<u8> {
     #[derive(Serialize)]
     struct Body<'a> {
         scene: SceneJson,
@@ -59,7 +59,7 @@ pub fn scene_json(scene: &Scene, base: &Resolved) -> Vec<u8> {
 }
 
 /// `POST /api/render`: starts a job.
-pub fn render(state: &State, body: &[u8]) -> Result<Reply, ApiError> {
+pub(crate) fn render(state: &State, body: &[u8]) -> Result<Reply, ApiError> {
     let resolved = ViewSettings::parse(body)?.resolve(&state.base)?;
     let job = state.jobs.submit(resolved);
     Ok(with_frame(job.status(), &job.resolved))
@@ -102,13 +102,13 @@ fn job_by_id(state: &State, id: u64) -> Result<Arc<super::jobs::Job>, ApiError> 
 }
 
 /// `GET /api/render/{job}`.
-pub fn render_status(state: &State, job: &str) -> Result<Reply, ApiError> {
+pub(crate) fn render_status(state: &State, job: &str) -> Result<Reply, ApiError> {
     let job = find_job(state, job)?;
     Ok(with_frame(job.status(), &job.resolved))
 }
 
 /// `GET /api/render/{job}/{level}.png`.
-pub fn render_png(state: &State, job: &str, level: &str) -> Result<Reply, ApiError> {
+pub(crate) fn render_png(state: &State, job: &str, level: &str) -> Result<Reply, ApiError> {
     let job = find_job(state, job)?;
     let k: usize = level
         .strip_suffix(".png")
@@ -136,7 +136,7 @@ pub fn render_png(state: &State, job: &str, level: &str) -> Result<Reply, ApiErr
 }
 
 /// `GET /api/pixel?job=J&x=X&y=Y`: the ray tree of pixel (x, y) of job J's full-size image.
-pub fn pixel(state: &State, q: &str) -> Result<Reply, ApiError> {
+pub(crate) fn pixel(state: &State, q: &str) -> Result<Reply, ApiError> {
     let pairs = query(q, &["job", "x", "y"])?;
     let job = job_by_id(state, number(&pairs, "job")?)?;
     let (x, y): (u32, u32) = (number(&pairs, "x")?, number(&pairs, "y")?);
@@ -150,7 +150,7 @@ pub fn pixel(state: &State, q: &str) -> Result<Reply, ApiError> {
 }
 
 /// `POST /api/compare`.
-pub fn compare(state: &State, body: &[u8]) -> Result<Reply, ApiError> {
+pub(crate) fn compare(state: &State, body: &[u8]) -> Result<Reply, ApiError> {
     let request = CompareRequest::parse(body)?;
     let result = state
         .comparisons
@@ -159,7 +159,7 @@ pub fn compare(state: &State, body: &[u8]) -> Result<Reply, ApiError> {
 }
 
 /// `GET /api/compare/{id}/{name}.png`.
-pub fn compare_png(state: &State, id: &str, name: &str) -> Result<Reply, ApiError> {
+pub(crate) fn compare_png(state: &State, id: &str, name: &str) -> Result<Reply, ApiError> {
     let n: u64 = id.parse().map_err(|_| {
         ApiError::bad(format!(
             "expected a comparison number, found `{}`",

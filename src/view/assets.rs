@@ -28,7 +28,7 @@ const ASSETS: [(&str, &str, &str); 4] = [
 ];
 
 /// `GET /`.
-pub fn page() -> Result<Reply, ApiError> {
+pub(crate) fn page() -> Result<Reply, ApiError> {
     Ok(Reply::bytes(
         "text/html; charset=utf-8",
         include_str!("assets/index.html").as_bytes().to_vec(),
@@ -36,7 +36,7 @@ pub fn page() -> Result<Reply, ApiError> {
 }
 
 /// `GET /assets/{name}`.
-pub fn asset(name: &str) -> Result<Reply, ApiError> {
+pub(crate) fn asset(name: &str) -> Result<Reply, ApiError> {
     ASSETS
         .iter()
         .find(|(n, _, _)| *n == name)

@@ -28,7 +28,7 @@ use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 /// How many comparisons are kept for their images.
-pub const KEPT: usize = 4;
+pub(crate) const KEPT: usize = 4;
 /// Points per light per hit for the penumbra mask.
 const MASK_SAMPLES: u32 = 64;
 
@@ -51,7 +51,7 @@ fn default_reference_samples() -> u32 {
 /// What the page asks to compare.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct CompareRequest {
+pub(crate) struct CompareRequest {
     /// Bounces, light model, camera, engine (size, shadows, sampler and seed are the
     /// comparison's own).
     #[serde(default)]
@@ -75,7 +75,7 @@ pub struct CompareRequest {
 
 impl CompareRequest {
     /// Parses and range-checks a request body (an empty body is every default).
-    pub fn parse(body: &[u8]) -> Result<CompareRequest, ApiError> {
+    pub(crate) fn parse(body: &[u8]) -> Result<CompareRequest, ApiError> {
         let text = if body.iter().all(u8::is_ascii_whitespace) {
             &b"{}"[..]
         } else {
@@ -112,7 +112,7 @@ impl CompareRequest {
 
 /// A mean over seeds and its standard error.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
-pub struct Estimate {
+pub(crate) struct Estimate {
     /// Mean.
     pub mean: f64,
     /// Standard error of the mean (sample standard deviation / √K).
@@ -137,7 +137,7 @@ impl Estimate {
 
 /// One sampler's side.
 #[derive(Clone, Debug, Serialize)]
-pub struct Side {
+pub(crate) struct Side {
     /// The sampler.
     pub sampler: LightSampler,
     /// URL of its first render (seed 1).
@@ -157,7 +157,7 @@ pub struct Side {
 
 /// What the page shows.
 #[derive(Clone, Debug, Serialize)]
-pub struct Comparison {
+pub(crate) struct Comparison {
     /// Its id (for the image URLs).
     pub id: u64,
     /// Image size.
@@ -189,7 +189,7 @@ type NamedPng = (String, Arc<Vec<u8>>);
 
 /// Kept comparisons and their images.
 #[derive(Default)]
-pub struct Comparisons {
+pub(crate) struct Comparisons {
     next: std::sync::atomic::AtomicU64,
     kept: Mutex<VecDeque<(u64, Vec<NamedPng>)>>,
     /// Held while one runs: a second request gets 409 instead of halving the first one's speed.
@@ -198,7 +198,7 @@ pub struct Comparisons {
 
 impl Comparisons {
     /// The PNG `name` of comparison `id`.
-    pub fn png(&self, id: u64, name: &str) -> Option<Arc<Vec<u8>>> {
+    pub(crate) fn png(&self, id: u64, name: &str) -> Option<Arc<Vec<u8>>> {
         let kept = self.kept.lock().unwrap_or_else(|e| e.into_inner());
         kept.iter()
             .find(|(i, _)| *i == id)
@@ -207,7 +207,7 @@ impl Comparisons {
     }
 
     /// Runs a comparison on `pool`.
-    pub fn run(
+    pub(crate) fn run(
         &self,
         request: &CompareRequest,
         scene: &Scene,

@@ -6,7 +6,7 @@ use serde::Serialize;
 use std::io::Read;
 
 /// The largest request body accepted: settings and comparison requests are a few hundred bytes.
-pub const MAX_BODY_BYTES: usize = 64 * 1024;
+pub(crate) const MAX_BODY_BYTES: usize = 64 * 1024;
 
 /// A request that cannot be served, with the status and message the client gets.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -55,7 +55,7 @@ impl ApiError {
 
 /// What a handler answers: a status, a content type and the bytes.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Reply {
+pub(crate) struct Reply {
     /// HTTP status.
     pub status: u16,
     /// `Content-Type`.
@@ -70,7 +70,7 @@ pub struct Reply {
 
 impl Reply {
     /// 200 with a JSON body.
-    pub fn json(value: &impl Serialize) -> Reply {
+    pub(crate) fn json(value: &impl Serialize) -> Reply {
         match serde_json::to_vec(value) {
             Ok(body) => Reply::bytes("application/json", body),
             Err(e) => Reply::from(ApiError::status(
@@ -81,7 +81,7 @@ impl Reply {
     }
 
     /// 200 with any body.
-    pub fn bytes(content_type: &'static str, body: Vec<u8>) -> Reply {
+    pub(crate) fn bytes(content_type: &'static str, body: Vec<u8>) -> Reply {
         Reply {
             status: 200,
             content_type,
@@ -117,7 +117,10 @@ impl From<ApiError> for Reply {
 /// Reads a body of at most [`MAX_BODY_BYTES`]: a larger declared length is refused before
 /// reading, and a body that turns out longer (chunked, or a lying header) after reading one byte
 /// past the limit.
-pub fn read_body(declared: Option<usize>, reader: &mut dyn Read) -> Result<Vec<u8>, ApiError> {
+pub(crate) fn read_body(
+    declared: Option<usize>,
+    reader: &mut dyn Read,
+) -> Result<Vec<u8>, ApiError> {
     let too_large = || {
         ApiError::status(
             413,
@@ -140,7 +143,7 @@ pub fn read_body(declared: Option<usize>, reader: &mut dyn Read) -> Result<Vec<u
 
 /// A query string's `name=value` pairs, with every name checked against `allowed` (an unknown
 /// or repeated parameter is a 400: a typo should not silently mean "the default").
-pub fn query<'a>(q: &'a str, allowed: &[&str]) -> Result<Vec<(&'a str, &'a str)>, ApiError> {
+pub(crate) fn query<'a>(q: &'a str, allowed: &[&str]) -> Result<Vec<(&'a str, &'a str)>, ApiError> {
     let mut out: Vec<(&str, &str)> = Vec::new();
     for pair in q.split('&').filter(|p| !p.is_empty()) {
         let (name, value) = pair.split_once('=').unwrap_or((pair, ""));
@@ -163,7 +166,10 @@ pub fn query<'a>(q: &'a str, allowed: &[&str]) -> Result<Vec<(&'a str, &'a str)>
 
 /// The parameter `name` of `pairs` as a whole number, or a 400 saying it is missing or what was
 /// found instead.
-pub fn number<T: std::str::FromStr>(pairs: &[(&str, &str)], name: &str) -> Result<T, ApiError> {
+pub(crate) fn number<T: std::str::FromStr>(
+    pairs: &[(&str, &str)],
+    name: &str,
+) -> Result<T, ApiError> {
     let value = pairs
         .iter()
         .find(|(n, _)| *n == name)

@@ -25,15 +25,15 @@ use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 /// How many finished jobs are kept for their images and pixels.
-pub const KEPT_JOBS: usize = 8;
+pub(crate) const KEPT_JOBS: usize = 8;
 
 /// The divisors of the levels, coarse to fine.
-pub const LEVEL_DIVISORS: [u32; 4] = [8, 4, 2, 1];
+pub(crate) const LEVEL_DIVISORS: [u32; 4] = [8, 4, 2, 1];
 
 /// Where a job is.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 #[serde(rename_all = "lowercase", tag = "state", content = "error")]
-pub enum Status {
+pub(crate) enum Status {
     /// Waiting for the render thread.
     Queued,
     /// Rendering level `levels_done`.
@@ -48,7 +48,7 @@ pub enum Status {
 
 /// One rendered level.
 #[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct Level {
+pub(crate) struct Level {
     /// Image width.
     pub width: u32,
     /// Image height.
@@ -64,7 +64,7 @@ pub struct Level {
 
 /// What the page polls.
 #[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct JobStatus {
+pub(crate) struct JobStatus {
     /// The job's id.
     pub job: u64,
     /// Where it is.
@@ -81,7 +81,7 @@ pub struct JobStatus {
 }
 
 /// One job: its inputs, and what it has produced so far.
-pub struct Job {
+pub(crate) struct Job {
     /// Its id (increasing).
     pub id: u64,
     /// The settings and camera at full resolution.
@@ -102,7 +102,7 @@ struct JobState {
 
 impl Job {
     /// The status for the page.
-    pub fn status(&self) -> JobStatus {
+    pub(crate) fn status(&self) -> JobStatus {
         let state = self.state.lock().unwrap_or_else(|e| e.into_inner());
         JobStatus {
             job: self.id,
@@ -118,7 +118,7 @@ impl Job {
     }
 
     /// Level `k`'s PNG, once rendered.
-    pub fn png(&self, k: usize) -> Option<Arc<Vec<u8>>> {
+    pub(crate) fn png(&self, k: usize) -> Option<Arc<Vec<u8>>> {
         let state = self.state.lock().unwrap_or_else(|e| e.into_inner());
         state.pngs.get(k).cloned()
     }
@@ -130,7 +130,7 @@ impl Job {
 
 /// The sizes of the levels of a `width` × `height` image: each divisor's, rounded up, without
 /// repeats (a 10-pixel image has fewer than four levels).
-pub fn level_sizes(width: u32, height: u32) -> Vec<[u32; 2]> {
+pub(crate) fn level_sizes(width: u32, height: u32) -> Vec<[u32; 2]> {
     let mut sizes: Vec<[u32; 2]> = Vec::new();
     for d in LEVEL_DIVISORS {
         let s = [width.div_ceil(d), height.div_ceil(d)];
@@ -142,7 +142,7 @@ pub fn level_sizes(width: u32, height: u32) -> Vec<[u32; 2]> {
 }
 
 /// The jobs, and the channel to the render thread.
-pub struct Jobs {
+pub(crate) struct Jobs {
     next: AtomicU64,
     kept: Mutex<VecDeque<Arc<Job>>>,
     queue: Mutex<Sender<Arc<Job>>>,
@@ -151,7 +151,7 @@ pub struct Jobs {
 impl Jobs {
     /// Starts the render thread, which renders on `pool` with `batch_size` (the wavefront
     /// engine's tile) and reads `scene`.
-    pub fn start(
+    pub(crate) fn start(
         scene: Arc<Scene>,
         pool: Arc<rayon::ThreadPool>,
         batch_size: usize,
@@ -169,7 +169,7 @@ impl Jobs {
     }
 
     /// Queues a job; every older job is superseded.
-    pub fn submit(&self, resolved: Resolved) -> Arc<Job> {
+    pub(crate) fn submit(&self, resolved: Resolved) -> Arc<Job> {
         let id = self.next.fetch_add(1, Ordering::Relaxed);
         let sizes = level_sizes(resolved.settings.width, resolved.settings.height);
         let job = Arc::new(Job {
@@ -206,15 +206,9 @@ impl Jobs {
     }
 
     /// The job `id`, while it is kept.
-    pub fn get(&self, id: u64) -> Option<Arc<Job>> {
+    pub(crate) fn get(&self, id: u64) -> Option<Arc<Job>> {
         let kept = self.kept.lock().unwrap_or_else(|e| e.into_inner());
         kept.iter().find(|j| j.id == id).cloned()
-    }
-
-    /// The newest job.
-    pub fn latest(&self) -> Option<Arc<Job>> {
-        let kept = self.kept.lock().unwrap_or_else(|e| e.into_inner());
-        kept.back().cloned()
     }
 }
 
@@ -252,7 +246,7 @@ fn render_thread(
 }
 
 /// The scene seen through `camera`: a copy only when the camera differs from the file's.
-pub fn with_camera<'a>(
+pub(crate) fn with_camera<'a>(
     scene: &'a Scene,
     camera: &crate::render::scene::Camera,
 ) -> std::borrow::Cow<'a, Scene> {
@@ -308,7 +302,7 @@ fn render_levels(
 }
 
 /// Engines by name, for the page's menu.
-pub const ENGINES: [Engine; 2] = [Engine::Wavefront, Engine::Reference];
+pub(crate) const ENGINES: [Engine; 2] = [Engine::Wavefront, Engine::Reference];
 
 #[cfg(test)]
 mod tests {

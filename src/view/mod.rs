@@ -15,15 +15,15 @@
 //! assets.rs      the page, its scripts and style (assets/)
 //! ```
 
-pub mod api;
-pub mod assets;
-pub mod compare;
-pub mod http;
-pub mod jobs;
+pub(crate) mod api;
+pub(crate) mod assets;
+pub(crate) mod compare;
+pub(crate) mod http;
+pub(crate) mod jobs;
 pub mod request;
-pub mod scene_json;
-pub mod server;
-pub mod tree;
+pub(crate) mod scene_json;
+pub(crate) mod server;
+pub(crate) mod tree;
 
 use anyhow::Result;
 use request::Resolved;

@@ -9,11 +9,11 @@ use serde::Serialize;
 
 /// The most triangles sent to the page: beyond this the 3D view shows the first ones and says
 /// so (a 1M-triangle mesh would be 100 MB of JSON; the render itself is not limited).
-pub const MAX_DRAWN_TRIANGLES: usize = 200_000;
+pub(crate) const MAX_DRAWN_TRIANGLES: usize = 200_000;
 
 /// The scene for WebGL.
 #[derive(Serialize)]
-pub struct SceneJson {
+pub(crate) struct SceneJson {
     /// Where the scene came from.
     pub source: String,
     /// Triangle corners, 9 floats per triangle.
@@ -34,7 +34,7 @@ pub struct SceneJson {
 
 /// A sphere for WebGL.
 #[derive(Serialize)]
-pub struct SphereJson {
+pub(crate) struct SphereJson {
     /// Centre.
     pub center: [f32; 3],
     /// Radius.
@@ -45,7 +45,7 @@ pub struct SphereJson {
 
 /// The colour a surface is drawn with: its emission for lights, else its diffuse colour plus
 /// half its mirror colour (so mirrors read as light grey), clamped to [0, 1].
-pub fn display_colour(m: &Material) -> [f32; 3] {
+pub(crate) fn display_colour(m: &Material) -> [f32; 3] {
     let c = if m.emitted.max_element() > 0.0 {
         m.emitted / m.emitted.max_element()
     } else {
@@ -56,7 +56,7 @@ pub fn display_colour(m: &Material) -> [f32; 3] {
 
 impl SceneJson {
     /// The scene's geometry for drawing.
-    pub fn new(scene: &Scene) -> SceneJson {
+    pub(crate) fn new(scene: &Scene) -> SceneJson {
         let drawn = scene.triangles.len().min(MAX_DRAWN_TRIANGLES);
         let mut positions = Vec::with_capacity(drawn * 9);
         let mut colors = Vec::with_capacity(drawn * 3);
@@ -120,7 +120,7 @@ impl SceneJson {
 /// The render camera's frame for drawing: its eye and the four corners of the image at unit
 /// distance along the view direction, top-left first, clockwise.
 #[derive(Serialize)]
-pub struct CameraFrame {
+pub(crate) struct CameraFrame {
     /// Eye.
     pub eye: [f32; 3],
     /// Image corners one unit in front of the eye.
@@ -130,7 +130,7 @@ pub struct CameraFrame {
 impl CameraFrame {
     /// The frame of `camera` for a `width` × `height` image (the lab's square field of view,
     /// cropped by non-square images).
-    pub fn new(camera: &Camera, width: u32, height: u32) -> CameraFrame {
+    pub(crate) fn new(camera: &Camera, width: u32, height: u32) -> CameraFrame {
         let rays = CameraRays::new(camera, width, height);
         let scale = 1.0 / width.max(height) as f32;
         let (hx, hy) = (width as f32 * scale, height as f32 * scale);

@@ -22,10 +22,10 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 /// Request-handling threads: enough that a slow comparison does not hold up the page's polls.
-pub const WORKERS: usize = 4;
+pub(crate) const WORKERS: usize = 4;
 
 /// A bound server.
-pub struct Server {
+pub(crate) struct Server {
     http: Arc<tiny_http::Server>,
     /// The port it listens on.
     pub port: u16,
@@ -33,7 +33,7 @@ pub struct Server {
 
 impl Server {
     /// Listens on 127.0.0.1:`port` (0: a free port the system chooses).
-    pub fn bind(port: u16) -> Result<Server> {
+    pub(crate) fn bind(port: u16) -> Result<Server> {
         let addr = format!("127.0.0.1:{port}");
         let http = tiny_http::Server::http(&addr)
             .map_err(|e| anyhow::anyhow!("{e}"))
@@ -50,7 +50,7 @@ impl Server {
     }
 
     /// Serves until SIGINT or SIGTERM; returns the signal's name.
-    pub fn serve(self, state: Arc<State>) -> Result<&'static str> {
+    pub(crate) fn serve(self, state: Arc<State>) -> Result<&'static str> {
         use signal_hook::consts::{SIGINT, SIGTERM};
         let stop = Arc::new(AtomicBool::new(false));
         let mut signals = signal_hook::iterator::Signals::new([SIGINT, SIGTERM])

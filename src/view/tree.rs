@@ -11,18 +11,18 @@ use serde::Serialize;
 
 /// The most segments a tree may have before it is traced (its JSON is about 1 KB a segment, and
 /// the page draws and lists each one).
-pub const MAX_TREE_SEGMENTS: u64 = 50_000;
+pub(crate) const MAX_TREE_SEGMENTS: u64 = 50_000;
 
 /// The most segments one pixel's tree can have: per camera sample, a camera or mirror ray at
 /// each depth, each followed by its shadow rays.
-pub fn max_segments(scene: &Scene, settings: &RenderSettings) -> u64 {
+pub(crate) fn max_segments(scene: &Scene, settings: &RenderSettings) -> u64 {
     let per_hit = 1 + scene.lights.len() as u64 * settings.points_per_light() as u64;
     settings.aa_samples.max(1) as u64 * (settings.bounces as u64 + 1) * per_hit
 }
 
 /// The ray tree of pixel (x, y) (from the top-left), with `check` filled in; a pixel outside
 /// the image, or settings whose tree could pass [`MAX_TREE_SEGMENTS`], are a 400.
-pub fn pixel_tree(
+pub(crate) fn pixel_tree(
     scene: &Scene,
     settings: &RenderSettings,
     x: u32,
@@ -44,7 +44,7 @@ pub fn pixel_tree(
 
 /// The colours of the 3D view, `raywave::trace::palette`'s (the lab's).
 #[derive(Serialize)]
-pub struct Palette {
+pub(crate) struct Palette {
     /// Camera rays.
     pub camera: Rgb,
     /// Reflection rays.
@@ -60,7 +60,7 @@ pub struct Palette {
 }
 
 /// The palette.
-pub const PALETTE: Palette = Palette {
+pub(crate) const PALETTE: Palette = Palette {
     camera: palette::CAMERA,
     reflection: palette::REFLECTION,
     shadow_visible: palette::SHADOW_VISIBLE,

@@ -197,7 +197,7 @@ pub fn parse_scene_str_with(
 /// colour 0.2·ke·area multiply up to four of them, which stays finite in f32 (1e36 < 3.4e38)
 /// below 1e9; larger values overflowed to infinity and came out as "degenerate" faces or
 /// infinite lights.
-pub const MAX_NUMBER: f32 = 1e9;
+pub(super) const MAX_NUMBER: f32 = 1e9;
 
 fn number(file: &str, line: usize, what: &str, token: Option<&str>) -> Result<f32, ParseError> {
     let error = |message: String| ParseError {
