@@ -184,6 +184,7 @@ fn measure(scene: &Scene, config: &StudyConfig) -> (usize, Vec<Measured>) {
         cache_dir()
             .map(|d| raywave::variance::Cache::new(&d, raywave::variance::cache::DEFAULT_LIMIT_MIB))
             .as_ref(),
+        &|line| eprintln!("{line}"),
     )
     .expect("the converged reference");
     if !reference.cached {

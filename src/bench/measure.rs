@@ -11,7 +11,7 @@
 //! ```
 
 use crate::output::bench_record::{EngineRecord, KindRates, Measurement, summarise};
-use crate::render::engine::{Engine, Prepared};
+use crate::render::engine::{Engine, Prepared, clamped_warning};
 use crate::render::film::Film;
 use crate::render::scene::Scene;
 use crate::render::settings::RenderSettings;
@@ -20,9 +20,10 @@ use crate::render::wavefront::lanes::LaneWidth;
 use std::time::Instant;
 
 /// Warm-up and timed runs of `engines` on `pool`, the wavefront engine `lanes` wide; `tick` is
-/// called after each run (warm-up included). Records come back in `engines`' order.
-// One more than clippy's 7: the lane width joined the point's settings, which are the
-// arguments' natural split (a struct for them would only be unpacked again below).
+/// called after each run (warm-up included), `notice` for a run that clamped pixels. Records
+/// come back in `engines`' order.
+// More than clippy's 7: the point's settings are the arguments' natural split (a struct for
+// them would only be unpacked again below), and the two hooks are the caller's.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn measure(
     pool: &rayon::ThreadPool,
@@ -33,10 +34,12 @@ pub(crate) fn measure(
     warmup: u32,
     runs: u32,
     tick: &(dyn Fn() + Sync),
+    notice: &(dyn Fn(&str) + Sync),
 ) -> Vec<EngineRecord> {
-    pool.install(|| timed(scene, settings, engines, lanes, warmup, runs, tick))
+    pool.install(|| timed(scene, settings, engines, lanes, warmup, runs, tick, notice))
 }
 
+#[allow(clippy::too_many_arguments)]
 fn timed(
     scene: &Scene,
     settings: &RenderSettings,
@@ -45,6 +48,7 @@ fn timed(
     warmup: u32,
     runs: u32,
     tick: &(dyn Fn() + Sync),
+    notice: &(dyn Fn(&str) + Sync),
 ) -> Vec<EngineRecord> {
     let prepared: Vec<Prepared> = engines
         .iter()
@@ -55,6 +59,9 @@ fn timed(
         let (film, stats) = engine.render(&|| {});
         let seconds = start.elapsed().as_secs_f64();
         drop::<Film>(film);
+        if let Some(w) = clamped_warning(&stats) {
+            notice(&w);
+        }
         let stages = match engine.engine() {
             Engine::Wavefront => stats.stage_figures(),
             Engine::Reference => Vec::new(),

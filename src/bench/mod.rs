@@ -23,11 +23,11 @@ pub(crate) mod report;
 pub mod sweep;
 
 use crate::output::bench_record::{self as record, BenchRecord, Machine, SceneId, Setup};
-use crate::render::engine::{Engine, thread_pool};
+use crate::render::engine::{Engine, Hooks, thread_pool};
 use crate::render::scene::{SceneFile, load_scene};
 use crate::render::settings::options::ImageOptions;
 use crate::render::wavefront::DEFAULT_BATCH_SIZE;
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 use std::path::PathBuf;
 
 pub use report::report;
@@ -80,37 +80,29 @@ pub struct BenchOptions {
     /// The flags given on the command line (clap ids: `size`, `threads`, `engine`, ...):
     /// with `--compare`, every other setting comes from the record.
     pub explicit: Vec<String>,
-    /// Print the report on standard error (standard output carries an export).
-    pub report_to_stderr: bool,
-    /// Print only the comparison (or nothing but errors without `compare`).
-    pub quiet: bool,
 }
 
-/// What `run` found: `Some(comparison)` with `--compare`.
+/// What `run` measured and did: the records, where they were saved, and with `--compare` the
+/// comparison with the record it read.
 pub struct Outcome {
     /// One record per point.
     pub records: Vec<BenchRecord>,
-    /// The comparison, if asked for.
-    pub comparison: Option<compare::Comparison>,
+    /// Each point's label ("" for a run of one point).
+    pub labels: Vec<String>,
+    /// The records saved, in order.
+    pub saved: Vec<PathBuf>,
+    /// The comparison and the record compared with, if asked for.
+    pub comparison: Option<(compare::Comparison, BenchRecord)>,
 }
 
 impl Outcome {
     /// The process exit code: [`EXIT_REGRESSION`] when the comparison regressed, else 0.
     pub fn exit_code(&self) -> u8 {
         match &self.comparison {
-            Some(c) if c.regressed() => EXIT_REGRESSION,
+            Some((c, _)) if c.regressed() => EXIT_REGRESSION,
             _ => 0,
         }
     }
-}
-
-/// How the bench reports while it runs: `progress(done, total)` after each run (warm-up
-/// included), `warn` for each warning (noisy figures, outliers, a loaded machine).
-pub struct Hooks<'a> {
-    /// Runs done and runs in all.
-    pub progress: &'a (dyn Fn(u64, u64) + Sync),
-    /// One warning line, without the `warning: ` prefix.
-    pub warn: &'a dyn Fn(&str),
 }
 
 /// One point, ready to time: everything refusable was checked.
@@ -146,7 +138,7 @@ pub fn run(args: &BenchOptions, hooks: &Hooks) -> Result<Outcome> {
     let SceneFile { scene, bytes } =
         load_scene(args.scene.as_deref(), &args.image.parse_options())?;
     for w in &scene.warnings {
-        eprintln!("{w}");
+        (hooks.notice)(&w.to_string());
     }
     let baseline = match &args.compare {
         Some(name) => {
@@ -240,7 +232,7 @@ pub fn run(args: &BenchOptions, hooks: &Hooks) -> Result<Outcome> {
     }
 
     if let Some(w) = report::load_warning() {
-        (hooks.warn)(&w);
+        (hooks.notice)(&format!("warning: {w}"));
     }
     let total: u64 = plans
         .iter()
@@ -249,9 +241,9 @@ pub fn run(args: &BenchOptions, hooks: &Hooks) -> Result<Outcome> {
     let done = std::sync::atomic::AtomicU64::new(0);
     let tick = || {
         let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-        (hooks.progress)(n, total);
+        (hooks.progress)(n, total, "");
     };
-    (hooks.progress)(0, total);
+    (hooks.progress)(0, total, "");
     let build = crate::output::build_info::current();
     let mut records = Vec::new();
     for plan in &plans {
@@ -264,6 +256,7 @@ pub fn run(args: &BenchOptions, hooks: &Hooks) -> Result<Outcome> {
             args.warmup,
             args.runs,
             &tick,
+            hooks.notice,
         );
         let record = BenchRecord {
             format: record::FORMAT,
@@ -286,7 +279,7 @@ pub fn run(args: &BenchOptions, hooks: &Hooks) -> Result<Outcome> {
             engines,
         };
         for w in report::warnings(&record, &plan.point.label) {
-            (hooks.warn)(&w);
+            (hooks.notice)(&format!("warning: {w}"));
         }
         records.push(record);
     }
@@ -306,36 +299,19 @@ pub fn run(args: &BenchOptions, hooks: &Hooks) -> Result<Outcome> {
         ),
         _ => None,
     };
-    let out = |text: &str| -> Result<()> {
-        if args.report_to_stderr {
-            eprint!("{text}");
-            Ok(())
-        } else {
-            emit(text)
-        }
-    };
-    if !args.quiet {
-        for (plan, record) in plans.iter().zip(&records) {
-            if !plan.point.label.is_empty() {
-                out(&format!("\npoint   {}\n", plan.point.label))?;
-            }
-            out(&report(record))?;
-        }
-    }
     let regressed = comparison.as_ref().is_some_and(|c| c.regressed());
+    let mut saved = Vec::new();
     for (plan, record) in plans.iter().zip(&records) {
         let Some(path) = &plan.save else { continue };
         if regressed && args.save == args.compare {
-            (hooks.warn)(&format!(
-                "not saved: this run regressed against {}, which is kept as it was; save \
-                 under another name to keep this run",
+            (hooks.notice)(&format!(
+                "warning: not saved: this run regressed against {}, which is kept as it was; \
+                 save under another name to keep this run",
                 path.display()
             ));
         } else {
             record::save(path, record)?;
-            if !args.quiet {
-                out(&format!("saved   {}\n", path.display()))?;
-            }
+            saved.push(path.clone());
         }
     }
     if let (Some(p), Some(record)) = (&args.json, records.first()) {
@@ -351,22 +327,44 @@ pub fn run(args: &BenchOptions, hooks: &Hooks) -> Result<Outcome> {
     if let Some(p) = &args.export_markdown {
         export::write(p, &export::markdown(&records, &labels))?;
     }
-    if let (Some(c), Some((_, before))) = (&comparison, &baseline) {
-        if !args.quiet {
-            out("\n")?;
-        }
-        out(&format!(
-            "compared with {} ({}, commit {}):\n{}",
-            args.compare.as_deref().unwrap_or_default(),
-            before.timestamp,
-            before.build.short_commit(),
-            c.table()
-        ))?;
-    }
     Ok(Outcome {
         records,
-        comparison,
+        labels,
+        saved,
+        comparison: comparison.zip(baseline.map(|(_, before)| before)),
     })
+}
+
+impl Outcome {
+    /// The text a run prints: each point's report (unless `quiet`), the records saved, then
+    /// the comparison with the record named `compared_with`.
+    pub fn text(&self, quiet: bool, compared_with: Option<&str>) -> String {
+        let mut out = String::new();
+        if !quiet {
+            for (label, record) in self.labels.iter().zip(&self.records) {
+                if !label.is_empty() {
+                    out.push_str(&format!("\npoint   {label}\n"));
+                }
+                out.push_str(&report(record));
+            }
+            for path in &self.saved {
+                out.push_str(&format!("saved   {}\n", path.display()));
+            }
+        }
+        if let Some((c, before)) = &self.comparison {
+            if !quiet {
+                out.push('\n');
+            }
+            out.push_str(&format!(
+                "compared with {} ({}, commit {}):\n{}",
+                compared_with.unwrap_or_default(),
+                before.timestamp,
+                before.build.short_commit(),
+                c.table()
+            ));
+        }
+        out
+    }
 }
 
 /// The error for a record that holds nothing this run can be compared with.
@@ -378,9 +376,4 @@ fn incomparable(path: &std::path::Path, problems: &[String]) -> String {
         path.display(),
         problems.join("\n  ")
     )
-}
-
-/// Writes to stdout; a closed pipe (`raywave bench | head`) is an error, not a panic.
-fn emit(text: &str) -> Result<()> {
-    crate::output::terminal::write_stdout(text).context("cannot write to stdout")
 }

@@ -8,13 +8,11 @@ use clap::parser::ValueSource;
 use clap::{ArgAction, ArgMatches, Args, Subcommand, ValueEnum};
 use raywave::bench::ab::{self, AbOptions, MIN_ROUNDS};
 use raywave::bench::sweep::{Sweep, record_name};
-use raywave::bench::{
-    BenchOptions, DEFAULT_RUNS, DEFAULT_THRESHOLD_PCT, EXIT_REGRESSION, Hooks, list,
-};
+use raywave::bench::{BenchOptions, DEFAULT_RUNS, DEFAULT_THRESHOLD_PCT, EXIT_REGRESSION, list};
 use raywave::output::OutputPlan;
 use raywave::output::bench_record::record_path;
 use raywave::output::memory::{self, RenderFootprint};
-use raywave::render::engine::Engine;
+use raywave::render::engine::{Engine, Hooks};
 use raywave::render::error::UsageError;
 use std::path::PathBuf;
 
@@ -222,8 +220,6 @@ impl BenchArgs {
             export_csv: self.export_csv.clone(),
             export_markdown: self.export_markdown.clone(),
             explicit,
-            report_to_stderr: output_plan(self, &[]).uses_stdout(),
-            quiet: self.quiet,
         }
     }
 }
@@ -321,20 +317,28 @@ pub fn run(args: &BenchArgs, matches: Option<&ArgMatches>) -> Result<u8> {
             "{elapsed_precise} [{bar:40}] {pos}/{len} runs (warm-up included), engines alternating",
             args.quiet,
         );
-        let progress = |done: u64, total: u64| {
+        let progress = |done: u64, total: u64, _: &str| {
             bar.set_length(total);
             bar.set_position(done);
         };
-        let warn = |w: &str| bar.suspend(|| eprintln!("warning: {w}"));
+        let notice = |line: &str| bar.suspend(|| eprintln!("{line}"));
         let outcome = raywave::bench::run(
             &options,
             &Hooks {
                 progress: &progress,
-                warn: &warn,
+                notice: &notice,
             },
         );
         bar.finish_and_clear();
-        return Ok(outcome?.exit_code());
+        let outcome = outcome?;
+        let text = outcome.text(args.quiet, options.compare.as_deref());
+        // Standard output may carry an export (`--json -`); the report then goes to stderr.
+        if output_plan(args, &[]).uses_stdout() {
+            eprint!("{text}");
+        } else {
+            raywave::output::terminal::print(&text)?;
+        }
+        return Ok(outcome.exit_code());
     };
     let points = options.sweep.points().len();
     if points > 1 || options.sweep.threads.len() > 1 {

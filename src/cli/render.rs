@@ -19,7 +19,7 @@ use raywave::output::render_record::{
 };
 use raywave::output::terminal::progress_bar;
 use raywave::render::camera::CameraRays;
-use raywave::render::engine::{Engine, Prepared};
+use raywave::render::engine::{Engine, Prepared, clamped_warning};
 use raywave::render::error::UsageError;
 use raywave::render::film::{Film, ToneMap};
 use raywave::render::scene::Scene;
@@ -195,6 +195,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let seconds = start.elapsed().as_secs_f64();
     phases.mark("render");
     progress.finish_and_clear();
+    if let Some(w) = clamped_warning(&stats) {
+        eprintln!("{w}");
+    }
     let mut img = match format {
         OutputFormat::Ldr(_) => Some(film.to_rgb8(args.tonemap.into())),
         OutputFormat::Linear => None,

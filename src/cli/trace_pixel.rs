@@ -11,7 +11,7 @@ use raywave::output::image_file::ldr_format;
 use raywave::output::terminal::progress_bar;
 use raywave::output::{OutputPlan, write_output};
 use raywave::render::camera::CameraRays;
-use raywave::render::engine::Engine;
+use raywave::render::engine::{Engine, clamped_warning};
 use raywave::render::error::UsageError;
 use raywave::trace::draw::{Overlay, depth_buffer};
 use raywave::trace::view::ViewPlacement;
@@ -154,7 +154,10 @@ pub fn run(args: &TracePixelArgs) -> Result<()> {
             false,
         );
         let (film, depth) = pool.install(|| {
-            let (film, _) = engine.render(&|| progress.inc(1));
+            let (film, stats) = engine.render(&|| progress.inc(1));
+            if let Some(w) = clamped_warning(&stats) {
+                progress.suspend(|| eprintln!("{w}"));
+            }
             let rays = CameraRays::new(&camera, width, height);
             (film, depth_buffer(&view_scene, &rays, settings.two_sided))
         });

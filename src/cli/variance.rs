@@ -5,7 +5,12 @@ use super::values::{EngineArg, LightModelArg, SamplerArg};
 use anyhow::Result;
 use clap::Args;
 use raywave::output::OutputPlan;
-use raywave::variance::command::VarianceOptions;
+use raywave::output::terminal::{print, progress_bar};
+use raywave::render::engine::{Hooks, clamped_warning};
+use raywave::render::scene::{ParseOptions, Scene, SceneFile, load_scene};
+use raywave::render::settings::RenderSettings;
+use raywave::render::wavefront::DEFAULT_BATCH_SIZE;
+use raywave::variance::command::{Outcome, VarianceOptions, study};
 use std::path::PathBuf;
 
 /// Flags of `raywave variance`.
@@ -113,12 +118,73 @@ fn output_plan(options: &VarianceOptions) -> OutputPlan {
     plan
 }
 
-/// Runs the study on `--threads` worker threads.
+/// Runs the study on `--threads` worker threads, with a progress bar, then prints its table.
 pub fn run(args: &VarianceArgs) -> Result<()> {
     let options = args.options();
+    if options.clean_cache {
+        let (files, bytes) = raywave::variance::cache::clean(&options.cache)?;
+        return print(&format!(
+            "removed {files} cache entr{} ({:.1} MiB) from {}\n",
+            if files == 1 { "y" } else { "ies" },
+            bytes as f64 / (1u64 << 20) as f64,
+            options.cache.display()
+        ));
+    }
     // The flags' own errors first, with their own messages; then the outputs.
     options.validate()?;
     output_plan(&options).check()?;
     let pool = args.workers.pool()?;
-    pool.install(|| raywave::variance::command::run(&options))
+    let SceneFile { scene, bytes } =
+        load_scene(options.scene.as_deref(), &ParseOptions::default())?;
+    for w in &scene.warnings {
+        eprintln!("{w}");
+    }
+    let heatmap_n = options.heatmap_budget();
+    if heatmap_n != options.heatmap_n {
+        eprintln!(
+            "note: --heatmap-n {} is not one of --budgets; drawing the heat maps at the nearest budget, N = {heatmap_n}",
+            options.heatmap_n
+        );
+    }
+    let bar = progress_bar(
+        0,
+        "{spinner} variance [{bar:30}] {pos}/{len} {msg} ({elapsed}, eta {eta})",
+        options.quiet,
+    );
+    let progress = |done: u64, total: u64, label: &str| {
+        bar.set_length(total);
+        bar.set_position(done);
+        bar.set_message(label.to_string());
+    };
+    let notice = |line: &str| bar.suspend(|| eprintln!("{line}"));
+    let render = |scene: &Scene, settings: &RenderSettings| {
+        let (film, stats) = options
+            .engine
+            .render(scene, settings, DEFAULT_BATCH_SIZE, &|| {});
+        if let Some(w) = clamped_warning(&stats) {
+            notice(&w);
+        }
+        (film, stats.counts)
+    };
+    let hooks = Hooks {
+        progress: &progress,
+        notice: &notice,
+    };
+    let outcome = pool.install(|| study(&options, &scene, &bytes, &render, &hooks));
+    bar.finish_and_clear();
+    let Outcome { result, written } = outcome?;
+    print(&format!(
+        "{}\nconverged reference: {}\nwrote   {}\n",
+        result.table(),
+        if result.reference_cached {
+            "from the cache"
+        } else {
+            "rendered"
+        },
+        written
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
+    ))
 }

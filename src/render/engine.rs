@@ -92,6 +92,26 @@ impl Engine {
     }
 }
 
+/// How a long job reports while it runs. The library never prints: the command line turns
+/// `progress` into a progress bar and `notice` into lines on stderr, and tests, benches and the
+/// viewer pass [`Hooks::SILENT`].
+#[derive(Clone, Copy)]
+pub struct Hooks<'a> {
+    /// Steps done, steps in all, and what is being done now.
+    pub progress: &'a (dyn Fn(u64, u64, &str) + Sync),
+    /// One line for the user, whole: `warning: ...`, `note: ...`, or a scene's
+    /// `file:line: warning: ...`.
+    pub notice: &'a (dyn Fn(&str) + Sync),
+}
+
+impl Hooks<'static> {
+    /// Hooks that show nothing.
+    pub const SILENT: Hooks<'static> = Hooks {
+        progress: &|_, _, _| {},
+        notice: &|_| {},
+    };
+}
+
 /// An engine set up for one scene and one set of settings.
 pub enum Prepared<'a> {
     /// The wavefront engine.
@@ -145,17 +165,11 @@ impl Prepared<'_> {
     ///
     /// Every pixel comes out finite: a scene's numbers are bounded by the parser, but a mirror
     /// that reflects more than it receives, over many bounces, or a bright light next to a
-    /// surface can still overflow f32; such pixels are clamped (see [`clamp_to_finite`]) with
-    /// one warning on stderr.
+    /// surface can still overflow f32; such pixels are clamped (see [`clamp_to_finite`]) and
+    /// counted in `clamped_pixels`, for the caller to warn with [`clamped_warning`].
     pub fn render(&self, progress: &(dyn Fn() + Sync)) -> (Film, RenderStats) {
-        let (mut film, stats) = self.render_raw(progress);
-        let clamped = clamp_to_finite(&mut film);
-        if clamped > 0 {
-            eprintln!(
-                "warning: {clamped} pixel(s) overflowed f32 and were clamped to finite values \
-                 (the scene's colours or mirrors amplify light past 3.4e38)"
-            );
-        }
+        let (mut film, mut stats) = self.render_raw(progress);
+        stats.clamped_pixels = clamp_to_finite(&mut film) as u64;
         (film, stats)
     }
 
@@ -193,6 +207,17 @@ pub fn clamp_to_finite(film: &mut Film) -> usize {
         }
     }
     changed
+}
+
+/// The warning for a render whose `stats` clamped pixels (`None` when none was clamped).
+pub fn clamped_warning(stats: &RenderStats) -> Option<String> {
+    (stats.clamped_pixels > 0).then(|| {
+        format!(
+            "warning: {} pixel(s) overflowed f32 and were clamped to finite values (the scene's colours \
+             or mirrors amplify light past 3.4e38)",
+            stats.clamped_pixels
+        )
+    })
 }
 
 /// The worker threads the engines render on: `threads`, or rayon's default (all cores).

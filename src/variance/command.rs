@@ -1,12 +1,11 @@
-//! `raywave variance`: the study as a command (options, progress, outputs); the flags are the
-//! binary's.
+//! `raywave variance`: the study as a command (options, checks, outputs); the flags, the
+//! progress bar and the printed table are the binary's (`cli/variance.rs`).
 
-use super::{Cache, Region, StudyConfig, cache, run_study};
-use crate::output::terminal::{print, progress_bar};
-use crate::render::engine::Engine;
+use super::{Cache, Region, RenderFn, StudyConfig, run_study};
+use crate::render::engine::{Engine, Hooks};
 use crate::render::error::UsageError;
 use crate::render::sampling::LightSampler;
-use crate::render::scene::{ParseOptions, Scene, SceneFile, load_scene};
+use crate::render::scene::Scene;
 use crate::render::settings::{LightModel, RenderSettings};
 use anyhow::{Context, Result, bail};
 use std::path::PathBuf;
@@ -113,25 +112,25 @@ pub fn nearest_budget(budgets: &[u32], n: u32) -> Option<u32> {
 /// The largest total size of the K images a study holds at once.
 pub const MAX_STUDY_BYTES: u64 = 4 << 30;
 
-/// Runs the study on the current rayon pool, writes the outputs, then prints the table.
-pub fn run(args: &VarianceOptions) -> Result<()> {
-    if args.clean_cache {
-        let (files, bytes) = cache::clean(&args.cache)?;
-        return print(&format!(
-            "removed {files} cache entr{} ({:.1} MiB) from {}\n",
-            if files == 1 { "y" } else { "ies" },
-            bytes as f64 / (1u64 << 20) as f64,
-            args.cache.display()
-        ));
-    }
-    args.validate()?;
-    let SceneFile {
-        scene,
-        bytes: scene_bytes,
-    } = load_scene(args.scene.as_deref(), &ParseOptions::default())?;
-    for w in &scene.warnings {
-        eprintln!("{w}");
-    }
+/// A finished study: its result, and the files written.
+pub struct Outcome {
+    /// The figures.
+    pub result: super::StudyResult,
+    /// The files written into `--out`, in order.
+    pub written: Vec<PathBuf>,
+}
+
+/// Runs the study of `scene` (whose file held `scene_bytes`) as `options` say, on the current
+/// rayon pool, and writes its files into `options.out`. Reports through `hooks`; prints
+/// nothing.
+pub fn study(
+    options: &VarianceOptions,
+    scene: &Scene,
+    scene_bytes: &[u8],
+    render: &RenderFn,
+    hooks: &Hooks,
+) -> Result<Outcome> {
+    options.validate()?;
     if scene.lights.is_empty() {
         bail!(
             "{}: expected a scene with at least one area light (a face whose material has a non-zero `emitted`), found none: there is no light sampling to study",
@@ -139,104 +138,75 @@ pub fn run(args: &VarianceOptions) -> Result<()> {
         );
     }
     // Fail on an unusable output directory now, not after minutes of rendering.
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("cannot create the output directory {}", args.out.display()))?;
-    let mut cache = (!args.no_cache).then(|| Cache::new(&args.cache, args.cache_limit_mib));
+    std::fs::create_dir_all(&options.out).with_context(|| {
+        format!(
+            "cannot create the output directory {}",
+            options.out.display()
+        )
+    })?;
+    let mut cache =
+        (!options.no_cache).then(|| Cache::new(&options.cache, options.cache_limit_mib));
     if let Some(c) = &cache
         && let Err(e) = std::fs::create_dir_all(&c.dir)
     {
-        eprintln!(
+        (hooks.notice)(&format!(
             "warning: cannot use the cache directory {} ({e}): the converged reference will not be cached",
             c.dir.display()
-        );
+        ));
         cache = None;
     }
     let mut samplers = Vec::new();
-    for s in &args.samplers {
+    for s in &options.samplers {
         if !samplers.contains(s) {
             samplers.push(*s);
         }
     }
     let mut budgets = Vec::new();
-    for n in &args.budgets {
+    for n in &options.budgets {
         if !budgets.contains(n) {
             budgets.push(*n);
         }
     }
     let base = RenderSettings {
-        width: args.size[0],
-        height: args.size[1],
-        bounces: args.bounces,
-        light_model: args.light_model,
+        width: options.size[0],
+        height: options.size[1],
+        bounces: options.bounces,
+        light_model: options.light_model,
         background: scene
             .background
             .map(|c| c.to_array())
             .unwrap_or(RenderSettings::default().background),
         ..RenderSettings::default()
     };
-    let heatmap_n = args.heatmap_budget();
-    if heatmap_n != args.heatmap_n {
-        eprintln!(
-            "note: --heatmap-n {} is not one of --budgets; drawing the heat maps at the nearest budget, N = {heatmap_n}",
-            args.heatmap_n
-        );
-    }
     let config = StudyConfig {
         budgets,
         samplers,
-        seeds: args.seeds,
-        reference_samples: args.reference_samples,
-        mask_samples: args.mask_samples,
-        heatmap_n,
+        seeds: options.seeds,
+        reference_samples: options.reference_samples,
+        mask_samples: options.mask_samples,
+        heatmap_n: options.heatmap_budget(),
         ..StudyConfig::standard(base)
     };
-    // The reference, the mask, then per sampler and N a warm-up render and K timed ones.
-    let steps =
-        2 + (config.samplers.len() * config.budgets.len()) as u64 * (config.seeds as u64 + 1);
-    let bar = progress_bar(
-        steps,
-        "{spinner} variance [{bar:30}] {pos}/{len} {msg} ({elapsed}, eta {eta})",
-        args.quiet,
-    );
-    bar.set_message("converged reference");
     let result = run_study(
-        &scene,
-        &scene_bytes,
+        scene,
+        scene_bytes,
         &config,
-        args.engine.name(),
-        &|scene: &Scene, settings: &RenderSettings| args.engine.image(scene, settings),
+        options.engine.name(),
+        render,
         cache.as_ref(),
-        &|label| {
-            bar.set_message(label.to_string());
-            bar.inc(1);
-        },
+        hooks,
     )?;
-    bar.finish_and_clear();
-    // Files first: a closed or full standard output must not cost the results.
-    let written = result.write(&args.out)?;
+    let written = result.write(&options.out)?;
     for region in [Region::Penumbra, Region::Lit] {
         let margin = result.reference_margin(region);
         if result.region_pixels[Region::ALL.iter().position(|&r| r == region).unwrap_or(0)] > 0
             && margin < 10.0
         {
-            eprintln!(
+            (hooks.notice)(&format!(
                 "warning: the converged reference's own error is only {margin:.1}× below the smallest MSE measured on the {} region; raise --reference-samples",
                 region.name()
-            );
+            ));
         }
     }
-    print(&format!(
-        "{}\nconverged reference: {}\nwrote   {}\n",
-        result.table(),
-        if result.reference_cached {
-            "from the cache"
-        } else {
-            "rendered"
-        },
-        written
-            .iter()
-            .map(|p| p.display().to_string())
-            .collect::<Vec<_>>()
-            .join(", ")
-    ))
+    Ok(Outcome { result, written })
 }

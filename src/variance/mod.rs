@@ -27,6 +27,7 @@ pub(crate) mod plot;
 pub mod report;
 pub mod sheet;
 
+use crate::render::engine::Hooks;
 use crate::render::film::Film;
 use crate::render::film::ToneMap;
 use crate::render::per_kind::RayCounts;
@@ -119,6 +120,7 @@ pub fn converged_reference(
     config: &StudyConfig,
     render: &RenderFn,
     cache: Option<&Cache>,
+    notice: &(dyn Fn(&str) + Sync),
 ) -> Result<Converged> {
     let halves = [0xa11c_e000u32, 0xb0b0_0001];
     let settings: Vec<RenderSettings> = halves
@@ -133,10 +135,10 @@ pub fn converged_reference(
         cache::Lookup::Hit(films) => films,
         miss => {
             if let (cache::Lookup::Invalid(what), Some(c)) = (&miss, cache) {
-                eprintln!(
+                notice(&format!(
                     "warning: ignoring the cache entry {}: {what}; rendering the reference again",
                     c.entry_path(key).display()
-                );
+                ));
             }
             let films = [render(scene, &settings[0]).0, render(scene, &settings[1]).0];
             let bad: usize = films.iter().map(Film::non_finite_pixels).sum();
@@ -150,10 +152,10 @@ pub fn converged_reference(
             if let Some(c) = cache
                 && let Err(e) = c.write(key, &films)
             {
-                eprintln!(
+                notice(&format!(
                     "warning: cannot cache the reference in {}: {e:#}",
                     c.entry_path(key).display()
-                );
+                ));
             }
             films
         }
@@ -354,9 +356,18 @@ pub fn run_study(
     engine: &str,
     render: &RenderFn,
     cache: Option<&Cache>,
-    progress: &dyn Fn(&str),
+    hooks: &Hooks,
 ) -> Result<StudyResult> {
-    let reference = converged_reference(scene, scene_id, config, render, cache)?;
+    // The reference, the mask, then per sampler and N a warm-up render and K timed ones.
+    let steps =
+        2 + (config.samplers.len() * config.budgets.len()) as u64 * (config.seeds as u64 + 1);
+    let done = std::cell::Cell::new(0u64);
+    let progress = |label: &str| {
+        done.set(done.get() + 1);
+        (hooks.progress)(done.get(), steps, label);
+    };
+    (hooks.progress)(0, steps, "converged reference");
+    let reference = converged_reference(scene, scene_id, config, render, cache, hooks.notice)?;
     progress("converged reference");
     let regions = penumbra_mask(scene, &config.base, config.mask_samples);
     progress("penumbra mask");

@@ -244,8 +244,9 @@ impl Comparisons {
             pool.install(|| engine.image(s, settings))
         };
         let internal = |e: anyhow::Error| ApiError::status(500, format!("{e:#}"));
-        let reference = converged_reference(&scene, b"raywave view", &config, &render, None)
-            .map_err(internal)?;
+        let reference =
+            converged_reference(&scene, b"raywave view", &config, &render, None, &|_| {})
+                .map_err(internal)?;
         let regions = pool.install(|| penumbra_mask(&scene, &config.base, MASK_SAMPLES));
         let whole = regions.whole();
         let id = self.next.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;

@@ -299,7 +299,7 @@ fn the_study_meets_its_floor_and_writes_its_outputs() {
         "wavefront",
         &render,
         None,
-        &|_| {},
+        &raywave::render::engine::Hooks::SILENT,
     )
     .unwrap();
     let slope = |sampler: &str| {

@@ -159,7 +159,7 @@ fn the_study_flags_biased_samplers_and_only_them() {
         "wavefront",
         &render,
         None,
-        &|_| {},
+        &raywave::render::engine::Hooks::SILENT,
     )
     .unwrap();
     assert!(result.region_pixels[1] > 200, "{:?}", result.region_pixels);
@@ -235,7 +235,8 @@ fn the_reference_noise_is_half_the_squared_half_difference() {
         (film, RayCounts::default())
     };
     let r =
-        raywave::variance::converged_reference(&scene, b"noise", &config, &render, None).unwrap();
+        raywave::variance::converged_reference(&scene, b"noise", &config, &render, None, &|_| {})
+            .unwrap();
     let seeds = seeds.into_inner().unwrap();
     assert_eq!(seeds.len(), 2, "two halves");
     assert_ne!(seeds[0], seeds[1], "independent halves");

@@ -54,6 +54,9 @@ pub struct RenderStats {
     /// stage timers: camera = generate + intersect of the camera rays; reflection = reflect +
     /// intersect of the mirror rays; shadow = the shadow stage; film belongs to no kind.
     pub kind_time: Option<PerKind<Duration>>,
+    /// Pixels that overflowed f32 and were clamped to finite values
+    /// ([`crate::render::engine::clamp_to_finite`]); the caller warns.
+    pub clamped_pixels: u64,
 }
 
 impl RenderStats {
@@ -134,6 +137,7 @@ impl Add for RenderStats {
         for (a, b) in self.stage_time.iter_mut().zip(o.stage_time) {
             *a += b;
         }
+        self.clamped_pixels += o.clamped_pixels;
         self.kind_time = match (self.kind_time, o.kind_time) {
             (Some(a), Some(b)) => Some(a + b),
             (a, b) => a.or(b),
