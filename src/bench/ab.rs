@@ -366,4 +366,25 @@ mod tests {
         let s = summarize(&around(1.10, 0.02), 5.0);
         assert!(s.low <= s.median && s.median <= s.high);
     }
+
+    /// The interval's ends are the sign test's order statistics, known by hand: for the 20
+    /// ratios 1 + i/64 (i = 0..20, given in reverse), rank 6, so the 6th and the 15th smallest,
+    /// 1 + 5/64 and 1 + 14/64, around the median 1 + 9.5/64 (all exact in binary). A threshold
+    /// whose bound equals the low end does not call a slowdown; one just below it does.
+    #[test]
+    fn the_interval_ends_are_the_sign_tests_order_statistics() {
+        let ratios: Vec<f64> = (0..20).rev().map(|i| 1.0 + i as f64 / 64.0).collect();
+        let s = summarize(&ratios, 5.0);
+        assert_eq!(
+            (s.low, s.median, s.high),
+            (1.0 + 5.0 / 64.0, 1.0 + 9.5 / 64.0, 1.0 + 14.0 / 64.0)
+        );
+        assert_eq!(s.verdict, Verdict::Slower);
+        let at_low_end = 100.0 * 5.0 / 64.0;
+        assert_ne!(summarize(&ratios, at_low_end).verdict, Verdict::Slower);
+        assert_eq!(
+            summarize(&ratios, at_low_end * 0.999).verdict,
+            Verdict::Slower
+        );
+    }
 }

@@ -182,6 +182,11 @@ fn bad_requests_get_their_4xx_and_a_message() {
         ("GET", "/api/compare/x/a.png".into(), vec![], b"", 400, "expected a comparison number"),
         ("GET", "/api/scene".into(), vec![("Host", "evil.example")], b"", 421, "unexpected Host"),
         ("POST", "/api/render".into(), vec![("Origin", "http://evil.example")], b"{}", 403, "are refused"),
+        // Both checks come before routing: the page, an asset and the other verbs refuse alike.
+        ("GET", "/".into(), vec![("Host", "evil.example")], b"", 421, "unexpected Host"),
+        ("POST", "/api/render".into(), vec![("Host", "evil.example")], b"{}", 421, "unexpected Host"),
+        ("GET", "/api/scene".into(), vec![("Origin", "http://evil.example")], b"", 403, "are refused"),
+        ("GET", "/assets/app.js".into(), vec![("Origin", "http://evil.example")], b"", 403, "are refused"),
     ];
     for (method, path, headers, body, status, message) in cases {
         let r = server.request(method, &path, &headers, body);
