@@ -13,6 +13,8 @@
 # clean work tree: it refuses to start when src/ has uncommitted changes, and it always reverts
 # what it applied. Each mutant rebuilds the library in release: about a minute on 2 cores.
 set -u
+# A mutant's property-test failures are the mutant's, not seeds for the real code's runs.
+export PROPTEST_DISABLE_FAILURE_PERSISTENCE=1
 cd "$(git rev-parse --show-toplevel)" || exit 2
 if ! git diff --quiet -- src; then
     echo "src/ has uncommitted changes: commit or stash them first" >&2
