@@ -1,6 +1,7 @@
-//! `raywave bench`: times the engines on one scene (or on each point of a sweep), prints every
-//! headline figure's min, median, 95% interval and max, warns when the figures are noisy, and
-//! keeps and compares records for regression checks.
+//! `raywave bench`: times the engines on one scene (or on each point of a sweep), summarises
+//! every headline figure (min, median, 95% interval, max), warns when the figures are noisy, and
+//! keeps and compares records for regression checks. It returns what it found; the command
+//! line prints it (`Outcome::text`).
 //!
 //! ```text
 //! --compare's record: load; adopt its settings, threads and engines unless a flag was given;
@@ -9,8 +10,8 @@
 //!     warm-up: --warmup untimed runs per engine
 //!     timed:   --runs rounds, each running every engine once, the first engine alternating
 //!     summary: per headline figure min, median, 95% interval, max, outlier runs; warnings
-//! compare -> verdict (median change past the threshold AND intervals apart); print; write
-//!   --save (never over the record it regressed against), --json and the exports
+//! compare -> verdict (median change past the threshold AND intervals apart); write --save
+//!   (never over the record it regressed against), --json and the exports; return the outcome
 //! ```
 
 pub mod ab;
@@ -115,7 +116,7 @@ struct Plan {
     save: Option<PathBuf>,
 }
 
-/// Runs the bench as the flags say, printing the tables; errors name the file or flag.
+/// Runs the bench as the flags say and writes its files; errors name the file or flag.
 pub fn run(args: &BenchOptions, hooks: &Hooks) -> Result<Outcome> {
     // Everything that can fail cheaply happens before the timed part.
     let points = args.sweep.points();

@@ -211,21 +211,24 @@ pub fn output_format(path: &Path) -> Result<OutputFormat> {
     }
 }
 
-/// An 8-bit image as PNG bytes: the one PNG encoder of every output (files, figures and the
-/// viewer's levels).
+/// Encodes an 8-bit image as PNG into `w`: the one PNG encoder of every output (files, figures
+/// and the viewer's levels), streaming, so a large image is not held twice.
+pub fn write_png(img: &image::RgbImage, w: &mut (impl Write + std::io::Seek)) -> Result<()> {
+    img.write_to(w, image::ImageFormat::Png)?;
+    Ok(())
+}
+
+/// An 8-bit image as PNG bytes (`write_png` into memory), for the viewer's replies.
 pub fn png_bytes(img: &image::RgbImage) -> Result<Vec<u8>> {
     let mut out = std::io::Cursor::new(Vec::new());
-    img.write_to(&mut out, image::ImageFormat::Png)?;
+    write_png(img, &mut out)?;
     Ok(out.into_inner())
 }
 
 /// Writes an 8-bit image whole or not at all; the format follows the extension (png, ppm).
 pub fn write_rgb8(img: &image::RgbImage, path: &Path) -> Result<()> {
     match ldr_format(path)? {
-        LdrFormat::Png => {
-            let bytes = png_bytes(img)?;
-            write_atomically(path, |w| Ok(w.write_all(&bytes)?))
-        }
+        LdrFormat::Png => write_atomically(path, |w| write_png(img, w)),
         LdrFormat::Ppm => write_atomically(path, |w| {
             // Netpbm's binary pixmap: magic, width, height, maxval, one whitespace byte, then
             // the RGB bytes row by row from the top.

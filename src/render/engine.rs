@@ -80,7 +80,8 @@ impl Engine {
     }
 
     /// One image at the default batch size, without progress, as the variance study's
-    /// `RenderFn` takes it.
+    /// `RenderFn` takes it. Pixels it clamps are not reported: a caller that warns of them
+    /// uses [`Engine::render`] and [`clamped_warning`].
     pub fn image(self, scene: &Scene, settings: &RenderSettings) -> (Film, RayCounts) {
         let (film, stats) = self.render(
             scene,
