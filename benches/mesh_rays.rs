@@ -46,7 +46,7 @@
 mod common;
 
 use criterion::{BenchmarkId, Criterion, Throughput};
-use raywave::output::bench_record::median;
+use raywave::output::statistics::median;
 use raywave::peer::{
     Hits, ObvhsMesh, RaySet, RaySetKind, RaySets, hit_agreement, occlusion_agreement,
     raywave_closest, wavefront_bvh_closest, wavefront_bvh_closest_one_ray, wavefront_closest,

@@ -19,7 +19,7 @@
 
 mod common;
 
-use raywave::output::bench_record::median;
+use raywave::output::statistics::median;
 use raywave::render::scene::Scene;
 use raywave::render::settings::RenderSettings;
 use raywave::render::wavefront::{DEFAULT_BATCH_SIZE, Wavefront};

@@ -23,7 +23,8 @@ pub(crate) mod measure;
 pub(crate) mod report;
 pub mod sweep;
 
-use crate::output::bench_record::{self as record, BenchRecord, Machine, SceneId, Setup};
+use crate::output::bench_record::{self as record, BenchRecord, SceneId, Setup};
+use crate::output::machine::Machine;
 use crate::render::engine::{Engine, Hooks, thread_pool};
 use crate::render::scene::{SceneFile, load_scene};
 use crate::render::settings::options::ImageOptions;

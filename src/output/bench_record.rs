@@ -1,7 +1,7 @@
 //! A bench record: what was measured (medians and every run) and under which conditions
 //! (machine, build, scene, settings), as it is saved to `.raywave-bench/NAME.json`.
 
-pub use crate::output::machine::Machine;
+use crate::output::machine::Machine;
 use crate::render::per_kind::{PerKind, RayCounts};
 use crate::render::settings::RenderSettings;
 use crate::render::wavefront::stats::{RenderStats, StageFigure};
@@ -298,7 +298,7 @@ pub fn per_thread_second(rays: u64, time: std::time::Duration) -> Option<f64> {
     (rays > 0 && seconds > 0.0).then(|| rays as f64 / seconds)
 }
 
-pub use crate::output::statistics::median;
+use crate::output::statistics::median;
 
 impl Measurement {
     /// Each figure's median over `runs` (ray counts from the first run: they do not vary).

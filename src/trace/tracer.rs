@@ -52,7 +52,7 @@ pub enum TraceError {
         /// Image height.
         height: u32,
     },
-    /// The tree could hold more segments than [`MAX_SEGMENTS`].
+    /// The tree could hold more segments than `MAX_SEGMENTS`.
     #[error("the tree could hold up to {bound} segments ({aa} camera rays × {paths} path segments × (1 + {lights} light(s) × {points} points)): expected at most {max}; use fewer --aa, --shadow-samples or --bounces", max = MAX_SEGMENTS)]
     TooLarge {
         /// The bound on the segment count.

@@ -38,7 +38,7 @@ pub struct Slope {
 }
 
 /// The budget at which a sampler's fitted MSE equals random's fitted MSE at
-/// [`LAB_RANDOM_POINTS`], for a (sampler, region).
+/// `LAB_RANDOM_POINTS`, for a (sampler, region).
 #[derive(Clone, Debug, Serialize)]
 pub struct Matching {
     /// Sampler name.
