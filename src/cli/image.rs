@@ -1,6 +1,6 @@
 //! The flags that shape the image, shared by `raywave render` and `raywave bench`.
 
-use super::values::{DefaultsArg, LightModelArg, SamplerArg, ShadowArg, float};
+use super::values::{DefaultsArg, LightModelArg, SamplerArg, ShadowArg, colour_component};
 use clap::Args;
 use raywave::output::OutputPlan;
 use raywave::render::scene::{Scene, load_scene};
@@ -34,10 +34,10 @@ pub struct ImageArgs {
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub aa: Option<u32>,
     /// Background colour for rays that hit nothing [default: the scene's, else white].
-    #[arg(long, num_args = 3, value_names = ["R", "G", "B"], value_parser = float("a finite non-negative colour component", |x: f32| x.is_finite() && x >= 0.0))]
+    #[arg(long, num_args = 3, value_names = ["R", "G", "B"], value_parser = colour_component())]
     pub background: Option<Vec<f32>>,
     /// Ambient light: every hit gets ambient ⊙ kd [default: 0.2 grey; RPI's 0.1].
-    #[arg(long, num_args = 3, value_names = ["R", "G", "B"], value_parser = float("a finite non-negative colour component", |x: f32| x.is_finite() && x >= 0.0))]
+    #[arg(long, num_args = 3, value_names = ["R", "G", "B"], value_parser = colour_component())]
     pub ambient: Option<Vec<f32>>,
     /// How a light's colour reaches a point: lab (no fall-off) or rpi (divided by π·d², as
     /// RPI's framework does) [default: lab; RPI's rpi].

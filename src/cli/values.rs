@@ -26,6 +26,13 @@ where
     })
 }
 
+/// A colour component of `--background` and `--ambient`: finite and not negative.
+pub fn colour_component() -> impl TypedValueParser<Value = f32> {
+    float("a finite non-negative colour component", |x: f32| {
+        x.is_finite() && x >= 0.0
+    })
+}
+
 /// Declares a clap value enum and its conversion into the library's enum of the same variants.
 macro_rules! mirror {
     ($(#[$doc:meta])* $name:ident => $lib:ident { $($(#[$vdoc:meta])* $variant:ident,)+ }) => {
