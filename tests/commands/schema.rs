@@ -82,7 +82,10 @@ fn violations(python: &str, name: &str, instance: &Value) -> Vec<String> {
         "docs/schema/{name} is not a usable JSON Schema, or the validator failed:\n{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    String::from_utf8_lossy(&out.stdout).lines().map(str::to_string).collect()
+    String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .map(str::to_string)
+        .collect()
 }
 
 fn assert_valid(python: &str, name: &str, instance: &Value) {

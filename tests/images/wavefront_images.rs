@@ -236,6 +236,66 @@ fn sixteen_and_eight_lanes_give_the_same_bytes_on_every_scene() {
     }
 }
 
+/// Soft shadows on small scenes are spawned, tested and shaded in registers, block by block
+/// (`shadow::fused`); every other shadow ray goes through the queue. Both give the same bytes and
+/// counts on every bundled scene: every sampler, point counts with dead tail lanes at 8 and 16
+/// lanes, both light models (the RPI model's fall-off is computed from each block's distances),
+/// bounces, antialiasing and odd batch sizes.
+#[test]
+fn fused_and_queued_shadow_blocks_give_the_same_bytes_on_every_scene() {
+    use raywave::render::settings::LightModel;
+    use raywave::render::wavefront::lanes::LaneWidth;
+    let soft = |n, sampler, light_model| RenderSettings {
+        shadows: ShadowMode::Soft,
+        shadow_samples: n,
+        sampler,
+        light_model,
+        ..modes()[1].clone()
+    };
+    let mut settings = Vec::new();
+    for sampler in [
+        LightSampler::Random,
+        LightSampler::Stratified,
+        LightSampler::Sobol,
+        LightSampler::Lab,
+    ] {
+        for n in [1, 7, 17, 64] {
+            settings.push(soft(n, sampler, LightModel::Lab));
+        }
+        settings.push(soft(9, sampler, LightModel::Rpi));
+    }
+    settings.push(RenderSettings {
+        aa_samples: 2,
+        bounces: 4,
+        two_sided: true,
+        ..soft(24, LightSampler::Stratified, LightModel::Lab)
+    });
+    for (name, scene) in bundled_scenes() {
+        for (m, s) in settings.iter().enumerate() {
+            let batches: &[usize] = if m % 4 == 0 { &[1, 7] } else { &[64] };
+            for &batch in batches {
+                for width in [LaneWidth::Eight, LaneWidth::Sixteen] {
+                    let render = |queued| {
+                        let w = Wavefront::new(&scene, s, batch)
+                            .with_lane_width(width)
+                            .with_queued_shadows(queued);
+                        let (film, stats) = w.render(&|| {});
+                        (film_bits(&film), stats.counts)
+                    };
+                    let (queued, cq) = render(true);
+                    let (fused, cf) = render(false);
+                    assert!(
+                        queued == fused,
+                        "{name}: the fused shadow blocks changed the image at {width:?}, batch \
+                         {batch}, {s:?}"
+                    );
+                    assert_eq!(cq, cf, "{name}: ray counts differ with {s:?}");
+                }
+            }
+        }
+    }
+}
+
 /// `LaneWidth::Auto` is the build's native width: 16 lanes when built for AVX-512, else 8.
 #[test]
 fn auto_lanes_follow_the_build() {

@@ -20,6 +20,7 @@ use raywave::render::sampling::{LightSampler, SampleKey, square_sample, strata_g
 use raywave::render::scene::{Light, LightShape, Material, NO_HIT, Scene, Sphere};
 use raywave::render::shading::shade;
 use raywave::render::spawn::{SurfaceHit, light_end, shadow_ray};
+use raywave::render::wavefront::batch::ShadowBlock;
 use raywave::render::wavefront::lanes::{Lanes, f32x8, f32x16};
 use raywave::render::wavefront::shade::{
     HitLight, MaterialTerms, ShadowLanes, shade_lanes, shade_terms, shade8,
@@ -282,6 +283,65 @@ fn check_batch(scene: &Scene, rays: &[(Ray, f32)], two_sided: bool) {
     }
 }
 
+/// `block_occluded` (one block of rays from one origin, in registers, as the fused shadow stage
+/// tests them) against `occluded` over the same rays in columns: the same answer on every live
+/// lane, with all triangles and with the shadow casters, for `n` rays cut into blocks of `V::N`
+/// (the last padded with dead lanes: NaN directions, tmax 0).
+fn check_blocks<V: Lanes>(scene: &Scene, n: usize, offset: usize, two_sided: bool) {
+    let rays = shared_origin_runs(n, offset, V::N);
+    // Blocks start where the runs do: from the offset's first whole run.
+    let first = (V::N - offset % V::N) % V::N;
+    let rays = &rays[first.min(rays.len())..];
+    let cols = Columns::new(rays);
+    let casters = shadow_casters(scene);
+    for triangles in [
+        &scene.triangles[..],
+        geometry::casters(scene, &casters, two_sided),
+    ] {
+        let mut want = vec![false; rays.len()];
+        simd::occluded(
+            triangles,
+            &scene.spheres,
+            &cols.view(),
+            two_sided,
+            &mut want,
+        );
+        for (b, chunk) in rays.chunks(V::N).enumerate() {
+            let mut block = ShadowBlock {
+                origin: chunk[0].0.origin,
+                l: [V::Array::default(); 3],
+                tmax: V::Array::default(),
+                n_dot_l: V::Array::default(),
+                dist: V::Array::default(),
+                live: 0,
+            };
+            for k in 0..V::N {
+                let (d, tmax) = chunk
+                    .get(k)
+                    .map_or((Vec3::NAN, 0.0), |(r, t)| (r.direction, *t));
+                block.l[0].as_mut()[k] = d.x;
+                block.l[1].as_mut()[k] = d.y;
+                block.l[2].as_mut()[k] = d.z;
+                block.tmax.as_mut()[k] = tmax;
+                if tmax > 0.0 {
+                    block.live |= 1 << k;
+                }
+            }
+            let got = simd::block_occluded::<V>(triangles, &scene.spheres, &block, two_sided);
+            for (k, (r, tmax)) in chunk.iter().enumerate() {
+                if block.live >> k & 1 == 1 {
+                    assert_eq!(
+                        got >> k & 1 == 1,
+                        want[b * V::N + k],
+                        "{}-lane block {b}, lane {k}: {r:?} tmax {tmax}",
+                        V::N
+                    );
+                }
+            }
+        }
+    }
+}
+
 fn lab_box() -> Scene {
     raywave::render::scene::Scene::builtin_default()
 }
@@ -340,6 +400,8 @@ fn batch_kernels_handle_lengths_around_the_lane_width() {
             check_batch(&scene, &shared_origin_rays(n, 3), two_sided);
             check_batch(&scene, &shared_origin_runs(n, 0, 16), two_sided);
             check_batch(&scene, &shared_origin_runs(n, 5, 16), two_sided);
+            check_blocks::<f32x8>(&scene, n, 0, two_sided);
+            check_blocks::<f32x16>(&scene, n, 5, two_sided);
         }
     }
 }
@@ -414,6 +476,8 @@ proptest! {
         }).collect();
         check_batch(&scene, &rays, seed % 2 == 0);
         check_batch(&scene, &shared_origin_rays(n, seed as usize % 8), seed % 3 == 0);
+        check_blocks::<f32x8>(&scene, n, seed as usize % 8, seed % 3 == 0);
+        check_blocks::<f32x16>(&scene, n, seed as usize % 16, seed % 5 == 0);
     }
 
     #[test]

@@ -84,6 +84,10 @@ pub struct Context<'a> {
     /// The lane width of the brute-force, light and shading kernels, resolved (`Eight` or
     /// `Sixteen`): [`auto_width`]'s choice unless [`Context::with_lane_width`] says otherwise.
     pub lane_width: LaneWidth,
+    /// Every shadow ray through the queue, even where the shadow stage would fuse spawn,
+    /// occlusion and Shade in registers (`shadow::fuses`): false unless
+    /// [`Context::with_queued_shadows`] says otherwise. Speed only.
+    pub queued_shadows: bool,
     /// Stratum column of every point index (padded to a multiple of 16), as floats.
     pub cell_x: Vec<f32>,
     /// Stratum row of every point index.
@@ -149,6 +153,7 @@ impl<'a> Context<'a> {
             lights,
             points_per_light,
             lane_width: auto_width(settings, points_per_light),
+            queued_shadows: false,
             cell_x,
             cell_y,
             grid: (nx as f32, ny as f32),
@@ -162,6 +167,13 @@ impl<'a> Context<'a> {
             LaneWidth::Auto => auto_width(self.settings, self.points_per_light),
             w => w,
         };
+        self
+    }
+
+    /// The same context with every shadow ray sent through the queue (`queued: true`), the
+    /// path the fused soft-shadow blocks are held to. Speed only: the image is the same.
+    pub fn with_queued_shadows(mut self, queued: bool) -> Self {
+        self.queued_shadows = queued;
         self
     }
 

@@ -117,6 +117,42 @@ pub fn shade8(at: &HitLight, rays: &ShadowLanes) -> [[f32; LANES]; 3] {
 /// there; `rays` holds N entries per column.
 #[inline]
 pub fn shade_lanes<V: Lanes>(at: &HitLight, rays: &ShadowLanes) -> [V::Array; 3] {
+    let ShadowLanes {
+        l,
+        n_dot_l,
+        blocked,
+        falloff,
+    } = *rays;
+    let lanes = ShadowRegisters {
+        l: [
+            V::load(l[0], 0, 0.0),
+            V::load(l[1], 0, 0.0),
+            V::load(l[2], 0, 0.0),
+        ],
+        n_dot_l: V::load(n_dot_l, 0, 0.0),
+        open: V::from_fn(|k| if blocked[k] { 0.0 } else { 1.0 }),
+        falloff: falloff.map(|f| V::load(f, 0, 1.0)),
+    };
+    shade_registers(at, &lanes)
+}
+
+/// N shadow rays from one hit towards one light, in registers: [`ShadowLanes`] loaded, or a
+/// block the fused shadow stage has just spawned and tested.
+#[derive(Clone, Copy, Debug)]
+pub struct ShadowRegisters<V> {
+    /// l: each ray's unit direction.
+    pub l: [V; 3],
+    /// n·l of each ray; ≤ 0 for a dead lane.
+    pub n_dot_l: V,
+    /// 1.0 where the ray is not blocked, 0.0 where it is.
+    pub open: V,
+    /// Each ray's light fall-off, or `None` in the lab's model (exactly 1).
+    pub falloff: Option<V>,
+}
+
+/// [`shade_lanes`] on rays already in registers: the same lanes, bit for bit.
+#[inline(always)]
+pub fn shade_registers<V: Lanes>(at: &HitLight, rays: &ShadowRegisters<V>) -> [V::Array; 3] {
     let HitLight {
         material: m,
         normal: n,
@@ -124,13 +160,12 @@ pub fn shade_lanes<V: Lanes>(at: &HitLight, rays: &ShadowLanes) -> [V::Array; 3]
         light_color,
         weight,
     } = *at;
-    let ShadowLanes {
-        l,
-        n_dot_l,
-        blocked,
+    let ShadowRegisters {
+        l: [lx, ly, lz],
+        n_dot_l: ndl,
+        open,
         falloff,
     } = *rays;
-    let ndl = V::load(n_dot_l, 0, 0.0);
     // Each lane's light colour: Lc · falloff (`spawn::falloff`), or Lc itself in the lab's
     // model, whose fall-off is exactly 1 (x · 1 = x, so both give the twin's bits).
     let lc = {
@@ -142,13 +177,9 @@ pub fn shade_lanes<V: Lanes>(at: &HitLight, rays: &ShadowLanes) -> [V::Array; 3]
         );
         match falloff {
             None => [r, g, b],
-            Some(f) => {
-                let f = V::load(f, 0, 1.0);
-                [r * f, g * f, b * f]
-            }
+            Some(f) => [r * f, g * f, b * f],
         }
     };
-    let open = V::from_fn(|k| if blocked[k] { 0.0 } else { 1.0 });
     let adds = ndl.simd_gt(V::ZERO) & open.simd_gt(V::ZERO);
     let nothing = V::splat(-0.0);
     let cr = V::splat(m.ambient_emitted.x) + lc[0] * V::splat(m.diffuse.x) * ndl;
@@ -160,11 +191,6 @@ pub fn shade_lanes<V: Lanes>(at: &HitLight, rays: &ShadowLanes) -> [V::Array; 3]
         let out = |c: V| adds.select(c * w, nothing).to_array();
         return [out(cr), out(cg), out(cb)];
     }
-    let (lx, ly, lz) = (
-        V::load(l[0], 0, 0.0),
-        V::load(l[1], 0, 0.0),
-        V::load(l[2], 0, 0.0),
-    );
     // r = normalize(2(n·l) n − l), glam's normalize: v · (1 / |v|).
     let k = V::splat(2.0) * ndl;
     let rx = k * V::splat(n.x) - lx;

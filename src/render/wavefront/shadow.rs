@@ -12,6 +12,12 @@
 //!     shade:   in queue order, direct[hit] += Shade(l) / N for the rays not blocked
 //! ```
 //!
+//! Soft shadows on a scene without a BVH whose lights are all parallelograms skip the queue:
+//! each block of N rays is spawned, tested and shaded while it is in registers
+//! ([`fused`]), in the same (hit, light, point) order with the same kernels, so the sums
+//! are the queue's, bit for bit. The queue is for what gains from rays gathered across hits:
+//! the BVH's one-ray-at-a-time walk, and hard shadows' one ray per light.
+//!
 //! Queue order is the reference's loop order, so each hit's sum is added in the same order and
 //! comes out bit-identical. Soft shadows on a parallelogram light (every lab light) go N points
 //! at a time, every sampler with a SIMD twin (`simd::light_points`); hard shadows and other
@@ -25,7 +31,9 @@
 use super::batch::{HitBatch, RayBatch, ShadowQueue};
 use super::context::Context;
 use super::lanes::{LaneWidth, Lanes, f32x8, f32x16};
-use super::shade::{HitLight, ShadowLanes, shade_lanes, shade_terms};
+use super::shade::{
+    HitLight, ShadowLanes, ShadowRegisters, shade_lanes, shade_registers, shade_terms,
+};
 use super::simd::{self, LightBlock, RayColumns};
 use crate::render::geometry::casters;
 use crate::render::sampling::{SampleKey, mix32, square_sample};
@@ -73,6 +81,9 @@ fn direct_light_lanes<V: Lanes>(
 ) -> u64 {
     let n = rays.len();
     hits.direct.fill(0..n, glam::Vec3::ZERO);
+    if fuses(ctx) {
+        return fused::<V>(ctx, rays, hits);
+    }
     // Room for one hit's rays at least, each light's points padded to whole N-lane blocks.
     let per_hit = ctx.lights.len() * (ctx.points_per_light as usize).div_ceil(V::N) * V::N;
     queue.reset(
@@ -95,6 +106,98 @@ fn direct_light_lanes<V: Lanes>(
         shade::<V>(ctx, rays, hits, queue);
     }
     if ctx.casts_shadow_rays() { cast } else { 0 }
+}
+
+/// True when every shadow ray goes through [`fused`]: soft shadows drawn by the SIMD samplers
+/// on parallelogram lights (every light; a queued light would change the order of a hit's
+/// sum), tested against the scene's few casters without a BVH.
+fn fuses(ctx: &Context) -> bool {
+    !ctx.queued_shadows
+        && ctx.accel.is_none()
+        && ctx.samples_lights()
+        && ctx.simd_light_sampling()
+        && ctx.lights.iter().all(|l| l.parallelogram.is_some())
+}
+
+/// [`direct_light`] without the queue: for hit, for light, for each block of N points, the
+/// block's rays (`simd::shadow_rays`), their blockers (`simd::block_occluded`) and their Shade
+/// (`shade_lanes`) in registers, added to the hit lane by lane in point order, as [`shade`]
+/// adds a queued block. Returns the rays cast. A function of its own, so that the queue's
+/// stage keeps the inlining it had without it.
+#[inline(never)]
+fn fused<V: Lanes>(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch) -> u64 {
+    let scene = ctx.scene;
+    let two_sided = ctx.settings.two_sided;
+    let triangles = casters(scene, &ctx.shadow_casters, two_sided);
+    let model = ctx.settings.light_model;
+    let weight = 1.0 / ctx.points_per_light as f32;
+    let count = ctx.points_per_light;
+    let mut cast = 0;
+    for i in 0..rays.len() {
+        if hits.prim[i] == NO_HIT {
+            continue;
+        }
+        let hit = hits.surface(i);
+        let m = &ctx.materials[hits.material[i] as usize];
+        let (normal, to_eye) = (hits.normal.get(i), -rays.direction.get(i));
+        let (mut r, mut g, mut b) = (hits.direct.x[i], hits.direct.y[i], hits.direct.z[i]);
+        for (li, light) in ctx.lights.iter().enumerate() {
+            let Some((origin, edge_u, edge_v)) = light.parallelogram else {
+                unreachable!("`fuses` admits parallelogram lights only")
+            };
+            let key = SampleKey {
+                pixel: rays.pixel[i],
+                sample: rays.sample[i],
+                bounce: rays.bounce,
+                light: li as u32,
+                seed: ctx.settings.seed,
+            };
+            let end = light_end(&scene.lights[li], light.end_offset, &hit);
+            let points = LightBlock {
+                prefix: key_prefix(&key),
+                j0: 0,
+                sampler: ctx.block_sampler(&key),
+                origin,
+                edge_u,
+                edge_v,
+            };
+            let at = HitLight {
+                material: m,
+                normal,
+                to_eye,
+                light_color: light.color,
+                weight,
+            };
+            let mut j0 = 0;
+            while j0 < count {
+                let target = simd::light_points::<V>(&LightBlock { j0, ..points });
+                let lanes = ((count - j0) as usize).min(V::N);
+                let block = simd::shadow_rays::<V>(&hit, &target, &end, lanes);
+                j0 += V::N as u32;
+                if block.live == 0 {
+                    continue;
+                }
+                cast += block.live.count_ones() as u64;
+                let blockers =
+                    simd::block_occluded::<V>(triangles, &scene.spheres, &block, two_sided);
+                let lanes = ShadowRegisters {
+                    l: block.l.map(V::from_array),
+                    n_dot_l: V::from_array(block.n_dot_l),
+                    open: V::from_fn(|k| if blockers >> k & 1 == 1 { 0.0 } else { 1.0 }),
+                    falloff: (model != LightModel::Lab)
+                        .then(|| V::from_fn(|k| falloff(model, block.dist.as_ref()[k]))),
+                };
+                let c = shade_registers::<V>(&at, &lanes);
+                for ((cr, cg), cb) in c[0].as_ref().iter().zip(c[1].as_ref()).zip(c[2].as_ref()) {
+                    r += cr;
+                    g += cg;
+                    b += cb;
+                }
+            }
+        }
+        (hits.direct.x[i], hits.direct.y[i], hits.direct.z[i]) = (r, g, b);
+    }
+    cast
 }
 
 /// Queues the shadow rays of hit `i`, in (light, point) order.

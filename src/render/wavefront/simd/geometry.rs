@@ -5,6 +5,7 @@
 use super::{RayColumns, Rays};
 use crate::render::geometry::{EDGE_EPSILON, MISS_MARGIN, T_MIN};
 use crate::render::scene::{NO_HIT, Sphere, Triangle};
+use crate::render::wavefront::batch::ShadowBlock;
 use crate::render::wavefront::lanes::{LaneWidth, Lanes, f32x8, f32x16, live_lanes, store_mask};
 use glam::Vec3;
 
@@ -374,6 +375,40 @@ pub fn occluded_lanes<V: Lanes>(
         let lanes = (n - i).min(V::N);
         store_mask::<V>(&mut out[i..i + lanes], blocked);
     }
+}
+
+/// The lanes of one block of shadow rays (`simd::shadow_rays`: N rays from one origin, dead
+/// lanes with tmax = 0) that something blocks, as a bit mask: for every live lane, the answer
+/// [`occluded_lanes`] gives for the same ray in a queue (the same rays, loaded from registers
+/// instead of the queue's columns); dead lanes' bits mean nothing.
+#[inline(always)]
+pub fn block_occluded<V: Lanes>(
+    triangles: &[Triangle],
+    spheres: &[Sphere],
+    block: &ShadowBlock<V::Array>,
+    two_sided: bool,
+) -> u32 {
+    let o = block.origin;
+    let r = Rays {
+        ox: V::splat(o.x),
+        oy: V::splat(o.y),
+        oz: V::splat(o.z),
+        dx: V::from_array(block.l[0]),
+        dy: V::from_array(block.l[1]),
+        dz: V::from_array(block.l[2]),
+    };
+    let tmax = V::from_array(block.tmax);
+    let live = tmax.simd_gt(V::ZERO).to_bitmask();
+    if live == 0 {
+        return 0;
+    }
+    occluded8(
+        triangles,
+        spheres,
+        live,
+        |s| sphere8_blocks(s, &r, tmax),
+        |tri| triangle8_blocks(tri, &r, tmax, two_sided),
+    )
 }
 
 /// Spheres, then triangles, until every live lane is blocked; returns the blocked lanes.

@@ -34,8 +34,8 @@ mod light;
 
 pub(crate) use geometry::{TriangleLanes, moller_trumbore8, moller_trumbore8_blocks};
 pub use geometry::{
-    closest_hits, closest_hits_at, closest_hits_lanes, occluded, occluded_at, occluded_lanes,
-    sphere8, triangle8,
+    block_occluded, closest_hits, closest_hits_at, closest_hits_lanes, occluded, occluded_at,
+    occluded_lanes, sphere8, triangle8,
 };
 pub use light::{BlockSampler, LightBlock, light_points, light_points8, shadow_rays, shadow_rays8};
 
