@@ -14,7 +14,7 @@
 //!
 //! Soft shadows on a scene without a BVH whose lights are all parallelograms skip the queue:
 //! each block of N rays is spawned, tested and shaded while it is in registers
-//! ([`fused`]), in the same (hit, light, point) order with the same kernels, so the sums
+//! (`fused`), in the same (hit, light, point) order with the same kernels, so the sums
 //! are the queue's, bit for bit. The queue is for what gains from rays gathered across hits:
 //! the BVH's one-ray-at-a-time walk, and hard shadows' one ray per light.
 //!
