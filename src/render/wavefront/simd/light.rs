@@ -90,7 +90,7 @@ pub fn light_points8(b: &LightBlock) -> [[f32; LANES]; 3] {
 
 /// Light points x, y, z of samples `j0..j0 + N`: lane k equals
 /// `light.point(square_sample(sampler, key, j0 + k, count))`.
-#[inline]
+#[inline(always)]
 pub fn light_points<V: Lanes>(b: &LightBlock) -> [V::Array; 3] {
     let j = V::U::splat(b.j0) + V::U::LANE_INDEX;
     let (u, v) = match b.sampler {
