@@ -237,12 +237,14 @@ fn sixteen_and_eight_lanes_give_the_same_bytes_on_every_scene() {
 }
 
 /// Soft shadows on small scenes are spawned, tested and shaded in registers, block by block
-/// (`shadow::fused`); every other shadow ray goes through the queue. Both give the same bytes and
-/// counts on every bundled scene: every sampler, point counts with dead tail lanes at 8 and 16
-/// lanes, both light models (the RPI model's fall-off is computed from each block's distances),
-/// bounces, antialiasing and odd batch sizes.
+/// (`shadow::fused`), and hard shadows (and the unshadowed centroid rays of `--shadows off`)
+/// are spawned N hits at a time (`shadow::spawn_across`); the per-hit path sends every ray
+/// through the queue hit by hit. Both give the same bytes and counts on every bundled scene:
+/// every sampler, point counts with dead tail lanes at 8 and 16 lanes, both light models (the
+/// RPI model's fall-off is computed from each block's distances), bounces, antialiasing, two-
+/// sided faces and odd batch sizes (groups of hits that end mid-vector).
 #[test]
-fn fused_and_queued_shadow_blocks_give_the_same_bytes_on_every_scene() {
+fn shadow_paths_give_the_per_hit_path_s_bytes() {
     use raywave::render::settings::LightModel;
     use raywave::render::wavefront::lanes::LaneWidth;
     let soft = |n, sampler, light_model| RenderSettings {
@@ -270,26 +272,41 @@ fn fused_and_queued_shadow_blocks_give_the_same_bytes_on_every_scene() {
         two_sided: true,
         ..soft(24, LightSampler::Stratified, LightModel::Lab)
     });
+    for shadows in [ShadowMode::Hard, ShadowMode::Off] {
+        for light_model in LightModel::ALL {
+            settings.push(RenderSettings {
+                shadows,
+                light_model,
+                ..soft(1, LightSampler::Stratified, light_model)
+            });
+        }
+    }
     for (name, scene) in bundled_scenes() {
         for (m, s) in settings.iter().enumerate() {
-            let batches: &[usize] = if m % 4 == 0 { &[1, 7] } else { &[64] };
+            // Odd batches for every mode without soft shadows too: groups of hits that end
+            // mid-vector.
+            let batches: &[usize] = if m % 4 == 0 || s.shadows != ShadowMode::Soft {
+                &[1, 7, 64]
+            } else {
+                &[64]
+            };
             for &batch in batches {
                 for width in [LaneWidth::Eight, LaneWidth::Sixteen] {
-                    let render = |queued| {
+                    let render = |per_hit| {
                         let w = Wavefront::new(&scene, s, batch)
                             .with_lane_width(width)
-                            .with_queued_shadows(queued);
+                            .with_per_hit_shadows(per_hit);
                         let (film, stats) = w.render(&|| {});
                         (film_bits(&film), stats.counts)
                     };
-                    let (queued, cq) = render(true);
-                    let (fused, cf) = render(false);
+                    let (per_hit, cp) = render(true);
+                    let (fast, cf) = render(false);
                     assert!(
-                        queued == fused,
-                        "{name}: the fused shadow blocks changed the image at {width:?}, batch \
-                         {batch}, {s:?}"
+                        per_hit == fast,
+                        "{name}: the shadow stage's fast paths changed the image at {width:?}, \
+                         batch {batch}, {s:?}"
                     );
-                    assert_eq!(cq, cf, "{name}: ray counts differ with {s:?}");
+                    assert_eq!(cp, cf, "{name}: ray counts differ with {s:?}");
                 }
             }
         }

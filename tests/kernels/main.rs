@@ -9,6 +9,7 @@ mod common;
 
 mod bvh_leaves;
 mod film;
+mod hit_rays;
 mod intersection;
 mod mesh_bvh;
 mod peer_agreement;

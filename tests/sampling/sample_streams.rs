@@ -232,9 +232,9 @@ fn reference_draws(scene: &Scene, s: &RenderSettings) -> Drawn {
 /// The wavefront engine's samples: its stages run one depth at a time, as `render_tile`
 /// does, with a shadow queue large enough for a whole depth, read after `direct_light`.
 fn wavefront_draws(scene: &Scene, s: &RenderSettings) -> Drawn {
-    // Through the queue, where the drawn points can be read back: the fused soft-shadow path
-    // draws the same points (`fused_and_queued_shadow_blocks_give_the_same_bytes_on_every_scene`).
-    let ctx = Context::new(scene, s).with_queued_shadows(true);
+    // Hit by hit through the queue, where the drawn points can be read back: the fused
+    // soft-shadow path draws the same points (`shadow_paths_give_the_per_hit_path_s_bytes`).
+    let ctx = Context::new(scene, s).with_per_hit_shadows(true);
     let n = s.points_per_light();
     let (mut rays, mut next) = (RayBatch::default(), RayBatch::default());
     let (mut hits, mut queue) = (HitBatch::default(), ShadowQueue::default());

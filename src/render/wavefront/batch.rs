@@ -298,6 +298,37 @@ impl ShadowQueue {
         self.len = i + 1;
     }
 
+    /// Queues lane `k` of `rays` (`simd::hit_shadow_rays`: one ray per hit), a live one.
+    #[inline]
+    pub fn push_lane<A: AsRef<[f32]>>(
+        &mut self,
+        rays: &HitRays<A>,
+        k: usize,
+        path: u32,
+        light: u32,
+    ) {
+        let i = self.len;
+        let at = |c: &A| c.as_ref()[k];
+        self.origin.set(
+            i,
+            Vec3::new(
+                at(&rays.origin[0]),
+                at(&rays.origin[1]),
+                at(&rays.origin[2]),
+            ),
+        );
+        self.direction
+            .set(i, Vec3::new(at(&rays.l[0]), at(&rays.l[1]), at(&rays.l[2])));
+        self.tmax[i] = at(&rays.tmax);
+        self.n_dot_l[i] = at(&rays.n_dot_l);
+        if let Some(d) = self.dist.get_mut(i) {
+            *d = at(&rays.dist);
+        }
+        self.path[i] = path;
+        self.light[i] = light;
+        self.len = i + 1;
+    }
+
     /// Queues a block of 8 or 16 lanes from one origin (`simd::shadow_rays`'s block: dead
     /// lanes already carry `n_dot_l = 0`, `tmax = 0`).
     #[inline]
@@ -340,6 +371,25 @@ pub struct ShadowBlock<A = [f32; 8]> {
     /// |target − point| per lane.
     pub dist: A,
     /// Live lanes as a bitmask.
+    pub live: u32,
+}
+
+/// One shadow ray from each of N hits towards one light point, as arrays (`A` = the lanes'
+/// array): lane k is `spawn::shadow_ray`'s answer for hit k, or a dead lane (`live` clear;
+/// its other entries mean nothing).
+#[derive(Clone, Copy, Debug)]
+pub struct HitRays<A> {
+    /// Each ray's origin: its hit's leaving point.
+    pub origin: [A; 3],
+    /// l, each ray's unit direction.
+    pub l: [A; 3],
+    /// Where each ray meets the light's moved plane.
+    pub tmax: A,
+    /// n·l of each ray.
+    pub n_dot_l: A,
+    /// |target − point| of each ray, for the light model's fall-off.
+    pub dist: A,
+    /// The lanes with a ray, as a bit mask.
     pub live: u32,
 }
 

@@ -84,10 +84,10 @@ pub struct Context<'a> {
     /// The lane width of the brute-force, light and shading kernels, resolved (`Eight` or
     /// `Sixteen`): [`auto_width`]'s choice unless [`Context::with_lane_width`] says otherwise.
     pub lane_width: LaneWidth,
-    /// Every shadow ray through the queue, even where the shadow stage would fuse spawn,
-    /// occlusion and Shade in registers (`shadow::fuses`): false unless
-    /// [`Context::with_queued_shadows`] says otherwise. Speed only.
-    pub queued_shadows: bool,
+    /// Every shadow ray spawned hit by hit and sent through the queue, where the shadow stage
+    /// would fuse soft-shadow blocks in registers or spawn hard-shadow rays across hits: false
+    /// unless [`Context::with_per_hit_shadows`] says otherwise. Speed only.
+    pub per_hit_shadows: bool,
     /// Stratum column of every point index (padded to a multiple of 16), as floats.
     pub cell_x: Vec<f32>,
     /// Stratum row of every point index.
@@ -153,7 +153,7 @@ impl<'a> Context<'a> {
             lights,
             points_per_light,
             lane_width: auto_width(settings, points_per_light),
-            queued_shadows: false,
+            per_hit_shadows: false,
             cell_x,
             cell_y,
             grid: (nx as f32, ny as f32),
@@ -170,10 +170,11 @@ impl<'a> Context<'a> {
         self
     }
 
-    /// The same context with every shadow ray sent through the queue (`queued: true`), the
-    /// path the fused soft-shadow blocks are held to. Speed only: the image is the same.
-    pub fn with_queued_shadows(mut self, queued: bool) -> Self {
-        self.queued_shadows = queued;
+    /// The same context with every shadow ray spawned hit by hit and sent through the queue
+    /// (`per_hit: true`): the path the fused soft-shadow blocks and the hard-shadow rays spawned
+    /// across hits are held to. Speed only: the image is the same.
+    pub fn with_per_hit_shadows(mut self, per_hit: bool) -> Self {
+        self.per_hit_shadows = per_hit;
         self
     }
 

@@ -106,11 +106,12 @@ impl<'a> Wavefront<'a> {
         self
     }
 
-    /// The same engine with every shadow ray sent through the queue, where soft shadows on a
-    /// small scene would otherwise be spawned, tested and shaded in registers. Speed only:
-    /// the image and the counts are the same either way (tests hold them so).
-    pub fn with_queued_shadows(mut self, queued: bool) -> Self {
-        self.ctx = self.ctx.with_queued_shadows(queued);
+    /// The same engine with every shadow ray spawned hit by hit and sent through the queue,
+    /// where soft shadows on a small scene would otherwise be spawned, tested and shaded in
+    /// registers, and hard shadows spawned N hits at a time. Speed only: the image and the
+    /// counts are the same either way (tests hold them so).
+    pub fn with_per_hit_shadows(mut self, per_hit: bool) -> Self {
+        self.ctx = self.ctx.with_per_hit_shadows(per_hit);
         self
     }
 

@@ -16,7 +16,8 @@
 //! each block of N rays is spawned, tested and shaded while it is in registers
 //! (`fused`), in the same (hit, light, point) order with the same kernels, so the sums
 //! are the queue's, bit for bit. The queue is for what gains from rays gathered across hits:
-//! the BVH's one-ray-at-a-time walk, and hard shadows' one ray per light.
+//! the BVH's one-ray-at-a-time walk, and hard shadows' one ray per light, which are spawned N
+//! hits at a time (`spawn_across`, `simd::hit_shadow_rays`).
 //!
 //! Queue order is the reference's loop order, so each hit's sum is added in the same order and
 //! comes out bit-identical. Soft shadows on a parallelogram light (every lab light) go N points
@@ -30,7 +31,7 @@
 
 use super::batch::{HitBatch, RayBatch, ShadowQueue};
 use super::context::Context;
-use super::lanes::{LaneWidth, Lanes, f32x8, f32x16};
+use super::lanes::{LaneWidth, Lanes, f32x8, f32x16, set_bits};
 use super::shade::{
     HitLight, ShadowLanes, ShadowRegisters, shade_lanes, shade_registers, shade_terms,
 };
@@ -91,13 +92,21 @@ fn direct_light_lanes<V: Lanes>(
         capacity.max(per_hit),
         ctx.settings.light_model != LightModel::Lab,
     );
+    // One ray per (hit, light) is spawned N hits at a time; a group of N hits needs at most
+    // lights × N entries, which is `per_hit` at one point per light.
+    let across = !ctx.per_hit_shadows && !ctx.samples_lights();
     let mut cast = 0;
     let mut next = 0;
     while next < n {
         queue.len = 0;
         while next < n && queue.room() >= per_hit {
-            cast += spawn::<V>(ctx, rays, hits, next, queue);
-            next += 1;
+            if across {
+                cast += spawn_across::<V>(ctx, rays, hits, next, queue);
+                next += V::N;
+            } else {
+                cast += spawn::<V>(ctx, rays, hits, next, queue);
+                next += 1;
+            }
         }
         if ctx.casts_shadow_rays() {
             occlude::<V>(ctx, queue); // writes every entry
@@ -142,7 +151,7 @@ fn first_block<'c>(
 /// on parallelogram lights (every light; a queued light would change the order of a hit's
 /// sum), tested against the scene's few casters without a BVH.
 fn fuses(ctx: &Context) -> bool {
-    !ctx.queued_shadows
+    !ctx.per_hit_shadows
         && ctx.accel.is_none()
         && ctx.samples_lights()
         && ctx.simd_light_sampling()
@@ -214,6 +223,42 @@ fn fused<V: Lanes>(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch) -> u64 {
             }
         }
         (hits.direct.x[i], hits.direct.y[i], hits.direct.z[i]) = (r, g, b);
+    }
+    cast
+}
+
+/// Queues the one shadow ray per light (hard shadows, or none: the centroid) of hits
+/// `i0..i0 + N`, N hits at a time (`simd::hit_shadow_rays`), in (light, hit) order: each hit's
+/// rays still come in light order, so [`shade`] adds each hit's sum as [`spawn`]'s order
+/// would. Returns the number of live rays queued.
+fn spawn_across<V: Lanes>(
+    ctx: &Context,
+    rays: &RayBatch,
+    hits: &HitBatch,
+    i0: usize,
+    queue: &mut ShadowQueue,
+) -> u64 {
+    let lanes = (rays.len() - i0).min(V::N);
+    let present = (0..lanes)
+        .filter(|&k| hits.prim[i0 + k] != NO_HIT)
+        .fold(0u32, |m, k| m | 1 << k);
+    if present == 0 {
+        return 0;
+    }
+    let group = simd::HitLanes::<V>::load(hits, i0);
+    let mut cast = 0;
+    for (li, light) in ctx.lights.iter().enumerate() {
+        let block = simd::hit_shadow_rays(
+            &group,
+            &ctx.scene.lights[li],
+            light.end_offset,
+            light.centroid,
+        );
+        let live = block.live & present;
+        for k in set_bits(live) {
+            queue.push_lane(&block, k, (i0 + k) as u32, li as u32);
+        }
+        cast += live.count_ones() as u64;
     }
     cast
 }

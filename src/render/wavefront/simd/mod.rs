@@ -30,6 +30,7 @@
 //! cannot hit (tmax = 0, NaN directions), and the padding is never stored back.
 
 mod geometry;
+mod hit_rays;
 mod light;
 
 pub(crate) use geometry::{TriangleLanes, moller_trumbore8, moller_trumbore8_blocks};
@@ -37,6 +38,7 @@ pub use geometry::{
     block_occluded, closest_hits, closest_hits_at, closest_hits_lanes, occluded, occluded_at,
     occluded_lanes, sphere8, triangle8,
 };
+pub use hit_rays::{HitLanes, hit_shadow_rays};
 pub use light::{BlockSampler, LightBlock, light_points, light_points8, shadow_rays, shadow_rays8};
 
 use super::lanes::{LANES, Lanes, f32x8};

@@ -1,0 +1,145 @@
+//! `simd::hit_shadow_rays` (one shadow ray per hit, N hits at a time: the hard-shadow spawn)
+//! == the scalar spawn both engines call, `spawn::light_end` then `spawn::shadow_ray`, lane by
+//! lane and bit for bit, at 8 and 16 lanes: on an edge-case table (hits on the light's plane
+//! at ±0, behind it, grazing the tangent plane, at the light point itself, NaN and infinite
+//! coordinates, zero offsets) and on random hits at every scale, for groups that end
+//! mid-vector.
+
+use crate::common;
+
+use common::{Draw, TestRng, seeded};
+use glam::Vec3;
+use raywave::render::scene::{Light, Scene};
+use raywave::render::spawn::{SurfaceHit, light_end, light_offset, shadow_ray};
+use raywave::render::wavefront::batch::HitBatch;
+use raywave::render::wavefront::lanes::{Lanes, f32x8, f32x16};
+use raywave::render::wavefront::simd::{HitLanes, hit_shadow_rays};
+
+const NAN: f32 = f32::NAN;
+const INF: f32 = f32::INFINITY;
+
+/// A batch holding `hits`.
+fn batch(hits: &[SurfaceHit]) -> HitBatch {
+    let mut b = HitBatch::default();
+    b.resize(hits.len());
+    for (i, h) in hits.iter().enumerate() {
+        b.point.set(i, h.point);
+        b.normal.set(i, h.normal);
+        b.offset[i] = h.offset;
+    }
+    b
+}
+
+/// Every group of `V::N` hits of `hits` (the last one short) against the scalar spawn.
+fn check<V: Lanes>(hits: &[SurfaceHit], light: &Light, target: Vec3) {
+    let b = batch(hits);
+    let end_offset = light_offset(light);
+    for i0 in (0..hits.len()).step_by(V::N) {
+        let got = hit_shadow_rays(&HitLanes::<V>::load(&b, i0), light, end_offset, target);
+        for (k, hit) in hits[i0..].iter().take(V::N).enumerate() {
+            let want = shadow_ray(hit, target, &light_end(light, end_offset, hit));
+            let live = got.live >> k & 1 == 1;
+            let what = format!("{}-lane group at {i0}, lane {k}: {hit:?} to {target}", V::N);
+            let Some(want) = want else {
+                assert!(!live, "{what}: live where the scalar spawn casts no ray");
+                continue;
+            };
+            assert!(live, "{what}: dead where the scalar spawn casts {want:?}");
+            let lane = |c: &V::Array| c.as_ref()[k].to_bits();
+            let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+            let origin = [
+                lane(&got.origin[0]),
+                lane(&got.origin[1]),
+                lane(&got.origin[2]),
+            ];
+            let l = [lane(&got.l[0]), lane(&got.l[1]), lane(&got.l[2])];
+            assert_eq!(origin, bits(want.ray.origin), "{what}: origin");
+            assert_eq!(l, bits(want.ray.direction), "{what}: l");
+            assert_eq!(lane(&got.tmax), want.tmax.to_bits(), "{what}: tmax");
+            assert_eq!(lane(&got.n_dot_l), want.n_dot_l.to_bits(), "{what}: n·l");
+            assert_eq!(lane(&got.dist), want.dist.to_bits(), "{what}: dist");
+        }
+    }
+}
+
+fn both_widths(hits: &[SurfaceHit], light: &Light, target: Vec3) {
+    check::<f32x8>(hits, light, target);
+    check::<f32x16>(hits, light, target);
+}
+
+fn lab_light() -> Light {
+    Scene::builtin_default().lights[0].clone()
+}
+
+fn hit(point: Vec3, normal: Vec3, offset: f32) -> SurfaceHit {
+    SurfaceHit {
+        point,
+        normal,
+        offset,
+    }
+}
+
+#[test]
+fn edge_cases_equal_the_scalar_spawn() {
+    let light = lab_light();
+    let (c, n) = (light.centroid, light.normal);
+    // Two directions in the light's plane.
+    let u = n.any_orthonormal_vector();
+    let v = n.cross(u);
+    let hits = [
+        // On the light's plane, at +0 and −0 height, and at the centroid itself.
+        hit(c + u * 0.3, -n, 1e-4),
+        hit(c - v * 0.3, n, 1e-4),
+        hit(c, n, 1e-4),
+        // Behind the light, facing it and facing away.
+        hit(c + n * 0.5, -n, 1e-4),
+        hit(c + n * 0.5, n, 1e-4),
+        // In front, facing the light, away from it, and grazing: the tangent plane through
+        // the centroid, and just above and below it by about the margin.
+        hit(c - n * 0.7, n, 1e-4),
+        hit(c - n * 0.7, -n, 1e-4),
+        hit(c - n * 0.7 + u * 0.2, u, 1e-4),
+        hit(c - n * 0.7 + u * 0.2, (u + n * 3e-4).normalize(), 1e-4),
+        hit(c - n * 0.7 + u * 0.2, (u - n * 3e-4).normalize(), 1e-4),
+        // No offset, a huge offset, and an offset that is NaN.
+        hit(c - n * 0.7, n, 0.0),
+        hit(c - n * 0.7, n, 10.0),
+        hit(c - n * 0.7, n, NAN),
+        // NaN and infinite points and normals, a zero normal.
+        hit(Vec3::new(NAN, 0.0, 0.0), n, 1e-4),
+        hit(Vec3::new(0.0, INF, 0.0), -n, 1e-4),
+        hit(c - n * 0.7, Vec3::new(NAN, NAN, NAN), 1e-4),
+        hit(c - n * 0.7, Vec3::ZERO, 1e-4),
+        // Far away and very close, in both directions along the plane.
+        hit(c - n * 1e6 + u * 1e6, -n, 1e2),
+        hit(c - n * 1e-6, -n, 1e-7),
+    ];
+    for len in [0, 1, 7, 8, 9, 16, 17, hits.len()] {
+        let hits = &hits[..len.min(hits.len())];
+        both_widths(hits, &light, c);
+        // A target off the centroid (the kernel takes any point of the light).
+        both_widths(hits, &light, c + u * 0.1 - v * 0.05);
+    }
+}
+
+#[test]
+fn random_hits_at_every_scale_equal_the_scalar_spawn() {
+    let mut rng: TestRng = seeded(0x4a7d);
+    for scale in [1e-3f32, 1e-1, 1.0, 10.0, 1e3] {
+        let base = lab_light();
+        let light = Light {
+            centroid: base.centroid * scale,
+            ..base
+        };
+        for len in [1, 7, 8, 9, 31, 33, 200] {
+            let hits: Vec<SurfaceHit> = (0..len)
+                .map(|_| {
+                    let normal = rng.direction().normalize();
+                    hit(rng.point(scale), normal, 1e-4 * scale * rng.unit())
+                })
+                .collect();
+            let target = light.centroid + rng.point(0.1 * scale);
+            both_widths(&hits, &light, target);
+        }
+    }
+}
