@@ -3,17 +3,21 @@
 //! lane and bit for bit, at 8 and 16 lanes: on an edge-case table (hits on the light's plane
 //! at ±0, behind it, grazing the tangent plane, at the light point itself, NaN and infinite
 //! coordinates, zero offsets) and on random hits at every scale, for groups that end
-//! mid-vector.
+//! mid-vector. And `simd::hit_rays_occluded` (the blockers of those rays, in registers) ==
+//! `simd::occluded` on the same rays in columns.
 
 use crate::common;
 
 use common::{Draw, TestRng, seeded};
 use glam::Vec3;
+use raywave::render::geometry::{self, shadow_casters};
 use raywave::render::scene::{Light, Scene};
 use raywave::render::spawn::{SurfaceHit, light_end, light_offset, shadow_ray};
 use raywave::render::wavefront::batch::HitBatch;
 use raywave::render::wavefront::lanes::{Lanes, f32x8, f32x16};
-use raywave::render::wavefront::simd::{HitLanes, hit_shadow_rays};
+use raywave::render::wavefront::simd::{
+    self, HitLanes, RayColumns, hit_rays_occluded, hit_shadow_rays,
+};
 
 const NAN: f32 = f32::NAN;
 const INF: f32 = f32::INFINITY;
@@ -140,6 +144,75 @@ fn random_hits_at_every_scale_equal_the_scalar_spawn() {
                 .collect();
             let target = light.centroid + rng.point(0.1 * scale);
             both_widths(&hits, &light, target);
+        }
+    }
+}
+
+/// The rays `hit_shadow_rays` makes from random hits inside the lab box (its three spheres and,
+/// two-sided, its walls block some of them), tested in registers and in columns.
+fn check_occlusion<V: Lanes>(rng: &mut TestRng, len: usize, two_sided: bool) {
+    let scene = Scene::builtin_default();
+    let light = &scene.lights[0];
+    let casters = shadow_casters(&scene);
+    let triangles = geometry::casters(&scene, &casters, two_sided);
+    let hits: Vec<SurfaceHit> = (0..len)
+        .map(|_| hit(rng.point(0.95), rng.direction().normalize(), 1e-4))
+        .collect();
+    let b = batch(&hits);
+    let mut some_blocked = false;
+    for i0 in (0..len).step_by(V::N) {
+        let rays = hit_shadow_rays(
+            &HitLanes::<V>::load(&b, i0),
+            light,
+            light_offset(light),
+            light.centroid,
+        );
+        let lanes = (len - i0).min(V::N);
+        let live = rays.live & ((1u32 << lanes) - 1);
+        let got = hit_rays_occluded::<V>(triangles, &scene.spheres, &rays, live, two_sided);
+        // The live rays as columns, dead ones with tmax 0 (the queue holds no dead rays; a
+        // tmax of 0 cannot be blocked).
+        let col = |c: &V::Array| -> Vec<f32> { c.as_ref()[..lanes].to_vec() };
+        let tmax: Vec<f32> = (0..lanes)
+            .map(|k| {
+                if live >> k & 1 == 1 {
+                    rays.tmax.as_ref()[k]
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        let (o, l) = (rays.origin.each_ref().map(col), rays.l.each_ref().map(col));
+        let cols = RayColumns {
+            origin: [&o[0], &o[1], &o[2]],
+            direction: [&l[0], &l[1], &l[2]],
+            tmax: &tmax,
+        };
+        let mut want = vec![false; lanes];
+        simd::occluded(triangles, &scene.spheres, &cols, two_sided, &mut want);
+        for k in (0..lanes).filter(|k| live >> k & 1 == 1) {
+            assert_eq!(
+                got >> k & 1 == 1,
+                want[k],
+                "{}-lane group at {i0}, lane {k}",
+                V::N
+            );
+            some_blocked |= want[k];
+        }
+    }
+    assert!(
+        len < 64 || some_blocked,
+        "no ray was blocked: the test has no power"
+    );
+}
+
+#[test]
+fn occlusion_in_registers_equals_occlusion_in_columns() {
+    let mut rng: TestRng = seeded(0x0cc1);
+    for len in [0, 1, 7, 8, 9, 17, 300] {
+        for two_sided in [false, true] {
+            check_occlusion::<f32x8>(&mut rng, len, two_sided);
+            check_occlusion::<f32x16>(&mut rng, len, two_sided);
         }
     }
 }

@@ -12,12 +12,13 @@
 //!     shade:   in queue order, direct[hit] += Shade(l) / N for the rays not blocked
 //! ```
 //!
-//! Soft shadows on a scene without a BVH whose lights are all parallelograms skip the queue:
-//! each block of N rays is spawned, tested and shaded while it is in registers
-//! (`fused`), in the same (hit, light, point) order with the same kernels, so the sums
-//! are the queue's, bit for bit. The queue is for what gains from rays gathered across hits:
-//! the BVH's one-ray-at-a-time walk, and hard shadows' one ray per light, which are spawned N
-//! hits at a time (`spawn_across`, `simd::hit_shadow_rays`).
+//! On a scene without a BVH the queue is skipped. Soft shadows whose lights are all
+//! parallelograms: each block of N rays is spawned, tested and shaded while it is in registers
+//! (`fused`), in the same (hit, light, point) order with the same kernels. Hard shadows: one
+//! ray per hit, N hits at a time (`fused_hard`, `simd::hit_shadow_rays`), each hit's rays in
+//! light order. Either way the sums are the queue's, bit for bit. The queue is for the BVH's
+//! one-ray-at-a-time walk (its hard-shadow rays too are spawned N hits at a time:
+//! `spawn_across`).
 //!
 //! Queue order is the reference's loop order, so each hit's sum is added in the same order and
 //! comes out bit-identical. Soft shadows on a parallelogram light (every lab light) go N points
@@ -85,6 +86,9 @@ fn direct_light_lanes<V: Lanes>(
     hits.direct.fill(0..n, glam::Vec3::ZERO);
     if fuses(ctx) {
         return fused::<V>(ctx, rays, hits);
+    }
+    if fuses_hard(ctx) {
+        return fused_hard::<V>(ctx, rays, hits);
     }
     // Room for one hit's rays at least, each light's points padded to whole N-lane blocks.
     let per_hit = ctx.lights.len() * (ctx.points_per_light as usize).div_ceil(V::N) * V::N;
@@ -227,6 +231,73 @@ fn fused<V: Lanes>(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch) -> u64 {
     cast
 }
 
+/// True when every shadow ray goes through [`fused_hard`]: one ray per (hit, light) to the
+/// light's centroid (hard shadows, or none), tested against the scene's few casters without a
+/// BVH.
+fn fuses_hard(ctx: &Context) -> bool {
+    !ctx.per_hit_shadows && ctx.accel.is_none() && !ctx.samples_lights()
+}
+
+/// [`direct_light`] without the queue for one ray per (hit, light): for each group of N hits,
+/// for light, the group's rays (`simd::hit_shadow_rays`) and their blockers
+/// (`simd::hit_rays_occluded`) in registers, then the Shade of each unblocked ray added to its
+/// hit as [`shade`] adds a queued one. Each hit's rays come in light order, so its sum is the
+/// queue's, bit for bit. Returns the rays cast.
+#[inline(never)]
+fn fused_hard<V: Lanes>(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch) -> u64 {
+    let scene = ctx.scene;
+    let two_sided = ctx.settings.two_sided;
+    let triangles = casters(scene, &ctx.shadow_casters, two_sided);
+    let model = ctx.settings.light_model;
+    let weight = 1.0 / ctx.points_per_light as f32;
+    let occludes = ctx.casts_shadow_rays();
+    let mut cast = 0;
+    for i0 in (0..rays.len()).step_by(V::N) {
+        let present = present_hits::<V>(hits, i0, rays.len());
+        if present == 0 {
+            continue;
+        }
+        let group = simd::HitLanes::<V>::load(hits, i0);
+        for (li, light) in ctx.lights.iter().enumerate() {
+            let block =
+                simd::hit_shadow_rays(&group, &scene.lights[li], light.end_offset, light.centroid);
+            let live = block.live & present;
+            cast += live.count_ones() as u64;
+            let blocked = if occludes {
+                simd::hit_rays_occluded::<V>(triangles, &scene.spheres, &block, live, two_sided)
+            } else {
+                0
+            };
+            // As the queue's Shade: unblocked rays with n·l > 0.
+            let lit = set_bits(live & !blocked).filter(|&k| block.n_dot_l.as_ref()[k] > 0.0);
+            for k in lit {
+                let n_dot_l = block.n_dot_l.as_ref()[k];
+                let i = i0 + k;
+                let lane = |c: &V::Array| c.as_ref()[k];
+                let l = Vec3::new(lane(&block.l[0]), lane(&block.l[1]), lane(&block.l[2]));
+                let m = &ctx.materials[hits.material[i] as usize];
+                // The queue keeps distances only under a light model with fall-off.
+                let fall = if model == LightModel::Lab {
+                    1.0
+                } else {
+                    falloff(model, lane(&block.dist))
+                };
+                let (n, e) = (hits.normal.get(i), -rays.direction.get(i));
+                let c = shade_terms(m, n, e, l, n_dot_l, light.color * fall) * weight;
+                hits.direct.add(i, c);
+            }
+        }
+    }
+    if occludes { cast } else { 0 }
+}
+
+/// The hits of `i0..i0 + N` (of `len` rays) that hit something, as a bit mask.
+fn present_hits<V: Lanes>(hits: &HitBatch, i0: usize, len: usize) -> u32 {
+    (0..(len - i0).min(V::N))
+        .filter(|&k| hits.prim[i0 + k] != NO_HIT)
+        .fold(0, |m, k| m | 1 << k)
+}
+
 /// Queues the one shadow ray per light (hard shadows, or none: the centroid) of hits
 /// `i0..i0 + N`, N hits at a time (`simd::hit_shadow_rays`), in (light, hit) order: each hit's
 /// rays still come in light order, so [`shade`] adds each hit's sum as [`spawn`]'s order
@@ -238,10 +309,7 @@ fn spawn_across<V: Lanes>(
     i0: usize,
     queue: &mut ShadowQueue,
 ) -> u64 {
-    let lanes = (rays.len() - i0).min(V::N);
-    let present = (0..lanes)
-        .filter(|&k| hits.prim[i0 + k] != NO_HIT)
-        .fold(0u32, |m, k| m | 1 << k);
+    let present = present_hits::<V>(hits, i0, rays.len());
     if present == 0 {
         return 0;
     }

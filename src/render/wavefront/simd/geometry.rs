@@ -5,7 +5,7 @@
 use super::{RayColumns, Rays};
 use crate::render::geometry::{EDGE_EPSILON, MISS_MARGIN, T_MIN};
 use crate::render::scene::{NO_HIT, Sphere, Triangle};
-use crate::render::wavefront::batch::ShadowBlock;
+use crate::render::wavefront::batch::{HitRays, ShadowBlock};
 use crate::render::wavefront::lanes::{LaneWidth, Lanes, f32x8, f32x16, live_lanes, store_mask};
 use glam::Vec3;
 
@@ -399,6 +399,48 @@ pub fn block_occluded<V: Lanes>(
     };
     let tmax = V::from_array(block.tmax);
     let live = tmax.simd_gt(V::ZERO).to_bitmask();
+    rays_occluded(triangles, spheres, &r, tmax, live, two_sided)
+}
+
+/// The `live` lanes of one ray per hit (`simd::hit_shadow_rays`) that something blocks, as a
+/// bit mask: for every live lane, the answer [`occluded_lanes`] gives for the same ray in a
+/// queue; the other lanes' bits mean nothing.
+#[inline(always)]
+pub fn hit_rays_occluded<V: Lanes>(
+    triangles: &[Triangle],
+    spheres: &[Sphere],
+    rays: &HitRays<V::Array>,
+    live: u32,
+    two_sided: bool,
+) -> u32 {
+    let r = Rays {
+        ox: V::from_array(rays.origin[0]),
+        oy: V::from_array(rays.origin[1]),
+        oz: V::from_array(rays.origin[2]),
+        dx: V::from_array(rays.l[0]),
+        dy: V::from_array(rays.l[1]),
+        dz: V::from_array(rays.l[2]),
+    };
+    rays_occluded(
+        triangles,
+        spheres,
+        &r,
+        V::from_array(rays.tmax),
+        live,
+        two_sided,
+    )
+}
+
+/// [`occluded8`] on rays in registers, `live` the lanes that count.
+#[inline(always)]
+fn rays_occluded<V: Lanes>(
+    triangles: &[Triangle],
+    spheres: &[Sphere],
+    r: &Rays<V>,
+    tmax: V,
+    live: u32,
+    two_sided: bool,
+) -> u32 {
     if live == 0 {
         return 0;
     }
@@ -406,8 +448,8 @@ pub fn block_occluded<V: Lanes>(
         triangles,
         spheres,
         live,
-        |s| sphere8_blocks(s, &r, tmax),
-        |tri| triangle8_blocks(tri, &r, tmax, two_sided),
+        |s| sphere8_blocks(s, r, tmax),
+        |tri| triangle8_blocks(tri, r, tmax, two_sided),
     )
 }
 
