@@ -164,9 +164,9 @@ fn fuses(ctx: &Context) -> bool {
 
 /// [`direct_light`] without the queue: for hit, for light, for each block of N points, the
 /// block's rays (`simd::shadow_rays`), their blockers (`simd::block_occluded`) and their Shade
-/// (`shade_lanes`) in registers, added to the hit lane by lane in point order, as [`shade`]
-/// adds a queued block. Returns the rays cast. A function of its own, so that the queue's
-/// stage keeps the inlining it had without it.
+/// (`shade_registers`) in registers, added to the hit lane by lane in point order, as
+/// [`shade`] adds a queued block. Returns the rays cast. Never inlined, so that profiles name
+/// it apart from the queued stage.
 #[inline(never)]
 fn fused<V: Lanes>(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch) -> u64 {
     let scene = ctx.scene;
@@ -242,7 +242,7 @@ fn fuses_hard(ctx: &Context) -> bool {
 /// for light, the group's rays (`simd::hit_shadow_rays`) and their blockers
 /// (`simd::hit_rays_occluded`) in registers, then the Shade of each unblocked ray added to its
 /// hit as [`shade`] adds a queued one. Each hit's rays come in light order, so its sum is the
-/// queue's, bit for bit. Returns the rays cast.
+/// queue's, bit for bit. Returns the rays cast. Never inlined, as [`fused`] is not.
 #[inline(never)]
 fn fused_hard<V: Lanes>(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch) -> u64 {
     let scene = ctx.scene;
