@@ -6,6 +6,7 @@
 //! Buffers are allocated once per worker and reused (`clear` keeps the capacity), so the memory
 //! of a render is bounded by the batch size, not by the image.
 
+use crate::render::geometry::Ray;
 use crate::render::spawn::{ShadowRay, SurfaceHit};
 use glam::Vec3;
 use std::ops::Range;
@@ -298,37 +299,6 @@ impl ShadowQueue {
         self.len = i + 1;
     }
 
-    /// Queues lane `k` of `rays` (`simd::hit_shadow_rays`: one ray per hit), a live one.
-    #[inline]
-    pub fn push_lane<A: AsRef<[f32]>>(
-        &mut self,
-        rays: &HitRays<A>,
-        k: usize,
-        path: u32,
-        light: u32,
-    ) {
-        let i = self.len;
-        let at = |c: &A| c.as_ref()[k];
-        self.origin.set(
-            i,
-            Vec3::new(
-                at(&rays.origin[0]),
-                at(&rays.origin[1]),
-                at(&rays.origin[2]),
-            ),
-        );
-        self.direction
-            .set(i, Vec3::new(at(&rays.l[0]), at(&rays.l[1]), at(&rays.l[2])));
-        self.tmax[i] = at(&rays.tmax);
-        self.n_dot_l[i] = at(&rays.n_dot_l);
-        if let Some(d) = self.dist.get_mut(i) {
-            *d = at(&rays.dist);
-        }
-        self.path[i] = path;
-        self.light[i] = light;
-        self.len = i + 1;
-    }
-
     /// Queues a block of 8 or 16 lanes from one origin (`simd::shadow_rays`'s block: dead
     /// lanes already carry `n_dot_l = 0`, `tmax = 0`).
     #[inline]
@@ -391,6 +361,24 @@ pub struct HitRays<A> {
     pub dist: A,
     /// The lanes with a ray, as a bit mask.
     pub live: u32,
+}
+
+impl<A: AsRef<[f32]>> HitRays<A> {
+    /// Lane `k` as the scalar spawn gives it (meaningful for a live lane).
+    #[inline]
+    pub fn lane(&self, k: usize) -> ShadowRay {
+        let at = |c: &A| c.as_ref()[k];
+        let v = |c: &[A; 3]| Vec3::new(at(&c[0]), at(&c[1]), at(&c[2]));
+        ShadowRay {
+            ray: Ray {
+                origin: v(&self.origin),
+                direction: v(&self.l),
+            },
+            tmax: at(&self.tmax),
+            dist: at(&self.dist),
+            n_dot_l: at(&self.n_dot_l),
+        }
+    }
 }
 
 /// Per camera sample of a tile: the radiance gathered so far.

@@ -183,7 +183,7 @@ fn fused<V: Lanes>(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch) -> u64 {
         let hit = hits.surface(i);
         let m = &ctx.materials[hits.material[i] as usize];
         let (normal, to_eye) = (hits.normal.get(i), -rays.direction.get(i));
-        let (mut r, mut g, mut b) = (hits.direct.x[i], hits.direct.y[i], hits.direct.z[i]);
+        let mut sum = (hits.direct.x[i], hits.direct.y[i], hits.direct.z[i]);
         for (li, light) in ctx.lights.iter().enumerate() {
             let Some(parallelogram) = light.parallelogram else {
                 unreachable!("`fuses` admits parallelogram lights only")
@@ -218,15 +218,10 @@ fn fused<V: Lanes>(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch) -> u64 {
                     falloff: (model != LightModel::Lab)
                         .then(|| V::from_fn(|k| falloff(model, block.dist.as_ref()[k]))),
                 };
-                let c = shade_registers::<V>(&at, &lanes);
-                for ((cr, cg), cb) in c[0].as_ref().iter().zip(c[1].as_ref()).zip(c[2].as_ref()) {
-                    r += cr;
-                    g += cg;
-                    b += cb;
-                }
+                sum = add_in_order::<V>(sum, &shade_registers::<V>(&at, &lanes));
             }
         }
-        (hits.direct.x[i], hits.direct.y[i], hits.direct.z[i]) = (r, g, b);
+        (hits.direct.x[i], hits.direct.y[i], hits.direct.z[i]) = sum;
     }
     cast
 }
@@ -271,20 +266,16 @@ fn fused_hard<V: Lanes>(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch) -> 
             // As the queue's Shade: unblocked rays with n·l > 0.
             let lit = set_bits(live & !blocked).filter(|&k| block.n_dot_l.as_ref()[k] > 0.0);
             for k in lit {
-                let n_dot_l = block.n_dot_l.as_ref()[k];
-                let i = i0 + k;
-                let lane = |c: &V::Array| c.as_ref()[k];
-                let l = Vec3::new(lane(&block.l[0]), lane(&block.l[1]), lane(&block.l[2]));
-                let m = &ctx.materials[hits.material[i] as usize];
+                let (i, s) = (i0 + k, block.lane(k));
                 // The queue keeps distances only under a light model with fall-off.
                 let fall = if model == LightModel::Lab {
                     1.0
                 } else {
-                    falloff(model, lane(&block.dist))
+                    falloff(model, s.dist)
                 };
-                let (n, e) = (hits.normal.get(i), -rays.direction.get(i));
-                let c = shade_terms(m, n, e, l, n_dot_l, light.color * fall) * weight;
-                hits.direct.add(i, c);
+                let light_color = light.color * fall;
+                let c = shade_ray(ctx, rays, hits, i, s.ray.direction, s.n_dot_l, light_color);
+                hits.direct.add(i, c * weight);
             }
         }
     }
@@ -324,7 +315,7 @@ fn spawn_across<V: Lanes>(
         );
         let live = block.live & present;
         for k in set_bits(live) {
-            queue.push_lane(&block, k, (i0 + k) as u32, li as u32);
+            queue.push(&block.lane(k), (i0 + k) as u32, li as u32);
         }
         cast += live.count_ones() as u64;
     }
@@ -418,6 +409,42 @@ fn occlude<V: Lanes>(ctx: &Context, queue: &mut ShadowQueue) {
     }
 }
 
+/// `sum` plus each lane of `c` (r, g, b), lane by lane in order, like the reference's loop
+/// over points; lanes that add nothing hold −0.0.
+#[inline(always)]
+fn add_in_order<V: Lanes>(sum: (f32, f32, f32), c: &[V::Array; 3]) -> (f32, f32, f32) {
+    let (mut r, mut g, mut b) = sum;
+    for ((cr, cg), cb) in c[0].as_ref().iter().zip(c[1].as_ref()).zip(c[2].as_ref()) {
+        r += cr;
+        g += cg;
+        b += cb;
+    }
+    (r, g, b)
+}
+
+/// The Shade of one unblocked shadow ray with direction `l` from ray `i`'s hit, its light's
+/// colour `light_color` (fall-off included), before the 1/N weight.
+#[inline(always)]
+fn shade_ray(
+    ctx: &Context,
+    rays: &RayBatch,
+    hits: &HitBatch,
+    i: usize,
+    l: Vec3,
+    n_dot_l: f32,
+    light_color: Vec3,
+) -> Vec3 {
+    let m = &ctx.materials[hits.material[i] as usize];
+    shade_terms(
+        m,
+        hits.normal.get(i),
+        -rays.direction.get(i),
+        l,
+        n_dot_l,
+        light_color,
+    )
+}
+
 /// Adds Shade / N of every unblocked queued ray to its hit, in queue order. Aligned blocks of
 /// N rays (the lane width) from one hit to one light (soft shadows) are shaded N lanes at a
 /// time, then added lane by lane in order.
@@ -458,25 +485,18 @@ fn shade<V: Lanes>(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch, queue: &
                 light_color: ctx.lights[queue.light[q] as usize].color,
                 weight,
             };
-            let c = shade_lanes::<V>(&at, &lanes);
-            // In lane order, like the reference's loop; lanes that add nothing hold −0.0.
-            let (mut r, mut g, mut b) = (hits.direct.x[i], hits.direct.y[i], hits.direct.z[i]);
-            for ((cr, cg), cb) in c[0].as_ref().iter().zip(c[1].as_ref()).zip(c[2].as_ref()) {
-                r += cr;
-                g += cg;
-                b += cb;
-            }
-            (hits.direct.x[i], hits.direct.y[i], hits.direct.z[i]) = (r, g, b);
+            let sum = (hits.direct.x[i], hits.direct.y[i], hits.direct.z[i]);
+            let sum = add_in_order::<V>(sum, &shade_lanes::<V>(&at, &lanes));
+            (hits.direct.x[i], hits.direct.y[i], hits.direct.z[i]) = sum;
             q = end;
             continue;
         }
         if !queue.blocked[q] && queue.n_dot_l[q] > 0.0 {
             let i = queue.path[q] as usize;
-            let (n, l, n_dot_l) = (hits.normal.get(i), queue.direction.get(q), queue.n_dot_l[q]);
-            let m = &ctx.materials[hits.material[i] as usize];
             let fall = queue.dist.get(q).map_or(1.0, |&d| falloff(model, d));
             let light_color = ctx.lights[queue.light[q] as usize].color * fall;
-            let c = shade_terms(m, n, -rays.direction.get(i), l, n_dot_l, light_color) * weight;
+            let (l, n_dot_l) = (queue.direction.get(q), queue.n_dot_l[q]);
+            let c = shade_ray(ctx, rays, hits, i, l, n_dot_l, light_color) * weight;
             hits.direct.add(i, c);
         }
         q += 1;
