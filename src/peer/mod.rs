@@ -27,6 +27,7 @@
 
 #[cfg(feature = "embree")]
 pub mod embree;
+pub mod stage;
 #[cfg(feature = "tinybvh")]
 pub mod tinybvh;
 
@@ -156,10 +157,13 @@ impl RaySet {
                 ..RayBatch::default()
             });
         }
+        let first = (self.batches.len() - 1) * BATCH;
         let batch = self.batches.last_mut().expect("a batch was just pushed");
         let n = batch.len() as u32;
+        // Ray i of a camera set is pixel i's, as in a frame of one sample per pixel, so the
+        // shadow stage draws a frame's light points from its hits (`stage::ShadowStage`).
         let path = PathId {
-            pixel: n,
+            pixel: (first + batch.len()) as u32,
             sample: 0,
             slot: n,
         };

@@ -5,6 +5,7 @@
 //! the rays of every set, on a small generated mesh and on the lab's box without its spheres
 //! (raywave's brute-force path), all two-sided like the peers.
 
+use raywave::peer::stage::ShadowStage;
 use raywave::peer::{
     Agreement, FAN_SIZES, Hits, ObvhsMesh, RaySet, RaySets, blocker_agreement, brute_force_closest,
     hit_agreement, occlusion_agreement, raywave_closest, wavefront_closest, wavefront_occluded,
@@ -13,6 +14,7 @@ use raywave::peer::{
 use raywave::render::scene::meshgen::cornell_box_mesh_spheres;
 use raywave::render::scene::{NO_HIT, Scene, parse_scene_str};
 use raywave::render::settings::RenderSettings;
+use raywave::render::wavefront::Wavefront;
 use raywave::render::wavefront::batch::HitBatch;
 use raywave::render::wavefront::context::Context;
 
@@ -432,4 +434,37 @@ fn camera_rays_entering_the_closed_box_hit_it() {
         }
     }
     assert!(leaks.is_empty(), "camera rays through cracks: {leaks:?}");
+}
+
+/// The peer table's stage rows time the frame's shadow stage: over the camera set's hits,
+/// `ShadowStage` casts exactly the shadow rays a whole frame at zero bounces casts, for hard
+/// shadows and every fan size, on the brute-force path (the lab box) and the BVH path.
+#[test]
+fn shadow_stage_casts_what_a_frame_casts() {
+    for (name, scene) in [("lab box", lab_scene()), ("mesh", mesh_scene())] {
+        let base = RenderSettings {
+            width: SIZE,
+            height: SIZE,
+            ..settings()
+        };
+        let obvhs = ObvhsMesh::new(&scene);
+        let sets = RaySets::new(&scene, &obvhs, SIZE, SIZE, SEED);
+        assert!(ShadowStage::settings(&base, sets.primary.kind).is_none());
+        assert!(ShadowStage::settings(&base, sets.incoherent.kind).is_none());
+        for set in occlusion_sets(&sets) {
+            let s = ShadowStage::settings(&base, set.kind).expect("a shadow set has a stage");
+            let mut stage = ShadowStage::new(&scene, &s, &sets.primary);
+            let cast = stage.run(&sets.primary);
+            let (_, stats) = Wavefront::new(&scene, &s, 4096).render(&|| {});
+            assert_eq!(stats.counts.camera, sets.primary.len() as u64, "{name}");
+            assert!(cast > 0, "{name}, {}: no shadow ray", set.kind.title());
+            assert_eq!(
+                cast,
+                stats.counts.shadow,
+                "{name}, {}: the stage against a frame",
+                set.kind.title()
+            );
+            assert_eq!(stage.run(&sets.primary), cast, "{name}: a second pass");
+        }
+    }
 }

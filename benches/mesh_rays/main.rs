@@ -43,10 +43,14 @@
 //! `RAYWAVE_MESH=lab` (or `12k`, `1M`) limits any mode but the test mode to one scene. The
 //! test mode ignores all three switches.
 
+#[path = "../common/mod.rs"]
 mod common;
+mod peer_table;
 
 use criterion::{BenchmarkId, Criterion, Throughput};
+use peer_table::{Tables, peer_rows, print_peer_table};
 use raywave::output::statistics::median;
+use raywave::peer::stage::ShadowStage;
 use raywave::peer::{
     Hits, ObvhsMesh, RaySet, RaySetKind, RaySets, hit_agreement, occlusion_agreement,
     raywave_closest, wavefront_bvh_closest, wavefront_bvh_closest_one_ray, wavefront_closest,
@@ -105,7 +109,7 @@ fn load(label: &'static str, source: Source) -> Scene {
     let start = Instant::now();
     let scene = match source {
         Source::Lab => {
-            let text = include_str!("../scenes/cornell_box_reflective_spheres.obj");
+            let text = include_str!("../../scenes/cornell_box_reflective_spheres.obj");
             let scene = parse_scene_str(text, "cornell_box_reflective_spheres.obj")
                 .expect("the bundled scene parses");
             without_spheres(&without_emitters(&scene))
@@ -131,14 +135,15 @@ fn setup(label: &'static str, source: Source, size: u32) -> Setup {
     let scene = load(label, source);
     let obvhs = ObvhsMesh::new(&scene);
     let sets = RaySets::new(&scene, &obvhs, size, size, SEED);
+    let settings = RenderSettings {
+        width: size,
+        height: size,
+        two_sided: true,
+        ..RenderSettings::default()
+    };
     Setup {
         label,
-        settings: RenderSettings {
-            width: size,
-            height: size,
-            two_sided: true,
-            ..RenderSettings::default()
-        },
+        settings,
         #[cfg(feature = "embree")]
         embree: EmbreeMesh::new(&scene).expect("Embree builds the scene"),
         #[cfg(feature = "tinybvh")]
@@ -280,8 +285,23 @@ fn bench_set(c: &mut Criterion, s: &Setup, ctx: &Context, set: &RaySet) {
     group.finish();
 }
 
-/// One pass of `engine` over `set`: the same calls the criterion groups time.
-fn trace(s: &Setup, ctx: &Context, set: &RaySet, engine: &str, out: &mut Outputs) {
+/// One pass of `engine` over `set`: the same calls the criterion groups time. Returns the
+/// number of rays traced: the set's, but for `raywave_stage` on a shadow set, the shadow
+/// stage's own rays (see `stage_engine`).
+fn trace<'s>(
+    s: &'s Setup,
+    ctx: &Context,
+    set: &RaySet,
+    engine: &str,
+    out: &mut Outputs<'s>,
+) -> usize {
+    if engine == "raywave_stage" {
+        let stage = out
+            .stage
+            .as_mut()
+            .expect("a shadow set's outputs carry its stage");
+        return black_box(stage.run(&s.sets.primary)) as usize;
+    }
     let shadow = set.kind.is_occlusion();
     let set = black_box(set);
     #[cfg(feature = "tinybvh")]
@@ -292,7 +312,7 @@ fn trace(s: &Setup, ctx: &Context, set: &RaySet, engine: &str, out: &mut Outputs
             s.tinybvh.closest(layout, set, &mut out.hits);
         }
         black_box(&*out);
-        return;
+        return set.len();
     }
     #[cfg(feature = "embree")]
     let coherent = set.kind.is_coherent();
@@ -315,13 +335,29 @@ fn trace(s: &Setup, ctx: &Context, set: &RaySet, engine: &str, out: &mut Outputs
         _ => unreachable!("engine {engine}"),
     }
     black_box(&*out);
+    set.len()
 }
 
+/// The engine that times the renderer's whole stage on `set`'s kind of ray: for closest hits
+/// the intersect stage on the set's own rays (`wavefront`: the hit search, then the shading
+/// columns); for shadow rays the shadow stage (`raywave_stage`: spawning, occlusion and
+/// shading, `peer::stage::ShadowStage`) on rays of the same kind from the same camera hits.
+fn stage_engine(set: &RaySet) -> &'static str {
+    if set.kind.is_occlusion() {
+        "raywave_stage"
+    } else {
+        "wavefront"
+    }
+}
+
+/// What an engine writes, kept across passes. One per ray set: `stage` is that set's shadow
+/// stage, for `raywave_stage`.
 #[derive(Default)]
-struct Outputs {
+struct Outputs<'s> {
     hits: Hits,
     blocked: Vec<bool>,
     scratch: HitBatch,
+    stage: Option<ShadowStage<'s>>,
 }
 
 /// The peers, in the order they are timed and tabled: (engine, column title).
@@ -359,15 +395,14 @@ fn engines(ctx: &Context, set: &RaySet) -> Vec<&'static str> {
 
 /// Rays/s (millions) of each of `engines` on `set`, one pass each per round, over `rounds`
 /// rounds after one warm-up round: `rates[engine][round]`.
-fn time_rounds(
-    s: &Setup,
+fn time_rounds<'s>(
+    s: &'s Setup,
     ctx: &Context,
     set: &RaySet,
     engines: &[&str],
     rounds: usize,
+    out: &mut Outputs<'s>,
 ) -> Vec<Vec<f64>> {
-    let mut out = Outputs::default();
-    let rays = set.len() as f64;
     let mut rates: Vec<Vec<f64>> = vec![Vec::new(); engines.len()];
     for round in 0..=rounds {
         // Each round starts one engine later, so that no engine always follows the same
@@ -376,7 +411,7 @@ fn time_rounds(
         for step in 0..engines.len() {
             let e = (round + step) % engines.len();
             let start = Instant::now();
-            trace(s, ctx, set, engines[e], &mut out);
+            let rays = trace(s, ctx, set, engines[e], out) as f64;
             let rate = rays / start.elapsed().as_secs_f64() / 1e6;
             if round > 0 {
                 // round 0 warms the caches and is not counted
@@ -400,7 +435,7 @@ fn ratio(rates: &[Vec<f64>], a: usize, b: usize) -> f64 {
 fn interleaved(s: &Setup, ctx: &Context, rounds: usize) {
     for set in s.sets.all() {
         let engines = engines(ctx, set);
-        let rates = time_rounds(s, ctx, set, &engines, rounds);
+        let rates = time_rounds(s, ctx, set, &engines, rounds, &mut Outputs::default());
         let mut line = format!(
             "{}_{} Mrays/s, median of {rounds}:",
             set.kind.name(),
@@ -423,121 +458,6 @@ fn interleaved(s: &Setup, ctx: &Context, rounds: usize) {
             }
         }
         println!("{line}");
-    }
-}
-
-/// Agreement of a peer with raywave below which the peer table flags a cell.
-const TABLE_MIN_AGREEMENT: f64 = 0.9999;
-
-/// The rows of the peer table for one scene, and its notes (builds, agreement).
-fn peer_rows(
-    s: &Setup,
-    ctx: &Context,
-    rounds: usize,
-    rows: &mut Vec<String>,
-    notes: &mut Vec<String>,
-) {
-    let peers = peers();
-    let title = match ctx.accel {
-        Some(_) => format!("{} ({} triangles)", s.label, s.scene.triangles.len()),
-        None => format!("lab box ({} triangles, no BVH)", s.scene.triangles.len()),
-    };
-    notes.push(format!("{title}, builds: {}.", builds(s, ctx).join("; ")));
-    for set in s.sets.all() {
-        let mut engines = vec!["raywave"];
-        engines.extend(peers.iter().map(|(engine, _)| *engine));
-        // Agreement with raywave first: a fast wrong answer is not a figure.
-        let reference = answer(s, ctx, set, "raywave");
-        let mut marks = Vec::new();
-        for (engine, column) in &peers {
-            let a = agreement(s, ctx, set, &reference, engine);
-            let low = a.fraction() <= TABLE_MIN_AGREEMENT;
-            if low {
-                notes.push(format!(
-                    "**{title}, {}, {column}: agrees with raywave on only {} of {} rays.**",
-                    set.kind.title(),
-                    a.agree,
-                    a.rays
-                ));
-            }
-            marks.push(if low { " ✗" } else { "" });
-        }
-        let rates = time_rounds(s, ctx, set, &engines, rounds);
-        // tinybvh has no occlusion query in the crate: its shadow figures are closest hits.
-        let closest_only = |engine: &str| set.kind.is_occlusion() && engine.starts_with("tinybvh");
-        let mut row = format!(
-            "| {title} | {} | {} | {:.2} |",
-            set.kind.title(),
-            set.len(),
-            median(&rates[0])
-        );
-        for (p, (engine, _)) in peers.iter().enumerate() {
-            let dagger = if closest_only(engine) { "†" } else { "" };
-            row += &format!(" {:.2}{dagger}{} |", median(&rates[p + 1]), marks[p]);
-        }
-        for p in 0..peers.len() {
-            row += &format!(" {:.2}× |", ratio(&rates, 0, p + 1));
-        }
-        rows.push(row);
-    }
-}
-
-/// `RAYWAVE_PEER_TABLE=ROUNDS`: the peer table of every scene, printed as Markdown.
-fn print_peer_table(rounds: usize, size: u32, rows: &[String], notes: &[String]) {
-    let peers = peers();
-    let mut header = "| scene | ray kind | rays | raywave".to_string();
-    let mut rule = "| --- | --- | ---: | ---:".to_string();
-    for (_, column) in &peers {
-        header += &format!(" | {column}");
-        rule += " | ---:";
-    }
-    for (_, column) in &peers {
-        header += &format!(" | raywave / {column}");
-        rule += " | ---:";
-    }
-    println!(
-        "Mrays/s on one thread, median of {rounds} interleaved rounds (every engine once per \
-         round, in rotating order); ratios are medians of the per-round ratios. {size}×{size} \
-         camera rays; machine: {}, simd {}.\n",
-        raywave::output::machine::cpu_model(),
-        raywave::simd_path()
-    );
-    println!("{header} |");
-    println!("{rule} |");
-    for row in rows {
-        println!("{row}");
-    }
-    println!();
-    println!(
-        "raywave: the path the renderer takes for the scene (the BVH traversal of the intersect \
-         stage, camera rays in packets of 8, and `MeshBvh::occluded` for shadow rays; below 64 \
-         triangles the brute-force `simd::closest_hits`/`simd::occluded`). Every engine traces \
-         two-sided, on the scene without its light wall (and the lab box without its spheres: \
-         the peers trace triangles)."
-    );
-    #[cfg(feature = "embree")]
-    println!(
-        "\nEmbree single: `rtcIntersect1`/`rtcOccluded1`. Embree packet8: \
-         `rtcIntersect8`/`rtcOccluded8` on 8 consecutive rays of the set (one origin per packet \
-         on soft-shadow rows), through the `embree` crate's `sys` bindings."
-    );
-    #[cfg(feature = "tinybvh")]
-    println!(
-        "\ntinybvh: one ray per `Intersect` call through tinybvh-rs 0.1.0-beta.3 (tinybvh 1.6.8). \
-         † tinybvh-rs binds no occlusion query: its shadow rays are traced with the closest-hit \
-         `Intersect` limited to tmax, which does not stop at the first blocker. tinybvh-rs has \
-         no BVH4_CPU layout and no packet calls."
-    );
-    if !peers.is_empty() {
-        println!(
-            "\n✗: the peer disagrees with raywave on more than 0.01% of the set's rays (the \
-             rules of `peer::hit_agreement`, `occlusion_agreement` and, for †, \
-             `blocker_agreement`; see the notes)."
-        );
-    }
-    println!();
-    for note in notes {
-        println!("- {note}");
     }
 }
 
@@ -579,7 +499,7 @@ fn main() {
         raywave::output::machine::cpu_model(),
         raywave::simd_path()
     );
-    let (mut rows, mut notes) = (Vec::new(), Vec::new());
+    let mut tables = Tables::default();
     for &(label, source) in SCENES {
         // CI's test mode leaves the 1M box out: its build alone takes seconds, and the 12k box
         // runs the same code.
@@ -589,7 +509,7 @@ fn main() {
         let s = setup(label, source, size);
         let ctx = Context::new(&s.scene, &s.settings);
         if let Some(rounds) = table {
-            peer_rows(&s, &ctx, rounds, &mut rows, &mut notes);
+            peer_rows(&s, &ctx, rounds, &mut tables);
             continue;
         }
         if let Some(rounds) = interleave {
@@ -604,13 +524,13 @@ fn main() {
             // The interleaved mode's and the peer table's code, once, so that CI keeps them
             // running.
             interleaved(&s, &ctx, 1);
-            peer_rows(&s, &ctx, 1, &mut rows, &mut notes);
+            peer_rows(&s, &ctx, 1, &mut tables);
         }
     }
     if let Some(rounds) = table {
-        print_peer_table(rounds, size, &rows, &notes);
+        print_peer_table(rounds, size, &tables);
     } else if test_mode {
-        print_peer_table(1, size, &rows, &notes);
+        print_peer_table(1, size, &tables);
     }
     if interleave.is_none() && table.is_none() {
         c.final_summary();
