@@ -176,6 +176,8 @@ pub fn run(args: &BenchOptions, hooks: &Hooks) -> Result<Outcome> {
                 }
             }
         }
+        crate::render::sampling::check(&settings)
+            .map_err(|e| crate::render::error::UsageError(e.to_string()))?;
         let pool = thread_pool(threads)?;
         let setup = Setup {
             scene: SceneId {

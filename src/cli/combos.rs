@@ -48,6 +48,10 @@ pub fn meaningless(command: &Command, typed: &dyn Fn(&str) -> String) -> Vec<Str
 
 fn image(args: &ImageArgs, typed: &dyn Fn(&str) -> String, out: &mut Vec<String>) {
     let options = args.options();
+    if options.shadow_samples == Some(0) {
+        // An error (`sampling::check`), not a combination to warn about.
+        return;
+    }
     let shadows = options.resolve(None).settings.shadows;
     if let (Some(given @ (ShadowMode::Off | ShadowMode::Hard)), Some(n)) =
         (options.shadows, options.shadow_samples)

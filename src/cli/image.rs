@@ -2,6 +2,7 @@
 
 use super::values::{DefaultsArg, LightModelArg, SamplerArg, ShadowArg, colour_component};
 use clap::Args;
+use raywave::render::error::UsageError;
 use raywave::output::OutputPlan;
 use raywave::render::scene::{Scene, load_scene};
 use raywave::render::settings::options::{Effective, ImageOptions};
@@ -24,8 +25,9 @@ pub struct ImageArgs {
     /// [soft; the lab's hard; RPI's off].
     #[arg(long, value_enum)]
     pub shadows: Option<ShadowArg>,
-    /// Points per light with soft shadows [default: 16].
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    /// Points per light with soft shadows [default: 16]; each sampler's limits are checked
+    /// with the rest of the settings, so that the error can name the sampler.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=65536))]
     pub shadow_samples: Option<u32>,
     /// How the points on a light are chosen.
     #[arg(long, value_enum, default_value = "stratified")]
@@ -169,6 +171,7 @@ pub fn scene_and_settings(
         eprintln!("{w}");
     }
     let effective = options.resolve(scene.background.map(|c| c.to_array()));
+    raywave::render::sampling::check(&effective.settings).map_err(|e| UsageError(e.to_string()))?;
     Ok((scene, effective))
 }
 

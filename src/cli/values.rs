@@ -124,16 +124,30 @@ mirror! {
         /// The lab's own strategy: the centre of the light's (u, v) square (its centroid, for a
         /// parallelogram) when N = 1, independent random points otherwise.
         Lab,
+        /// Halton points (bases 2 and 3), Owen-scrambled for every (pixel, sample, bounce,
+        /// light).
+        Halton,
+        /// Progressive multi-jittered (0,2) points (Christensen et al. 2018): 1 to 4096 points.
+        Pmj02,
+        /// Sobol points in the pixels' Morton order (Ahmed and Wonka 2020, pbrt-v4's
+        /// ZSobolSampler): the error as blue noise in screen space.
+        Zsobol,
+        /// Heitz et al.'s 2019 blue-noise tables: aa samples × points ≤ 256.
+        Bluenoise,
     }
 }
 
 impl SamplerArg {
     /// Every sampler, in the order reports list them (`LightSampler::ALL`).
-    pub const ALL: [SamplerArg; 4] = [
+    pub const ALL: [SamplerArg; 8] = [
         SamplerArg::Random,
         SamplerArg::Stratified,
         SamplerArg::Sobol,
         SamplerArg::Lab,
+        SamplerArg::Halton,
+        SamplerArg::Pmj02,
+        SamplerArg::Zsobol,
+        SamplerArg::Bluenoise,
     ];
 }
 

@@ -16,7 +16,7 @@ use crate::render::camera::CameraRays;
 use crate::render::film::Film;
 use crate::render::geometry::{Accel, Hit, Ray};
 use crate::render::per_kind::{KindClock, PerKind, RayCounts, RayKind};
-use crate::render::sampling::{SampleKey, square_sample};
+use crate::render::sampling::{PointSet, SampleKey};
 use crate::render::scene::{Material, Scene};
 use crate::render::settings::{RenderSettings, ShadowMode};
 use crate::render::shading::shade;
@@ -90,6 +90,8 @@ pub struct Reference<'a> {
     camera: CameraRays,
     /// `spawn::light_offset` of every light.
     light_offsets: Vec<f32>,
+    /// Where soft shadows' points fall on a light.
+    points: PointSet,
 }
 
 impl<'a> Reference<'a> {
@@ -101,6 +103,7 @@ impl<'a> Reference<'a> {
             accel: Accel::new(scene),
             camera: CameraRays::new(&scene.camera, settings.width, settings.height),
             light_offsets: scene.lights.iter().map(light_offset).collect(),
+            points: PointSet::new(settings),
         }
     }
 
@@ -272,7 +275,7 @@ impl<'a> Reference<'a> {
             for j in 0..count {
                 let (uv, point) = match settings.shadows {
                     ShadowMode::Soft => {
-                        let (u, v) = square_sample(settings.sampler, &light_key, j, count);
+                        let (u, v) = self.points.point(&light_key, j);
                         (Some([u, v]), light.point(u, v))
                     }
                     _ => (None, light.centroid),

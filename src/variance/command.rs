@@ -6,7 +6,7 @@ use crate::render::engine::{Engine, Hooks};
 use crate::render::error::UsageError;
 use crate::render::sampling::LightSampler;
 use crate::render::scene::Scene;
-use crate::render::settings::{LightModel, RenderSettings};
+use crate::render::settings::{LightModel, RenderSettings, ShadowMode};
 use anyhow::{Context, Result, bail};
 use std::path::PathBuf;
 
@@ -83,11 +83,32 @@ impl VarianceOptions {
             );
         }
         if self.samplers.is_empty() {
-            return Err(UsageError(
-                "--samplers is empty: expected at least one of random, stratified, sobol, lab"
-                    .into(),
-            )
+            let names: Vec<&str> = LightSampler::ALL.iter().map(|s| s.name()).collect();
+            return Err(UsageError(format!(
+                "--samplers is empty: expected at least one of {}",
+                names.join(", ")
+            ))
             .into());
+        }
+        // Every sampler takes every budget, or the study stops before it starts.
+        for &sampler in &self.samplers {
+            for &n in &self.budgets {
+                let settings = RenderSettings {
+                    width: self.size[0],
+                    height: self.size[1],
+                    shadows: ShadowMode::Soft,
+                    shadow_samples: n,
+                    sampler,
+                    aa_samples: 1,
+                    ..RenderSettings::default()
+                };
+                crate::render::sampling::check(&settings).map_err(|e| {
+                    UsageError(format!(
+                        "{e}; the study's --budgets include {n}: leave {} out of --samplers, or that budget out",
+                        sampler.name()
+                    ))
+                })?;
+            }
         }
         Ok(())
     }

@@ -9,7 +9,7 @@
 
 use crate::render::camera::CameraRays;
 use crate::render::geometry::Accel;
-use crate::render::sampling::{LightSampler, SampleKey, square_sample};
+use crate::render::sampling::{LightSampler, PointSet, SampleKey};
 use crate::render::scene::Scene;
 use crate::render::settings::RenderSettings;
 use crate::render::spawn::{light_end, light_offset, mirror_ray, shadow_ray, surface_hit};
@@ -90,8 +90,9 @@ fn classify(
             };
             let end = light_end(light, end_offsets[li], &surface);
             let mut visible = 0;
+            let set = PointSet::of(LightSampler::Stratified, points);
             for j in 0..points {
-                let (u, v) = square_sample(LightSampler::Stratified, &key, j, points);
+                let (u, v) = set.point(&key, j);
                 // Spawned as the renderers spawn it: no ray below the tangent plane.
                 let shadow = shadow_ray(&surface, light.point(u, v), &end);
                 if shadow

@@ -185,6 +185,7 @@ impl ViewSettings {
                 "width × height × aa = {samples} camera samples: the viewer renders at most {MAX_CAMERA_SAMPLES}"
             )));
         }
+        crate::render::sampling::check(&s).map_err(|e| ApiError::bad(e.to_string()))?;
         let camera = match &self.camera {
             Some(c) => c.to_camera()?,
             None => base.camera,
@@ -255,12 +256,16 @@ mod tests {
 
     #[test]
     fn bad_settings_are_refused_with_the_reason() {
-        let cases: [(&[u8], &str); 7] = [
+        let cases: [(&[u8], &str); 8] = [
             (b"{", "EOF"),
             (br#"{"widht": 3}"#, "unknown field"),
             (br#"{"width": "x"}"#, "invalid type"),
             (br#"{"width": 0}"#, "width must be in 1..=2048"),
             (br#"{"sampler": "best"}"#, "unknown variant"),
+            (
+                br#"{"shadows": "soft", "sampler": "bluenoise", "shadow_samples": 300}"#,
+                "--sampler bluenoise with 300 points per light",
+            ),
             (br#"{"width": 2048, "height": 2048, "aa": 4}"#, "camera samples"),
             (
                 br#"{"camera": {"position": [0,0,1], "look_at": [0,0,1], "up": [0,1,0], "fov_degrees": 30}}"#,

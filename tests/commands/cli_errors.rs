@@ -168,6 +168,48 @@ const FAILS_EARLY: &[FailsEarly] = &[
         args: "cornell_box.obj --size 16384 16384 -o out.jpg",
         code: 2,
         stderr: &["out.jpg"],
+    },    // A sampler past its limit: the error names the sampler, the limit and why.
+    FailsEarly {
+        setup: &[Scene("cornell_box.obj")],
+        args: "cornell_box.obj --sampler pmj02 --shadow-samples 0",
+        code: 2,
+        stderr: &["--shadow-samples 0", "pmj02", "1 to 4096"],
+    },
+    FailsEarly {
+        setup: &[Scene("cornell_box.obj")],
+        args: "cornell_box.obj --sampler pmj02 --shadow-samples 8192",
+        code: 2,
+        stderr: &["pmj02", "8192", "4096", "tables"],
+    },
+    FailsEarly {
+        setup: &[Scene("cornell_box.obj")],
+        args: "cornell_box.obj --sampler bluenoise --shadow-samples 64 --aa 8",
+        code: 2,
+        stderr: &["bluenoise", "512 per pixel", "256"],
+    },
+    FailsEarly {
+        setup: &[Scene("cornell_box.obj")],
+        args: "cornell_box.obj --sampler zsobol --size 16384 16384 --shadow-samples 64",
+        code: 2,
+        stderr: &["zsobol", "34-bit", "32"],
+    },
+    FailsEarly {
+        setup: &[Scene("cornell_box.obj")],
+        args: "bench cornell_box.obj --sampler bluenoise --shadow-samples 16,512 --runs 1",
+        code: 2,
+        stderr: &["bluenoise", "512", "256"],
+    },
+    FailsEarly {
+        setup: &[Scene("cornell_box.obj")],
+        args: "variance cornell_box.obj --samplers random,bluenoise --budgets 4,1024 --out study",
+        code: 2,
+        stderr: &["bluenoise", "1024", "--samplers"],
+    },
+    FailsEarly {
+        setup: &[Scene("cornell_box.obj")],
+        args: "trace-pixel 1 1 cornell_box.obj --sampler pmj02 --shadow-samples 5000",
+        code: 2,
+        stderr: &["pmj02", "4096"],
     },
 ];
 

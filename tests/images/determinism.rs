@@ -47,7 +47,7 @@ fn render_on(threads: usize, scene: &Scene, settings: &RenderSettings) -> Vec<[u
 #[test]
 fn reference_is_bit_identical_across_runs_and_thread_counts() {
     let scene = Scene::load(&scene_path("cornell_box_reflective_spheres.obj")).unwrap();
-    for sampler in [LightSampler::Random, LightSampler::Stratified] {
+    for sampler in LightSampler::ALL {
         let settings = RenderSettings {
             sampler,
             ..soft_settings(7)

@@ -197,12 +197,7 @@ fn sixteen_and_eight_lanes_give_the_same_bytes_on_every_scene() {
         sampler,
         ..modes()[1].clone()
     };
-    for sampler in [
-        LightSampler::Random,
-        LightSampler::Stratified,
-        LightSampler::Sobol,
-        LightSampler::Lab,
-    ] {
+    for sampler in LightSampler::ALL {
         // 15, 17 and 33 points: 16-lane blocks with dead tail lanes; 64 the lab benchmark's.
         for n in [15, 17, 33, 64] {
             settings.push(soft(n, sampler));
@@ -255,12 +250,7 @@ fn shadow_paths_give_the_per_hit_path_s_bytes() {
         ..modes()[1].clone()
     };
     let mut settings = Vec::new();
-    for sampler in [
-        LightSampler::Random,
-        LightSampler::Stratified,
-        LightSampler::Sobol,
-        LightSampler::Lab,
-    ] {
+    for sampler in LightSampler::ALL {
         for n in [1, 7, 17, 64] {
             settings.push(soft(n, sampler, LightModel::Lab));
         }

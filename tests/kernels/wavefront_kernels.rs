@@ -16,7 +16,7 @@ use proptest::prelude::*;
 use raywave::render::geometry::{
     self, Accel, Ray, intersect_sphere, intersect_triangle, shadow_casters,
 };
-use raywave::render::sampling::{LightSampler, SampleKey, square_sample, strata_grid, uniform};
+use raywave::render::sampling::{LightSampler, SampleKey, PointSet, strata_grid, uniform};
 use raywave::render::scene::{Light, LightShape, Material, NO_HIT, Scene, Sphere};
 use raywave::render::shading::shade;
 use raywave::render::spawn::{SurfaceHit, light_end, shadow_ray};
@@ -518,7 +518,7 @@ proptest! {
     #[test]
     fn simd_light_points_equal_scalar_sampling(
         pixel in any::<u32>(), sample in 0u32..4, bounce in 0u32..6, light in 0u32..3, seed in any::<u32>(),
-        count in 1u32..80, which in 0usize..4,
+        count in 1u32..80, which in 0usize..8,
         origin in vec3(HALF), edge_u in vec3(HALF), edge_v in vec3(HALF), point in vec3(HALF), n in vec3(HALF),
         offset in prop_oneof![Just(0.0f32), 0.0f32..0.01],
         end_offset in prop_oneof![Just(0.0f32), 0.0f32..0.01],
@@ -529,8 +529,8 @@ proptest! {
             let h = raywave::render::sampling::mix32(key_prefix(&key) ^ dim);
             prop_assert_eq!((h >> 8) as f32 * (1.0 / 16_777_216.0), uniform(&key, dim));
         }
-        // Every sampler with a SIMD twin (the lab's strategy only for N > 1).
-        let sampler = [LightSampler::Random, LightSampler::Stratified, LightSampler::Sobol, LightSampler::Lab][which];
+        // Every sampler (the lab's strategy only for N > 1: at N = 1 it is the scalar path's).
+        let sampler = LightSampler::ALL[which];
         let count = if sampler == LightSampler::Lab { count.max(2) } else { count };
         let case = LightCase { key, sampler, count, origin, edge_u, edge_v, point, n: n.normalize_or(Vec3::Z), offset, end_offset };
         check_light_points::<f32x8>(&case, |b| simd::light_points8(b).map(|c| c.to_vec()), |hit, pts, end, lanes| {
@@ -653,8 +653,9 @@ struct BlockOut {
     live: u32,
 }
 
-/// The light-point and shadow-ray kernels at the width of `V` against `square_sample`,
-/// `Light::point` and `spawn::shadow_ray`, block by block of `V::N` points.
+/// The light-point and shadow-ray kernels at the width of `V` against `PointSet::point`,
+/// `Light::point` and `spawn::shadow_ray`, block by block of `V::N` points (on a 640×480
+/// image, for the samplers that read the pixel's place).
 fn check_light_points<V: Lanes>(
     case: &LightCase,
     points: impl Fn(&LightBlock) -> [Vec<f32>; 3],
@@ -689,6 +690,7 @@ fn check_light_points<V: Lanes>(
         color: Vec3::ONE,
     };
     let width = V::N as u32;
+    let set = PointSet::with(sampler, count, (640, 480), 1);
     for j0 in (0..count).step_by(V::N) {
         let block = LightBlock {
             prefix: key_prefix(&key),
@@ -707,6 +709,13 @@ fn check_light_points<V: Lanes>(
                     ),
                 },
                 LightSampler::Random | LightSampler::Lab => BlockSampler::Random,
+                LightSampler::Halton
+                | LightSampler::Pmj02
+                | LightSampler::Zsobol
+                | LightSampler::Bluenoise => BlockSampler::PerLane {
+                    points: &set,
+                    key,
+                },
             },
             origin,
             edge_u,
@@ -723,7 +732,7 @@ fn check_light_points<V: Lanes>(
         let block = rays(&hit, &pts, &end, lanes);
         let (l, live) = (&block.l, block.live);
         for k in 0..lanes {
-            let (u, v) = square_sample(sampler, &key, j0 + k as u32, count);
+            let (u, v) = set.point(&key, j0 + k as u32);
             let target = lamp.point(u, v);
             prop_assert_eq!(
                 [pts[0][k], pts[1][k], pts[2][k]].map(f32::to_bits),
@@ -815,7 +824,7 @@ fn simd_sobol_points_equal_scalar_up_to_the_largest_index() {
                 let Some(j) = j0.checked_add(k).filter(|&j| j < count) else {
                     continue;
                 };
-                let (u, v) = square_sample(LightSampler::Sobol, &key, j, count);
+                let (u, v) = PointSet::of(LightSampler::Sobol, count).point(&key, j);
                 let want = lamp.point(u, v);
                 let k = k as usize;
                 assert_eq!(
@@ -833,7 +842,7 @@ fn simd_sobol_points_equal_scalar_up_to_the_largest_index() {
                 edge_v,
             });
             for (k, ((x, y), z)) in pts[0].iter().zip(&pts[1]).zip(&pts[2]).enumerate() {
-                let (u, v) = square_sample(LightSampler::Sobol, &key, j0 + k as u32, count);
+                let (u, v) = PointSet::of(LightSampler::Sobol, count).point(&key, j0 + k as u32);
                 let want = lamp.point(u, v);
                 assert_eq!(
                     [*x, *y, *z].map(f32::to_bits),

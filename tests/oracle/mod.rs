@@ -60,7 +60,7 @@
 
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
-use raywave::render::sampling::{CAMERA_LIGHT, SampleKey, pixel_offset, square_sample};
+use raywave::render::sampling::{CAMERA_LIGHT, PointSet, SampleKey, pixel_offset};
 use raywave::render::scene::{Camera, LightShape, Scene};
 use raywave::render::settings::{LightModel, RenderSettings, ShadowMode};
 
@@ -598,6 +598,7 @@ impl<'a> Oracle<'a> {
         let s = self.settings;
         let count = s.points_per_light();
         let mut sum = DVec3::ZERO;
+        let points = PointSet::new(s);
         for (li, lamp) in self.lamps.iter().enumerate() {
             let light_key = SampleKey {
                 light: li as u32,
@@ -606,7 +607,7 @@ impl<'a> Oracle<'a> {
             for j in 0..count {
                 let p = match s.shadows {
                     ShadowMode::Soft => {
-                        let (u, v) = square_sample(s.sampler, &light_key, j, count);
+                        let (u, v) = points.point(&light_key, j);
                         lamp.point(u, v)
                     }
                     _ => lamp.centroid,

@@ -8,6 +8,7 @@ mod common;
 #[path = "../oracle/mod.rs"]
 mod oracle;
 
+mod point_sets;
 mod sample_streams;
 mod sampling;
 mod sampling_edges;

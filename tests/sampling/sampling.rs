@@ -5,7 +5,7 @@ use glam::Vec3;
 use raywave::render::per_kind::RayCounts;
 use raywave::render::reference::Reference;
 use raywave::render::sampling::{
-    LightSampler, SampleKey, pixel_offset, square_sample, strata_grid,
+    LightSampler, SampleKey, pixel_offset, PointSet, strata_grid,
 };
 use raywave::render::scene::parse_scene_str;
 use raywave::render::settings::{RenderSettings, ShadowMode};
@@ -68,7 +68,7 @@ fn light_points_are_uniform_for_both_samplers() {
                     seed: 9,
                 };
                 for j in 0..n {
-                    let (u, v) = square_sample(sampler, &k, j, n);
+                    let (u, v) = PointSet::of(sampler, n).point(&k, j);
                     assert!((0.0..1.0).contains(&u) && (0.0..1.0).contains(&v));
                     bins[(v * 8.0) as usize * 8 + (u * 8.0) as usize] += 1;
                 }
@@ -99,8 +99,8 @@ fn streams_for_different_lights_and_bounces_are_uncorrelated() {
                 light: b.1,
                 ..ka
             };
-            let x = square_sample(LightSampler::Random, &ka, 0, 1).0 as f64;
-            let y = square_sample(LightSampler::Random, &kb, 0, 1).0 as f64;
+            let x = PointSet::of(LightSampler::Random, 1).point(&ka, 0).0 as f64;
+            let y = PointSet::of(LightSampler::Random, 1).point(&kb, 0).0 as f64;
             sx += x;
             sy += y;
             sxy += x * y;

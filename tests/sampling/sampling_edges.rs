@@ -2,7 +2,7 @@
 //! strategy, which must equal `random` for every N but 1.
 
 use raywave::render::sampling::{
-    CAMERA_LIGHT, LightSampler, SampleKey, pixel_offset, square_sample, strata_grid, uniform,
+    CAMERA_LIGHT, LightSampler, SampleKey, pixel_offset, PointSet, strata_grid, uniform,
 };
 
 /// The first pixel whose stream draws, in dimension `dim`, one of the two largest values
@@ -29,7 +29,7 @@ fn strata_stay_below_one_when_the_jitter_rounds_up() {
     let (nx, _) = strata_grid(3);
     assert_eq!(nx, 3);
     let key = key_with_top_jitter(0, 2 * 2);
-    let (u, _) = square_sample(LightSampler::Stratified, &key, 2, 3);
+    let (u, _) = PointSet::of(LightSampler::Stratified, 3).point(&key, 2);
     assert!(u < 1.0, "{key:?}: u = {u}");
     assert!(
         u > 0.999_999,
@@ -37,7 +37,7 @@ fn strata_stay_below_one_when_the_jitter_rounds_up() {
     );
     // N = 9: 3 × 3; point 6 is in the top row, v = (2 + ξ)/3 from dimension 2·6 + 1.
     let key = key_with_top_jitter(0, 2 * 6 + 1);
-    let (_, v) = square_sample(LightSampler::Stratified, &key, 6, 9);
+    let (_, v) = PointSet::of(LightSampler::Stratified, 9).point(&key, 6);
     assert!(v < 1.0 && v > 0.999_999, "{key:?}: v = {v}");
     // The camera's strata: 9 antialiasing samples, sample 8 in the top-right stratum, its
     // jitter from dimensions 0 and 1 of the camera stream.
@@ -61,11 +61,11 @@ fn the_lab_strategy_is_random_except_at_one_point() {
                 seed: 6,
             };
             for j in 0..n {
-                let lab = square_sample(LightSampler::Lab, &key, j, n);
+                let lab = PointSet::of(LightSampler::Lab, n).point(&key, j);
                 let want = if n == 1 {
                     (0.5, 0.5)
                 } else {
-                    square_sample(LightSampler::Random, &key, j, n)
+                    PointSet::of(LightSampler::Random, n).point(&key, j)
                 };
                 assert_eq!(lab, want, "N = {n}, pixel {pixel}, point {j}");
             }

@@ -13,7 +13,7 @@ use glam::{DVec3, Vec3};
 use oracle::Oracle;
 use raywave::render::per_kind::RayCounts;
 use raywave::render::reference::Reference;
-use raywave::render::sampling::{LightSampler, SampleKey, square_sample, strata_grid};
+use raywave::render::sampling::{LightSampler, SampleKey, PointSet, strata_grid};
 use raywave::render::scene::{Scene, parse_scene_str};
 use raywave::render::settings::RenderSettings;
 use raywave::variance::{Region, penumbra_mask};
@@ -138,7 +138,7 @@ fn points_stay_on_the_unit_square_and_cover_it() {
                     seed: 9,
                 };
                 for j in 0..n {
-                    let (u, v) = square_sample(sampler, &key, j, n);
+                    let (u, v) = PointSet::of(sampler, n).point(&key, j);
                     assert!(
                         (0.0..1.0).contains(&u) && (0.0..1.0).contains(&v),
                         "{} n={n}: ({u}, {v})",
@@ -167,7 +167,7 @@ fn points_stay_on_the_unit_square_and_cover_it() {
         };
         let mut cells = [0i32; 16];
         for j in 0..4096 {
-            let (u, v) = square_sample(sampler, &key, j, 4096);
+            let (u, v) = PointSet::of(sampler, 4096).point(&key, j);
             cells[((v * 4.0) as usize) * 4 + (u * 4.0) as usize] += 1;
         }
         assert!(
@@ -225,7 +225,7 @@ fn light_points_stay_on_the_light() {
                 light: li as u32,
                 seed: 2,
             };
-            let (u, v) = square_sample(LightSampler::Random, &key, j, count);
+            let (u, v) = PointSet::of(LightSampler::Random, count).point(&key, j);
             let p = light.point(u, v);
             assert!(inside(li, p), "light {li}: {p} is off the light");
             sum += p;
@@ -409,7 +409,7 @@ fn assert_one_point_per_stratum(sampler: LightSampler, n: u32, sample: u32, boun
         };
         let mut cells = vec![0; n as usize];
         for j in 0..n {
-            let (u, v) = square_sample(sampler, &key, j, n);
+            let (u, v) = PointSet::of(sampler, n).point(&key, j);
             cells[((v * ny as f32) as u32 * nx + (u * nx as f32) as u32) as usize] += 1;
         }
         assert!(

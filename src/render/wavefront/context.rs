@@ -7,7 +7,7 @@ use super::shade::MaterialTerms;
 use super::simd::BlockSampler;
 use crate::render::camera::CameraRays;
 use crate::render::geometry::shadow_casters;
-use crate::render::sampling::{LightSampler, SOBOL_SEED_DIM, SampleKey, hash, strata_grid};
+use crate::render::sampling::{LightSampler, PointSet, SOBOL_SEED_DIM, SampleKey, hash, strata_grid};
 use crate::render::scene::{LightShape, Scene, Triangle};
 use crate::render::settings::{RenderSettings, ShadowMode};
 use crate::render::spawn::{
@@ -88,6 +88,9 @@ pub struct Context<'a> {
     /// would fuse soft-shadow blocks in registers or spawn hard-shadow rays across hits: false
     /// unless [`Context::with_per_hit_shadows`] says otherwise. Speed only.
     pub per_hit_shadows: bool,
+    /// Where soft shadows' points fall on a light (the reference's, for the scalar paths and
+    /// the samplers without a lane formula of their own).
+    pub points: PointSet,
     /// Stratum column of every point index (padded to a multiple of 16), as floats.
     pub cell_x: Vec<f32>,
     /// Stratum row of every point index.
@@ -154,6 +157,7 @@ impl<'a> Context<'a> {
             points_per_light,
             lane_width: auto_width(settings, points_per_light),
             per_hit_shadows: false,
+            points: PointSet::new(settings),
             cell_x,
             cell_y,
             grid: (nx as f32, ny as f32),
@@ -188,14 +192,14 @@ impl<'a> Context<'a> {
         self.settings.shadows == ShadowMode::Soft
     }
 
-    /// True when the 8-wide light sampler (`simd::light_points8`) implements the chosen
-    /// sampler: all of them, except the lab's strategy at N = 1 (the centroid), which goes
-    /// through the scalar `sampling::square_sample`.
+    /// True when the N-lane light sampler (`simd::light_points`) takes the chosen sampler: all
+    /// of them, except the lab's strategy at N = 1 (the centroid), which goes through the
+    /// scalar `PointSet::point`.
     pub fn simd_light_sampling(&self) -> bool {
         match self.settings.sampler {
-            LightSampler::Random | LightSampler::Stratified | LightSampler::Sobol => true,
             // The lab's strategy is random points, except the centroid for N = 1.
             LightSampler::Lab => self.points_per_light > 1,
+            _ => true,
         }
     }
 
@@ -213,6 +217,13 @@ impl<'a> Context<'a> {
                 scramble: hash(key, SOBOL_SEED_DIM),
             },
             LightSampler::Random | LightSampler::Lab => BlockSampler::Random,
+            LightSampler::Halton
+            | LightSampler::Pmj02
+            | LightSampler::Zsobol
+            | LightSampler::Bluenoise => BlockSampler::PerLane {
+                points: &self.points,
+                key: *key,
+            },
         }
     }
 

@@ -38,7 +38,7 @@ use super::shade::{
 };
 use super::simd::{self, LightBlock, RayColumns};
 use crate::render::geometry::casters;
-use crate::render::sampling::{SampleKey, mix32, square_sample};
+use crate::render::sampling::{SampleKey, mix32};
 use crate::render::scene::NO_HIT;
 use crate::render::settings::LightModel;
 use crate::render::spawn::{falloff, light_end, shadow_ray};
@@ -359,7 +359,7 @@ fn spawn<V: Lanes>(
             _ => {
                 for j in 0..count {
                     let target = if ctx.samples_lights() {
-                        let (u, v) = square_sample(ctx.settings.sampler, &key, j, count);
+                        let (u, v) = ctx.points.point(&key, j);
                         ctx.scene.lights[li].point(u, v)
                     } else {
                         light.centroid

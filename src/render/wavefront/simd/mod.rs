@@ -21,7 +21,7 @@
 //! | [`sphere8`]          | `geometry::intersect_sphere`                             |
 //! | [`closest_hits`]     | `Accel::closest` without a BVH                           |
 //! | [`occluded`]         | `Accel::occluded` without a BVH                          |
-//! | [`light_points8`]    | `sampling::square_sample` then `Light::point`            |
+//! | [`light_points8`]    | `sampling::PointSet::point` then `Light::point`          |
 //! | [`shadow_rays8`]     | the start of `Reference::direct` (l, dist, n·l)          |
 //! | `shade::shade8`      | `shade::shade_terms`, twin of `shading::shade`           |
 //!

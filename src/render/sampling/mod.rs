@@ -1,0 +1,471 @@
+//! Sample placement shared by every engine.
+//!
+//! Every random number is a pure function of (pixel, sample, bounce, light, dimension, seed):
+//! there is no generator state, so any engine, tile order or thread count draws the same
+//! numbers and renders the same bytes.
+//!
+//! Dimensions: the camera ray uses 0 and 1 (pixel jitter, light = `CAMERA_LIGHT`); light sample
+//! j uses 2j and 2j + 1 of its (bounce, light) stream.
+//!
+//! The point sets on a light are [`LightSampler`]s, one file each for those that are more than
+//! a few lines: `halton.rs`, `pmj02.rs`, `zsobol.rs`, `bluenoise.rs`. [`PointSet`] is a render's
+//! choice of one, with what it needs of the render (the image's width for the screen-space
+//! samplers, the tables), and [`check`] says when a render asks more of one than it holds.
+
+pub mod bluenoise;
+pub mod halton;
+pub mod pmj02;
+pub mod zsobol;
+
+use crate::render::settings::RenderSettings;
+
+use serde::{Deserialize, Serialize};
+
+/// The `light` value used for the camera's own dimensions.
+pub const CAMERA_LIGHT: u32 = u32::MAX;
+
+/// How points are chosen on an area light.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "tools", derive(schemars::JsonSchema))]
+#[serde(rename_all = "lowercase")]
+pub enum LightSampler {
+    /// N independent uniform points on the light.
+    Random,
+    /// Jittered: the light's (u, v) square split into N strata (nx × ny, see `strata_grid`),
+    /// one uniform point in each.
+    Stratified,
+    /// Owen-scrambled Sobol points (Burley 2020), scrambled independently for every
+    /// (pixel, sample, bounce, light): low discrepancy for any N, best at powers of two.
+    Sobol,
+    /// The lab's own strategy: the centre of the light's (u, v) square (its centroid, for a
+    /// parallelogram) when N = 1, independent random points otherwise.
+    Lab,
+    /// Halton points in bases 2 and 3, Owen-scrambled independently for every stream
+    /// (`halton.rs`).
+    Halton,
+    /// Progressive multi-jittered (0,2) points (Christensen et al. 2018), from tables of our
+    /// own generator, digitally shifted for every stream: at most 4096 points (`pmj02.rs`).
+    Pmj02,
+    /// Sobol points indexed through the pixel's Morton order (Ahmed and Wonka 2020, pbrt-v4's
+    /// ZSobolSampler): the error as blue noise in screen space; image and samples together
+    /// within 32 index bits (`zsobol.rs`).
+    Zsobol,
+    /// The blue-noise sampler of Heitz et al. 2019, from the paper's tables: at most 256
+    /// samples per pixel (aa samples × points) (`bluenoise.rs`).
+    Bluenoise,
+}
+
+impl LightSampler {
+    /// The name used on the command line and in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            LightSampler::Random => "random",
+            LightSampler::Stratified => "stratified",
+            LightSampler::Sobol => "sobol",
+            LightSampler::Lab => "lab",
+            LightSampler::Halton => "halton",
+            LightSampler::Pmj02 => "pmj02",
+            LightSampler::Zsobol => "zsobol",
+            LightSampler::Bluenoise => "bluenoise",
+        }
+    }
+
+    /// Every sampler, in the order reports list them: the lab's four, then the rest of the
+    /// point sets pbrt-v4 offers and the blue-noise tables.
+    pub const ALL: [LightSampler; 8] = [
+        LightSampler::Random,
+        LightSampler::Stratified,
+        LightSampler::Sobol,
+        LightSampler::Lab,
+        LightSampler::Halton,
+        LightSampler::Pmj02,
+        LightSampler::Zsobol,
+        LightSampler::Bluenoise,
+    ];
+
+    /// The most points per light a stream of this sampler holds, and why; `None` for no limit
+    /// below the command line's 65536.
+    pub fn max_points(self) -> Option<(u32, &'static str)> {
+        match self {
+            LightSampler::Sobol => Some((65_536, "its Sobol indices are 16 bits")),
+            LightSampler::Pmj02 => Some((
+                pmj02::TABLE_POINTS as u32,
+                "its tables hold 4096 points",
+            )),
+            LightSampler::Bluenoise => Some((
+                bluenoise::MAX_SAMPLES,
+                "the paper's tables hold 256 samples per pixel",
+            )),
+            _ => None,
+        }
+    }
+}
+
+/// A render that asks a sampler for more than it holds: the message names the sampler, its
+/// limit and why.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum SamplerLimit {
+    /// No points per light.
+    NoPoints(LightSampler),
+    /// More points per stream than the sampler holds.
+    TooManyPoints {
+        /// The sampler.
+        sampler: LightSampler,
+        /// The points asked for, in words.
+        asked: String,
+    },
+    /// An image and sample count whose ZSobol indices pass 32 bits.
+    IndexBits {
+        /// The bits the render needs.
+        bits: u32,
+        /// The image's size, W×H.
+        image: String,
+        /// Samples per pixel (aa × points, each rounded up to a power of two).
+        samples: u64,
+    },
+}
+
+impl std::fmt::Display for SamplerLimit {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let range = |s: &LightSampler| match s.max_points() {
+            Some((n, why)) => format!("1 to {n} points per light ({why})"),
+            None => "1 to 65536 points per light".to_string(),
+        };
+        match self {
+            SamplerLimit::NoPoints(s) => write!(
+                f,
+                "--shadow-samples 0 with --sampler {}: expected {}",
+                s.name(),
+                range(s)
+            ),
+            SamplerLimit::TooManyPoints { sampler, asked } => write!(
+                f,
+                "--sampler {} with {asked}: expected {}",
+                sampler.name(),
+                range(sampler)
+            ),
+            SamplerLimit::IndexBits {
+                bits,
+                image,
+                samples,
+            } => write!(
+                f,
+                "--sampler zsobol on a {image} image with {samples} samples per pixel needs {bits}-bit \
+                 sample indices: expected at most 32 (2 bits per doubling of the image's larger \
+                 side, plus those of the aa samples × points per light, each rounded up to a \
+                 power of two); use a smaller image or fewer points"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for SamplerLimit {}
+
+/// Whether `settings` ask their sampler for no more than it holds, and for at least one point
+/// (whatever the shadows: 0 points per light is never a setting). Only soft shadows sample
+/// points; hard shadows count as one point per light.
+pub fn check(settings: &RenderSettings) -> Result<(), SamplerLimit> {
+    let sampler = settings.sampler;
+    let n = settings.points_per_light();
+    if settings.shadow_samples == 0 {
+        return Err(SamplerLimit::NoPoints(sampler));
+    }
+    let aa = settings.aa_samples.max(1);
+    match sampler {
+        LightSampler::Bluenoise if u64::from(n) * u64::from(aa) > u64::from(bluenoise::MAX_SAMPLES) => {
+            Err(SamplerLimit::TooManyPoints {
+                sampler,
+                asked: if aa > 1 {
+                    format!("{n} points per light × {aa} aa samples = {} per pixel", u64::from(n) * u64::from(aa))
+                } else {
+                    format!("{n} points per light")
+                },
+            })
+        }
+        LightSampler::Zsobol => {
+            let layout = zsobol::Layout::new(settings.width, settings.height, aa, n);
+            let bits = layout.index_bits();
+            if bits > 32 {
+                Err(SamplerLimit::IndexBits {
+                    bits,
+                    image: format!("{}×{}", settings.width, settings.height),
+                    samples: 1u64 << (layout.aa_bits + layout.point_bits),
+                })
+            } else {
+                Ok(())
+            }
+        }
+        _ => match sampler.max_points() {
+            Some((max, _)) if n > max => Err(SamplerLimit::TooManyPoints {
+                sampler,
+                asked: format!("{n} points per light"),
+            }),
+            _ => Ok(()),
+        },
+    }
+}
+
+/// The point set of one render: its sampler, its points per light, and what the sampler needs
+/// of the render. Built once per render (both engines), then [`PointSet::point`] per point.
+/// Within [`check`]'s limits every point is what the sampler defines; past them the tables and
+/// indices wrap (never a panic).
+#[derive(Clone, Copy, Debug)]
+pub struct PointSet {
+    /// The sampler.
+    pub sampler: LightSampler,
+    /// Points per light, N.
+    pub count: u32,
+    width: u32,
+    halton_digits: (u32, u32),
+    pmj02: Option<&'static [Vec<(u32, u32)>]>,
+    zsobol: zsobol::Layout,
+    bluenoise: Option<bluenoise::Tables>,
+}
+
+impl PointSet {
+    /// The point set of a render with `settings`.
+    pub fn new(settings: &RenderSettings) -> Self {
+        Self::with(
+            settings.sampler,
+            settings.points_per_light(),
+            (settings.width, settings.height),
+            settings.aa_samples,
+        )
+    }
+
+    /// `count` points per light of `sampler` on an image of `size` pixels with `aa` samples
+    /// per pixel (the image and aa matter to zsobol and bluenoise only).
+    pub fn with(sampler: LightSampler, count: u32, size: (u32, u32), aa: u32) -> Self {
+        let aa = aa.max(1);
+        PointSet {
+            sampler,
+            count,
+            width: size.0.max(1),
+            halton_digits: halton::digits(count),
+            pmj02: (sampler == LightSampler::Pmj02).then(|| pmj02::tables(count)),
+            zsobol: zsobol::Layout::new(size.0, size.1, aa, count),
+            bluenoise: (sampler == LightSampler::Bluenoise)
+                .then(|| bluenoise::Tables::for_samples(count.saturating_mul(aa))),
+        }
+    }
+
+    /// A point set that needs nothing of an image: for the samplers whose points depend on the
+    /// stream alone (on a 1×1 image for the others).
+    pub fn of(sampler: LightSampler, count: u32) -> Self {
+        Self::with(sampler, count, (1, 1), 1)
+    }
+
+    /// The point in [0, 1)² for sample `index` of `key`'s stream.
+    #[inline(always)]
+    pub fn point(&self, key: &SampleKey, index: u32) -> (f32, f32) {
+        let count = self.count;
+        match self.sampler {
+            LightSampler::Random => (uniform(key, 2 * index), uniform(key, 2 * index + 1)),
+            LightSampler::Lab if count == 1 => (0.5, 0.5),
+            LightSampler::Lab => (uniform(key, 2 * index), uniform(key, 2 * index + 1)),
+            LightSampler::Sobol => {
+                // One scramble seed per stream; the Sobol index is the sample number (< 2^16,
+                // which `check` guarantees).
+                // `sample_4d` computes dimensions 0–3 together, with the index shuffle done once:
+                // the same values as `sample(index, 0 | 1, scramble)` (tests/sampling/sampling.rs), at
+                // about half the cost.
+                let scramble = hash(key, SOBOL_SEED_DIM);
+                let [u, v, _, _] = sobol_burley::sample_4d(index, 0, scramble);
+                (u, v)
+            }
+            LightSampler::Stratified => {
+                let xi0 = uniform(key, 2 * index);
+                let xi1 = uniform(key, 2 * index + 1);
+                let (nx, ny) = strata_grid(count);
+                let (cx, cy) = (index % nx, index / nx);
+                // `min` keeps (c + ξ)/n below 1 when rounding would land exactly on it.
+                let u = ((cx as f32 + xi0) / nx as f32).min(ONE_MINUS_EPS);
+                let v = ((cy as f32 + xi1) / ny as f32).min(ONE_MINUS_EPS);
+                (u, v)
+            }
+            LightSampler::Halton
+            | LightSampler::Pmj02
+            | LightSampler::Zsobol
+            | LightSampler::Bluenoise => self.table_point(key, index),
+        }
+    }
+
+    /// [`PointSet::point`] for the samplers of digit loops and table reads, out of line: their
+    /// code inlined beside the lab's four in the engines' inner loops cost those 3–8% more
+    /// instructions (tests/gates/icount.rs).
+    #[inline(never)]
+    pub fn table_point(&self, key: &SampleKey, index: u32) -> (f32, f32) {
+        let count = self.count;
+        match self.sampler {
+            LightSampler::Halton => {
+                let seeds = (hash(key, HALTON_SEED_DIM), hash(key, HALTON_SEED_DIM - 1));
+                halton::point(index, self.halton_digits, seeds)
+            }
+            LightSampler::Pmj02 => {
+                let h = hash(key, PMJ02_SEED_DIM);
+                let tables = self.pmj02.unwrap_or_else(|| pmj02::tables(count));
+                let table = &tables[h as usize % tables.len()];
+                let masks = (mix32(h ^ 0x243f_6a88), mix32(h ^ 0x85a3_08d3));
+                pmj02::point(table, index, masks)
+            }
+            LightSampler::Zsobol => zsobol::point(&self.zsobol, key, index),
+            LightSampler::Bluenoise => {
+                let tables = self
+                    .bluenoise
+                    .unwrap_or_else(|| bluenoise::Tables::for_samples(count));
+                bluenoise::Stream::new(key, self.width, count).point(&tables, index)
+            }
+            _ => self.point(key, index),
+        }
+    }
+}
+
+/// The hash dimensions that seed a stream's Halton scrambles and its PMJ02 table and shift
+/// (far above the 2j, 2j + 1 range, below Sobol's).
+pub const HALTON_SEED_DIM: u32 = u32::MAX - 2;
+/// See [`HALTON_SEED_DIM`].
+pub const PMJ02_SEED_DIM: u32 = u32::MAX - 3;
+
+/// Identifies one stream of random numbers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SampleKey {
+    /// Pixel index, row-major from the top-left.
+    pub pixel: u32,
+    /// Antialiasing sample index within the pixel.
+    pub sample: u32,
+    /// Path depth: 0 for the camera hit, 1 after one reflection, ...
+    pub bounce: u32,
+    /// Light index, or `CAMERA_LIGHT`.
+    pub light: u32,
+    /// The render's seed.
+    pub seed: u32,
+}
+
+/// Chris Wellons' `lowbias32` integer finaliser: a bijection on u32 with very low bias.
+#[inline(always)]
+pub fn mix32(mut x: u32) -> u32 {
+    x ^= x >> 16;
+    x = x.wrapping_mul(0x7feb_352d);
+    x ^= x >> 15;
+    x = x.wrapping_mul(0x846c_a68b);
+    x ^= x >> 16;
+    x
+}
+
+/// Hashes the key and a dimension to 32 random bits.
+#[inline(always)]
+pub fn hash(key: &SampleKey, dim: u32) -> u32 {
+    let mut h = mix32(key.seed ^ 0x9e37_79b9);
+    h = mix32(h ^ key.pixel);
+    h = mix32(h ^ key.sample);
+    h = mix32(h ^ key.bounce);
+    h = mix32(h ^ key.light);
+    mix32(h ^ dim)
+}
+
+/// A uniform number in [0, 1) for (key, dim): the top 24 bits, so the float is exact.
+#[inline(always)]
+pub fn uniform(key: &SampleKey, dim: u32) -> f32 {
+    (hash(key, dim) >> 8) as f32 * (1.0 / 16_777_216.0)
+}
+
+/// Splits n strata into an nx × ny grid with nx·ny = n and nx ≥ ny as close to square as n's
+/// divisors allow: 16 → 4×4, 8 → 4×2, 10 → 5×2, 7 → 7×1 (a prime gives strips, which are
+/// still strata: unbiased, but only one-dimensional).
+pub fn strata_grid(n: u32) -> (u32, u32) {
+    let n = n.max(1);
+    let mut ny = (n as f64).sqrt() as u32;
+    while ny > 1 && !n.is_multiple_of(ny) {
+        ny -= 1;
+    }
+    (n / ny.max(1), ny.max(1))
+}
+
+/// The hash dimension that seeds a stream's Sobol scramble (far above the 2j, 2j + 1 range).
+pub const SOBOL_SEED_DIM: u32 = u32::MAX;
+
+/// The largest f32 below 1.
+pub const ONE_MINUS_EPS: f32 = 1.0 - f32::EPSILON / 2.0;
+
+/// Sub-pixel offset in [0, 1)² for antialiasing sample `index` of `count`: the pixel centre for
+/// one sample, jittered strata for more.
+#[inline]
+pub fn pixel_offset(key: &SampleKey, index: u32, count: u32) -> (f32, f32) {
+    if count <= 1 {
+        return (0.5, 0.5);
+    }
+    let key = SampleKey {
+        light: CAMERA_LIGHT,
+        bounce: 0,
+        ..*key
+    };
+    // The camera stream uses dimensions 0 and 1 only: the stratum is chosen by `index`.
+    let (nx, ny) = strata_grid(count);
+    let (cx, cy) = (index % nx, index / nx);
+    let u = ((cx as f32 + uniform(&key, 0)) / nx as f32).min(ONE_MINUS_EPS);
+    let v = ((cy as f32 + uniform(&key, 1)) / ny as f32).min(ONE_MINUS_EPS);
+    (u, v)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn strata_grids_multiply_back_to_n() {
+        for n in 1..300 {
+            let (nx, ny) = strata_grid(n);
+            assert_eq!(nx * ny, n, "n = {n}");
+            assert!(nx >= ny);
+        }
+        assert_eq!(strata_grid(16), (4, 4));
+        assert_eq!(strata_grid(8), (4, 2));
+        assert_eq!(strata_grid(7), (7, 1));
+    }
+
+    #[test]
+    fn uniform_is_in_unit_interval_and_depends_on_every_field() {
+        let key = SampleKey {
+            pixel: 3,
+            sample: 1,
+            bounce: 2,
+            light: 0,
+            seed: 7,
+        };
+        let base = uniform(&key, 5);
+        assert!((0.0..1.0).contains(&base));
+        let variants = [
+            SampleKey { pixel: 4, ..key },
+            SampleKey { sample: 2, ..key },
+            SampleKey { bounce: 3, ..key },
+            SampleKey { light: 1, ..key },
+            SampleKey { seed: 8, ..key },
+        ];
+        for v in variants {
+            assert_ne!(uniform(&v, 5), base, "{v:?}");
+        }
+        assert_ne!(uniform(&key, 6), base);
+    }
+
+    #[test]
+    fn stratified_puts_one_point_in_every_stratum() {
+        for n in [1u32, 2, 3, 4, 7, 9, 10, 16, 64] {
+            let key = SampleKey {
+                pixel: 11,
+                sample: 0,
+                bounce: 0,
+                light: 0,
+                seed: 1,
+            };
+            let (nx, ny) = strata_grid(n);
+            let mut seen = vec![0u32; n as usize];
+            for j in 0..n {
+                let (u, v) = PointSet::of(LightSampler::Stratified, n).point(&key, j);
+                assert!((0.0..1.0).contains(&u) && (0.0..1.0).contains(&v));
+                let cell = (v * ny as f32) as u32 * nx + (u * nx as f32) as u32;
+                seen[cell as usize] += 1;
+            }
+            assert!(seen.iter().all(|&c| c == 1), "n = {n}: {seen:?}");
+        }
+    }
+}

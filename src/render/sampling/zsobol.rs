@@ -1,0 +1,255 @@
+//! ZSobol: Sobol points indexed through the pixel's Morton order (Ahmed and Wonka, SIGGRAPH
+//! Asia 2020, "Screen-space blue-noise diffusion of Monte Carlo sampling error via hierarchical
+//! ordering of pixels"), as pbrt-v4's ZSobolSampler does it.
+//!
+//! ```text
+//! index  = morton(x, y) · 2^S + (aa sample · 2^n + j)     S = s + n bits of samples per pixel,
+//!                                                         2^s ≥ aa samples, 2^n ≥ N points
+//! index' = index with every base-4 digit (from the top; the lowest is one bit when the
+//!          length is odd) permuted by one of the 24 permutations, chosen by hashing the
+//!          digits above it with the stream's seed
+//! (u, v) = Sobol dimensions 0 and 1 of index', each Owen-scrambled with the stream's seed
+//! ```
+//!
+//! The stream's seed hashes the render's seed, the bounce and the light, and not the pixel: so
+//! neighbouring pixels take neighbouring runs of one scrambled Sobol sequence, which is
+//! stratified as a whole, and their errors are negatively correlated: the error moves to high
+//! frequencies in screen space (blue noise). The digit permutations hide the Morton order's
+//! structure. Every point is still uniform on the square (the Owen scramble alone makes it so),
+//! so the estimate is unbiased.
+//!
+//! The Sobol points are computed here on 32-bit indices (`sobol_burley`, used by the `sobol`
+//! sampler, takes indices below 2^16), so the image and the samples per pixel may use up to
+//! 32 index bits together: [`Layout::index_bits`].
+
+use super::{SampleKey, mix32};
+
+/// How a render's pixels and samples make up a ZSobol index.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Layout {
+    /// Bits of each pixel coordinate: 2^b ≥ width and height.
+    pub pixel_bits: u32,
+    /// Bits of the antialiasing sample: 2^s ≥ samples per pixel.
+    pub aa_bits: u32,
+    /// Bits of the point index: 2^n ≥ points per light.
+    pub point_bits: u32,
+    /// The image's width, to turn a pixel index into (x, y).
+    pub width: u32,
+}
+
+/// The smallest b with 2^b ≥ n (0 for n ≤ 1).
+pub fn bits_for(n: u32) -> u32 {
+    n.max(1).next_power_of_two().trailing_zeros()
+}
+
+impl Layout {
+    /// The layout of a width × height image with `aa` samples per pixel and `points` per light.
+    pub fn new(width: u32, height: u32, aa: u32, points: u32) -> Self {
+        Layout {
+            pixel_bits: bits_for(width.max(height)),
+            aa_bits: bits_for(aa),
+            point_bits: bits_for(points),
+            width: width.max(1),
+        }
+    }
+
+    /// The bits of an index: two per pixel-coordinate bit, then the samples'. At most 32.
+    pub fn index_bits(&self) -> u32 {
+        2 * self.pixel_bits + self.aa_bits + self.point_bits
+    }
+
+    /// The Morton-ordered index of point `j` of `key`'s stream, before the digit permutation.
+    #[inline]
+    pub fn index(&self, key: &SampleKey, j: u32) -> u32 {
+        let (x, y) = (key.pixel % self.width, key.pixel / self.width);
+        let sample_bits = self.aa_bits + self.point_bits;
+        let sample = (key.sample << self.point_bits) | j;
+        (morton(x, y) << sample_bits) | sample
+    }
+}
+
+/// x's bits in the even positions, y's in the odd ones (each below 2^16).
+#[inline]
+pub fn morton(x: u32, y: u32) -> u32 {
+    let spread = |v: u32| {
+        let mut v = v & 0xffff;
+        v = (v | (v << 8)) & 0x00ff_00ff;
+        v = (v | (v << 4)) & 0x0f0f_0f0f;
+        v = (v | (v << 2)) & 0x3333_3333;
+        (v | (v << 1)) & 0x5555_5555
+    };
+    spread(x) | (spread(y) << 1)
+}
+
+/// The 24 permutations of {0, 1, 2, 3}.
+const PERMUTATIONS_4: [[u32; 4]; 24] = {
+    let mut table = [[0u32; 4]; 24];
+    let mut n = 0;
+    let mut a = 0;
+    while a < 4 {
+        let mut b = 0;
+        while b < 4 {
+            let mut c = 0;
+            while c < 4 {
+                if a != b && a != c && b != c {
+                    table[n] = [a, b, c, 6 - a - b - c];
+                    n += 1;
+                }
+                c += 1;
+            }
+            b += 1;
+        }
+        a += 1;
+    }
+    table
+};
+
+/// `index` (of `bits` bits) with its base-4 digits permuted from the top, each by the
+/// permutation that hashing the digits above it with `seed` picks; when `bits` is odd the
+/// lowest digit is one bit, flipped by a hashed bit.
+#[inline]
+pub fn permute_digits(index: u32, bits: u32, seed: u32) -> u32 {
+    let odd = bits % 2;
+    let mut out = 0;
+    let mut shift = bits;
+    while shift >= 2 + odd {
+        shift -= 2;
+        let digit = (index >> shift) & 3;
+        let above = if shift + 2 >= 32 { 0 } else { index >> (shift + 2) };
+        // `shift` tells the depth apart: an empty prefix at two depths must not share a hash.
+        let h = mix32(above ^ mix32(seed ^ shift.wrapping_mul(0x9e37_79b9)));
+        out |= PERMUTATIONS_4[(h % 24) as usize][digit as usize] << shift;
+    }
+    if odd == 1 {
+        let h = mix32((index >> 1) ^ mix32(seed ^ 0x5bd1_e995));
+        out |= (index & 1) ^ (h & 1);
+    }
+    out
+}
+
+/// Owen scrambling of `x` with `seed`: Burley's (2020) hash-based nested uniform scramble,
+/// the Laine–Karras permutation on the reversed bits, in which each output bit depends only
+/// on the input bits above it.
+#[inline]
+pub fn owen_scramble(x: u32, seed: u32) -> u32 {
+    let mut v = x.reverse_bits();
+    v = v.wrapping_add(seed);
+    v ^= v.wrapping_mul(0x6c50_b47c);
+    v ^= v.wrapping_mul(0xb82f_1e52);
+    v ^= v.wrapping_mul(0xc7af_e638);
+    v ^= v.wrapping_mul(0x8d22_f6e6);
+    v.reverse_bits()
+}
+
+/// Sobol dimensions 0 and 1 of `index`, as 32-bit fractions: dimension 0 is the van der
+/// Corput sequence, dimension 1 the one of the primitive polynomial x + 1 (direction numbers
+/// v₀ = 2⁻¹, vₖ = vₖ₋₁ ⊕ vₖ₋₁/2).
+#[inline]
+pub fn sobol_2d(index: u32) -> (u32, u32) {
+    let mut v = 1u32 << 31;
+    let mut y = 0;
+    let mut i = index;
+    while i != 0 {
+        if i & 1 == 1 {
+            y ^= v;
+        }
+        i >>= 1;
+        v ^= v >> 1;
+    }
+    (index.reverse_bits(), y)
+}
+
+/// The stream seed: the render's seed, the bounce and the light, not the pixel or sample.
+#[inline]
+pub fn stream_seed(key: &SampleKey) -> u32 {
+    let mut h = mix32(key.seed ^ 0x2f1e_5c3b);
+    h = mix32(h ^ key.bounce);
+    mix32(h ^ key.light)
+}
+
+/// Point `j` of `key`'s stream.
+#[inline]
+pub fn point(layout: &Layout, key: &SampleKey, j: u32) -> (f32, f32) {
+    let seed = stream_seed(key);
+    let index = permute_digits(layout.index(key, j), layout.index_bits(), seed);
+    let (x, y) = sobol_2d(index);
+    let unit = |bits: u32| (bits >> 8) as f32 * (1.0 / 16_777_216.0);
+    (
+        unit(owen_scramble(x, mix32(seed ^ 0x6a09_e667))),
+        unit(owen_scramble(y, mix32(seed ^ 0xbb67_ae85))),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_first_sobol_points_are_the_textbook_ones() {
+        let unit = |b: u32| b as f64 / 4_294_967_296.0;
+        let dim0 = [0.0, 0.5, 0.25, 0.75, 0.125, 0.625, 0.375, 0.875];
+        let dim1 = [0.0, 0.5, 0.75, 0.25, 0.625, 0.125, 0.375, 0.875];
+        for i in 0..8 {
+            let (x, y) = sobol_2d(i);
+            assert_eq!((unit(x), unit(y)), (dim0[i as usize], dim1[i as usize]), "{i}");
+        }
+    }
+
+    /// Dimensions 0 and 1 are a (0,2)-sequence: every aligned block of 2^m points has one point
+    /// in each elementary interval of area 2^-m; the Owen scramble keeps it so.
+    #[test]
+    fn scrambled_blocks_are_02_nets() {
+        for m in 0..=8u32 {
+            for block in [0u32, 3, 1000] {
+                for k in 0..=m {
+                    let mut seen = vec![false; 1 << m];
+                    for i in 0..1u32 << m {
+                        let (x, y) = sobol_2d((block << m) | i);
+                        let (x, y) = (owen_scramble(x, 7), owen_scramble(y, 11));
+                        let top = |v: u32, b: u32| if b == 0 { 0 } else { v >> (32 - b) };
+                        let cell = ((top(x, k) << (m - k)) | top(y, m - k)) as usize;
+                        assert!(!seen[cell], "m {m}, block {block}, shape {k}");
+                        seen[cell] = true;
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn the_digit_permutation_is_a_bijection_that_keeps_aligned_blocks() {
+        for bits in [1u32, 2, 5, 8] {
+            let n = 1u32 << bits;
+            let mut seen = vec![false; n as usize];
+            for i in 0..n {
+                let p = permute_digits(i, bits, 42);
+                assert!(p < n && !seen[p as usize], "bits {bits}");
+                seen[p as usize] = true;
+                // The digits above the lowest one (two bits, or one for odd lengths) decide
+                // the block: the lowest digit is permuted within it.
+                let low = if bits % 2 == 1 { 1 } else { 2 };
+                let block = permute_digits(i & !((1 << low) - 1), bits, 42) >> low;
+                assert_eq!(p >> low, block, "bits {bits}");
+            }
+        }
+        assert_eq!(PERMUTATIONS_4.len(), 24);
+    }
+
+    #[test]
+    fn morton_interleaves_x_in_the_even_bits() {
+        assert_eq!(morton(0, 0), 0);
+        assert_eq!(morton(1, 0), 1);
+        assert_eq!(morton(0, 1), 2);
+        assert_eq!(morton(3, 3), 15);
+        assert_eq!(morton(0xffff, 0), 0x5555_5555);
+    }
+
+    #[test]
+    fn layouts_count_their_bits() {
+        let l = Layout::new(512, 300, 1, 16);
+        assert_eq!((l.pixel_bits, l.aa_bits, l.point_bits), (9, 0, 4));
+        assert_eq!(l.index_bits(), 22);
+        assert_eq!(Layout::new(1, 1, 1, 1).index_bits(), 0);
+        assert_eq!(Layout::new(16384, 16384, 4, 4).index_bits(), 32);
+    }
+}
