@@ -163,9 +163,9 @@ pub fn print_peer_table(rounds: usize, size: u32, tables: &Tables) {
          intersect stage on the same rays (the hit search, then each hit's point, normal and \
          material); for shadow rays the whole shadow stage (`peer::stage::ShadowStage`: \
          spawning, occlusion and shading, as a frame at zero bounces runs it) over the camera \
-         hits, on rays of the same kind: one per hit for hard shadows, n per hit for n soft \
-         points, drawn by the default stratified sampler. The other columns are the table \
-         above's.\n"
+         hits, on rays of the same kind: one per hit for hard shadows (to the light's \
+         centroid), n per hit for n soft points (stratified). The other columns are the \
+         table above's.\n"
     );
     println!("{header} |");
     println!("{rule} |");

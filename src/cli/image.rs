@@ -2,8 +2,8 @@
 
 use super::values::{DefaultsArg, LightModelArg, SamplerArg, ShadowArg, colour_component};
 use clap::Args;
-use raywave::render::error::UsageError;
 use raywave::output::OutputPlan;
+use raywave::render::error::UsageError;
 use raywave::render::scene::{Scene, load_scene};
 use raywave::render::settings::options::{Effective, ImageOptions};
 use std::path::Path;

@@ -10,10 +10,10 @@
 //!
 //! They are the rays a frame at zero bounces casts from those hits (the camera set's ray i is
 //! pixel i's, so the stage draws the frame's light points: `tests/kernels/peer_agreement.rs`
-//! counts them against a frame), of the same kind as the sets' but not the same rays: the
-//! stage draws its points with the default sampler (stratified; for hard shadows one uniform
-//! point, as the hard-shadow set's), and casts soft shadows from every camera hit, where the
-//! fan sets take one origin in n hits.
+//! counts them against a frame), of the same kind as the sets' but not the same rays: hard
+//! shadows aim at the light's centroid (the set's at a uniform point on it), soft shadows at
+//! the default sampler's stratified points from every camera hit, where the fan sets take
+//! one origin in n hits.
 
 use super::{BATCH, RaySet, RaySetKind};
 use crate::render::scene::Scene;

@@ -26,6 +26,7 @@ pub mod mask;
 pub(crate) mod plot;
 pub mod report;
 pub mod sheet;
+pub mod spectrum;
 
 use crate::render::engine::Hooks;
 use crate::render::film::Film;

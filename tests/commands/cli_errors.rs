@@ -168,7 +168,7 @@ const FAILS_EARLY: &[FailsEarly] = &[
         args: "cornell_box.obj --size 16384 16384 -o out.jpg",
         code: 2,
         stderr: &["out.jpg"],
-    },    // A sampler past its limit: the error names the sampler, the limit and why.
+    }, // A sampler past its limit: the error names the sampler, the limit and why.
     FailsEarly {
         setup: &[Scene("cornell_box.obj")],
         args: "cornell_box.obj --sampler pmj02 --shadow-samples 0",

@@ -16,7 +16,7 @@ use proptest::prelude::*;
 use raywave::render::geometry::{
     self, Accel, Ray, intersect_sphere, intersect_triangle, shadow_casters,
 };
-use raywave::render::sampling::{LightSampler, SampleKey, PointSet, strata_grid, uniform};
+use raywave::render::sampling::{LightSampler, PointSet, SampleKey, strata_grid, uniform};
 use raywave::render::scene::{Light, LightShape, Material, NO_HIT, Scene, Sphere};
 use raywave::render::shading::shade;
 use raywave::render::spawn::{SurfaceHit, light_end, shadow_ray};
@@ -712,10 +712,7 @@ fn check_light_points<V: Lanes>(
                 LightSampler::Halton
                 | LightSampler::Pmj02
                 | LightSampler::Zsobol
-                | LightSampler::Bluenoise => BlockSampler::PerLane {
-                    points: &set,
-                    key,
-                },
+                | LightSampler::Bluenoise => BlockSampler::PerLane { points: &set, key },
             },
             origin,
             edge_u,

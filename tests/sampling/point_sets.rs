@@ -106,7 +106,12 @@ fn zsobol_pixel_blocks_take_one_net_between_them() {
                         set.point(&key(y * w + x, 9), 0)
                     })
                     .collect();
-                assert_intervals(&format!("{side}×{side} pixels at ({bx}, {by})"), &points, m, 1);
+                assert_intervals(
+                    &format!("{side}×{side} pixels at ({bx}, {by})"),
+                    &points,
+                    m,
+                    1,
+                );
             }
         }
     }
@@ -133,7 +138,10 @@ fn bluenoise_points_keep_the_tables_lattice_and_differ_from_their_neighbours() {
             let (u0, v0) = points[0];
             for &(u, v) in &points {
                 for d in [(u - u0) * 256.0, (v - v0) * 256.0] {
-                    assert!((d - d.round()).abs() < 1e-3, "N={n}, pixel {pixel}: off the lattice");
+                    assert!(
+                        (d - d.round()).abs() < 1e-3,
+                        "N={n}, pixel {pixel}: off the lattice"
+                    );
                 }
             }
             let mut cells: Vec<(u32, u32)> = points
@@ -142,8 +150,16 @@ fn bluenoise_points_keep_the_tables_lattice_and_differ_from_their_neighbours() {
                 .collect();
             cells.sort_unstable();
             cells.dedup();
-            assert_eq!(cells.len(), n as usize, "N={n}, pixel {pixel}: repeated points");
-            assert_ne!(points[0], set.point(&key(pixel, 4), 0), "the seed moves nothing");
+            assert_eq!(
+                cells.len(),
+                n as usize,
+                "N={n}, pixel {pixel}: repeated points"
+            );
+            assert_ne!(
+                points[0],
+                set.point(&key(pixel, 4), 0),
+                "the seed moves nothing"
+            );
         }
         let a = set.point(&key(40, 3), 0);
         let b = set.point(&key(41, 3), 0);
@@ -171,7 +187,10 @@ fn every_sampler_s_limits_are_checked_and_named() {
         ok(soft(sampler, 1, (512, 512), 1));
         ok(soft(sampler, 256, (512, 512), 1));
         let e = err(soft(sampler, 0, (512, 512), 1));
-        assert!(e.contains("--shadow-samples 0") && e.contains(sampler.name()), "{e}");
+        assert!(
+            e.contains("--shadow-samples 0") && e.contains(sampler.name()),
+            "{e}"
+        );
         // No points is an error with any shadows: it is never a setting.
         let hard = RenderSettings {
             shadows: ShadowMode::Hard,
@@ -199,7 +218,10 @@ fn every_sampler_s_limits_are_checked_and_named() {
     // 16384² is 28 index bits, 16 samples 4 more: 32, the most.
     ok(soft(LightSampler::Zsobol, 16, (16384, 16384), 1));
     let e = err(soft(LightSampler::Zsobol, 17, (16384, 16384), 1));
-    assert!(e.contains("zsobol") && e.contains("33-bit") && e.contains("32"), "{e}");
+    assert!(
+        e.contains("zsobol") && e.contains("33-bit") && e.contains("32"),
+        "{e}"
+    );
     // Hard shadows count one point per light.
     let hard = RenderSettings {
         shadows: ShadowMode::Hard,

@@ -4,9 +4,7 @@
 use glam::Vec3;
 use raywave::render::per_kind::RayCounts;
 use raywave::render::reference::Reference;
-use raywave::render::sampling::{
-    LightSampler, SampleKey, pixel_offset, PointSet, strata_grid,
-};
+use raywave::render::sampling::{LightSampler, PointSet, SampleKey, pixel_offset, strata_grid};
 use raywave::render::scene::parse_scene_str;
 use raywave::render::settings::{RenderSettings, ShadowMode};
 

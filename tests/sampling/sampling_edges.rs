@@ -2,7 +2,7 @@
 //! strategy, which must equal `random` for every N but 1.
 
 use raywave::render::sampling::{
-    CAMERA_LIGHT, LightSampler, SampleKey, pixel_offset, PointSet, strata_grid, uniform,
+    CAMERA_LIGHT, LightSampler, PointSet, SampleKey, pixel_offset, strata_grid, uniform,
 };
 
 /// The first pixel whose stream draws, in dimension `dim`, one of the two largest values

@@ -13,7 +13,7 @@ use glam::{DVec3, Vec3};
 use oracle::Oracle;
 use raywave::render::per_kind::RayCounts;
 use raywave::render::reference::Reference;
-use raywave::render::sampling::{LightSampler, SampleKey, PointSet, strata_grid};
+use raywave::render::sampling::{LightSampler, PointSet, SampleKey, strata_grid};
 use raywave::render::scene::{Scene, parse_scene_str};
 use raywave::render::settings::RenderSettings;
 use raywave::variance::{Region, penumbra_mask};

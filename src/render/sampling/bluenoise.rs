@@ -10,8 +10,9 @@
 //! ```
 //!
 //! A stream takes the tables for the next power of two of (samples per pixel × points per
-//! light), dimensions 2p and 2p + 1 for its (bounce, light) pair p (the 8 optimised dimensions
-//! hold 4 pairs), and its point index i = aa sample · N + j. The tables alone are one fixed
+//! light), dimensions 0 and 1 (the pair whose 2-D points are a (0,2)-net; the later optimised
+//! pairs are Sobol dimensions with worse 2-D stratification, which measured a larger MSE), and
+//! its point index i = aa sample · N + j. The tables alone are one fixed
 //! pattern: every render would draw the same points, and a pixel's estimate would be biased
 //! (its 8-bit values are cell centres). So each render's seed also moves the tile by a hashed
 //! offset, and adds to every coordinate one hashed rotation (Cranley–Patterson, modulo 1) per
@@ -45,13 +46,41 @@ impl Tables {
             ranking,
         };
         match samples.max(1).next_power_of_two() {
-            1 => t(b::spp1::SOBOL, b::spp1::SCRAMBLING_TILE, b::spp1::RANKING_TILE),
-            2 => t(b::spp2::SOBOL, b::spp2::SCRAMBLING_TILE, b::spp2::RANKING_TILE),
-            4 => t(b::spp4::SOBOL, b::spp4::SCRAMBLING_TILE, b::spp4::RANKING_TILE),
-            8 => t(b::spp8::SOBOL, b::spp8::SCRAMBLING_TILE, b::spp8::RANKING_TILE),
-            16 => t(b::spp16::SOBOL, b::spp16::SCRAMBLING_TILE, b::spp16::RANKING_TILE),
-            32 => t(b::spp32::SOBOL, b::spp32::SCRAMBLING_TILE, b::spp32::RANKING_TILE),
-            64 => t(b::spp64::SOBOL, b::spp64::SCRAMBLING_TILE, b::spp64::RANKING_TILE),
+            1 => t(
+                b::spp1::SOBOL,
+                b::spp1::SCRAMBLING_TILE,
+                b::spp1::RANKING_TILE,
+            ),
+            2 => t(
+                b::spp2::SOBOL,
+                b::spp2::SCRAMBLING_TILE,
+                b::spp2::RANKING_TILE,
+            ),
+            4 => t(
+                b::spp4::SOBOL,
+                b::spp4::SCRAMBLING_TILE,
+                b::spp4::RANKING_TILE,
+            ),
+            8 => t(
+                b::spp8::SOBOL,
+                b::spp8::SCRAMBLING_TILE,
+                b::spp8::RANKING_TILE,
+            ),
+            16 => t(
+                b::spp16::SOBOL,
+                b::spp16::SCRAMBLING_TILE,
+                b::spp16::RANKING_TILE,
+            ),
+            32 => t(
+                b::spp32::SOBOL,
+                b::spp32::SCRAMBLING_TILE,
+                b::spp32::RANKING_TILE,
+            ),
+            64 => t(
+                b::spp64::SOBOL,
+                b::spp64::SCRAMBLING_TILE,
+                b::spp64::RANKING_TILE,
+            ),
             128 => t(
                 b::spp128::SOBOL,
                 b::spp128::SCRAMBLING_TILE,
@@ -99,7 +128,6 @@ impl Stream {
     pub fn new(key: &SampleKey, width: u32, points: u32) -> Self {
         let width = width.max(1);
         let tile = mix32(key.seed ^ 0x1b87_3593);
-        let pair = mix32(mix32(key.bounce ^ 0x85eb_ca6b) ^ key.light) % 4;
         let mut h = mix32(key.seed ^ 0xcc9e_2d51);
         h = mix32(h ^ key.bounce);
         h = mix32(h ^ key.light);
@@ -107,7 +135,7 @@ impl Stream {
         Stream {
             x: key.pixel % width + (tile & 127),
             y: key.pixel / width + ((tile >> 7) & 127),
-            dims: (2 * pair, 2 * pair + 1),
+            dims: (0, 1),
             rotation: (unit(mix32(h ^ 1)), unit(mix32(h ^ 2))),
             first: key.sample.wrapping_mul(points),
         }
@@ -152,9 +180,14 @@ mod tests {
             let n = 1u32 << k;
             let t = Tables::for_samples(n);
             for (x, y, dim) in [(0, 0, 0), (5, 9, 1), (127, 64, 6)] {
-                let mut strata: Vec<u32> = (0..n).map(|i| t.value(x, y, i, dim) >> (8 - k)).collect();
+                let mut strata: Vec<u32> =
+                    (0..n).map(|i| t.value(x, y, i, dim) >> (8 - k)).collect();
                 strata.sort_unstable();
-                assert_eq!(strata, (0..n).collect::<Vec<_>>(), "{n} samples, ({x}, {y}), dim {dim}");
+                assert_eq!(
+                    strata,
+                    (0..n).collect::<Vec<_>>(),
+                    "{n} samples, ({x}, {y}), dim {dim}"
+                );
             }
         }
     }

@@ -128,7 +128,10 @@ mod tests {
         }
         for (c, expected) in [(&first[0][..2], 3000.0), (&first[1][..], 2000.0)] {
             for &n in c {
-                assert!((n as f64 - expected).abs() < 5.0 * expected.sqrt(), "{first:?}");
+                assert!(
+                    (n as f64 - expected).abs() < 5.0 * expected.sqrt(),
+                    "{first:?}"
+                );
             }
         }
     }

@@ -88,10 +88,9 @@ impl LightSampler {
     pub fn max_points(self) -> Option<(u32, &'static str)> {
         match self {
             LightSampler::Sobol => Some((65_536, "its Sobol indices are 16 bits")),
-            LightSampler::Pmj02 => Some((
-                pmj02::TABLE_POINTS as u32,
-                "its tables hold 4096 points",
-            )),
+            LightSampler::Pmj02 => {
+                Some((pmj02::TABLE_POINTS as u32, "its tables hold 4096 points"))
+            }
             LightSampler::Bluenoise => Some((
                 bluenoise::MAX_SAMPLES,
                 "the paper's tables hold 256 samples per pixel",
@@ -172,11 +171,16 @@ pub fn check(settings: &RenderSettings) -> Result<(), SamplerLimit> {
     }
     let aa = settings.aa_samples.max(1);
     match sampler {
-        LightSampler::Bluenoise if u64::from(n) * u64::from(aa) > u64::from(bluenoise::MAX_SAMPLES) => {
+        LightSampler::Bluenoise
+            if u64::from(n) * u64::from(aa) > u64::from(bluenoise::MAX_SAMPLES) =>
+        {
             Err(SamplerLimit::TooManyPoints {
                 sampler,
                 asked: if aa > 1 {
-                    format!("{n} points per light × {aa} aa samples = {} per pixel", u64::from(n) * u64::from(aa))
+                    format!(
+                        "{n} points per light × {aa} aa samples = {} per pixel",
+                        u64::from(n) * u64::from(aa)
+                    )
                 } else {
                     format!("{n} points per light")
                 },

@@ -47,7 +47,9 @@ const LEVELS: usize = TABLE_POINTS.trailing_zeros() as usize + 1;
 /// The [`SETS`] tables that hold at least `points` points (at most [`TABLE_POINTS`]), as
 /// 32-bit fixed-point coordinates.
 pub fn tables(points: u32) -> &'static [Vec<(u32, u32)>] {
-    let size = (points.max(1) as usize).next_power_of_two().min(TABLE_POINTS);
+    let size = (points.max(1) as usize)
+        .next_power_of_two()
+        .min(TABLE_POINTS);
     TABLES[size.trailing_zeros() as usize].get_or_init(|| {
         (0..SETS as u64)
             .map(|set| generate(size, 0x706d_6a30_3262 ^ set))
@@ -276,7 +278,10 @@ mod tests {
                 let mut seen = vec![false; 1 << m];
                 for &(x, y) in &points[..n] {
                     let cell = ((top(x, k) << (m - k)) | top(y, m - k)) as usize;
-                    assert!(!seen[cell], "prefix {n}, shape {k} of level {m}: two points in cell {cell}");
+                    assert!(
+                        !seen[cell],
+                        "prefix {n}, shape {k} of level {m}: two points in cell {cell}"
+                    );
                     seen[cell] = true;
                 }
             }

@@ -115,7 +115,11 @@ pub fn permute_digits(index: u32, bits: u32, seed: u32) -> u32 {
     while shift >= 2 + odd {
         shift -= 2;
         let digit = (index >> shift) & 3;
-        let above = if shift + 2 >= 32 { 0 } else { index >> (shift + 2) };
+        let above = if shift + 2 >= 32 {
+            0
+        } else {
+            index >> (shift + 2)
+        };
         // `shift` tells the depth apart: an empty prefix at two depths must not share a hash.
         let h = mix32(above ^ mix32(seed ^ shift.wrapping_mul(0x9e37_79b9)));
         out |= PERMUTATIONS_4[(h % 24) as usize][digit as usize] << shift;
@@ -191,7 +195,11 @@ mod tests {
         let dim1 = [0.0, 0.5, 0.75, 0.25, 0.625, 0.125, 0.375, 0.875];
         for i in 0..8 {
             let (x, y) = sobol_2d(i);
-            assert_eq!((unit(x), unit(y)), (dim0[i as usize], dim1[i as usize]), "{i}");
+            assert_eq!(
+                (unit(x), unit(y)),
+                (dim0[i as usize], dim1[i as usize]),
+                "{i}"
+            );
         }
     }
 

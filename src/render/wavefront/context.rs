@@ -7,7 +7,9 @@ use super::shade::MaterialTerms;
 use super::simd::BlockSampler;
 use crate::render::camera::CameraRays;
 use crate::render::geometry::shadow_casters;
-use crate::render::sampling::{LightSampler, PointSet, SOBOL_SEED_DIM, SampleKey, hash, strata_grid};
+use crate::render::sampling::{
+    LightSampler, PointSet, SOBOL_SEED_DIM, SampleKey, hash, strata_grid,
+};
 use crate::render::scene::{LightShape, Scene, Triangle};
 use crate::render::settings::{RenderSettings, ShadowMode};
 use crate::render::spawn::{
