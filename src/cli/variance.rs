@@ -111,7 +111,11 @@ fn output_plan(options: &VarianceOptions) -> OutputPlan {
     if let Some(scene) = &options.scene {
         plan = plan.input("SCENE", scene);
     }
-    let names = raywave::variance::report::file_names(&options.samplers, options.heatmap_budget());
+    let names = raywave::variance::report::file_names(
+        &options.samplers,
+        &options.budgets,
+        options.heatmap_budget(),
+    );
     for name in names {
         plan = plan.output_in_new_dir("--out", &options.out.join(name));
     }

@@ -54,7 +54,7 @@ pub struct Matching {
 }
 
 /// The mean of `xs` over the indices `idx` (all of `xs` when `idx` is None).
-pub(super) fn mean_at(xs: &[f64], idx: Option<&[usize]>) -> f64 {
+pub(crate) fn mean_at(xs: &[f64], idx: Option<&[usize]>) -> f64 {
     match idx {
         Some(idx) => idx.iter().map(|&i| xs[i]).sum::<f64>() / idx.len().max(1) as f64,
         None => xs.iter().sum::<f64>() / xs.len().max(1) as f64,
@@ -89,7 +89,7 @@ pub fn match_budget(random: LogLogFit, other: LogLogFit, random_n: f64) -> f64 {
 }
 
 /// A bootstrap interval over `k` seeds with the study's resamples and seed.
-pub(super) fn interval(k: usize, stat: impl FnMut(&[usize]) -> f64) -> Option<[f64; 2]> {
+pub(crate) fn interval(k: usize, stat: impl FnMut(&[usize]) -> f64) -> Option<[f64; 2]> {
     bootstrap_interval(k, BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, stat).map(|(a, b)| [a, b])
 }
 

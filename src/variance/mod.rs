@@ -23,10 +23,13 @@ pub mod command;
 pub(crate) mod figures;
 pub(crate) mod fits;
 pub mod mask;
+pub mod perceived;
+mod perceived_report;
 pub(crate) mod plot;
 pub mod report;
 pub mod sheet;
 pub mod spectrum;
+pub(crate) mod spectrum_plot;
 
 use crate::render::engine::Hooks;
 use crate::render::film::Film;
@@ -249,6 +252,9 @@ pub struct Row {
     /// 95% interval of `efficiency_vs_random`, resampling the same seeds for both samplers
     /// (their renders were timed in the same rounds, so a slow round slows both).
     pub efficiency_vs_random_interval: Option<[f64; 2]>,
+    /// Where the error sits in screen space: its spectrum, its low band and its low-pass
+    /// error (`perceived.rs`).
+    pub perceived: perceived::Perceived,
     /// Per seed (seeds 1..=K): MSE.
     #[serde(skip)]
     pub seed_mse: Vec<f64>,
@@ -310,6 +316,12 @@ fn rows_of(m: &Measured, reference: &Converged, masks: &[Vec<bool>; 3]) -> Vec<R
         .zip(masks)
         .map(|(region, mask)| {
             let stats = error_stats(&m.images, &reference.film.pixels, &reference.noise, mask);
+            let (width, height) = (
+                reference.film.width as usize,
+                reference.film.height as usize,
+            );
+            let perceived =
+                perceived::measure(&m.images, &reference.film.pixels, width, height, mask);
             let per = per_image_errors(&m.images, &reference.film.pixels, mask);
             let seed_mse: Vec<f64> = per.iter().map(|e| e.0).collect();
             let seed_bias: Vec<f64> = per.iter().map(|e| e.1).collect();
@@ -341,6 +353,7 @@ fn rows_of(m: &Measured, reference: &Converged, masks: &[Vec<bool>; 3]) -> Vec<R
                 error_reduction_interval: None,
                 efficiency_vs_random: None,
                 efficiency_vs_random_interval: None,
+                perceived,
                 seed_mse,
                 seed_bias,
                 seed_seconds: m.times.clone(),
@@ -442,6 +455,7 @@ pub fn run_study(
     });
     let k = config.seeds as usize;
     fits::ratios_to_random(&mut rows, k);
+    perceived::low_band_vs_random(&mut rows, k);
     let slopes = fits::slopes(&rows, samplers, k);
     let matching = fits::matching(&rows, samplers, k);
     Ok(StudyResult {

@@ -12,11 +12,17 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
 
-const PALETTE: [RGBColor; 4] = [
+/// One colour per sampler, in `LightSampler::ALL`'s order where all are studied (matplotlib's
+/// tab10 less its grey and olive).
+pub(crate) const PALETTE: [RGBColor; 8] = [
     RGBColor(31, 119, 180),
     RGBColor(255, 127, 14),
     RGBColor(44, 160, 44),
     RGBColor(214, 39, 40),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(23, 190, 207),
 ];
 
 /// Which quantity a panel puts on its x axis.
@@ -40,7 +46,11 @@ fn x_of(r: &Row, axis: Axis) -> (f64, Option<[f64; 2]>) {
 }
 
 /// A range for a log axis holding `values` (all positive), padded by `pad` times.
-fn log_range(values: impl Iterator<Item = f64>, pad: f64, empty: (f64, f64)) -> (f64, f64) {
+pub(crate) fn log_range(
+    values: impl Iterator<Item = f64>,
+    pad: f64,
+    empty: (f64, f64),
+) -> (f64, f64) {
     let (lo, hi) = values
         .filter(|v| v.is_finite() && *v > 0.0)
         .fold((f64::INFINITY, 0.0f64), |(lo, hi), v| {

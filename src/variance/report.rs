@@ -12,7 +12,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 /// Version of `results.json`'s layout; raised whenever a key changes meaning or goes away.
-pub const SCHEMA_VERSION: u32 = 2;
+pub const SCHEMA_VERSION: u32 = 3;
 
 /// The keys of `results.json`, each with what it holds.
 pub const SCHEMA: [(&str, &str); 15] = [
@@ -55,7 +55,7 @@ pub const SCHEMA: [(&str, &str); 15] = [
     ),
     (
         "rows",
-        "per sampler, N and region: mse, bias, bias_bound, variance, pixels; mse_interval; excluded_from_fit; seconds (median per image) and seconds_interval; rays, rays_per_second; efficiency = 1/(mse·seconds) and efficiency_interval; efficiency_vs_random (over random's at the same N and region) and its interval; error_reduction (random's MSE over this one's) and its interval. Intervals are 95%, [low, high]; null when there are too few seeds (an end of null is unbounded)",
+        "per sampler, N and region: mse, bias, bias_bound, variance, pixels; mse_interval; excluded_from_fit; seconds (median per image) and seconds_interval; rays, rays_per_second; efficiency = 1/(mse·seconds) and efficiency_interval; efficiency_vs_random (over random's at the same N and region) and its interval; error_reduction (random's MSE over this one's) and its interval; perceived: lowpass_mse (MSE after a Gaussian blur of σ = 1 and 2 pixels) and lowpass_interval, low_band_power (mean error power over 0 < |f| ≤ 1/8 cycles per pixel) and its interval, low_band_vs_random (over random's) and its interval, low_band_share (over the mean power of the whole band: 1 for white noise) and its interval, spectrum (radially averaged error power in 32 rings of width 1/64 cycles per pixel up to 1/2; null for a ring the image has no frequency in) and spectrum_interval. Intervals are 95%, [low, high]; null when there are too few seeds (an end of null is unbounded)",
     ),
     (
         "slopes",
@@ -76,11 +76,13 @@ pub const SCHEMA: [(&str, &str); 15] = [
 ];
 
 /// The files a study writes into its directory (`heatmap_n` is the budget drawn).
-pub fn file_names(samplers: &[LightSampler], heatmap_n: u32) -> Vec<String> {
+pub fn file_names(samplers: &[LightSampler], budgets: &[u32], heatmap_n: u32) -> Vec<String> {
     let mut names: Vec<String> = [
         "table.txt",
         "results.csv",
         "seeds.csv",
+        "perceived.csv",
+        "spectra.csv",
         "results.json",
         "mse.png",
         "contact_sheet.png",
@@ -89,6 +91,13 @@ pub fn file_names(samplers: &[LightSampler], heatmap_n: u32) -> Vec<String> {
     .to_vec();
     for s in samplers {
         names.push(format!("heat_{}_N{heatmap_n}.png", s.name()));
+    }
+    let mut seen = Vec::new();
+    for &n in budgets {
+        if !seen.contains(&n) {
+            seen.push(n);
+            names.push(super::spectrum_plot::file_name(n));
+        }
     }
     names
 }
@@ -350,6 +359,7 @@ impl StudyResult {
                 region_row(&mut s, sampler.name(), cell);
             }
         }
+        s.push_str(&self.perceived_table());
         s
     }
 
@@ -428,7 +438,7 @@ impl StudyResult {
                 .map(|(r, x)| (r.name(), x))
                 .collect()
         };
-        let outputs = file_names(&self.config.samplers, self.config.heatmap_n)
+        let outputs = file_names(&self.config.samplers, &self.config.budgets, self.config.heatmap_n)
             .into_iter()
             .filter(|n| n != "results.json")
             .map(|n| {
@@ -438,6 +448,9 @@ impl StudyResult {
                     "seeds.csv" => "the rows of `seeds`",
                     "mse.png" => "MSE against N (top) and against time per image (bottom), per region, with 95% intervals",
                     "contact_sheet.png" => "seed 0's render of every sampler (rows) and budget (columns)",
+                    "perceived.csv" => "per row: MSE after the σ = 1 and 2 pixel blurs, the low band and its ratio to random's, with 95% intervals",
+                    "spectra.csv" => "per row and ring: the radially averaged error power with its 95% interval",
+                    s if s.starts_with("spectrum_N") => "the error's radially averaged power spectrum at one budget, whole image and penumbra, one curve per sampler with its 95% band",
                     _ => "per-pixel MSE at the heat-map budget, on one log scale shared by all samplers",
                 };
                 (n, what.to_string())
@@ -497,6 +510,8 @@ impl StudyResult {
         text("table.txt", self.table(), &mut written)?;
         text("results.csv", self.csv(), &mut written)?;
         text("seeds.csv", self.seeds_csv(), &mut written)?;
+        text("perceived.csv", self.perceived_csv(), &mut written)?;
+        text("spectra.csv", self.spectra_csv(), &mut written)?;
         text("results.json", self.json()?, &mut written)?;
         let plot_path = dir.join("mse.png");
         plot::mse_plot(self, &plot_path)?;
@@ -506,6 +521,7 @@ impl StudyResult {
             written.push(sheet_path);
         }
         written.extend(plot::heatmaps(self, dir)?);
+        written.extend(super::spectrum_plot::spectra(self, dir)?);
         Ok(written)
     }
 }

@@ -35,6 +35,9 @@ pub struct Radial {
     pub power: Vec<f64>,
     /// Mean power over 0 < |f| ≤ [`LOW_BAND`].
     pub low_band: f64,
+    /// Mean power over the whole disc, 0 < |f| ≤ ½: `low_band` over it is the low band's share
+    /// (1 for white noise, below 1 for blue noise), whatever the error's size.
+    pub all_band: f64,
 }
 
 /// The centre of ring `i`, in cycles per pixel.
@@ -67,6 +70,7 @@ pub fn radial_power(error: &[f64], width: usize, height: usize, region: &[bool])
     let mut sums = vec![0.0f64; RINGS];
     let mut counts = vec![0usize; RINGS];
     let (mut low_sum, mut low_count) = (0.0, 0usize);
+    let (mut all_sum, mut all_count) = (0.0, 0usize);
     let frequency = |k: usize, n: usize| {
         let k = if k <= n / 2 {
             k as f64
@@ -87,6 +91,8 @@ pub fn radial_power(error: &[f64], width: usize, height: usize, region: &[bool])
             let ring = ((r / 0.5 * RINGS as f64) as usize).min(RINGS - 1);
             sums[ring] += p;
             counts[ring] += 1;
+            all_sum += p;
+            all_count += 1;
             if r <= LOW_BAND {
                 low_sum += p;
                 low_count += 1;
@@ -103,6 +109,11 @@ pub fn radial_power(error: &[f64], width: usize, height: usize, region: &[bool])
             f64::NAN
         } else {
             low_sum / low_count as f64
+        },
+        all_band: if all_count == 0 {
+            f64::NAN
+        } else {
+            all_sum / all_count as f64
         },
     })
 }
@@ -220,6 +231,7 @@ mod tests {
                 .map(|i| spectra.iter().map(|s| s.power[i]).sum::<f64>() / k)
                 .collect(),
             low_band: spectra.iter().map(|s| s.low_band).sum::<f64>() / k,
+            all_band: spectra.iter().map(|s| s.all_band).sum::<f64>() / k,
         }
     }
 
@@ -238,6 +250,11 @@ mod tests {
             );
         }
         assert!((s.low_band - 1.0).abs() < 0.1, "low band {}", s.low_band);
+        assert!(
+            (s.low_band / s.all_band - 1.0).abs() < 0.1,
+            "share {}",
+            s.low_band / s.all_band
+        );
         let all: f64 = s.power.iter().sum::<f64>() / RINGS as f64;
         assert!((all - 1.0).abs() < 0.03, "mean over rings {all}");
     }

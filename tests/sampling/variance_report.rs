@@ -239,10 +239,37 @@ fn per_seed_rows_pool_to_the_summary_and_the_json_says_what_it_holds() {
         .unwrap();
     assert_eq!(lab_whole["excluded"], serde_json::json!([1]));
     assert_eq!(lab_whole["fitted"], serde_json::json!([4]));
-    // Every file the report names exists.
+    // Every file the report names exists, the spectra among them.
     for name in doc["outputs"].as_object().unwrap().keys() {
         assert!(report.join(name).is_file(), "{name}");
     }
+    for name in [
+        "perceived.csv",
+        "spectra.csv",
+        "spectrum_N1.png",
+        "spectrum_N4.png",
+    ] {
+        assert!(doc["outputs"].get(name).is_some(), "outputs lack {name}");
+    }
+    // The perceived figures: finite, with intervals; random's low band is 1× random's.
+    for row in doc["rows"].as_array().unwrap() {
+        let p = &row["perceived"];
+        assert_eq!(p["spectrum"].as_array().unwrap().len(), 32, "{row}");
+        for key in ["low_band_power", "low_band_share"] {
+            assert!(p[key].as_f64().is_some_and(f64::is_finite), "{key}: {p}");
+        }
+        assert_eq!(p["lowpass_mse"].as_array().unwrap().len(), 2);
+        if row["sampler"] == "random" && row["region"] != "lit" {
+            assert_eq!(p["low_band_vs_random"].as_f64(), Some(1.0), "{p}");
+        }
+    }
+    let perceived = std::fs::read_to_string(report.join("perceived.csv")).unwrap();
+    assert!(perceived.starts_with("sampler,n,region,lowpass1_mse,"));
+    assert_eq!(perceived.lines().count(), 1 + 2 * 2 * 3);
+    let spectra = std::fs::read_to_string(report.join("spectra.csv")).unwrap();
+    assert_eq!(spectra.lines().count(), 1 + 2 * 2 * 3 * 32);
+    let table = std::fs::read_to_string(report.join("table.txt")).unwrap();
+    assert!(table.contains("where the error sits"), "{table}");
 }
 
 /// The heat map's colour bar: columns right of the map that run from the map's brightest

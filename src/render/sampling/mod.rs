@@ -221,7 +221,7 @@ pub struct PointSet {
     pub count: u32,
     width: u32,
     halton_digits: (u32, u32),
-    pmj02: Option<&'static [Vec<(u32, u32)>]>,
+    pmj02: Option<&'static [pmj02::Table]>,
     zsobol: zsobol::Layout,
     bluenoise: Option<bluenoise::Tables>,
 }

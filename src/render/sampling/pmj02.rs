@@ -39,14 +39,17 @@ pub const SETS: usize = 8;
 /// about 25 ms, one of 16 points 5 µs, and a stream of N points reads the tables of the next
 /// power of two. The generator is progressive and its random bits per point do not depend on
 /// the length asked for, so a smaller table is a prefix of a larger one from the same seed.
-static TABLES: [OnceLock<Vec<Vec<(u32, u32)>>>; LEVELS] = [const { OnceLock::new() }; LEVELS];
+static TABLES: [OnceLock<Vec<Table>>; LEVELS] = [const { OnceLock::new() }; LEVELS];
+
+/// One generated sequence: 32-bit fixed-point (x, y).
+pub type Table = Vec<(u32, u32)>;
 
 /// Table sizes: 1, 2, 4, ..., [`TABLE_POINTS`].
 const LEVELS: usize = TABLE_POINTS.trailing_zeros() as usize + 1;
 
 /// The [`SETS`] tables that hold at least `points` points (at most [`TABLE_POINTS`]), as
 /// 32-bit fixed-point coordinates.
-pub fn tables(points: u32) -> &'static [Vec<(u32, u32)>] {
+pub fn tables(points: u32) -> &'static [Table] {
     let size = (points.max(1) as usize)
         .next_power_of_two()
         .min(TABLE_POINTS);

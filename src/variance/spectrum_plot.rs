@@ -1,0 +1,157 @@
+//! `spectrum_N<n>.png`: the radially averaged power spectrum of each sampler's error at one
+//! budget, over the whole image and over the penumbra, one curve per sampler with its 95%
+//! interval as a band, the low band (|f| ≤ 1/8) marked. A blue-noise error is a curve that
+//! starts low and rises; white noise is flat.
+
+use super::plot::{PALETTE, log_range};
+use super::spectrum::{LOW_BAND, RINGS, ring_frequency};
+use super::{Region, StudyResult};
+use crate::output::false_colour::register_font;
+use crate::output::image_file::write_rgb8;
+use anyhow::{Context, Result, anyhow};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use std::path::{Path, PathBuf};
+
+/// The regions a spectrum is drawn for.
+pub(crate) const REGIONS: [Region; 2] = [Region::Whole, Region::Penumbra];
+
+/// The file of budget `n`.
+pub(crate) fn file_name(n: u32) -> String {
+    format!("spectrum_N{n}.png")
+}
+
+/// Writes one `spectrum_N<n>.png` per budget into `dir`; returns the paths written.
+pub(crate) fn spectra(result: &StudyResult, dir: &Path) -> Result<Vec<PathBuf>> {
+    register_font();
+    let mut written = Vec::new();
+    for &n in &result.config.budgets {
+        let path = dir.join(file_name(n));
+        let (w, h) = (1400u32, 560u32);
+        let mut buffer = vec![0u8; (w * h * 3) as usize];
+        {
+            let root = BitMapBackend::with_buffer(&mut buffer, (w, h)).into_drawing_area();
+            root.fill(&WHITE).map_err(|e| anyhow!("plot: {e}"))?;
+            let panels = root.split_evenly((1, 2));
+            for (area, region) in panels.iter().zip(REGIONS) {
+                panel(area, result, n, region)?;
+            }
+            root.present().map_err(|e| anyhow!("plot: {e}"))?;
+        }
+        let img = image::RgbImage::from_raw(w, h, buffer).context("plot buffer")?;
+        write_rgb8(&img, &path)?;
+        written.push(path);
+    }
+    Ok(written)
+}
+
+/// One panel: every sampler's spectrum at budget `n` over `region`.
+fn panel(
+    area: &DrawingArea<BitMapBackend, Shift>,
+    result: &StudyResult,
+    n: u32,
+    region: Region,
+) -> Result<()> {
+    let err = |e| anyhow!("plot: {e}");
+    let rows: Vec<_> = result
+        .rows
+        .iter()
+        .filter(|r| r.n == n && r.region == region && !r.perceived.spectrum.is_empty())
+        .collect();
+    let (y_lo, y_hi) = log_range(
+        rows.iter().flat_map(|r| {
+            r.perceived
+                .spectrum_interval
+                .iter()
+                .zip(&r.perceived.spectrum)
+                .flat_map(|(iv, p)| {
+                    let [a, b] = iv.unwrap_or([*p; 2]);
+                    [*p, a, b]
+                })
+        }),
+        1.5,
+        (1e-8, 1.0),
+    );
+    let i = Region::ALL.iter().position(|&r| r == region).unwrap_or(0);
+    let mut chart = ChartBuilder::on(area)
+        .caption(
+            format!(
+                "{}: error spectrum at N = {n} ({} px)",
+                region.name(),
+                result.region_pixels[i]
+            ),
+            ("sans-serif", 20),
+        )
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(70)
+        .build_cartesian_2d(0.0..0.5f64, (y_lo..y_hi).log_scale())
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("frequency |f|, cycles per pixel")
+        .y_desc("error power (white noise: flat at its variance)")
+        .y_label_formatter(&|y| format!("{y:.0e}"))
+        .label_style(("sans-serif", 14))
+        .draw()
+        .map_err(err)?;
+    chart
+        .draw_series(std::iter::once(PathElement::new(
+            vec![(LOW_BAND, y_lo), (LOW_BAND, y_hi)],
+            BLACK.mix(0.4).stroke_width(1),
+        )))
+        .map_err(err)?;
+    for (k, sampler) in result.config.samplers.iter().enumerate() {
+        let Some(row) = rows.iter().find(|r| r.sampler == sampler.name()) else {
+            continue;
+        };
+        let colour = PALETTE[k % PALETTE.len()];
+        let p = &row.perceived;
+        let pts: Vec<(f64, f64)> = (0..RINGS)
+            .filter(|&i| p.spectrum[i].is_finite() && p.spectrum[i] > 0.0)
+            .map(|i| (ring_frequency(i), p.spectrum[i]))
+            .collect();
+        // The 95% band: up along the high ends, back along the low ones.
+        let mut band: Vec<(f64, f64)> = (0..RINGS)
+            .filter_map(|i| p.spectrum_interval[i].map(|[_, b]| (ring_frequency(i), b.min(y_hi))))
+            .collect();
+        band.extend(
+            (0..RINGS).rev().filter_map(|i| {
+                p.spectrum_interval[i].map(|[a, _]| (ring_frequency(i), a.max(y_lo)))
+            }),
+        );
+        if band.len() > 2 {
+            chart
+                .draw_series(std::iter::once(Polygon::new(
+                    band,
+                    colour.mix(0.15).filled(),
+                )))
+                .map_err(err)?;
+        }
+        let ratio = p
+            .low_band_vs_random
+            .map(|v| format!(" (low band {v:.2}× random's)"))
+            .unwrap_or_default();
+        // The lab's strategy draws random's points for N > 1: dashed, so both show.
+        let series = if *sampler == crate::render::sampling::LightSampler::Lab {
+            chart.draw_series(DashedLineSeries::new(pts, 8, 6, colour.stroke_width(2)))
+        } else {
+            chart.draw_series(LineSeries::new(pts, colour.stroke_width(2)))
+        };
+        series
+            .map_err(err)?
+            .label(format!("{}{ratio}", sampler.name()))
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
+            });
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::LowerRight)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 13))
+        .draw()
+        .map_err(err)?;
+    Ok(())
+}
