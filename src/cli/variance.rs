@@ -45,8 +45,8 @@ pub struct VarianceArgs {
     /// picks the nearest of them on a log scale (with a note on standard error).
     #[arg(long, default_value_t = 16)]
     pub heatmap_n: u32,
-    /// Directory for table.txt, results.csv, seeds.csv, results.json, mse.png,
-    /// contact_sheet.png and the heat maps.
+    /// Directory for table.txt, results.csv, seeds.csv, perceived.csv, spectra.csv,
+    /// results.json, mse.png, contact_sheet.png, the heat maps and the spectra.
     #[arg(long, default_value = "variance-report")]
     pub out: PathBuf,
     /// Directory caching converged references (keyed by the scene bytes parsed, the settings

@@ -272,10 +272,18 @@ impl<'a> Reference<'a> {
             };
             let end_offset = self.light_offsets[li];
             let end = light_end(light, end_offset, surface);
+            // The table samplers' per-stream state, taken once for the N points.
+            let stream = match settings.shadows {
+                ShadowMode::Soft => self.points.stream(&light_key),
+                _ => None,
+            };
             for j in 0..count {
                 let (uv, point) = match settings.shadows {
                     ShadowMode::Soft => {
-                        let (u, v) = self.points.point(&light_key, j);
+                        let (u, v) = match &stream {
+                            Some(stream) => stream.point(j),
+                            None => self.points.point(&light_key, j),
+                        };
                         (Some([u, v]), light.point(u, v))
                     }
                     _ => (None, light.centroid),

@@ -712,7 +712,10 @@ fn check_light_points<V: Lanes>(
                 LightSampler::Halton
                 | LightSampler::Pmj02
                 | LightSampler::Zsobol
-                | LightSampler::Bluenoise => BlockSampler::PerLane { points: &set, key },
+                | LightSampler::Bluenoise => BlockSampler::PerLane {
+                    stream: set.stream(&key).expect("a table sampler"),
+                    count,
+                },
             },
             origin,
             edge_u,

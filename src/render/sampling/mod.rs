@@ -15,7 +15,10 @@
 pub mod bluenoise;
 pub mod halton;
 pub mod pmj02;
+pub mod stream;
 pub mod zsobol;
+
+pub use stream::Stream;
 
 use crate::render::settings::RenderSettings;
 
@@ -219,11 +222,11 @@ pub struct PointSet {
     pub sampler: LightSampler,
     /// Points per light, N.
     pub count: u32,
-    width: u32,
-    halton_digits: (u32, u32),
-    pmj02: Option<&'static [pmj02::Table]>,
-    zsobol: zsobol::Layout,
-    bluenoise: Option<bluenoise::Tables>,
+    pub(crate) width: u32,
+    pub(crate) halton_digits: (u32, u32),
+    pub(crate) pmj02: Option<&'static [pmj02::Table]>,
+    pub(crate) zsobol: zsobol::Layout,
+    pub(crate) bluenoise: Option<bluenoise::Tables>,
 }
 
 impl PointSet {
@@ -294,32 +297,15 @@ impl PointSet {
         }
     }
 
-    /// [`PointSet::point`] for the samplers of digit loops and table reads, out of line: their
-    /// code inlined beside the lab's four in the engines' inner loops cost those 3–8% more
-    /// instructions (tests/gates/icount.rs).
+    /// [`PointSet::point`] for the samplers of digit loops and table reads (through their
+    /// [`Stream`]), out of line: their code inlined beside the lab's four in the engines'
+    /// inner loops cost those 3–8% more instructions (tests/gates/icount.rs). A loop over a
+    /// stream's points should take its [`PointSet::stream`] once instead.
     #[inline(never)]
     pub fn table_point(&self, key: &SampleKey, index: u32) -> (f32, f32) {
-        let count = self.count;
-        match self.sampler {
-            LightSampler::Halton => {
-                let seeds = (hash(key, HALTON_SEED_DIM), hash(key, HALTON_SEED_DIM - 1));
-                halton::point(index, self.halton_digits, seeds)
-            }
-            LightSampler::Pmj02 => {
-                let h = hash(key, PMJ02_SEED_DIM);
-                let tables = self.pmj02.unwrap_or_else(|| pmj02::tables(count));
-                let table = &tables[h as usize % tables.len()];
-                let masks = (mix32(h ^ 0x243f_6a88), mix32(h ^ 0x85a3_08d3));
-                pmj02::point(table, index, masks)
-            }
-            LightSampler::Zsobol => zsobol::point(&self.zsobol, key, index),
-            LightSampler::Bluenoise => {
-                let tables = self
-                    .bluenoise
-                    .unwrap_or_else(|| bluenoise::Tables::for_samples(count));
-                bluenoise::Stream::new(key, self.width, count).point(&tables, index)
-            }
-            _ => self.point(key, index),
+        match self.stream(key) {
+            Some(stream) => stream.point(index),
+            None => self.point(key, index),
         }
     }
 }

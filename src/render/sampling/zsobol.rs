@@ -63,7 +63,7 @@ impl Layout {
     pub fn index(&self, key: &SampleKey, j: u32) -> u32 {
         let (x, y) = (key.pixel % self.width, key.pixel / self.width);
         let sample_bits = self.aa_bits + self.point_bits;
-        let sample = (key.sample << self.point_bits) | j;
+        let sample = (key.sample << self.point_bits) | (j & low_mask(self.point_bits));
         (morton(x, y) << sample_bits) | sample
     }
 }
@@ -109,11 +109,23 @@ const PERMUTATIONS_4: [[u32; 4]; 24] = {
 /// lowest digit is one bit, flipped by a hashed bit.
 #[inline]
 pub fn permute_digits(index: u32, bits: u32, seed: u32) -> u32 {
+    permute_part(index, bits, seed, |_| true)
+}
+
+/// The digits of [`permute_digits`] whose lowest bit's position `keep` accepts, permuted; the
+/// others 0. A digit's permutation depends only on the digits above it, so the digits above
+/// the points' bits are the same for a whole stream and are permuted once
+/// ([`StreamIndex`]).
+#[inline(always)]
+fn permute_part(index: u32, bits: u32, seed: u32, keep: impl Fn(u32) -> bool) -> u32 {
     let odd = bits % 2;
     let mut out = 0;
     let mut shift = bits;
     while shift >= 2 + odd {
         shift -= 2;
+        if !keep(shift) {
+            continue;
+        }
         let digit = (index >> shift) & 3;
         let above = if shift + 2 >= 32 {
             0
@@ -124,11 +136,68 @@ pub fn permute_digits(index: u32, bits: u32, seed: u32) -> u32 {
         let h = mix32(above ^ mix32(seed ^ shift.wrapping_mul(0x9e37_79b9)));
         out |= PERMUTATIONS_4[(h % 24) as usize][digit as usize] << shift;
     }
-    if odd == 1 {
+    if odd == 1 && keep(0) {
         let h = mix32((index >> 1) ^ mix32(seed ^ 0x5bd1_e995));
         out |= (index & 1) ^ (h & 1);
     }
     out
+}
+
+/// One stream's ZSobol state: its index without the point's bits, the part of the permuted
+/// index above them and that part's Sobol bits (Sobol points are linear over GF(2) in the
+/// index's bits, so the two parts' contributions XOR together), and the Owen scramble seeds.
+#[derive(Clone, Copy, Debug)]
+pub struct StreamIndex {
+    base: u32,
+    bits: u32,
+    point_bits: u32,
+    seed: u32,
+    high: (u32, u32),
+    scramble: (u32, u32),
+}
+
+impl StreamIndex {
+    /// The state of `key`'s stream under `layout`.
+    #[inline]
+    pub fn new(layout: &Layout, key: &SampleKey) -> Self {
+        let seed = stream_seed(key);
+        let base = layout.index(key, 0);
+        let bits = layout.index_bits();
+        let split = layout.point_bits;
+        let high = permute_part(base, bits, seed, |shift| shift >= split);
+        StreamIndex {
+            base,
+            bits,
+            point_bits: split,
+            seed,
+            high: sobol_2d(high),
+            scramble: (mix32(seed ^ 0x6a09_e667), mix32(seed ^ 0xbb67_ae85)),
+        }
+    }
+
+    /// Point `j` of the stream (j below 2^point_bits; above, its high bits are dropped).
+    #[inline]
+    pub fn point(&self, j: u32) -> (f32, f32) {
+        let split = self.point_bits;
+        let j = j & low_mask(split);
+        let low = permute_part(self.base | j, self.bits, self.seed, |shift| shift < split);
+        let (lx, ly) = sobol_2d(low);
+        let unit = |bits: u32| (bits >> 8) as f32 * (1.0 / 16_777_216.0);
+        (
+            unit(owen_scramble(self.high.0 ^ lx, self.scramble.0)),
+            unit(owen_scramble(self.high.1 ^ ly, self.scramble.1)),
+        )
+    }
+}
+
+/// The lowest `bits` bits set.
+#[inline]
+fn low_mask(bits: u32) -> u32 {
+    if bits >= 32 {
+        u32::MAX
+    } else {
+        (1 << bits) - 1
+    }
 }
 
 /// Owen scrambling of `x` with `seed`: Burley's (2020) hash-based nested uniform scramble,
@@ -174,14 +243,7 @@ pub fn stream_seed(key: &SampleKey) -> u32 {
 /// Point `j` of `key`'s stream.
 #[inline]
 pub fn point(layout: &Layout, key: &SampleKey, j: u32) -> (f32, f32) {
-    let seed = stream_seed(key);
-    let index = permute_digits(layout.index(key, j), layout.index_bits(), seed);
-    let (x, y) = sobol_2d(index);
-    let unit = |bits: u32| (bits >> 8) as f32 * (1.0 / 16_777_216.0);
-    (
-        unit(owen_scramble(x, mix32(seed ^ 0x6a09_e667))),
-        unit(owen_scramble(y, mix32(seed ^ 0xbb67_ae85))),
-    )
+    StreamIndex::new(layout, key).point(j)
 }
 
 #[cfg(test)]
@@ -241,6 +303,45 @@ mod tests {
             }
         }
         assert_eq!(PERMUTATIONS_4.len(), 24);
+    }
+
+    /// A stream's two parts, permuted apart and XORed through Sobol, are the whole index's
+    /// point: for odd and even lengths, and a split inside a digit.
+    #[test]
+    fn a_stream_s_parts_make_the_whole_point() {
+        for (w, h, aa, points) in [
+            (64, 64, 1, 16),
+            (100, 30, 2, 8),
+            (5, 5, 1, 1),
+            (512, 512, 3, 64),
+        ] {
+            let layout = Layout::new(w, h, aa, points);
+            for pixel in [0u32, 7, 99, w * h - 1] {
+                let key = SampleKey {
+                    pixel,
+                    sample: aa - 1,
+                    bounce: 2,
+                    light: 1,
+                    seed: 3,
+                };
+                let stream = StreamIndex::new(&layout, &key);
+                for j in 0..points {
+                    let seed = stream_seed(&key);
+                    let index = permute_digits(layout.index(&key, j), layout.index_bits(), seed);
+                    let (x, y) = sobol_2d(index);
+                    let unit = |bits: u32| (bits >> 8) as f32 * (1.0 / 16_777_216.0);
+                    let whole = (
+                        unit(owen_scramble(x, mix32(seed ^ 0x6a09_e667))),
+                        unit(owen_scramble(y, mix32(seed ^ 0xbb67_ae85))),
+                    );
+                    assert_eq!(
+                        stream.point(j),
+                        whole,
+                        "{w}×{h}, aa {aa}, N {points}, j {j}"
+                    );
+                }
+            }
+        }
     }
 
     #[test]

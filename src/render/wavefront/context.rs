@@ -223,8 +223,11 @@ impl<'a> Context<'a> {
             | LightSampler::Pmj02
             | LightSampler::Zsobol
             | LightSampler::Bluenoise => BlockSampler::PerLane {
-                points: &self.points,
-                key: *key,
+                stream: self
+                    .points
+                    .stream(key)
+                    .expect("the table samplers have a stream"),
+                count: self.points_per_light,
             },
         }
     }

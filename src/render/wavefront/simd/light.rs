@@ -2,7 +2,7 @@
 //! uniforms, jittered strata and Owen-scrambled Sobol points of one (pixel, sample, bounce,
 //! light) stream on a parallelogram light, and the shadow rays from a hit to them.
 
-use crate::render::sampling::{PointSet, SampleKey};
+use crate::render::sampling::Stream;
 use crate::render::spawn::{LightEnd, SurfaceHit};
 use crate::render::wavefront::batch::ShadowBlock;
 use crate::render::wavefront::lanes::{LANES, Lanes, LanesU, f32x8};
@@ -51,14 +51,14 @@ pub enum BlockSampler<'a> {
         /// The scramble seed.
         scramble: u32,
     },
-    /// Each lane's (u, v) from the scalar `PointSet::point` of the stream `key`, the rest of
-    /// the block on N lanes: the samplers whose points are table reads and digit loops
-    /// (halton, pmj02, zsobol, bluenoise). Lanes past the point count get (0, 0).
+    /// Each lane's (u, v) from the scalar `Stream::point` of the stream, the rest of the block
+    /// on N lanes: the samplers whose points are table reads and digit loops (halton, pmj02,
+    /// zsobol, bluenoise). Lanes past the point count get (0, 0).
     PerLane {
-        /// The render's point set.
-        points: &'a PointSet,
-        /// The stream.
-        key: SampleKey,
+        /// The stream's state (`PointSet::stream`), taken once per (hit, light).
+        stream: Stream<'a>,
+        /// Points per light.
+        count: u32,
     },
 }
 
@@ -126,19 +126,19 @@ pub fn light_points<V: Lanes>(b: &LightBlock) -> [V::Array; 3] {
             )
         }
         BlockSampler::Sobol { scramble } => sobol8(j, scramble),
-        BlockSampler::PerLane { points, key } => per_lane::<V>(points, &key, b.j0),
+        BlockSampler::PerLane { stream, count } => per_lane::<V>(&stream, count, b.j0),
     };
     parallelogram_points8(b.origin, b.edge_u, b.edge_v, u, v)
 }
 
-/// Points `j0..j0 + N` of `key`'s stream, each from the scalar `PointSet::table_point`; lanes
-/// past the point count get (0, 0). Out of line, as `table_point` is.
+/// Points `j0..j0 + N` of a stream of `count`, each from the scalar `Stream::point`; lanes
+/// past the count get (0, 0). Out of line, as `Stream::point` is.
 #[inline(never)]
-fn per_lane<V: Lanes>(points: &PointSet, key: &SampleKey, j0: u32) -> (V, V) {
+fn per_lane<V: Lanes>(stream: &Stream, count: u32, j0: u32) -> (V, V) {
     let (mut u, mut v) = (V::ZERO.to_array(), V::ZERO.to_array());
-    let live = (points.count.saturating_sub(j0) as usize).min(V::N);
+    let live = (count.saturating_sub(j0) as usize).min(V::N);
     for k in 0..live {
-        let (pu, pv) = points.table_point(key, j0 + k as u32);
+        let (pu, pv) = stream.point(j0 + k as u32);
         u[k] = pu;
         v[k] = pv;
     }
