@@ -145,7 +145,8 @@ fn permute_part(index: u32, bits: u32, seed: u32, keep: impl Fn(u32) -> bool) ->
 
 /// One stream's ZSobol state: its index without the point's bits, the part of the permuted
 /// index above them and that part's Sobol bits (Sobol points are linear over GF(2) in the
-/// index's bits, so the two parts' contributions XOR together), and the Owen scramble seeds.
+/// index's bits, so the two parts' contributions XOR together), the hash state of each digit
+/// below (it depends on the seed and the digit's place only), and the Owen scramble seeds.
 #[derive(Clone, Copy, Debug)]
 pub struct StreamIndex {
     base: u32,
@@ -154,6 +155,8 @@ pub struct StreamIndex {
     seed: u32,
     high: (u32, u32),
     scramble: (u32, u32),
+    /// `mix32(seed ^ shift · φ)` for the digit at each shift below `point_bits`.
+    depth_hash: [u32; 32],
 }
 
 impl StreamIndex {
@@ -165,6 +168,14 @@ impl StreamIndex {
         let bits = layout.index_bits();
         let split = layout.point_bits;
         let high = permute_part(base, bits, seed, |shift| shift >= split);
+        let mut depth_hash = [0; 32];
+        for (shift, h) in depth_hash
+            .iter_mut()
+            .enumerate()
+            .take(split.min(32) as usize)
+        {
+            *h = mix32(seed ^ (shift as u32).wrapping_mul(0x9e37_79b9));
+        }
         StreamIndex {
             base,
             bits,
@@ -172,21 +183,48 @@ impl StreamIndex {
             seed,
             high: sobol_2d(high),
             scramble: (mix32(seed ^ 0x6a09_e667), mix32(seed ^ 0xbb67_ae85)),
+            depth_hash,
         }
     }
 
     /// Point `j` of the stream (j below 2^point_bits; above, its high bits are dropped).
     #[inline]
     pub fn point(&self, j: u32) -> (f32, f32) {
-        let split = self.point_bits;
-        let j = j & low_mask(split);
-        let low = permute_part(self.base | j, self.bits, self.seed, |shift| shift < split);
+        let low = self.permute_low(self.base | (j & low_mask(self.point_bits)));
         let (lx, ly) = sobol_2d(low);
         let unit = |bits: u32| (bits >> 8) as f32 * (1.0 / 16_777_216.0);
         (
             unit(owen_scramble(self.high.0 ^ lx, self.scramble.0)),
             unit(owen_scramble(self.high.1 ^ ly, self.scramble.1)),
         )
+    }
+
+    /// `permute_part(index, bits, seed, |shift| shift < point_bits)`, visiting only those
+    /// digits, with their depth hashes from the table.
+    #[inline]
+    fn permute_low(&self, index: u32) -> u32 {
+        let (bits, split) = (self.bits, self.point_bits);
+        let odd = bits % 2;
+        let mut out = 0;
+        // Digit shifts have the parity of `bits` and are at least `odd`: the highest below
+        // the split first.
+        let mut shift = i64::from(split) - 1;
+        if shift >= 0 && (shift as u32) % 2 != odd {
+            shift -= 1;
+        }
+        while shift >= i64::from(odd) && shift + 2 <= i64::from(bits) {
+            let s = shift as u32;
+            let digit = (index >> s) & 3;
+            let above = if s + 2 >= 32 { 0 } else { index >> (s + 2) };
+            let h = mix32(above ^ self.depth_hash[s as usize]);
+            out |= PERMUTATIONS_4[(h % 24) as usize][digit as usize] << s;
+            shift -= 2;
+        }
+        if odd == 1 && split > 0 {
+            let h = mix32((index >> 1) ^ mix32(self.seed ^ 0x5bd1_e995));
+            out |= (index & 1) ^ (h & 1);
+        }
+        out
     }
 }
 
@@ -311,6 +349,8 @@ mod tests {
     fn a_stream_s_parts_make_the_whole_point() {
         for (w, h, aa, points) in [
             (64, 64, 1, 16),
+            (64, 64, 2, 16),
+            (9, 9, 2, 1),
             (100, 30, 2, 8),
             (5, 5, 1, 1),
             (512, 512, 3, 64),
