@@ -29,7 +29,7 @@ pub(crate) mod plot;
 pub mod report;
 pub mod sheet;
 pub mod spectrum;
-pub(crate) mod spectrum_plot;
+pub mod spectrum_plot;
 
 use crate::render::engine::Hooks;
 use crate::render::film::Film;

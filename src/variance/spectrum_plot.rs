@@ -3,11 +3,13 @@
 //! interval as a band, the low band (|f| ≤ 1/8) marked. A blue-noise error is a curve that
 //! starts low and rises; white noise is flat.
 
+use super::perceived::Perceived;
 use super::plot::{PALETTE, log_range};
 use super::spectrum::{LOW_BAND, RINGS, ring_frequency};
 use super::{Region, StudyResult};
 use crate::output::false_colour::register_font;
 use crate::output::image_file::write_rgb8;
+use crate::render::sampling::LightSampler;
 use anyhow::{Context, Result, anyhow};
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -45,6 +47,14 @@ pub(crate) fn spectra(result: &StudyResult, dir: &Path) -> Result<Vec<PathBuf>> 
     Ok(written)
 }
 
+/// One curve of a spectrum panel: its label, colour, whether dashed, and its figures.
+struct Curve<'a> {
+    label: String,
+    colour: RGBColor,
+    dashed: bool,
+    perceived: &'a Perceived,
+}
+
 /// One panel: every sampler's spectrum at budget `n` over `region`.
 fn panel(
     area: &DrawingArea<BitMapBackend, Shift>,
@@ -52,36 +62,98 @@ fn panel(
     n: u32,
     region: Region,
 ) -> Result<()> {
-    let err = |e| anyhow!("plot: {e}");
-    let rows: Vec<_> = result
-        .rows
+    let i = Region::ALL.iter().position(|&r| r == region).unwrap_or(0);
+    let title = format!(
+        "{}: error spectrum at N = {n} ({} px)",
+        region.name(),
+        result.region_pixels[i]
+    );
+    let curves: Vec<Curve> = result
+        .config
+        .samplers
         .iter()
-        .filter(|r| r.n == n && r.region == region && !r.perceived.spectrum.is_empty())
+        .enumerate()
+        .filter_map(|(k, sampler)| {
+            let row = result.rows.iter().find(|r| {
+                r.n == n
+                    && r.region == region
+                    && r.sampler == sampler.name()
+                    && !r.perceived.spectrum.is_empty()
+            })?;
+            let ratio = row
+                .perceived
+                .low_band_vs_random
+                .map(|v| format!(" (low band {v:.2}× random's)"))
+                .unwrap_or_default();
+            Some(Curve {
+                label: format!("{}{ratio}", sampler.name()),
+                colour: PALETTE[k % PALETTE.len()],
+                // The lab's strategy draws random's points for N > 1: dashed, so both show.
+                dashed: *sampler == LightSampler::Lab,
+                perceived: &row.perceived,
+            })
+        })
         .collect();
+    draw_curves(area, &title, &curves)
+}
+
+/// The viewer's comparison: the spectra of its two samplers' errors over the whole image, with
+/// their 95% bands, as an image of `width` × `height`.
+pub(crate) fn comparison_image(
+    sides: &[(LightSampler, &Perceived)],
+    n: u32,
+    (width, height): (u32, u32),
+) -> Result<image::RgbImage> {
+    register_font();
+    let mut buffer = vec![0u8; (width * height * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut buffer, (width, height)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| anyhow!("plot: {e}"))?;
+        let curves: Vec<Curve> = sides
+            .iter()
+            .enumerate()
+            .map(|(k, (sampler, p))| Curve {
+                label: format!(
+                    "{} {}: low band's share {:.2}",
+                    ["A", "B"][k % 2],
+                    sampler.name(),
+                    p.low_band_share
+                ),
+                colour: PALETTE[k % PALETTE.len()],
+                dashed: false,
+                perceived: p,
+            })
+            .collect();
+        draw_curves(&root, &format!("error spectra at N = {n}"), &curves)?;
+        root.present().map_err(|e| anyhow!("plot: {e}"))?;
+    }
+    image::RgbImage::from_raw(width, height, buffer).context("plot buffer")
+}
+
+/// Draws `curves` (radially averaged power against frequency, log power) with their bands and
+/// the low band's edge.
+fn draw_curves(
+    area: &DrawingArea<BitMapBackend, Shift>,
+    title: &str,
+    curves: &[Curve],
+) -> Result<()> {
+    let err = |e| anyhow!("plot: {e}");
     let (y_lo, y_hi) = log_range(
-        rows.iter().flat_map(|r| {
-            r.perceived
-                .spectrum_interval
+        curves.iter().flat_map(|c| {
+            let p = c.perceived;
+            p.spectrum_interval
                 .iter()
-                .zip(&r.perceived.spectrum)
-                .flat_map(|(iv, p)| {
-                    let [a, b] = iv.unwrap_or([*p; 2]);
-                    [*p, a, b]
+                .zip(&p.spectrum)
+                .flat_map(|(iv, v)| {
+                    let [a, b] = iv.unwrap_or([*v; 2]);
+                    [*v, a, b]
                 })
         }),
         1.5,
         (1e-8, 1.0),
     );
-    let i = Region::ALL.iter().position(|&r| r == region).unwrap_or(0);
     let mut chart = ChartBuilder::on(area)
-        .caption(
-            format!(
-                "{}: error spectrum at N = {n} ({} px)",
-                region.name(),
-                result.region_pixels[i]
-            ),
-            ("sans-serif", 20),
-        )
+        .caption(title, ("sans-serif", 20))
         .margin(12)
         .x_label_area_size(40)
         .y_label_area_size(70)
@@ -101,24 +173,21 @@ fn panel(
             BLACK.mix(0.4).stroke_width(1),
         )))
         .map_err(err)?;
-    for (k, sampler) in result.config.samplers.iter().enumerate() {
-        let Some(row) = rows.iter().find(|r| r.sampler == sampler.name()) else {
-            continue;
-        };
-        let colour = PALETTE[k % PALETTE.len()];
-        let p = &row.perceived;
-        let pts: Vec<(f64, f64)> = (0..RINGS)
+    for curve in curves {
+        let (colour, p) = (curve.colour, curve.perceived);
+        let pts: Vec<(f64, f64)> = (0..RINGS.min(p.spectrum.len()))
             .filter(|&i| p.spectrum[i].is_finite() && p.spectrum[i] > 0.0)
             .map(|i| (ring_frequency(i), p.spectrum[i]))
             .collect();
         // The 95% band: up along the high ends, back along the low ones.
+        let ends = |i: usize| p.spectrum_interval.get(i).copied().flatten();
         let mut band: Vec<(f64, f64)> = (0..RINGS)
-            .filter_map(|i| p.spectrum_interval[i].map(|[_, b]| (ring_frequency(i), b.min(y_hi))))
+            .filter_map(|i| ends(i).map(|[_, b]| (ring_frequency(i), b.min(y_hi))))
             .collect();
         band.extend(
-            (0..RINGS).rev().filter_map(|i| {
-                p.spectrum_interval[i].map(|[a, _]| (ring_frequency(i), a.max(y_lo)))
-            }),
+            (0..RINGS)
+                .rev()
+                .filter_map(|i| ends(i).map(|[a, _]| (ring_frequency(i), a.max(y_lo)))),
         );
         if band.len() > 2 {
             chart
@@ -128,19 +197,14 @@ fn panel(
                 )))
                 .map_err(err)?;
         }
-        let ratio = p
-            .low_band_vs_random
-            .map(|v| format!(" (low band {v:.2}× random's)"))
-            .unwrap_or_default();
-        // The lab's strategy draws random's points for N > 1: dashed, so both show.
-        let series = if *sampler == crate::render::sampling::LightSampler::Lab {
+        let series = if curve.dashed {
             chart.draw_series(DashedLineSeries::new(pts, 8, 6, colour.stroke_width(2)))
         } else {
             chart.draw_series(LineSeries::new(pts, colour.stroke_width(2)))
         };
         series
             .map_err(err)?
-            .label(format!("{}{ratio}", sampler.name()))
+            .label(curve.label.clone())
             .legend(move |(x, y)| {
                 PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
             });

@@ -8,6 +8,8 @@
 //! reference = converged_reference(stratified, 2 × reference_samples)     (no disk cache)
 //! for each sampler: K renders (seeds 1..=K) at N points
 //!     heat = pixel_mse(renders, reference); MSE whole and penumbra, mean ± standard error over seeds
+//!     perceived = the error's spectrum, low band and blurred MSE (variance/perceived.rs)
+//! spectrum.png = both sides' spectra, one plot
 //! ```
 
 use super::http::ApiError;
@@ -18,8 +20,10 @@ use crate::render::engine::Engine;
 use crate::render::film::{Film, ToneMap};
 use crate::render::sampling::LightSampler;
 use crate::render::scene::Scene;
+use crate::variance::perceived::{self, Perceived};
 use crate::variance::{
     StudyConfig, converged_reference, error_stats, penumbra_mask, pixel_mse, plot::heat_images,
+    spectrum_plot,
 };
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
@@ -153,6 +157,10 @@ pub(crate) struct Side {
     pub bias: [f64; 2],
     /// Median seconds per render.
     pub seconds: f64,
+    /// Where the error sits over the whole image (the variance study's figures): the
+    /// radially averaged spectrum, the low band's share, the MSE after blurs of 1 and 2
+    /// pixels, over the seeds.
+    pub perceived: Perceived,
 }
 
 /// What the page shows.
@@ -178,6 +186,8 @@ pub(crate) struct Comparison {
     pub heat_scale: Option<[f32; 2]>,
     /// Pixels in the penumbra.
     pub penumbra_pixels: usize,
+    /// URL of the two sides' error spectra, one plot.
+    pub spectrum: String,
     /// The two sides.
     pub sides: Vec<Side>,
     /// Seconds for the whole comparison.
@@ -282,6 +292,13 @@ impl Comparisons {
                 Arc::new(png(&films[0]).map_err(internal)?),
             ));
             maps.push(pixel_mse(&images, &reference.film.pixels));
+            let perceived = perceived::measure(
+                &images,
+                &reference.film.pixels,
+                config.base.width as usize,
+                config.base.height as usize,
+                &whole,
+            );
             sides.push(Side {
                 sampler,
                 image: url(&format!("image-{side_name}")),
@@ -294,6 +311,7 @@ impl Comparisons {
                     .then(|| per_seed(&regions.penumbra)),
                 bias: [all.bias, all.bias_bound],
                 seconds: median(&times),
+                perceived,
             });
         }
         let map_refs: Vec<&[f32]> = maps.iter().map(Vec::as_slice).collect();
@@ -309,6 +327,14 @@ impl Comparisons {
                 Arc::new(png_bytes(img).map_err(internal)?),
             ));
         }
+        let spectra: Vec<(LightSampler, &Perceived)> =
+            sides.iter().map(|s| (s.sampler, &s.perceived)).collect();
+        let spectrum =
+            spectrum_plot::comparison_image(&spectra, request.n, (640, 400)).map_err(internal)?;
+        pngs.push((
+            "spectrum".to_string(),
+            Arc::new(png_bytes(&spectrum).map_err(internal)?),
+        ));
         let noise = reference.noise.iter().map(|&v| v as f64).sum::<f64>()
             / reference.noise.len().max(1) as f64;
         let mut kept = self.kept.lock().unwrap_or_else(|e| e.into_inner());
@@ -327,6 +353,7 @@ impl Comparisons {
             reference: url("reference"),
             heat_scale,
             penumbra_pixels: regions.penumbra.iter().filter(|&&b| b).count(),
+            spectrum: url("spectrum"),
             sides,
             seconds: start.elapsed().as_secs_f64(),
         })

@@ -309,16 +309,16 @@ fn drive(c: &Session, url: &str, screenshot: Option<PathBuf>) {
     wait_render(c, job);
     click_centre_and_count(c, 5);
 
-    // The comparison: the reference, two renders and two heat maps, all loaded.
+    // The comparison: the reference, two renders, two heat maps and the spectra, all loaded.
     set_value(c, "#compare-form [name=size]", "16");
     set_value(c, "#compare-form [name=seeds]", "2");
     c.click(&c.find("#compare-run").expect("the compare button"));
-    wait_attr(c, "#compare-result", "data-images", |v| v == "5");
+    wait_attr(c, "#compare-result", "data-images", |v| v == "6");
     let sizes = c.execute(
         "return [...document.querySelectorAll('#compare-result img')].map(i => i.naturalWidth);",
         vec![],
     );
-    assert_eq!(sizes, json!([16, 16, 16, 16, 16]));
+    assert_eq!(sizes, json!([16, 16, 16, 16, 16, 640]));
 
     if let Some(path) = screenshot {
         // The ray tree and the comparison in view.

@@ -124,7 +124,18 @@ fn every_endpoint_answers() {
         let mse = &side["mse"];
         assert!(mse["mean"].as_f64().unwrap() > 0.0, "{side}");
         assert!(mse["se"].as_f64().unwrap() >= 0.0, "{side}");
+        // Where the error sits: a spectrum of 32 rings and the low band's share.
+        let p = &side["perceived"];
+        assert_eq!(p["spectrum"].as_array().unwrap().len(), 32, "{side}");
+        assert!(
+            p["low_band_share"].as_f64().is_some_and(f64::is_finite),
+            "{side}"
+        );
     }
+    let spectrum = compare["spectrum"].as_str().unwrap();
+    let png = server.get(spectrum);
+    assert_eq!(png.status, 200, "{spectrum}");
+    assert_eq!(png_size(&png.body), (640, 400), "{spectrum}");
 }
 
 /// A bad request: method, path, extra headers, body, the status and a part of the message.

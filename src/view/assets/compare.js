@@ -1,5 +1,6 @@
 // The comparison mode: two samplers at the same budget, side by side, with their per-pixel
-// error against the converged reference as heat maps on one shared scale.
+// error against the converged reference as heat maps on one shared scale, and both errors'
+// spectra in one plot.
 'use strict';
 
 const Compare = (() => {
@@ -33,6 +34,11 @@ const Compare = (() => {
       out.appendChild(figure(s.heat, `${name} error: MSE ${est(s.mse)} (mean ± s.e. over ${result.seeds} seeds)${pen}; ` +
         `bias ${sci(s.bias[0])} (bound ${sci(s.bias[1])})`, count));
     });
+    const share = s => `${s.sampler} ${s.perceived.low_band_share.toFixed(2)}`;
+    const blurred = s => `${s.sampler} ${sci(s.perceived.lowpass_mse[1])}`;
+    out.appendChild(figure(result.spectrum, `error spectra over the whole image (flat: white noise; rising: blue noise). ` +
+      `Low band's share of the error power (1 for white noise): ${result.sides.map(share).join(', ')}; ` +
+      `MSE blurred by 2 pixels: ${result.sides.map(blurred).join(', ')}`, count));
     if (result.heat_scale) {
       const p = document.createElement('p');
       p.className = 'note';
