@@ -122,6 +122,10 @@ pub(crate) fn low_band_vs_random(rows: &mut [Row], k: usize) {
             continue;
         };
         let p = &mut row.perceived;
+        // An empty region measured nothing: no seeds to resample.
+        if p.seed_low_band.len() != k || base_seeds.len() != k {
+            continue;
+        }
         if *base > 0.0 {
             p.low_band_vs_random = Some(p.low_band_power / base);
         }

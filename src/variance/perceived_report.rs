@@ -6,16 +6,23 @@ use super::spectrum_plot::REGIONS;
 use super::{Region, StudyResult};
 use std::fmt::Write;
 
-/// `v` with its interval, scientific: `6.4e-5 [6.1e-5, 6.8e-5]`.
+/// `v` with its interval, scientific: `6.4e-5 [6.1e-5, 6.8e-5]`; `-` for a figure with nothing
+/// to measure (a low band without a frequency in it, on a tiny image).
 fn sci(v: f64, iv: Option<[f64; 2]>) -> String {
+    if !v.is_finite() {
+        return "-".into();
+    }
     match iv {
         Some([a, b]) => format!("{v:.2e} [{a:.1e}, {b:.1e}]"),
         None => format!("{v:.2e} [-]"),
     }
 }
 
-/// `v` with its interval, fixed: `0.42 [0.31, 0.55]`.
+/// `v` with its interval, fixed: `0.42 [0.31, 0.55]`; `-` as for [`sci`].
 fn fixed(v: f64, iv: Option<[f64; 2]>) -> String {
+    if !v.is_finite() {
+        return "-".into();
+    }
     match iv {
         Some([a, b]) => format!("{v:.2} [{a:.2}, {b:.2}]"),
         None => format!("{v:.2} [-]"),
