@@ -39,10 +39,13 @@ const REPORT: &[&str] = &[
     "rep/table.txt",
     "rep/results.csv",
     "rep/seeds.csv",
+    "rep/perceived.csv",
+    "rep/spectra.csv",
     "rep/results.json",
     "rep/mse.png",
     "rep/contact_sheet.png",
     "rep/heat_random_N1.png",
+    "rep/spectrum_N1.png",
 ];
 
 /// `VARIANCE` followed by `extra`, for a case's arguments.

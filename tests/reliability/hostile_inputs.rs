@@ -26,10 +26,14 @@ const VARIANCE_OUT: &[&str] = &[
     "r/table.txt",
     "r/results.csv",
     "r/seeds.csv",
+    "r/perceived.csv",
+    "r/spectra.csv",
     "r/results.json",
     "r/mse.png",
     "r/contact_sheet.png",
     "r/heat_random_N4.png",
+    "r/spectrum_N1.png",
+    "r/spectrum_N4.png",
 ];
 
 #[test]
