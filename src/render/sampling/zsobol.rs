@@ -63,8 +63,10 @@ impl Layout {
     pub fn index(&self, key: &SampleKey, j: u32) -> u32 {
         let (x, y) = (key.pixel % self.width, key.pixel / self.width);
         let sample_bits = self.aa_bits + self.point_bits;
-        let sample = (key.sample << self.point_bits) | (j & low_mask(self.point_bits));
-        (morton(x, y) << sample_bits) | sample
+        // Past 32 bits (which `sampling::check` refuses) the high bits are dropped, not a panic.
+        let sample =
+            key.sample.checked_shl(self.point_bits).unwrap_or(0) | (j & low_mask(self.point_bits));
+        morton(x, y).checked_shl(sample_bits).unwrap_or(0) | sample
     }
 }
 
