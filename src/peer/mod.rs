@@ -33,6 +33,7 @@ pub mod tinybvh;
 
 use crate::render::camera::CameraRays;
 use crate::render::geometry::{Ray, casters, intersect_triangle, obvhs_ray};
+use crate::render::sampling::SplitMix64;
 use crate::render::scene::{NO_HIT, Scene};
 use crate::render::spawn::surface_hit;
 use crate::render::wavefront::batch::{HitBatch, PathId, RayBatch};
@@ -321,29 +322,6 @@ impl RaySets {
 /// How far off its surface a ray of the benchmark sets starts, and short of the light a
 /// shadow segment ends: the lab's 1e-4, the scale of the generated mesh scenes.
 const LEAVE: f32 = 1e-4;
-
-/// A small, fixed-seed generator (SplitMix64): the ray sets must not depend on `rand`'s
-/// version or platform.
-struct SplitMix64(u64);
-
-impl SplitMix64 {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in [0, 1) with 24 bits.
-    fn unit(&mut self) -> f32 {
-        (self.next() >> 40) as f32 * (1.0 / (1u64 << 24) as f32)
-    }
-
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n as u64) as usize
-    }
-}
 
 /// Closest hits of a ray set, in ray order: `t = INFINITY`, `prim = NO_HIT` for a miss.
 #[derive(Clone, Debug, Default, PartialEq)]

@@ -310,6 +310,32 @@ impl PointSet {
     }
 }
 
+/// A small fixed-seed generator (SplitMix64) for inputs that are not samples: the PMJ02
+/// tables and the peer benchmark's ray sets, which must not depend on `rand`'s version or
+/// platform. A render's samples come from [`hash`] alone.
+pub struct SplitMix64(pub u64);
+
+impl SplitMix64 {
+    /// The next 64 random bits.
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+
+    /// Uniform in [0, 1) with 24 bits.
+    pub fn unit(&mut self) -> f32 {
+        (self.next_u64() >> 40) as f32 * (1.0 / (1u64 << 24) as f32)
+    }
+
+    /// Below `n` (n > 0), with the modulo's bias of at most n/2^64.
+    pub fn below(&mut self, n: usize) -> usize {
+        (self.next_u64() % n as u64) as usize
+    }
+}
+
 /// The hash dimensions that seed a stream's Halton scrambles and its PMJ02 table and shift
 /// (far above the 2j, 2j + 1 range, below Sobol's).
 pub const HALTON_SEED_DIM: u32 = u32::MAX - 2;

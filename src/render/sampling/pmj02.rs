@@ -27,6 +27,7 @@
 //! onto another of the same shape, so the shifted points are still a (0,2) sequence, and it
 //! makes each point uniform on the square, which makes the estimate unbiased.
 
+use super::SplitMix64;
 use std::sync::OnceLock;
 
 /// Points per table: the most points per light the `pmj02` sampler takes.
@@ -135,7 +136,7 @@ impl Occupancy {
         if d == self.m {
             return Some(y_top);
         }
-        let first = (rng.next() & 1) as u32;
+        let first = (rng.next_u64() & 1) as u32;
         for b in [first, first ^ 1] {
             if let Some((bits, value)) = prefix
                 && d < bits
@@ -162,7 +163,7 @@ fn choose(
     let mut columns: Vec<u32> = (0..1u32 << m).filter(|&x| !grid.taken(x, 0, 0)).collect();
     // Fisher–Yates: the columns in random order.
     for i in (1..columns.len()).rev() {
-        columns.swap(i, (rng.next() % (i as u64 + 1)) as usize);
+        columns.swap(i, (rng.next_u64() % (i as u64 + 1)) as usize);
     }
     let mut attempts = Vec::new();
     if let Some(p) = prefer {
@@ -204,7 +205,7 @@ pub fn try_generate(n: usize, seed: u64) -> Option<Vec<(u32, u32)>> {
     if n == 0 {
         return Some(points);
     }
-    points.push((rng.next() as u32, rng.next() as u32));
+    points.push((rng.next_u64() as u32, rng.next_u64() as u32));
     let mut grid = Occupancy::new(0, &points);
     // For even levels: whether point j's new partner flips x (else y).
     let mut flips: Vec<bool> = Vec::new();
@@ -229,7 +230,7 @@ pub fn try_generate(n: usize, seed: u64) -> Option<Vec<(u32, u32)>> {
             let k = (m - 2) / 2;
             let half = 1usize << (m - 2);
             let flip_x = if j < half {
-                let f = rng.next() & 1 == 1;
+                let f = rng.next_u64() & 1 == 1;
                 flips.push(f);
                 f
             } else {
@@ -244,27 +245,13 @@ pub fn try_generate(n: usize, seed: u64) -> Option<Vec<(u32, u32)>> {
         let (x, y) = choose(&grid, prefer, &mut rng)?;
         let jitter = |r: u64| if m == 32 { 0 } else { (r as u32) >> m };
         let p = (
-            (x << (32 - m)) | jitter(rng.next()),
-            (y << (32 - m)) | jitter(rng.next()),
+            (x << (32 - m)) | jitter(rng.next_u64()),
+            (y << (32 - m)) | jitter(rng.next_u64()),
         );
         grid.mark(p);
         points.push(p);
     }
     Some(points)
-}
-
-/// SplitMix64: the generator's fixed-seed random bits (the tables must not depend on `rand`'s
-/// version).
-struct SplitMix64(u64);
-
-impl SplitMix64 {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
 }
 
 #[cfg(test)]
