@@ -13,6 +13,7 @@ mod hit_rays;
 mod intersection;
 mod mesh_bvh;
 mod peer_agreement;
+mod point_set_lanes;
 mod shading_pixels;
 mod shadow_casters;
 mod spawn;

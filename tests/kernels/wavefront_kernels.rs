@@ -712,7 +712,7 @@ fn check_light_points<V: Lanes>(
                 LightSampler::Halton
                 | LightSampler::Pmj02
                 | LightSampler::Zsobol
-                | LightSampler::Bluenoise => BlockSampler::PerLane {
+                | LightSampler::Bluenoise => BlockSampler::Stream {
                     stream: set.stream(&key).expect("a table sampler"),
                     count,
                 },

@@ -28,8 +28,16 @@ pub fn digits(count: u32) -> (u32, u32) {
     (needed(2), needed(3))
 }
 
+/// The salt of a stream's root node: its hash is `mix32(seed ^ ROOT_SALT)`.
+pub(crate) const ROOT_SALT: u32 = 0x3c6e_f372;
+/// The child of a node with hash h along original digit d has hash
+/// `mix32(h ^ (d + 1) · CHILD_STEP)`.
+pub(crate) const CHILD_STEP: u32 = 0x9e37_79b9;
+/// The digits below the last permuted one come from `mix32(h ^ TAIL_SALT)` of the last node.
+pub(crate) const TAIL_SALT: u32 = 0x68e3_1da4;
+
 /// The six permutations of {0, 1, 2}.
-const PERMUTATIONS_3: [[u32; 3]; 6] = [
+pub(crate) const PERMUTATIONS_3: [[u32; 3]; 6] = [
     [0, 1, 2],
     [0, 2, 1],
     [1, 0, 2],
@@ -54,7 +62,7 @@ fn permute(base: u32, h: u32, d: u32) -> u32 {
 /// scramble. In [0, 1).
 #[inline]
 pub fn radical_inverse(base: u32, digits: u32, index: u32, seed: u32) -> f32 {
-    let mut h = mix32(seed ^ 0x3c6e_f372);
+    let mut h = mix32(seed ^ ROOT_SALT);
     let mut n = index;
     let mut kept = 0u32;
     let mut scale = 1u32;
@@ -65,9 +73,9 @@ pub fn radical_inverse(base: u32, digits: u32, index: u32, seed: u32) -> f32 {
         scale *= base;
         // The child node: the original digit picks it, so the permutations below depend on
         // the path above (nested scrambling).
-        h = mix32(h ^ (d + 1).wrapping_mul(0x9e37_79b9));
+        h = mix32(h ^ (d + 1).wrapping_mul(CHILD_STEP));
     }
-    let rest = (mix32(h ^ 0x68e3_1da4) >> 8) as f32 * (1.0 / 16_777_216.0);
+    let rest = (mix32(h ^ TAIL_SALT) >> 8) as f32 * (1.0 / 16_777_216.0);
     ((kept as f32 + rest) / scale as f32).min(ONE_MINUS_EPS)
 }
 

@@ -84,7 +84,7 @@ pub fn morton(x: u32, y: u32) -> u32 {
 }
 
 /// The 24 permutations of {0, 1, 2, 3}.
-const PERMUTATIONS_4: [[u32; 4]; 24] = {
+pub(crate) const PERMUTATIONS_4: [[u32; 4]; 24] = {
     let mut table = [[0u32; 4]; 24];
     let mut n = 0;
     let mut a = 0;
@@ -139,26 +139,39 @@ fn permute_part(index: u32, bits: u32, seed: u32, keep: impl Fn(u32) -> bool) ->
         out |= PERMUTATIONS_4[(h % 24) as usize][digit as usize] << shift;
     }
     if odd == 1 && keep(0) {
-        let h = mix32((index >> 1) ^ mix32(seed ^ 0x5bd1_e995));
+        let h = mix32((index >> 1) ^ mix32(seed ^ ODD_SALT));
         out |= (index & 1) ^ (h & 1);
     }
     out
 }
 
+/// An odd-length index's one-bit lowest digit is flipped by bit 0 of
+/// `mix32((index >> 1) ^ mix32(seed ^ ODD_SALT))`.
+const ODD_SALT: u32 = 0x5bd1_e995;
+
 /// One stream's ZSobol state: its index without the point's bits, the part of the permuted
 /// index above them and that part's Sobol bits (Sobol points are linear over GF(2) in the
 /// index's bits, so the two parts' contributions XOR together), the hash state of each digit
 /// below (it depends on the seed and the digit's place only), and the Owen scramble seeds.
+///
+/// The wavefront engine computes [`StreamIndex::point`] on lanes from these fields
+/// (`wavefront/simd/point_sets.rs`).
 #[derive(Clone, Copy, Debug)]
 pub struct StreamIndex {
-    base: u32,
-    bits: u32,
-    point_bits: u32,
-    seed: u32,
-    high: (u32, u32),
-    scramble: (u32, u32),
+    /// The stream's index with the point's bits 0.
+    pub(crate) base: u32,
+    /// The index's length in bits ([`Layout::index_bits`]).
+    pub(crate) bits: u32,
+    /// The point's bits: the low `point_bits` of the index.
+    pub(crate) point_bits: u32,
+    /// `mix32(seed ^ ODD_SALT)`: the hash salt of an odd length's one-bit digit.
+    pub(crate) odd_salt: u32,
+    /// The Sobol bits (dimensions 0 and 1) of the permuted digits above the point's.
+    pub(crate) high: (u32, u32),
+    /// The Owen scramble seeds of dimensions 0 and 1.
+    pub(crate) scramble: (u32, u32),
     /// `mix32(seed ^ shift · φ)` for the digit at each shift below `point_bits`.
-    depth_hash: [u32; 32],
+    pub(crate) depth_hash: [u32; 32],
 }
 
 impl StreamIndex {
@@ -182,7 +195,7 @@ impl StreamIndex {
             base,
             bits,
             point_bits: split,
-            seed,
+            odd_salt: mix32(seed ^ ODD_SALT),
             high: sobol_2d(high),
             scramble: (mix32(seed ^ 0x6a09_e667), mix32(seed ^ 0xbb67_ae85)),
             depth_hash,
@@ -223,7 +236,7 @@ impl StreamIndex {
             shift -= 2;
         }
         if odd == 1 && split > 0 {
-            let h = mix32((index >> 1) ^ mix32(self.seed ^ 0x5bd1_e995));
+            let h = mix32((index >> 1) ^ self.odd_salt);
             out |= (index & 1) ^ (h & 1);
         }
         out

@@ -222,7 +222,7 @@ impl<'a> Context<'a> {
             LightSampler::Halton
             | LightSampler::Pmj02
             | LightSampler::Zsobol
-            | LightSampler::Bluenoise => BlockSampler::PerLane {
+            | LightSampler::Bluenoise => BlockSampler::Stream {
                 stream: self
                     .points
                     .stream(key)

@@ -232,6 +232,7 @@ pub trait Lanes:
 pub trait LanesU:
     Copy
     + Add<Output = Self>
+    + Sub<Output = Self>
     + Mul<Output = Self>
     + BitAnd<Output = Self>
     + BitOr<Output = Self>
@@ -256,6 +257,16 @@ pub trait LanesU:
     fn to_f32_signed(self) -> Self::F;
     /// Every lane's bits read as a float.
     fn bits_to_f32(self) -> Self::F;
+    /// Lane k is `f(k)`.
+    fn from_fn(f: impl FnMut(usize) -> u32) -> Self;
+    /// The high 32 bits of each lane's 64-bit product with `m` (exact division by a constant:
+    /// x / 3 = `x.mul_high(0xaaaa_aaab) >> 1` for every u32 x).
+    fn mul_high(self, m: u32) -> Self;
+    /// Each lane shifted right by its own lane of `by` (each below 32).
+    fn shr_each(self, by: Self) -> Self;
+    /// Lane k is `table[self[k]]`: a lookup in a table of up to N entries held in a vector
+    /// (every index below N).
+    fn lookup(self, table: Self) -> Self;
 }
 
 macro_rules! impl_lanes {
@@ -392,6 +403,22 @@ macro_rules! impl_lanes {
             fn bits_to_f32(self) -> $f {
                 wide::bytemuck::cast(self)
             }
+            #[inline(always)]
+            fn from_fn(f: impl FnMut(usize) -> u32) -> Self {
+                $u::new(std::array::from_fn(f))
+            }
+            #[inline(always)]
+            fn mul_high(self, m: u32) -> Self {
+                self.mul_keep_high($u::splat(m))
+            }
+            #[inline(always)]
+            fn shr_each(self, by: Self) -> Self {
+                self.unbounded_shr(by)
+            }
+            #[inline(always)]
+            fn lookup(self, table: Self) -> Self {
+                table.shuffle(self)
+            }
         }
     };
 }
@@ -494,6 +521,55 @@ mod tests {
         assert_eq!(LaneWidth::Eight.lanes(), 8);
         assert_eq!(LaneWidth::Sixteen.lanes(), 16);
         assert_eq!(LaneWidth::Auto.resolve(), LaneWidth::NATIVE);
+    }
+
+    /// mul_high, shr_each and lookup at both widths, against u64 products, shifts and indexing
+    /// on edge values.
+    fn integer_ops_equal_scalar<U: LanesU>(to_array: impl Fn(U) -> Vec<u32>) {
+        let n = <U::F as Lanes>::N;
+        let values = [
+            0u32,
+            1,
+            2,
+            3,
+            23,
+            24,
+            25,
+            0x7fff_ffff,
+            0x8000_0000,
+            0xffff_fffe,
+            u32::MAX,
+        ];
+        let x =
+            U::from_fn(|k| values[k % values.len()].wrapping_add(k as u32 / values.len() as u32));
+        let xs = to_array(x);
+        for m in [0xaaaa_aaabu32, 3, u32::MAX] {
+            let want: Vec<u32> = xs
+                .iter()
+                .map(|&v| ((u64::from(v) * u64::from(m)) >> 32) as u32)
+                .collect();
+            assert_eq!(to_array(x.mul_high(m)), want, "mul_high by {m:#x}");
+        }
+        for v in xs.iter().copied() {
+            assert_eq!(to_array(U::splat(v).mul_high(0xaaaa_aaab) >> 1)[0], v / 3);
+        }
+        let by = U::from_fn(|k| (k as u32 * 7) % 32);
+        let want: Vec<u32> = xs
+            .iter()
+            .enumerate()
+            .map(|(k, &v)| v >> ((k as u32 * 7) % 32))
+            .collect();
+        assert_eq!(to_array(x.shr_each(by)), want);
+        let table = U::from_fn(|k| 100 + k as u32);
+        let idx = U::from_fn(|k| ((k * 5 + 3) % n) as u32);
+        let want: Vec<u32> = (0..n).map(|k| 100 + ((k * 5 + 3) % n) as u32).collect();
+        assert_eq!(to_array(idx.lookup(table)), want);
+    }
+
+    #[test]
+    fn integer_ops_at_both_widths() {
+        integer_ops_equal_scalar::<u32x8>(|v| v.to_array().to_vec());
+        integer_ops_equal_scalar::<u32x16>(|v| v.to_array().to_vec());
     }
 
     #[test]

@@ -1,7 +1,9 @@
 //! Light sampling on N lanes (8 or 16, one source generic over [`Lanes`]): the hashed
 //! uniforms, jittered strata and Owen-scrambled Sobol points of one (pixel, sample, bounce,
-//! light) stream on a parallelogram light, and the shadow rays from a hit to them.
+//! light) stream on a parallelogram light (the per-stream point sets in `point_sets.rs`), and
+//! the shadow rays from a hit to them.
 
+use super::point_sets;
 use crate::render::sampling::Stream;
 use crate::render::spawn::{LightEnd, SurfaceHit};
 use crate::render::wavefront::batch::ShadowBlock;
@@ -10,7 +12,7 @@ use glam::Vec3;
 
 /// Chris Wellons' `lowbias32`, N lanes; twin of `sampling::mix32`.
 #[inline(always)]
-fn mix32x8<U: LanesU>(mut x: U) -> U {
+pub(super) fn mix32x8<U: LanesU>(mut x: U) -> U {
     x = x ^ (x >> 16);
     x = x * U::splat(0x7feb_352d);
     x = x ^ (x >> 15);
@@ -51,10 +53,10 @@ pub enum BlockSampler<'a> {
         /// The scramble seed.
         scramble: u32,
     },
-    /// Each lane's (u, v) from the scalar `Stream::point` of the stream, the rest of the block
-    /// on N lanes: the samplers whose points are table reads and digit loops (halton, pmj02,
-    /// zsobol, bluenoise). Lanes past the point count get (0, 0).
-    PerLane {
+    /// The samplers with per-stream state (halton, pmj02, zsobol, bluenoise): Halton's digit
+    /// loops, ZSobol's index and PMJ02's table rows on N lanes (`point_sets.rs`), the
+    /// blue-noise tables one lane at a time through the scalar `Stream::point`.
+    Stream {
         /// The stream's state (`PointSet::stream`), taken once per (hit, light).
         stream: Stream<'a>,
         /// Points per light.
@@ -126,7 +128,12 @@ pub fn light_points<V: Lanes>(b: &LightBlock) -> [V::Array; 3] {
             )
         }
         BlockSampler::Sobol { scramble } => sobol8(j, scramble),
-        BlockSampler::PerLane { stream, count } => per_lane::<V>(&stream, count, b.j0),
+        BlockSampler::Stream { stream, count } => match stream {
+            Stream::Halton { digits, seeds } => point_sets::halton(j, digits, seeds),
+            Stream::Zsobol(index) => point_sets::zsobol(j, &index),
+            Stream::Pmj02 { table, masks } => point_sets::pmj02::<V::U>(table, b.j0, masks),
+            Stream::Bluenoise { .. } => per_lane::<V>(&stream, count, b.j0),
+        },
     };
     parallelogram_points8(b.origin, b.edge_u, b.edge_v, u, v)
 }
@@ -166,7 +173,7 @@ fn owen_scramble_rev8<U: LanesU>(mut n: U, scramble: u32) -> U {
 
 /// `u32::reverse_bits`, N lanes.
 #[inline(always)]
-fn reverse_bits8<U: LanesU>(mut x: U) -> U {
+pub(super) fn reverse_bits8<U: LanesU>(mut x: U) -> U {
     for (shift, mask) in [
         (1, 0x5555_5555u32),
         (2, 0x3333_3333),

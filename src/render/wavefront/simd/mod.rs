@@ -1,5 +1,6 @@
 //! The SIMD kernels of the stages, by idea: ray–primitive tests (`geometry.rs`) and light
-//! sampling with shadow-ray spawning (`light.rs`); the shading kernel sits with its scalar twin
+//! sampling with shadow-ray spawning (`light.rs`, the per-stream point sets in
+//! `point_sets.rs`); the shading kernel sits with its scalar twin
 //! in `wavefront/shade.rs`, and the mesh BVH's node and leaf tests in `wavefront/bvh/`. Lanes,
 //! loads and masks come from `wavefront/lanes.rs`.
 //!
@@ -22,6 +23,7 @@
 //! | [`closest_hits`]     | `Accel::closest` without a BVH                           |
 //! | [`occluded`]         | `Accel::occluded` without a BVH                          |
 //! | [`light_points8`]    | `sampling::PointSet::point` then `Light::point`          |
+//! | `point_sets::{halton, zsobol, pmj02}` | `sampling::Stream::point` of those samplers |
 //! | [`shadow_rays8`]     | the start of `Reference::direct` (l, dist, n·l)          |
 //! | `shade::shade8`      | `shade::shade_terms`, twin of `shading::shade`           |
 //!
@@ -32,6 +34,7 @@
 mod geometry;
 mod hit_rays;
 mod light;
+mod point_sets;
 
 pub(crate) use geometry::{TriangleLanes, moller_trumbore8, moller_trumbore8_blocks};
 pub use geometry::{
