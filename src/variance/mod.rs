@@ -45,7 +45,8 @@ use std::time::Instant;
 
 pub use cache::Cache;
 pub use figures::{
-    ErrorStats, LogLogFit, deterministic, error_stats, loglog_fit, per_image_errors, pixel_mse,
+    BIAS_FALSE_ALARM, ErrorStats, LogLogFit, bias_bound, deterministic, error_stats, loglog_fit,
+    per_image_errors, pixel_mse,
 };
 pub use fits::{Matching, Slope, match_budget};
 pub use mask::{Regions, penumbra_mask};

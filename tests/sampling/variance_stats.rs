@@ -1,10 +1,14 @@
-//! The variance study's bias check (`variance::error_stats`): its bound is four standard errors
-//! of the mean error, SE² = s²/(P·K) + σ²_ref/P (s² the per-pixel variance across the K seeds,
-//! σ²_ref the reference's own per-pixel error variance, P pixels in the region; a pixel's three
-//! channels count once, being correlated). A bound built from the standard deviation instead is
-//! √(P·K) times looser (about 100× at the study's sizes) and flags nothing; these tests pin the
-//! bound to a hand computation and make the study flag samplers whose bias is known. Also by
-//! hand: the converged reference's own noise estimate, and a zero MSE left out of the fit.
+//! The variance study's bias check (`variance::error_stats`, `variance::bias_bound`). The K
+//! seeds' images are the independent unit: the bound is Student's t quantile (K − 1 degrees of
+//! freedom, at the false-alarm rate of a normal's four standard errors) times the standard
+//! error SE² = s²/K + σ²_ref/P, with s² the variance of the K images' mean errors and σ²_ref
+//! the reference's own per-pixel error variance over P pixels. A bound built from per-pixel
+//! variances instead assumes independent pixels, which the blue-noise samplers are not: it
+//! flags an unbiased sampler whose error is shared across the image. One built from the
+//! standard deviation instead of the standard error is √K times looser. These tests pin the
+//! bound to a hand computation, to images whose pixels share their error, and make the study
+//! flag samplers whose bias is known. Also by hand: the converged reference's own noise
+//! estimate, and a zero MSE left out of the fit.
 
 use crate::common;
 
@@ -16,7 +20,7 @@ use raywave::render::sampling::LightSampler;
 use raywave::render::scene::Scene;
 use raywave::render::settings::RenderSettings;
 use raywave::render::wavefront::{DEFAULT_BATCH_SIZE, Wavefront};
-use raywave::variance::{ErrorStats, StudyConfig, error_stats, run_study};
+use raywave::variance::{BIAS_FALSE_ALARM, ErrorStats, StudyConfig, error_stats, run_study};
 
 fn grey(values: &[f32]) -> Vec<Vec3> {
     values.iter().map(|&v| Vec3::splat(v)).collect()
@@ -29,37 +33,97 @@ fn flagged(s: &ErrorStats) -> bool {
 #[test]
 fn bias_bound_matches_a_hand_computation() {
     // Reference 0 on three pixels; the third is outside the region and holds wild values.
-    // K = 4 images. Pixel A: 0.1 0.3 0.1 0.3 (mean 0.2); pixel B: 0.2 0.2 0.4 0.4 (mean 0.3).
+    // K = 3 images. Pixel A: 0.1 0.3 0.2; pixel B: 0.2 0.2 0.5.
     let reference = grey(&[0.0, 0.0, 0.0]);
     let images = [
         grey(&[0.1, 0.2, 9.0]),
         grey(&[0.3, 0.2, -9.0]),
-        grey(&[0.1, 0.4, 5.0]),
-        grey(&[0.3, 0.4, 7.0]),
+        grey(&[0.2, 0.5, 5.0]),
     ];
     let images: Vec<&[Vec3]> = images.iter().map(|i| i.as_slice()).collect();
     let region = [true, true, false];
     let noise = [0.001f32, 0.003, 100.0];
     let s = error_stats(&images, &reference, &noise, &region);
     assert_eq!(s.pixels, 2);
-    // bias = (0.8 + 1.2) / 8 = 0.25.
+    // bias = (0.6 + 0.9) / 6 = 0.25.
     assert!((s.bias - 0.25).abs() < 1e-6, "{s:?}");
-    // MSE = (0.01 + 0.09 + 0.01 + 0.09 + 0.04 + 0.04 + 0.16 + 0.16) / 8 = 0.075.
-    assert!((s.mse - 0.075).abs() < 1e-6, "{s:?}");
-    // s² per pixel: deviations ±0.1 four times, 0.04 / (K − 1) = 0.013333 for A and for B.
-    assert!((s.variance - 0.04 / 3.0).abs() < 1e-6, "{s:?}");
-    // σ²_ref = (0.001 + 0.003) / 2 = 0.002.
-    // SE² = 0.013333 / (2 · 4) + 0.002 / 2 = 0.0016667 + 0.001 = 0.0026667; 4·SE = 0.206559.
+    // MSE = (0.01 + 0.09 + 0.04 + 0.04 + 0.04 + 0.25) / 6 = 0.078333.
+    assert!((s.mse - 0.47 / 6.0).abs() < 1e-6, "{s:?}");
+    // Per-pixel s²: A 0.02 / 2 = 0.01, B 0.06 / 2 = 0.03: 0.02 on average.
+    assert!((s.variance - 0.02).abs() < 1e-6, "{s:?}");
+    // Image means 0.15, 0.25, 0.35: s² = 0.02 / 2 = 0.01, s²/K = 0.0033333;
+    // σ²_ref/P = (0.001 + 0.003) / 2 / 2 = 0.001; SE = √0.0043333 = 0.0658281.
+    // t(2) at 1 − α/2 in closed form: (1 − α) / √(2·(α/2)·(1 − α/2)) = 125.6411.
+    let a = BIAS_FALSE_ALARM;
+    let t2 = (1.0 - a) / (2.0 * (a / 2.0) * (1.0 - a / 2.0)).sqrt();
+    assert!((t2 - 125.6411).abs() < 1e-3, "{t2}");
+    let by_hand = t2 * 0.004_333_333_f64.sqrt();
     assert!(
-        (s.bias_bound - 0.206_559).abs() < 1e-5,
-        "bias bound {} against 0.206559 by hand",
+        (s.bias_bound / by_hand - 1.0).abs() < 1e-5,
+        "bias bound {} against {by_hand} by hand",
         s.bias_bound
     );
-    assert!(flagged(&s), "0.25 > 0.2066: biased");
+    assert!(!flagged(&s), "three images cannot tell 0.25 from noise");
 
-    // Without the reference's noise: SE² = 0.0016667, 4·SE = 0.163299.
+    // Without the reference's noise: SE = √0.0033333.
     let s = error_stats(&images, &reference, &[0.0; 3], &region);
-    assert!((s.bias_bound - 0.163_299).abs() < 1e-5, "{s:?}");
+    let by_hand = t2 * (0.01f64 / 3.0).sqrt();
+    assert!((s.bias_bound / by_hand - 1.0).abs() < 1e-5, "{s:?}");
+}
+
+/// Images whose pixels share their error: each image is the reference plus one zero-mean
+/// shift for the whole image (like the blue-noise tables' rotation, shared by every pixel)
+/// and a little per-pixel noise. Unbiased, so never flagged; a per-pixel bound, which takes
+/// the pixels as independent, would be √P times too tight and flag it.
+#[test]
+fn errors_shared_across_pixels_are_not_bias() {
+    let (p, k) = (4096, 8);
+    let reference = vec![Vec3::splat(0.5); p];
+    let region = vec![true; p];
+    let noise = vec![0.0f32; p];
+    let mut rng = seeded(0x5ea7);
+    let mut flagged_by_pixels = 0;
+    for trial in 0..20 {
+        // Shifts ±0.01 in a balanced order, so their mean is exactly 0.
+        let images: Vec<Vec<Vec3>> = (0..k)
+            .map(|i| {
+                let shift = if (i + trial) % 2 == 0 { 0.01 } else { -0.01 };
+                (0..p)
+                    .map(|_| Vec3::splat(0.5 + shift + 0.001 * (2.0 * rng.unit() - 1.0)))
+                    .collect()
+            })
+            .collect();
+        let views: Vec<&[Vec3]> = images.iter().map(|i| i.as_slice()).collect();
+        let s = error_stats(&views, &reference, &noise, &region);
+        assert!(!flagged(&s), "trial {trial}: {s:?}");
+        // What the per-pixel bound would say: 4·√(s²_pixel / (P·K)).
+        let per_pixel = 4.0 * (s.variance / (p * k) as f64).sqrt();
+        flagged_by_pixels += usize::from(s.bias.abs() > per_pixel);
+        // The shift's spread is in the bound: about t(7) · 0.01/√8.
+        assert!(s.bias_bound > 0.01, "{s:?}");
+    }
+    assert_eq!(
+        flagged_by_pixels, 0,
+        "the shifts cancel here, so even per pixel: none"
+    );
+    // With an odd number of images the shifts do not cancel: mean ±0.01/9, which the
+    // per-pixel bound (about 4·0.01/√(9P) = 7e-5) calls bias and the image bound does not.
+    let images: Vec<Vec<Vec3>> = (0..9)
+        .map(|i| {
+            let shift = if i % 2 == 0 { 0.01 } else { -0.01 };
+            (0..p)
+                .map(|_| Vec3::splat(0.5 + shift + 0.001 * (2.0 * rng.unit() - 1.0)))
+                .collect()
+        })
+        .collect();
+    let views: Vec<&[Vec3]> = images.iter().map(|i| i.as_slice()).collect();
+    let s = error_stats(&views, &reference, &noise, &region);
+    let per_pixel = 4.0 * (s.variance / (p * 9) as f64).sqrt();
+    assert!(
+        s.bias.abs() > per_pixel,
+        "{s:?}: per-pixel bound {per_pixel}"
+    );
+    assert!(!flagged(&s), "{s:?}");
 }
 
 /// K images of P grey pixels: reference 0.5, each value 0.5 + δ + uniform noise in (−a, a)
@@ -77,11 +141,11 @@ fn noisy_images(p: usize, k: usize, delta: f32, a: f32, seed: u64) -> Vec<Vec<Ve
 
 #[test]
 fn a_small_known_bias_is_flagged_and_measured() {
-    // P = 1000 pixels, K = 8 seeds, noise uniform in ±0.3: σ = 0.3/√3 = 0.173 per pixel, so
-    // SE = σ/√(P·K) = 0.00194 and the bound 4·SE = 0.0077. A bias of 0.02 is a tenth of one
-    // image's noise (invisible pixel by pixel) yet 10 standard errors: it must be flagged. A
-    // bound from σ itself would be 0.69.
-    let (p, k, a) = (1000, 8, 0.3f32);
+    // P = 1000 pixels, K = 32 seeds, noise uniform in ±0.3: σ = 0.3/√3 = 0.173 per pixel, so
+    // SE = σ/√(P·K) = 0.00097 and the bound t(31)·SE = 4.62·SE = 0.0045. A bias of 0.02 is a
+    // tenth of one image's noise (invisible pixel by pixel) yet 20 standard errors: it must be
+    // flagged. A bound from σ itself would be 0.8.
+    let (p, k, a) = (1000, 32, 0.3f32);
     let reference = vec![Vec3::splat(0.5); p];
     let region = vec![true; p];
     let noise = vec![0.0f32; p];
@@ -90,10 +154,12 @@ fn a_small_known_bias_is_flagged_and_measured() {
         let images = noisy_images(p, k, delta, a, seed);
         let views: Vec<&[Vec3]> = images.iter().map(|i| i.as_slice()).collect();
         let s = error_stats(&views, &reference, &noise, &region);
-        let expected_bound = 4.0 * sigma / ((p * k) as f64).sqrt();
+        // t(31) at 1 − α/2 is 4.6216; s² from 32 images is within ~25% of σ²/P (two of its
+        // standard errors), so SE within ~13%.
+        let expected_bound = 4.6216 * sigma / ((p * k) as f64).sqrt();
         assert!(
-            (s.bias_bound / expected_bound - 1.0).abs() < 0.1,
-            "δ = {delta}: bound {} vs 4σ/√(PK) = {expected_bound}",
+            (s.bias_bound / expected_bound - 1.0).abs() < 0.15,
+            "δ = {delta}: bound {} vs t·σ/√(PK) = {expected_bound}",
             s.bias_bound
         );
         assert!(
@@ -126,9 +192,10 @@ fn render_with_bias(delta: f32) -> impl Fn(&Scene, &RenderSettings) -> (Film, Ra
 
 #[test]
 fn the_study_flags_biased_samplers_and_only_them() {
-    // The lab's box at 48², N = 1 and 4, 8 seeds. Biased: `random` + 0.05 (a known shift of
-    // every pixel, a third of one image's noise at N = 1: measured √variance 0.16 on the whole
-    // image, bound 0.005) and `lab` at N = 1 (the centroid: the hard shadow, docs/SAMPLING.md;
+    // The lab's box at 48², N = 1 and 4, 16 seeds (the lit region is small: at 8 seeds its
+    // bound at N = 1 is 0.038, too close to the shift). Biased: `random` + 0.05 (a known shift
+    // of every pixel, a third of one image's noise at N = 1: measured √variance 0.16 on the
+    // whole image, bound 0.004; 0.014 on lit pixels) and `lab` at N = 1 (the centroid: the hard shadow, docs/SAMPLING.md;
     // on lit pixels too, where n·l and the highlight at the centroid are not their mean over the
     // light). Unbiased: `stratified`, and `lab` at N = 4.
     let scene = Scene::builtin_default();
@@ -144,7 +211,7 @@ fn the_study_flags_biased_samplers_and_only_them() {
             LightSampler::Stratified,
             LightSampler::Lab,
         ],
-        seeds: 8,
+        seeds: 16,
         reference_samples: 256,
         mask_samples: 64,
         heatmap_n: 4,
