@@ -152,8 +152,8 @@ pub(crate) struct Side {
     pub mse: Estimate,
     /// The same over the penumbra (pixels with a partly visible light on their path).
     pub mse_penumbra: Option<Estimate>,
-    /// Mean signed error over everything, and four standard errors of it (no bias expected
-    /// within that bound).
+    /// Mean signed error over everything, and its bound (`variance::bias_bound`: no bias
+    /// expected within it).
     pub bias: [f64; 2],
     /// Median seconds per render.
     pub seconds: f64,
