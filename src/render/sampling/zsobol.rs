@@ -245,7 +245,7 @@ impl StreamIndex {
 
 /// The lowest `bits` bits set.
 #[inline]
-fn low_mask(bits: u32) -> u32 {
+pub(crate) fn low_mask(bits: u32) -> u32 {
     if bits >= 32 {
         u32::MAX
     } else {

@@ -25,9 +25,14 @@ pub(super) fn mix32x8<U: LanesU>(mut x: U) -> U {
 /// (see `shadow::key_prefix`): twin of `sampling::uniform`.
 #[inline(always)]
 fn uniform8<U: LanesU>(prefix: u32, dims: U) -> U::F {
-    let h = mix32x8(U::splat(prefix) ^ dims) >> 8;
-    // h < 2^24, so the signed conversion is exact.
-    h.to_f32_signed() * U::F::splat(1.0 / 16_777_216.0)
+    unit(mix32x8(U::splat(prefix) ^ dims))
+}
+
+/// The 24-bit unit float of the top bits of `bits`: `(bits >> 8) as f32 · 2⁻²⁴`.
+#[inline(always)]
+pub(super) fn unit<U: LanesU>(bits: U) -> U::F {
+    // bits >> 8 < 2^24, so the signed conversion is exact.
+    (bits >> 8).to_f32_signed() * U::F::splat(1.0 / 16_777_216.0)
 }
 
 /// How a block's (u, v) are drawn: the samplers with a SIMD twin.
@@ -128,14 +133,23 @@ pub fn light_points<V: Lanes>(b: &LightBlock) -> [V::Array; 3] {
             )
         }
         BlockSampler::Sobol { scramble } => sobol8(j, scramble),
-        BlockSampler::Stream { stream, count } => match stream {
-            Stream::Halton { digits, seeds } => point_sets::halton(j, digits, seeds),
-            Stream::Zsobol(index) => point_sets::zsobol(j, &index),
-            Stream::Pmj02 { table, masks } => point_sets::pmj02::<V::U>(table, b.j0, masks),
-            Stream::Bluenoise { .. } => per_lane::<V>(&stream, count, b.j0),
-        },
+        BlockSampler::Stream { stream, count } => stream_points::<V>(&stream, count, b.j0),
     };
     parallelogram_points8(b.origin, b.edge_u, b.edge_v, u, v)
+}
+
+/// Points `j0..j0 + N` of a per-stream sampler: Halton, ZSobol and PMJ02 on lanes, the
+/// blue-noise tables per lane. Out of line, so that the lab's four samplers' path keeps its
+/// code (the instruction-count gate, `tests/gates/icount.rs`).
+#[inline(never)]
+fn stream_points<V: Lanes>(stream: &Stream, count: u32, j0: u32) -> (V, V) {
+    let j = V::U::splat(j0) + V::U::LANE_INDEX;
+    match stream {
+        Stream::Halton { digits, seeds } => point_sets::halton(j, *digits, *seeds),
+        Stream::Zsobol(index) => point_sets::zsobol(j, index),
+        Stream::Pmj02 { table, masks } => point_sets::pmj02::<V::U>(table, j0, *masks),
+        Stream::Bluenoise { .. } => per_lane::<V>(stream, count, j0),
+    }
 }
 
 /// Points `j0..j0 + N` of a stream of `count`, each from the scalar `Stream::point`; lanes

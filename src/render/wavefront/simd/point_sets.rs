@@ -15,16 +15,9 @@
 //! The blue-noise sampler stays one lane at a time (`light::per_lane`): its points are three
 //! table reads at addresses that differ per lane, which lanes cannot gather any faster.
 
-use super::light::{mix32x8, reverse_bits8};
+use super::light::{mix32x8, reverse_bits8, unit};
 use crate::render::sampling::{ONE_MINUS_EPS, halton, mix32, zsobol};
 use crate::render::wavefront::lanes::{Lanes, LanesU};
-
-/// The 24-bit unit float of the top bits of `bits`: `(bits >> 8) as f32 · 2⁻²⁴`.
-#[inline(always)]
-fn unit<U: LanesU>(bits: U) -> U::F {
-    // bits >> 8 < 2^24, so the signed conversion is exact.
-    (bits >> 8).to_f32_signed() * U::F::splat(1.0 / 16_777_216.0)
-}
 
 /// x / 3 for every u32 x: 0xaaaa_aaab = ⌈2³³ / 3⌉.
 #[inline(always)]
@@ -139,12 +132,7 @@ const SOBOL_DIM1: [u32; 32] = {
 #[inline(never)]
 pub(super) fn zsobol<U: LanesU>(j: U, stream: &zsobol::StreamIndex) -> (U::F, U::F) {
     let (bits, split) = (stream.bits, stream.point_bits);
-    let point_mask = if split >= 32 {
-        u32::MAX
-    } else {
-        (1 << split) - 1
-    };
-    let index = U::splat(stream.base) | (j & U::splat(point_mask));
+    let index = U::splat(stream.base) | (j & U::splat(zsobol::low_mask(split)));
 
     // The digits below the split, permuted: `StreamIndex::permute_low`.
     let words: U = table(&PERM4_WORDS);
