@@ -71,6 +71,23 @@ fn bias_bound_matches_a_hand_computation() {
     assert!((s.bias_bound / by_hand - 1.0).abs() < 1e-5, "{s:?}");
 }
 
+/// K images of P grey pixels around the reference 0.5: image i shifted as a whole by +0.01
+/// when i + phase is even and −0.01 when odd, plus uniform per-pixel noise in ±0.001.
+fn shifted_images(p: usize, k: usize, phase: usize, rng: &mut impl Draw) -> Vec<Vec<Vec3>> {
+    (0..k)
+        .map(|i| {
+            let shift = if (i + phase).is_multiple_of(2) {
+                0.01
+            } else {
+                -0.01
+            };
+            (0..p)
+                .map(|_| Vec3::splat(0.5 + shift + 0.001 * (2.0 * rng.unit() - 1.0)))
+                .collect()
+        })
+        .collect()
+}
+
 /// Images whose pixels share their error: each image is the reference plus one zero-mean
 /// shift for the whole image (like the blue-noise tables' rotation, shared by every pixel)
 /// and a little per-pixel noise. Unbiased, so never flagged; a per-pixel bound, which takes
@@ -85,14 +102,7 @@ fn errors_shared_across_pixels_are_not_bias() {
     let mut flagged_by_pixels = 0;
     for trial in 0..20 {
         // Shifts ±0.01 in a balanced order, so their mean is exactly 0.
-        let images: Vec<Vec<Vec3>> = (0..k)
-            .map(|i| {
-                let shift = if (i + trial) % 2 == 0 { 0.01 } else { -0.01 };
-                (0..p)
-                    .map(|_| Vec3::splat(0.5 + shift + 0.001 * (2.0 * rng.unit() - 1.0)))
-                    .collect()
-            })
-            .collect();
+        let images = shifted_images(p, k, trial, &mut rng);
         let views: Vec<&[Vec3]> = images.iter().map(|i| i.as_slice()).collect();
         let s = error_stats(&views, &reference, &noise, &region);
         assert!(!flagged(&s), "trial {trial}: {s:?}");
@@ -108,14 +118,7 @@ fn errors_shared_across_pixels_are_not_bias() {
     );
     // With an odd number of images the shifts do not cancel: mean ±0.01/9, which the
     // per-pixel bound (about 4·0.01/√(9P) = 7e-5) calls bias and the image bound does not.
-    let images: Vec<Vec<Vec3>> = (0..9)
-        .map(|i| {
-            let shift = if i % 2 == 0 { 0.01 } else { -0.01 };
-            (0..p)
-                .map(|_| Vec3::splat(0.5 + shift + 0.001 * (2.0 * rng.unit() - 1.0)))
-                .collect()
-        })
-        .collect();
+    let images = shifted_images(p, 9, 0, &mut rng);
     let views: Vec<&[Vec3]> = images.iter().map(|i| i.as_slice()).collect();
     let s = error_stats(&views, &reference, &noise, &region);
     let per_pixel = 4.0 * (s.variance / (p * 9) as f64).sqrt();

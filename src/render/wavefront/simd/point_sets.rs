@@ -1,4 +1,4 @@
-//! The per-stream point sets on N lanes: Halton's scrambled digit loops, ZSobol's permuted
+//! The per-stream point sets on N lanes (called from `light::stream_points`, out of line): Halton's scrambled digit loops, ZSobol's permuted
 //! Morton index and PMJ02's table rows, each lane k the point `j + k` of one stream. The
 //! scalar twins are the sampling module's own: `halton::point`, `zsobol::StreamIndex::point`
 //! and `pmj02::point`, reached through `sampling::Stream::point`.
@@ -65,7 +65,7 @@ fn table<U: LanesU>(table: &[u32; 16]) -> U {
 
 /// Halton points `j` of the stream with `digits` per base and scramble `seeds`: lane k
 /// equals `halton::point(j[k], digits, seeds)`.
-#[inline(never)]
+#[inline]
 pub(super) fn halton<U: LanesU>(j: U, digits: (u32, u32), seeds: (u32, u32)) -> (U::F, U::F) {
     (
         radical_inverse_2(j, digits.0, seeds.0),
@@ -129,7 +129,7 @@ const SOBOL_DIM1: [u32; 32] = {
 };
 
 /// ZSobol points `j` of `stream`: lane k equals `stream.point(j[k])`.
-#[inline(never)]
+#[inline]
 pub(super) fn zsobol<U: LanesU>(j: U, stream: &zsobol::StreamIndex) -> (U::F, U::F) {
     let (bits, split) = (stream.bits, stream.point_bits);
     let index = U::splat(stream.base) | (j & U::splat(zsobol::low_mask(split)));
@@ -200,7 +200,7 @@ fn owen_scramble<U: LanesU>(x: U, seed: u32) -> U {
 
 /// PMJ02 points `j0..j0 + N` of the stream reading `table` with the digital shift `masks`:
 /// lane k equals `pmj02::point(table, j0 + k, masks)`.
-#[inline(never)]
+#[inline]
 pub(super) fn pmj02<U: LanesU>(table: &[(u32, u32)], j0: u32, masks: (u32, u32)) -> (U::F, U::F) {
     let n = <U::F as Lanes>::N;
     let at = j0 as usize;
