@@ -1,23 +1,102 @@
-//! `raywave variance` flags, turned into `raywave::variance::command::VarianceOptions`.
+//! `raywave variance` flags, turned into `raywave::variance::command::VarianceOptions`; `raywave
+//! variance prepare` (fill the reference cache) and `raywave variance merge` (join shards).
 
 use super::image::ThreadsArg;
 use super::values::{EngineArg, LightModelArg, SamplerArg};
 use anyhow::Result;
-use clap::Args;
+use clap::{Args, Subcommand};
 use raywave::output::OutputPlan;
+use raywave::output::shard::Shard;
 use raywave::output::terminal::{print, progress_bar};
 use raywave::render::engine::{Hooks, clamped_warning};
-use raywave::render::scene::{ParseOptions, Scene, SceneFile, load_scene};
+use raywave::render::scene::Scene;
 use raywave::render::settings::RenderSettings;
 use raywave::render::wavefront::DEFAULT_BATCH_SIZE;
-use raywave::variance::command::{Outcome, VarianceOptions, study};
-use std::path::PathBuf;
+use raywave::variance::command::{VarianceOptions, load_cases, prepare, run_shard, study};
+use raywave::variance::plan::Case;
+use std::path::{Path, PathBuf};
 
-/// Flags of `raywave variance`.
+/// Flags of `raywave variance`. A scene file literally named `prepare` or `merge` is given as
+/// `./prepare` or `./merge` (the bare words are the subcommands).
 #[derive(Args, Debug, Clone)]
+#[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
 pub struct VarianceArgs {
-    /// Scene file; without one, the built-in lab Cornell box with mirror spheres.
-    pub scene: Option<PathBuf>,
+    /// Fill the cache ahead of a sharded study, or merge the shards' parts.
+    #[command(subcommand)]
+    pub action: Option<VarianceAction>,
+    /// What to study.
+    #[command(flatten)]
+    pub study: StudyArgs,
+    /// Directory for the report: table.txt, results.csv, seeds.csv, perceived.csv,
+    /// spectra.csv, results.json, mse.png, contact_sheet.png, the heat maps and the spectra
+    /// (with several cases, one directory per case and summary.txt/.csv/.json); with --shard,
+    /// the directory of the shard's part, shard-I-of-N.part.
+    #[arg(long, default_value = "variance-report")]
+    pub out: PathBuf,
+    /// Run only shard I of N (0-based: 0/4 to 3/4) and write its part into --out, for a batch
+    /// system to run every shard ($SLURM_ARRAY_TASK_ID/4, $JOB_COMPLETION_INDEX/4, GNU
+    /// parallel's {}); `raywave variance merge` joins the parts. The jobs are split by their
+    /// estimated rays.
+    #[arg(long, value_name = "I/N")]
+    pub shard: Option<Shard>,
+    /// Remove every converged reference from the --cache directory (other files are left
+    /// alone) and exit, without running a study.
+    #[arg(long, conflicts_with_all = ["scenes", "study", "shard"])]
+    pub clean_cache: bool,
+    #[command(flatten)]
+    pub workers: ThreadsArg,
+    /// No progress bar.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// The subcommands of `raywave variance`.
+#[derive(Subcommand, Debug, Clone)]
+pub enum VarianceAction {
+    /// Render every case's converged reference into --cache, so that the shards of a study
+    /// find it there instead of racing to render it.
+    Prepare(PrepareArgs),
+    /// Join the parts of every shard of a study into its report, the same as one process
+    /// would have written; refuses parts that are missing, repeated, cut short, or of another
+    /// study or raywave build.
+    Merge(MergeArgs),
+}
+
+/// Flags of `raywave variance prepare`.
+#[derive(Args, Debug, Clone)]
+pub struct PrepareArgs {
+    /// What to study.
+    #[command(flatten)]
+    pub study: StudyArgs,
+    #[command(flatten)]
+    pub workers: ThreadsArg,
+    /// No progress bar.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// Flags of `raywave variance merge`.
+#[derive(Args, Debug, Clone)]
+pub struct MergeArgs {
+    /// The shards' part files, or directories holding them (their *.part files).
+    #[arg(required = true, value_name = "PARTS")]
+    pub parts: Vec<PathBuf>,
+    /// Directory for the report (not one of the inputs).
+    #[arg(long, default_value = "variance-report")]
+    pub out: PathBuf,
+}
+
+/// What a study measures and where: the scenes or a study file, and the measuring flags.
+#[derive(Args, Debug, Clone)]
+pub struct StudyArgs {
+    /// Scene files; without one, the built-in lab Cornell box with mirror spheres.
+    pub scenes: Vec<PathBuf>,
+    /// A study file (TOML: scenes, samplers, budgets, seeds, sizes, ...; docs/SAMPLING.md and
+    /// docs/schema/study.schema.json), instead of the scenes and measuring flags.
+    #[arg(long, value_name = "FILE.toml", conflicts_with_all = ["scenes", "budgets", "samplers",
+          "seeds", "size", "bounces", "reference_samples", "mask_samples", "heatmap_n",
+          "light_model", "engine"])]
+    pub study: Option<PathBuf>,
     /// Light-sample budgets N: comma- or space-separated (`1,4,16` or `1 4 16`; with spaces,
     /// give SCENE before this flag).
     #[arg(long, num_args = 1.., value_delimiter = ',', default_values_t = [1u32, 4, 16, 64, 256], value_parser = clap::value_parser!(u32).range(1..=65536))]
@@ -45,16 +124,14 @@ pub struct VarianceArgs {
     /// picks the nearest of them on a log scale (with a note on standard error).
     #[arg(long, default_value_t = 16)]
     pub heatmap_n: u32,
-    /// Directory for table.txt, results.csv, seeds.csv, perceived.csv, spectra.csv,
-    /// results.json, mse.png, contact_sheet.png, the heat maps and the spectra.
-    #[arg(long, default_value = "variance-report")]
-    pub out: PathBuf,
     /// Directory caching converged references (keyed by the scene bytes parsed, the settings
     /// and the executable; every entry is checked when read and rendered again if it fails).
+    /// Shards on several machines share it on a shared filesystem: an entry is rendered once,
+    /// under a lock, and read by the others.
     #[arg(long, default_value = ".raywave-cache")]
     pub cache: PathBuf,
     /// Always render the converged reference, ignoring and not writing the cache.
-    #[arg(long, conflicts_with_all = ["cache", "cache_limit", "clean_cache"])]
+    #[arg(long, conflicts_with_all = ["cache", "cache_limit"])]
     pub no_cache: bool,
     /// Bound on the cache's total size in MiB; the least recently used entries are removed
     /// above it.
@@ -62,10 +139,6 @@ pub struct VarianceArgs {
           default_value_t = raywave::variance::cache::DEFAULT_LIMIT_MIB,
           value_parser = clap::value_parser!(u64).range(1..=1 << 30))]
     pub cache_limit: u64,
-    /// Remove every converged reference from the --cache directory (other files are left
-    /// alone) and exit, without running a study.
-    #[arg(long, conflicts_with = "scene")]
-    pub clean_cache: bool,
     /// How a light's colour reaches a point: lab (no fall-off) or rpi (divided by π·d², as
     /// RPI's framework does).
     #[arg(long, value_enum, default_value = "lab")]
@@ -73,76 +146,52 @@ pub struct VarianceArgs {
     /// The engine that renders the images (both draw the same samples).
     #[arg(long, value_enum, default_value = "wavefront")]
     pub engine: EngineArg,
-    #[command(flatten)]
-    pub workers: ThreadsArg,
-    /// No progress bar.
-    #[arg(short, long)]
-    pub quiet: bool,
 }
 
-impl VarianceArgs {
-    /// The flags as the library's options.
-    pub fn options(&self) -> VarianceOptions {
-        VarianceOptions {
-            scene: self.scene.clone(),
+impl StudyArgs {
+    /// The flags (or the study file they name) as the library's options, writing into `out`.
+    pub fn options(&self, out: &Path, quiet: bool) -> Result<VarianceOptions> {
+        let mut options = VarianceOptions {
+            scenes: self.scenes.iter().cloned().map(Some).collect(),
             budgets: self.budgets.clone(),
             samplers: self.samplers.iter().map(|&s| s.into()).collect(),
             seeds: self.seeds,
-            size: [self.size[0], self.size[1]],
+            sizes: vec![[self.size[0], self.size[1]]],
             bounces: self.bounces,
             reference_samples: self.reference_samples,
             mask_samples: self.mask_samples,
             heatmap_n: self.heatmap_n,
-            out: self.out.clone(),
+            out: out.to_path_buf(),
             cache: self.cache.clone(),
             no_cache: self.no_cache,
             cache_limit_mib: self.cache_limit,
-            clean_cache: self.clean_cache,
+            clean_cache: false,
             light_model: self.light_model.into(),
             engine: self.engine.into(),
-            quiet: self.quiet,
+            quiet,
+        };
+        if let Some(file) = &self.study {
+            raywave::variance::study_file::read(file, &mut options)?;
         }
+        Ok(options)
+    }
+
+    /// The inputs: the scene files and the study file.
+    fn inputs(&self, options: &VarianceOptions, mut plan: OutputPlan) -> OutputPlan {
+        if let Some(file) = &self.study {
+            plan = plan.input("--study", file);
+        }
+        for scene in options.scenes.iter().flatten() {
+            plan = plan.input("SCENE", scene);
+        }
+        plan
     }
 }
 
-/// The scene (an input) and the files the study writes into `--out` (outputs).
-fn output_plan(options: &VarianceOptions) -> OutputPlan {
-    let mut plan = OutputPlan::new();
-    if let Some(scene) = &options.scene {
-        plan = plan.input("SCENE", scene);
-    }
-    let names = raywave::variance::report::file_names(
-        &options.samplers,
-        &options.budgets,
-        options.heatmap_budget(),
-    );
-    for name in names {
-        plan = plan.output_in_new_dir("--out", &options.out.join(name));
-    }
-    plan
-}
-
-/// Runs the study on `--threads` worker threads, with a progress bar, then prints its table.
-pub fn run(args: &VarianceArgs) -> Result<()> {
-    let options = args.options();
-    if options.clean_cache {
-        let (files, bytes) = raywave::variance::cache::clean(&options.cache)?;
-        return print(&format!(
-            "removed {files} cache entr{} ({:.1} MiB) from {}\n",
-            if files == 1 { "y" } else { "ies" },
-            bytes as f64 / (1u64 << 20) as f64,
-            options.cache.display()
-        ));
-    }
-    // The flags' own errors first, with their own messages; then the outputs.
+/// Loads the cases, printing the scenes' warnings and the heat-map note.
+fn cases(options: &VarianceOptions) -> Result<Vec<Case>> {
     options.validate()?;
-    output_plan(&options).check()?;
-    let pool = args.workers.pool()?;
-    let SceneFile { scene, bytes } =
-        load_scene(options.scene.as_deref(), &ParseOptions::default())?;
-    for w in &scene.warnings {
-        eprintln!("{w}");
-    }
+    let cases = load_cases(options, &|w| eprintln!("{w}"))?;
     let heatmap_n = options.heatmap_budget();
     if heatmap_n != options.heatmap_n {
         eprintln!(
@@ -150,11 +199,22 @@ pub fn run(args: &VarianceArgs) -> Result<()> {
             options.heatmap_n
         );
     }
+    Ok(cases)
+}
+
+/// Runs `work` with a progress bar over estimated rays (`prefix` before it) and the renderer
+/// of `options`, whose clamp warnings are printed above the bar.
+fn with_progress<T>(
+    options: &VarianceOptions,
+    prefix: String,
+    work: impl FnOnce(&raywave::variance::RenderFn, &Hooks) -> Result<T>,
+) -> Result<T> {
     let bar = progress_bar(
         0,
-        "{spinner} variance [{bar:30}] {pos}/{len} {msg} ({elapsed}, eta {eta})",
+        "{spinner} {prefix} [{bar:30}] {human_pos}/{human_len} rays, {msg} ({elapsed}, eta {eta})",
         options.quiet,
     );
+    bar.set_prefix(prefix);
     let progress = |done: u64, total: u64, label: &str| {
         bar.set_length(total);
         bar.set_position(done);
@@ -174,21 +234,130 @@ pub fn run(args: &VarianceArgs) -> Result<()> {
         progress: &progress,
         notice: &notice,
     };
-    let outcome = pool.install(|| study(&options, &scene, &bytes, &render, &hooks));
+    let out = work(&render, &hooks);
     bar.finish_and_clear();
-    let Outcome { result, written } = outcome?;
+    out
+}
+
+fn joined(paths: &[PathBuf]) -> String {
+    paths
+        .iter()
+        .map(|p| p.display().to_string())
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// Runs the study (or one shard of it, or a subcommand) on `--threads` worker threads.
+pub fn run(args: &VarianceArgs) -> Result<()> {
+    match &args.action {
+        Some(VarianceAction::Prepare(p)) => return run_prepare(p),
+        Some(VarianceAction::Merge(m)) => return run_merge(m),
+        None => {}
+    }
+    let options = args.study.options(&args.out, args.quiet)?;
+    if args.clean_cache {
+        let (files, bytes) = raywave::variance::cache::clean(&options.cache)?;
+        return print(&format!(
+            "removed {files} cache entr{} ({:.1} MiB) from {}\n",
+            if files == 1 { "y" } else { "ies" },
+            bytes as f64 / (1u64 << 20) as f64,
+            options.cache.display()
+        ));
+    }
+    let cases = cases(&options)?;
+    let pool = args.workers.pool()?;
+    let plan = args.study.inputs(&options, OutputPlan::new());
+    if let Some(shard) = args.shard {
+        let part = options.out.join(raywave::variance::part::file_name(shard));
+        plan.output_in_new_dir("--out", &part).check()?;
+        let prefix = format!("variance shard {shard}");
+        let (path, jobs) = with_progress(&options, prefix, |render, hooks| {
+            pool.install(|| run_shard(&options, &cases, shard, render, hooks))
+        })?;
+        return print(&format!(
+            "shard {shard}: ran {jobs} job{} of the study\nwrote   {}\n",
+            if jobs == 1 { "" } else { "s" },
+            path.display()
+        ));
+    }
+    let mut plan = plan;
+    for name in report_files(&options, &cases) {
+        plan = plan.output_in_new_dir("--out", &options.out.join(name));
+    }
+    plan.check()?;
+    let outcome = with_progress(&options, "variance".into(), |render, hooks| {
+        pool.install(|| study(&options, &cases, render, hooks))
+    })?;
+    let cached = outcome
+        .results
+        .iter()
+        .filter(|r| r.reference_cached)
+        .count();
     print(&format!(
-        "{}\nconverged reference: {}\nwrote   {}\n",
-        result.table(),
-        if result.reference_cached {
-            "from the cache"
-        } else {
-            "rendered"
+        "{}\nconverged reference{}: {}\nwrote   {}\n",
+        outcome.table(),
+        if cases.len() == 1 { "" } else { "s" },
+        match (cached, outcome.results.len()) {
+            (0, _) => "rendered".to_string(),
+            (c, n) if c == n => "from the cache".to_string(),
+            (c, n) => format!("{c} of {n} from the cache"),
         },
-        written
-            .iter()
-            .map(|p| p.display().to_string())
-            .collect::<Vec<_>>()
-            .join(", ")
+        joined(&outcome.written)
+    ))
+}
+
+/// The files the study's report writes into --out.
+fn report_files(options: &VarianceOptions, cases: &[Case]) -> Vec<String> {
+    let per_case = raywave::variance::report::file_names(
+        &options.samplers,
+        &options.budgets,
+        options.heatmap_budget(),
+    );
+    if cases.len() == 1 {
+        per_case
+    } else {
+        let names: Vec<String> = cases.iter().map(|c| c.name.clone()).collect();
+        raywave::variance::summary::file_names(&names, &per_case)
+    }
+}
+
+fn run_prepare(args: &PrepareArgs) -> Result<()> {
+    let options = args
+        .study
+        .options(Path::new("variance-report"), args.quiet)?;
+    let cases = cases(&options)?;
+    let pool = args.workers.pool()?;
+    let prepared = with_progress(&options, "prepare".into(), |render, hooks| {
+        pool.install(|| prepare(&options, &cases, render, hooks))
+    })?;
+    let mut text = String::new();
+    for (name, cached) in prepared {
+        text.push_str(&format!(
+            "{name}: converged reference {}\n",
+            if cached {
+                "already in the cache"
+            } else {
+                "rendered and cached"
+            }
+        ));
+    }
+    text.push_str(&format!("cache   {}\n", options.cache.display()));
+    print(&text)
+}
+
+fn run_merge(args: &MergeArgs) -> Result<()> {
+    let started = std::time::Instant::now();
+    let mut plan = OutputPlan::new();
+    for part in &args.parts {
+        plan = plan.input("PARTS", part);
+    }
+    plan.check()?;
+    let merged = raywave::variance::merge::merge(&args.parts, &args.out, &|w| eprintln!("{w}"))?;
+    print(&format!(
+        "{}\n{}merge   {:.2} s\nwrote   {}\n",
+        merged.outcome.table(),
+        merged.describe(),
+        started.elapsed().as_secs_f64(),
+        joined(&merged.outcome.written)
     ))
 }

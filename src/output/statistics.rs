@@ -200,6 +200,41 @@ pub fn bootstrap_interval(
             values.push(v);
         }
     }
+    percentile_interval(values)
+}
+
+/// [`bootstrap_interval`] over independent groups: each resample draws, within every group
+/// of `sizes[g]` units, that many units with replacement (a study's seeds, case by case), and
+/// `stat` sees one index list per group. None when a group has fewer than two units.
+pub fn grouped_bootstrap_interval(
+    sizes: &[usize],
+    resamples: usize,
+    seed: u64,
+    mut stat: impl FnMut(&[Vec<usize>]) -> f64,
+) -> Option<(f64, f64)> {
+    use rand::{RngExt, SeedableRng};
+    if sizes.is_empty() || sizes.iter().any(|&n| n < 2) || resamples == 0 {
+        return None;
+    }
+    let mut rng = rand::rngs::Xoshiro256PlusPlus::seed_from_u64(seed);
+    let mut idx: Vec<Vec<usize>> = sizes.iter().map(|&n| vec![0; n]).collect();
+    let mut values = Vec::with_capacity(resamples);
+    for _ in 0..resamples {
+        for (group, &n) in idx.iter_mut().zip(sizes) {
+            for i in group.iter_mut() {
+                *i = rng.random_range(0..n);
+            }
+        }
+        let v = stat(&idx);
+        if !v.is_nan() {
+            values.push(v);
+        }
+    }
+    percentile_interval(values)
+}
+
+/// The 2.5% and 97.5% points of `values` (NaN left out before), None when empty.
+fn percentile_interval(mut values: Vec<f64>) -> Option<(f64, f64)> {
     if values.is_empty() {
         return None;
     }

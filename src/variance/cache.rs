@@ -12,6 +12,12 @@
 //! payload  2 × width × height × 3 f32 LE: half A then half B, rows from the top
 //! ```
 //!
+//! Shards of one study on several machines share the cache on a shared filesystem. An entry is
+//! rendered under an exclusive lock on its own `reference-KEY.lock` (`flock`, which NFS v4 and
+//! Lustre honour), so that the first shard to need it renders it while the others wait and then
+//! read it; a reader never sees half an entry, since an entry is written to a temporary file and
+//! renamed into place.
+//!
 //! Anything else found at an entry's path (short, long, another magic or format, other
 //! dimensions, a checksum that does not match, a value that is not finite, a directory, a FIFO,
 //! an unreadable file) is reported in one warning line naming the file and what was wrong, and
@@ -106,6 +112,38 @@ impl Cache {
     /// The file of `key`.
     pub fn entry_path(&self, key: u64) -> PathBuf {
         self.dir.join(format!("reference-{key:016x}.rwref"))
+    }
+
+    /// The lock file of `key`'s entry.
+    pub fn lock_path(&self, key: u64) -> PathBuf {
+        self.dir.join(format!("reference-{key:016x}.lock"))
+    }
+
+    /// Takes the exclusive lock on `key`'s entry, held until the returned file is dropped;
+    /// calls `waiting` first when another process holds it, then blocks until it is released.
+    /// An error means the filesystem cannot lock (the caller goes on without the lock).
+    pub fn lock(&self, key: u64, waiting: impl FnOnce(&Path)) -> Result<std::fs::File> {
+        let path = self.lock_path(key);
+        std::fs::create_dir_all(&self.dir)
+            .with_context(|| format!("cannot create {}", self.dir.display()))?;
+        let file = std::fs::File::options()
+            .create(true)
+            .truncate(false)
+            .write(true)
+            .open(&path)
+            .with_context(|| format!("cannot open the lock file {}", path.display()))?;
+        match file.try_lock() {
+            Ok(()) => Ok(file),
+            Err(std::fs::TryLockError::WouldBlock) => {
+                waiting(&path);
+                file.lock()
+                    .with_context(|| format!("cannot lock {}", path.display()))?;
+                Ok(file)
+            }
+            Err(std::fs::TryLockError::Error(e)) => {
+                Err(e).with_context(|| format!("cannot lock {}", path.display()))
+            }
+        }
     }
 
     /// Reads and checks the entry of `key`, expected to be `width × height`.

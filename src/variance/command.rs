@@ -1,28 +1,34 @@
 //! `raywave variance`: the study as a command (options, checks, outputs); the flags, the
 //! progress bar and the printed table are the binary's (`cli/variance.rs`).
 
-use super::{Cache, Region, RenderFn, StudyConfig, run_study};
+use super::jobs::{self, CaseFacts, Job, JobResult, Setup};
+use super::part::{Host, JobRecord, Part};
+use super::plan::{Case, StudyIdentity, case_names, identity};
+use super::summary::Summary;
+use super::{Cache, Region, RenderFn, StudyConfig};
+use crate::output::shard::Shard;
 use crate::render::engine::{Engine, Hooks};
 use crate::render::error::UsageError;
 use crate::render::sampling::LightSampler;
-use crate::render::scene::Scene;
+use crate::render::scene::{ParseOptions, SceneFile, load_scene};
 use crate::render::settings::{LightModel, RenderSettings, ShadowMode};
 use anyhow::{Context, Result, bail};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// What `raywave variance` is asked to do (its flags, as plain values).
 #[derive(Clone, Debug)]
 pub struct VarianceOptions {
-    /// Scene file; `None` for the built-in lab Cornell box with mirror spheres.
-    pub scene: Option<PathBuf>,
+    /// Scene files; none for the built-in lab Cornell box with mirror spheres (`None` in the
+    /// list stands for it too).
+    pub scenes: Vec<Option<PathBuf>>,
     /// Light-sample budgets N.
     pub budgets: Vec<u32>,
     /// Samplers to compare.
     pub samplers: Vec<LightSampler>,
     /// Seeds (independent renders) per sampler and budget.
     pub seeds: u32,
-    /// Image width and height.
-    pub size: [u32; 2],
+    /// Image sizes, width and height: each scene is studied at each.
+    pub sizes: Vec<[u32; 2]>,
     /// Mirror bounces.
     pub bounces: u32,
     /// Stratified points per light in each half of the converged reference.
@@ -50,26 +56,56 @@ pub struct VarianceOptions {
     pub quiet: bool,
 }
 
+impl Default for VarianceOptions {
+    /// The command's defaults: the built-in scene at 128×128, N = 1, 4, 16, 64, 256, every
+    /// sampler, 8 seeds.
+    fn default() -> Self {
+        VarianceOptions {
+            scenes: Vec::new(),
+            budgets: vec![1, 4, 16, 64, 256],
+            samplers: LightSampler::ALL.to_vec(),
+            seeds: 8,
+            sizes: vec![[128, 128]],
+            bounces: 5,
+            reference_samples: 4096,
+            mask_samples: 1024,
+            heatmap_n: 16,
+            out: PathBuf::from("variance-report"),
+            cache: PathBuf::from(".raywave-cache"),
+            no_cache: false,
+            cache_limit_mib: super::cache::DEFAULT_LIMIT_MIB,
+            clean_cache: false,
+            light_model: LightModel::Lab,
+            engine: Engine::Wavefront,
+            quiet: false,
+        }
+    }
+}
+
 impl VarianceOptions {
     /// Checks the flags against each other; errors name the flag.
     pub fn validate(&self) -> Result<()> {
         // Every seed's image of every sampler at one N is kept until its statistics are taken
         // (the samplers are interleaved), and one 8-bit render per sampler and N for the
         // contact sheet.
-        let pixels = self.size[0] as u64 * self.size[1] as u64;
-        let samplers = self.samplers.len().max(1) as u64;
-        let bytes = pixels * samplers * (self.seeds as u64 * 12 + self.budgets.len() as u64 * 3);
-        if bytes > MAX_STUDY_BYTES {
-            return Err(UsageError(format!(
-                "--seeds {} of {} samplers at --size {} {} would hold {:.1} GiB of images at once: expected at most {} GiB; use fewer seeds or samplers, or a smaller size",
-                self.seeds,
-                samplers,
-                self.size[0],
-                self.size[1],
-                bytes as f64 / (1u64 << 30) as f64,
-                MAX_STUDY_BYTES >> 30
-            ))
-            .into());
+        if self.sizes.is_empty() {
+            return Err(UsageError("no image size: expected at least one".into()).into());
+        }
+        for &[w, h] in &self.sizes {
+            let pixels = w as u64 * h as u64;
+            let samplers = self.samplers.len().max(1) as u64;
+            let bytes =
+                pixels * samplers * (self.seeds as u64 * 12 + self.budgets.len() as u64 * 3);
+            if bytes > MAX_STUDY_BYTES {
+                return Err(UsageError(format!(
+                    "--seeds {} of {} samplers at --size {w} {h} would hold {:.1} GiB of images at once: expected at most {} GiB; use fewer seeds or samplers, or a smaller size",
+                    self.seeds,
+                    samplers,
+                    bytes as f64 / (1u64 << 30) as f64,
+                    MAX_STUDY_BYTES >> 30
+                ))
+                .into());
+            }
         }
         if self.out.exists() && !self.out.is_dir() {
             bail!(
@@ -94,8 +130,8 @@ impl VarianceOptions {
         for &sampler in &self.samplers {
             for &n in &self.budgets {
                 let settings = RenderSettings {
-                    width: self.size[0],
-                    height: self.size[1],
+                    width: self.sizes[0][0],
+                    height: self.sizes[0][1],
                     shadows: ShadowMode::Soft,
                     shadow_samples: n,
                     sampler,
@@ -133,49 +169,34 @@ pub fn nearest_budget(budgets: &[u32], n: u32) -> Option<u32> {
 /// The largest total size of the K images a study holds at once.
 pub const MAX_STUDY_BYTES: u64 = 4 << 30;
 
-/// A finished study: its result, and the files written.
-pub struct Outcome {
-    /// The figures.
-    pub result: super::StudyResult,
-    /// The files written into `--out`, in order.
-    pub written: Vec<PathBuf>,
-}
-
-/// Runs the study of `scene` (whose file held `scene_bytes`) as `options` say, on the current
-/// rayon pool, and writes its files into `options.out`. Reports through `hooks`; prints
-/// nothing.
-pub fn study(
-    options: &VarianceOptions,
-    scene: &Scene,
-    scene_bytes: &[u8],
-    render: &RenderFn,
-    hooks: &Hooks,
-) -> Result<Outcome> {
-    options.validate()?;
-    if scene.lights.is_empty() {
-        bail!(
-            "{}: expected a scene with at least one area light (a face whose material has a non-zero `emitted`), found none: there is no light sampling to study",
-            scene.source
-        );
+/// The cases of the study `options` describe: each scene at each size, in that order. Scene
+/// warnings go to `notice`.
+pub fn load_cases(options: &VarianceOptions, notice: &dyn Fn(&str)) -> Result<Vec<Case>> {
+    let scenes = if options.scenes.is_empty() {
+        vec![None]
+    } else {
+        options.scenes.clone()
+    };
+    let mut loaded = Vec::new();
+    for path in &scenes {
+        let SceneFile { scene, bytes } = load_scene(path.as_deref(), &ParseOptions::default())?;
+        for w in &scene.warnings {
+            notice(&w.to_string());
+        }
+        if scene.lights.is_empty() {
+            bail!(
+                "{}: expected a scene with at least one area light (a face whose material has a non-zero `emitted`), found none: there is no light sampling to study",
+                scene.source
+            );
+        }
+        let stem = path
+            .as_ref()
+            .and_then(|p| p.file_stem())
+            .map_or("builtin".to_string(), |s| s.to_string_lossy().into_owned());
+        loaded.push((stem, scene, bytes));
     }
-    // Fail on an unusable output directory now, not after minutes of rendering.
-    std::fs::create_dir_all(&options.out).with_context(|| {
-        format!(
-            "cannot create the output directory {}",
-            options.out.display()
-        )
-    })?;
-    let mut cache =
-        (!options.no_cache).then(|| Cache::new(&options.cache, options.cache_limit_mib));
-    if let Some(c) = &cache
-        && let Err(e) = std::fs::create_dir_all(&c.dir)
-    {
-        (hooks.notice)(&format!(
-            "warning: cannot use the cache directory {} ({e}): the converged reference will not be cached",
-            c.dir.display()
-        ));
-        cache = None;
-    }
+    let stems: Vec<String> = loaded.iter().map(|l| l.0.clone()).collect();
+    let names = case_names(&stems, &options.sizes);
     let mut samplers = Vec::new();
     for s in &options.samplers {
         if !samplers.contains(s) {
@@ -188,46 +209,310 @@ pub fn study(
             budgets.push(*n);
         }
     }
-    let base = RenderSettings {
-        width: options.size[0],
-        height: options.size[1],
-        bounces: options.bounces,
-        light_model: options.light_model,
-        background: scene
-            .background
-            .map(|c| c.to_array())
-            .unwrap_or(RenderSettings::default().background),
-        ..RenderSettings::default()
-    };
-    let config = StudyConfig {
-        budgets,
-        samplers,
-        seeds: options.seeds,
-        reference_samples: options.reference_samples,
-        mask_samples: options.mask_samples,
-        heatmap_n: options.heatmap_budget(),
-        ..StudyConfig::standard(base)
-    };
-    let result = run_study(
-        scene,
-        scene_bytes,
-        &config,
-        options.engine.name(),
-        render,
-        cache.as_ref(),
-        hooks,
-    )?;
-    let written = result.write(&options.out)?;
-    for region in [Region::Penumbra, Region::Lit] {
-        let margin = result.reference_margin(region);
-        if result.region_pixels[Region::ALL.iter().position(|&r| r == region).unwrap_or(0)] > 0
-            && margin < 10.0
-        {
-            (hooks.notice)(&format!(
-                "warning: the converged reference's own error is only {margin:.1}× below the smallest MSE measured on the {} region; raise --reference-samples",
-                region.name()
-            ));
+    let mut cases = Vec::new();
+    let mut names = names.into_iter();
+    for (_, scene, bytes) in loaded {
+        for &[width, height] in &options.sizes {
+            let base = RenderSettings {
+                width,
+                height,
+                bounces: options.bounces,
+                light_model: options.light_model,
+                background: scene
+                    .background
+                    .map(|c| c.to_array())
+                    .unwrap_or(RenderSettings::default().background),
+                ..RenderSettings::default()
+            };
+            let config = StudyConfig {
+                budgets: budgets.clone(),
+                samplers: samplers.clone(),
+                seeds: options.seeds,
+                reference_samples: options.reference_samples,
+                mask_samples: options.mask_samples,
+                heatmap_n: options.heatmap_budget(),
+                ..StudyConfig::standard(base)
+            };
+            cases.push(Case {
+                name: names.next().unwrap_or_default(),
+                scene: scene.clone(),
+                bytes: bytes.clone(),
+                config,
+            });
         }
     }
-    Ok(Outcome { result, written })
+    Ok(cases)
+}
+
+/// The cache `options` ask for, if its directory can be made (else a warning, and none).
+pub fn open_cache(options: &VarianceOptions, notice: &dyn Fn(&str)) -> Option<Cache> {
+    let cache = (!options.no_cache).then(|| Cache::new(&options.cache, options.cache_limit_mib))?;
+    match std::fs::create_dir_all(&cache.dir) {
+        Ok(()) => Some(cache),
+        Err(e) => {
+            notice(&format!(
+                "warning: cannot use the cache directory {} ({e}): the converged reference will not be cached",
+                cache.dir.display()
+            ));
+            None
+        }
+    }
+}
+
+/// A progress counter over estimated rays, for `hooks.progress`.
+struct Progress<'a> {
+    done: std::cell::Cell<f64>,
+    total: f64,
+    hooks: &'a Hooks<'a>,
+}
+
+impl Progress<'_> {
+    fn add(&self, rays: f64, label: &str) {
+        self.done.set(self.done.get() + rays);
+        (self.hooks.progress)(self.done.get() as u64, self.total as u64, label);
+    }
+}
+
+/// Runs the jobs `selected` (numbers in `identity.jobs()`) of `cases`, each case's setup first;
+/// returns per case touched its number, facts and results.
+fn run_selected(
+    cases: &[Case],
+    identity: &StudyIdentity,
+    selected: &[usize],
+    cache: Option<&Cache>,
+    render: &RenderFn,
+    hooks: &Hooks,
+) -> Result<Vec<(usize, CaseFacts, Vec<JobResult>)>> {
+    let all = identity.jobs();
+    let costs = identity.costs();
+    let progress = Progress {
+        done: std::cell::Cell::new(0.0),
+        total: selected.iter().map(|&j| costs[j]).sum(),
+        hooks,
+    };
+    let host = crate::output::machine::hostname();
+    let mut out = Vec::new();
+    for (c, case) in cases.iter().enumerate() {
+        let jobs: Vec<Job> = selected
+            .iter()
+            .map(|&j| all[j])
+            .filter(|j| j.case == c)
+            .collect();
+        if jobs.is_empty() {
+            continue;
+        }
+        (hooks.progress)(
+            progress.done.get() as u64,
+            progress.total as u64,
+            &format!("{}: converged reference and regions", case.name),
+        );
+        let setup = Setup::new(
+            &case.scene,
+            &case.bytes,
+            &case.config,
+            render,
+            cache,
+            hooks.notice,
+        )?;
+        let label = |rays: f64, what: &str| progress.add(rays, &format!("{}: {what}", case.name));
+        let results = jobs::run_jobs(
+            &case.scene,
+            &case.config,
+            &setup,
+            &jobs,
+            render,
+            &host,
+            &label,
+        );
+        out.push((c, setup.facts(), results));
+    }
+    Ok(out)
+}
+
+/// A finished study: its cases' results, and the files written.
+pub struct Outcome {
+    /// One per case, in order.
+    pub results: Vec<super::StudyResult>,
+    /// The summary across cases (None for one case).
+    pub summary: Option<Summary>,
+    /// The files written into `--out`, in order.
+    pub written: Vec<PathBuf>,
+}
+
+impl Outcome {
+    /// What a finished study prints: the one case's table, or the summary across cases.
+    pub fn table(&self) -> String {
+        match (&self.summary, self.results.as_slice()) {
+            (Some(summary), results) => summary.table(results),
+            (None, [one]) => one.table(),
+            (None, _) => String::new(),
+        }
+    }
+}
+
+/// Runs the whole study of `cases` in this process, on the current rayon pool, and writes its
+/// report into `options.out`. Reports through `hooks`; prints nothing.
+pub fn study(
+    options: &VarianceOptions,
+    cases: &[Case],
+    render: &RenderFn,
+    hooks: &Hooks,
+) -> Result<Outcome> {
+    options.validate()?;
+    create_out(&options.out)?;
+    let cache = open_cache(options, hooks.notice);
+    let identity = identity(cases, options.engine.name());
+    let selected: Vec<usize> = (0..identity.jobs().len()).collect();
+    let ran = run_selected(cases, &identity, &selected, cache.as_ref(), render, hooks)?;
+    let threads = rayon::current_num_threads();
+    let results = ran
+        .into_iter()
+        .map(|(c, facts, results)| {
+            let case = &cases[c];
+            jobs::assemble(
+                &case.config,
+                &case.scene.source,
+                options.engine.name(),
+                threads,
+                &facts,
+                results,
+            )
+        })
+        .collect::<Vec<_>>();
+    let names: Vec<String> = cases.iter().map(|c| c.name.clone()).collect();
+    write_report(&names, results, &options.out, hooks.notice)
+}
+
+/// Makes the output directory, failing now rather than after minutes of rendering.
+pub(crate) fn create_out(out: &Path) -> Result<()> {
+    std::fs::create_dir_all(out)
+        .with_context(|| format!("cannot create the output directory {}", out.display()))
+}
+
+/// Writes the report of `results` (named `names`) into `out`: one case's files there, or each
+/// case's in `out/NAME/` and the summary across them; then warns where a reference's own error
+/// comes near the errors measured.
+pub(crate) fn write_report(
+    names: &[String],
+    results: Vec<super::StudyResult>,
+    out: &Path,
+    notice: &(dyn Fn(&str) + Sync),
+) -> Result<Outcome> {
+    let mut written = Vec::new();
+    let summary = if let [one] = results.as_slice() {
+        written.extend(one.write(out)?);
+        None
+    } else {
+        for (name, result) in names.iter().zip(&results) {
+            written.extend(result.write(&out.join(name))?);
+        }
+        let summary = super::summary::summarize(names, &results);
+        written.extend(summary.write(&results, out)?);
+        Some(summary)
+    };
+    for (name, result) in names.iter().zip(&results) {
+        for region in [Region::Penumbra, Region::Lit] {
+            let margin = result.reference_margin(region);
+            let i = Region::ALL.iter().position(|&r| r == region).unwrap_or(0);
+            if result.region_pixels[i] > 0 && margin < 10.0 {
+                let case = if results.len() > 1 {
+                    format!("{name}: ")
+                } else {
+                    String::new()
+                };
+                notice(&format!(
+                    "warning: {case}the converged reference's own error is only {margin:.1}× below the smallest MSE measured on the {} region; raise --reference-samples",
+                    region.name()
+                ));
+            }
+        }
+    }
+    Ok(Outcome {
+        results,
+        summary,
+        written,
+    })
+}
+
+/// Runs shard `shard` of the study of `cases` and writes its part into `options.out`; returns
+/// the part's path and how many jobs it ran.
+pub fn run_shard(
+    options: &VarianceOptions,
+    cases: &[Case],
+    shard: Shard,
+    render: &RenderFn,
+    hooks: &Hooks,
+) -> Result<(PathBuf, usize)> {
+    options.validate()?;
+    create_out(&options.out)?;
+    let cache = open_cache(options, hooks.notice);
+    let identity = identity(cases, options.engine.name());
+    let assignment = identity.assignment(shard.count);
+    let selected = &assignment[shard.index as usize];
+    let started = unix_now();
+    let ran = run_selected(cases, &identity, selected, cache.as_ref(), render, hooks)?;
+    let mut part = Part {
+        identity,
+        shard,
+        jobs: selected.clone(),
+        host: Host {
+            hostname: crate::output::machine::hostname(),
+            cpu: crate::output::machine::cpu_model(),
+            threads: rayon::current_num_threads(),
+            started,
+            finished: 0.0,
+        },
+        cases: Vec::new(),
+        results: Vec::new(),
+    };
+    for (c, facts, results) in ran {
+        part.cases.push((c, cases[c].scene.source.clone(), facts));
+        part.results
+            .extend(results.into_iter().map(JobRecord::from));
+    }
+    part.host.finished = unix_now();
+    let path = options.out.join(super::part::file_name(shard));
+    super::part::write(&path, &part)?;
+    Ok((path, selected.len()))
+}
+
+/// Seconds since the Unix epoch.
+pub(crate) fn unix_now() -> f64 {
+    std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0.0, |d| d.as_secs_f64())
+}
+
+/// Fills the cache with the converged reference of every case (`raywave variance prepare`);
+/// returns per case its name and whether the reference was already there.
+pub fn prepare(
+    options: &VarianceOptions,
+    cases: &[Case],
+    render: &RenderFn,
+    hooks: &Hooks,
+) -> Result<Vec<(String, bool)>> {
+    options.validate()?;
+    if options.no_cache {
+        bail!("`raywave variance prepare` fills the cache: --no-cache leaves it nothing to do");
+    }
+    let Some(cache) = open_cache(options, hooks.notice) else {
+        bail!(
+            "cannot use the cache directory {}: nothing prepared",
+            options.cache.display()
+        );
+    };
+    let mut out = Vec::new();
+    for (i, case) in cases.iter().enumerate() {
+        (hooks.progress)(i as u64, cases.len() as u64, &case.name);
+        let reference = super::converged_reference(
+            &case.scene,
+            &case.bytes,
+            &case.config,
+            render,
+            Some(&cache),
+            hooks.notice,
+        )?;
+        out.push((case.name.clone(), reference.cached));
+    }
+    Ok(out)
 }

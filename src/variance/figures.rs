@@ -7,7 +7,7 @@ use glam::Vec3;
 use serde::Serialize;
 
 /// Error statistics of K images of one (sampler, N) over one region.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, serde::Deserialize)]
 pub struct ErrorStats {
     /// Mean squared error against the reference, over images, pixels and channels.
     pub mse: f64,

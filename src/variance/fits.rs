@@ -63,7 +63,7 @@ pub(crate) fn mean_at(xs: &[f64], idx: Option<&[usize]>) -> f64 {
 
 /// The log-log fit of `rows` (one sampler and region, the fitted budgets), on the seeds `idx`
 /// (a bootstrap resample) or on the rows' own MSE.
-fn fit_rows(rows: &[&Row], idx: Option<&[usize]>) -> Option<LogLogFit> {
+pub(crate) fn fit_rows(rows: &[&Row], idx: Option<&[usize]>) -> Option<LogLogFit> {
     let pts: Vec<(f64, f64)> = rows
         .iter()
         .map(|r| {
@@ -102,7 +102,7 @@ fn common<'r>(a: &[&'r Row], b: &[&Row]) -> Vec<&'r Row> {
 }
 
 /// The rows fitted for `sampler` in `region`.
-fn fitted(rows: &[Row], sampler: LightSampler, region: Region) -> Vec<&Row> {
+pub(crate) fn fitted(rows: &[Row], sampler: LightSampler, region: Region) -> Vec<&Row> {
     rows.iter()
         .filter(|r| r.sampler == sampler.name() && r.region == region && !r.excluded_from_fit)
         .collect()

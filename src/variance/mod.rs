@@ -22,26 +22,29 @@ pub mod cache;
 pub mod command;
 pub(crate) mod figures;
 pub(crate) mod fits;
+pub mod jobs;
 pub mod mask;
+pub mod merge;
+pub mod part;
 pub mod perceived;
 mod perceived_report;
+pub mod plan;
 pub(crate) mod plot;
 pub mod report;
 pub mod sheet;
 pub mod spectrum;
 pub mod spectrum_plot;
+pub mod study_file;
+pub mod summary;
 
 use crate::render::engine::Hooks;
 use crate::render::film::Film;
-use crate::render::film::ToneMap;
 use crate::render::per_kind::RayCounts;
 use crate::render::sampling::LightSampler;
 use crate::render::scene::Scene;
 use crate::render::settings::{RenderSettings, ShadowMode};
 use anyhow::{Result, bail};
-use glam::Vec3;
-use serde::Serialize;
-use std::time::Instant;
+use serde::{Deserialize, Serialize};
 
 pub use cache::Cache;
 pub use figures::{
@@ -55,7 +58,7 @@ pub use mask::{Regions, penumbra_mask};
 pub type RenderFn<'a> = dyn Fn(&Scene, &RenderSettings) -> (Film, RayCounts) + Sync + 'a;
 
 /// What to measure.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct StudyConfig {
     /// Size, bounces, background, two-sidedness (shadows, N, sampler and seed are set per run;
     /// antialiasing is forced to 1 so that light sampling is the only noise).
@@ -134,6 +137,22 @@ pub fn converged_reference(
         .collect();
     let key = cache::key(scene_id, &settings);
     let (width, height) = (config.base.width, config.base.height);
+    // Held until the entry is read, or rendered and written: concurrent shards render it once.
+    let _lock = cache.and_then(|c| {
+        let waiting = |path: &std::path::Path| {
+            notice(&format!(
+                "note: another process is rendering this converged reference; waiting for its lock {}",
+                path.display()
+            ))
+        };
+        c.lock(key, waiting)
+            .map_err(|e| {
+                notice(&format!(
+                    "warning: {e:#}: rendering the reference without the lock, so another process may render it too"
+                ))
+            })
+            .ok()
+    });
     let lookup = cache.map_or(cache::Lookup::Miss, |c| c.read(key, width, height));
     let cached = matches!(lookup, cache::Lookup::Hit(_));
     let [a, b] = match lookup {
@@ -189,7 +208,7 @@ pub fn converged_reference(
 }
 
 /// The three regions a study reports.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Region {
     /// Every pixel.
@@ -214,10 +233,11 @@ impl Region {
 }
 
 /// One line of the results: a (sampler, N, region).
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Row {
     /// Sampler name.
-    pub sampler: &'static str,
+    #[serde(deserialize_with = "sampler_name")]
+    pub sampler: SamplerName,
     /// Light samples per light.
     pub n: u32,
     /// Region.
@@ -256,6 +276,8 @@ pub struct Row {
     /// Where the error sits in screen space: its spectrum, its low band and its low-pass
     /// error (`perceived.rs`).
     pub perceived: perceived::Perceived,
+    /// The host whose clock measured `seconds` and the figures made from it.
+    pub host: String,
     /// Per seed (seeds 1..=K): MSE.
     #[serde(skip)]
     pub seed_mse: Vec<f64>,
@@ -265,6 +287,15 @@ pub struct Row {
     /// Per seed: seconds for its image.
     #[serde(skip)]
     pub seed_seconds: Vec<f64>,
+}
+
+/// A sampler's name (an alias, so that serde's derive does not take the field for a borrow of
+/// the input and tie rows to a `'static` input).
+pub type SamplerName = &'static str;
+
+/// A sampler's name as the `&'static str` a [`Row`] holds.
+fn sampler_name<'de, D: serde::Deserializer<'de>>(d: D) -> Result<&'static str, D::Error> {
+    LightSampler::deserialize(d).map(LightSampler::name)
 }
 
 /// Everything a study found.
@@ -298,72 +329,8 @@ pub struct StudyResult {
     pub thumbnails: Vec<(LightSampler, u32, image::RgbImage)>,
 }
 
-/// The rows of one (sampler, N): one per region.
-struct Measured<'a> {
-    sampler: LightSampler,
-    n: u32,
-    images: Vec<&'a [Vec3]>,
-    times: Vec<f64>,
-    rays: u64,
-}
-
-fn rows_of(m: &Measured, reference: &Converged, masks: &[Vec<bool>; 3]) -> Vec<Row> {
-    let k = m.images.len();
-    let (seconds, lo, hi) = crate::output::statistics::median_with_interval(&m.times);
-    let seconds_interval = (lo.is_finite() && hi.is_finite()).then_some([lo, hi]);
-    let excluded_sampler = deterministic(m.sampler, m.n);
-    Region::ALL
-        .iter()
-        .zip(masks)
-        .map(|(region, mask)| {
-            let stats = error_stats(&m.images, &reference.film.pixels, &reference.noise, mask);
-            let (width, height) = (
-                reference.film.width as usize,
-                reference.film.height as usize,
-            );
-            let perceived =
-                perceived::measure(&m.images, &reference.film.pixels, width, height, mask);
-            let per = per_image_errors(&m.images, &reference.film.pixels, mask);
-            let seed_mse: Vec<f64> = per.iter().map(|e| e.0).collect();
-            let seed_bias: Vec<f64> = per.iter().map(|e| e.1).collect();
-            let mse_interval = fits::interval(k, |idx| fits::mean_at(&seed_mse, Some(idx)));
-            let times = &m.times;
-            let efficiency_interval = fits::interval(k, |idx| {
-                let t: Vec<f64> = idx.iter().map(|&i| times[i]).collect();
-                1.0 / (fits::mean_at(&seed_mse, Some(idx))
-                    * crate::output::statistics::median(&t).max(1e-12))
-            });
-            Row {
-                sampler: m.sampler.name(),
-                n: m.n,
-                region: *region,
-                stats,
-                mse_interval,
-                excluded_from_fit: excluded_sampler || (stats.pixels > 0 && stats.variance == 0.0),
-                seconds,
-                seconds_interval,
-                rays: m.rays,
-                rays_per_second: m.rays as f64 / seconds.max(1e-12),
-                efficiency: if stats.mse > 0.0 {
-                    1.0 / (stats.mse * seconds.max(1e-12))
-                } else {
-                    f64::INFINITY
-                },
-                efficiency_interval,
-                error_reduction: None,
-                error_reduction_interval: None,
-                efficiency_vs_random: None,
-                efficiency_vs_random_interval: None,
-                perceived,
-                seed_mse,
-                seed_bias,
-                seed_seconds: m.times.clone(),
-            }
-        })
-        .collect()
-}
-
-/// Runs the study. `progress` is called after each render with a short label.
+/// Runs the study of one scene in this process: the reference and masks, every job, then the
+/// figures across them. `hooks.progress` counts estimated rays.
 pub fn run_study(
     scene: &Scene,
     scene_id: &[u8],
@@ -373,106 +340,26 @@ pub fn run_study(
     cache: Option<&Cache>,
     hooks: &Hooks,
 ) -> Result<StudyResult> {
-    // The reference, the mask, then per sampler and N a warm-up render and K timed ones.
-    let steps =
-        2 + (config.samplers.len() * config.budgets.len()) as u64 * (config.seeds as u64 + 1);
-    let done = std::cell::Cell::new(0u64);
-    let progress = |label: &str| {
-        done.set(done.get() + 1);
-        (hooks.progress)(done.get(), steps, label);
+    let all = jobs::case_jobs(0, config);
+    let lights = scene.lights.len();
+    let total: f64 = all.iter().map(|j| jobs::cost(config, lights, j)).sum();
+    let done = std::cell::Cell::new(0.0f64);
+    (hooks.progress)(0, total as u64, "converged reference and regions");
+    let setup = jobs::Setup::new(scene, scene_id, config, render, cache, hooks.notice)?;
+    let progress = |rays: f64, label: &str| {
+        done.set(done.get() + rays);
+        (hooks.progress)(done.get() as u64, total as u64, label);
     };
-    (hooks.progress)(0, steps, "converged reference");
-    let reference = converged_reference(scene, scene_id, config, render, cache, hooks.notice)?;
-    progress("converged reference");
-    let regions = penumbra_mask(scene, &config.base, config.mask_samples);
-    progress("penumbra mask");
-    let masks = [
-        regions.whole(),
-        regions.penumbra.clone(),
-        regions.lit.clone(),
-    ];
-    let region_pixels = masks.clone().map(|m| m.iter().filter(|&&b| b).count());
-    let reference_mse = masks.clone().map(|m| {
-        let (sum, count) = reference
-            .noise
-            .iter()
-            .zip(&m)
-            .filter(|(_, in_region)| **in_region)
-            .fold((0.0f64, 0usize), |(s, c), (v, _)| (s + *v as f64, c + 1));
-        if count == 0 { 0.0 } else { sum / count as f64 }
-    });
-    let samplers = &config.samplers;
-    let mut rows = Vec::new();
-    let mut heatmaps = Vec::new();
-    let mut thumbnails = Vec::new();
-    for &n in &config.budgets {
-        // Warm-up: caches, page tables and the thread pool reach their working state before
-        // the first timed render; the images (seed 0, used by no timed render) are kept.
-        for &sampler in samplers {
-            let (film, _) = render(scene, &config.run_settings(sampler, n, 0));
-            thumbnails.push((sampler, n, film.to_rgb8(ToneMap::Clamp)));
-            progress(&format!("{} N={n} warm-up", sampler.name()));
-        }
-        let mut films: Vec<Vec<crate::render::film::Film>> = vec![Vec::new(); samplers.len()];
-        let mut times = vec![Vec::new(); samplers.len()];
-        let mut rays = vec![0u64; samplers.len()];
-        for k in 0..config.seeds {
-            // Rotate the order per seed, so that no sampler always runs first (or after the
-            // same one): slow drifts of the machine fall on every sampler alike.
-            for j in 0..samplers.len() {
-                let i = (j + k as usize) % samplers.len();
-                let settings = config.run_settings(samplers[i], n, k + 1);
-                let start = Instant::now();
-                let (film, counts) = render(scene, &settings);
-                times[i].push(start.elapsed().as_secs_f64());
-                rays[i] += counts.total();
-                films[i].push(film);
-                progress(&format!("{} N={n} seed {}", samplers[i].name(), k + 1));
-            }
-        }
-        for (i, &sampler) in samplers.iter().enumerate() {
-            let images: Vec<&[Vec3]> = films[i].iter().map(|f| f.pixels.as_slice()).collect();
-            let measured = Measured {
-                sampler,
-                n,
-                images,
-                times: std::mem::take(&mut times[i]),
-                rays: rays[i] / config.seeds.max(1) as u64,
-            };
-            rows.extend(rows_of(&measured, &reference, &masks));
-            if n == config.heatmap_n {
-                heatmaps.push((sampler, pixel_mse(&measured.images, &reference.film.pixels)));
-            }
-        }
-    }
-    // Report order: sampler, then N, then region (the rows were made N first).
-    let position = |name: &str| samplers.iter().position(|s| s.name() == name);
-    rows.sort_by_key(|r| {
-        (
-            position(r.sampler),
-            config.budgets.iter().position(|&b| b == r.n),
-            Region::ALL.iter().position(|&g| g == r.region),
-        )
-    });
-    let k = config.seeds as usize;
-    fits::ratios_to_random(&mut rows, k);
-    perceived::low_band_vs_random(&mut rows, k);
-    let slopes = fits::slopes(&rows, samplers, k);
-    let matching = fits::matching(&rows, samplers, k);
-    Ok(StudyResult {
-        config: config.clone(),
-        scene: scene.source.clone(),
-        engine: engine.to_string(),
-        threads: rayon::current_num_threads(),
-        region_pixels,
-        reference_mse,
-        reference_cached: reference.cached,
-        rows,
-        slopes,
-        matching,
-        heatmaps,
-        thumbnails,
-    })
+    let host = crate::output::machine::hostname();
+    let results = jobs::run_jobs(scene, config, &setup, &all, render, &host, &progress);
+    Ok(jobs::assemble(
+        config,
+        &scene.source,
+        engine,
+        rayon::current_num_threads(),
+        &setup.facts(),
+        results,
+    ))
 }
 
 impl StudyResult {

@@ -11,7 +11,7 @@ use glam::Vec3;
 use serde::Serialize;
 
 /// The perceived-error figures of one row.
-#[derive(Clone, Debug, Default, Serialize)]
+#[derive(Clone, Debug, Default, Serialize, serde::Deserialize)]
 pub struct Perceived {
     /// Mean square error after a Gaussian blur of σ = 1 and 2 pixels, mean over seeds.
     pub lowpass_mse: [f64; 2],

@@ -1,0 +1,349 @@
+//! A study of several cases (scenes, sizes): each case's report in a directory of its own, and
+//! a summary across the cases in `summary.txt`, `summary.csv` and `summary.json`.
+//!
+//! ```text
+//! slope(sampler, region)        = mean over the cases of each case's fitted slope
+//! ratio(sampler, N, region)     = geometric mean over the cases of random's MSE / the sampler's
+//! 95% interval                  = bootstrap: every resample redraws each case's K seeds on its
+//!                                 own (statistics::grouped_bootstrap_interval), so the interval
+//!                                 is the figure's uncertainty from seed noise, for these cases
+//! ```
+//!
+//! The cases are the study's, not a sample of all scenes: the interval does not say how another
+//! scene would fare.
+
+use super::fits::{fit_rows, fitted, mean_at};
+use super::{Region, Row, StudyResult};
+use crate::output::statistics::{BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, grouped_bootstrap_interval};
+use crate::render::sampling::LightSampler;
+use anyhow::{Context, Result};
+use serde::Serialize;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// A sampler's slope across the cases, in one region.
+#[derive(Clone, Debug, Serialize)]
+pub struct SlopeAcross {
+    /// Sampler name.
+    pub sampler: &'static str,
+    /// Region.
+    pub region: Region,
+    /// Each case's fitted slope (None where it had no fit).
+    pub per_case: Vec<Option<f64>>,
+    /// Mean of `per_case` (None unless every case has a fit).
+    pub mean: Option<f64>,
+    /// 95% interval of `mean`.
+    pub interval: Option<[f64; 2]>,
+}
+
+/// A sampler's error reduction against random across the cases, at one N and region.
+#[derive(Clone, Debug, Serialize)]
+pub struct RatioAcross {
+    /// Sampler name.
+    pub sampler: &'static str,
+    /// Points per light.
+    pub n: u32,
+    /// Region.
+    pub region: Region,
+    /// Each case's random MSE / this sampler's MSE.
+    pub per_case: Vec<Option<f64>>,
+    /// Geometric mean of `per_case` (None unless every case has one).
+    pub geometric_mean: Option<f64>,
+    /// 95% interval of `geometric_mean`.
+    pub interval: Option<[f64; 2]>,
+}
+
+/// The summary across cases.
+#[derive(Clone, Debug, Serialize)]
+pub struct Summary {
+    /// The cases' names, in order.
+    pub cases: Vec<String>,
+    /// Per sampler and region.
+    pub slopes: Vec<SlopeAcross>,
+    /// Per sampler other than random, N and region (when random was studied).
+    pub ratios: Vec<RatioAcross>,
+}
+
+fn row<'r>(rows: &'r [Row], sampler: &str, n: u32, region: Region) -> Option<&'r Row> {
+    rows.iter()
+        .find(|r| r.sampler == sampler && r.n == n && r.region == region)
+}
+
+fn interval(sizes: &[usize], stat: impl FnMut(&[Vec<usize>]) -> f64) -> Option<[f64; 2]> {
+    grouped_bootstrap_interval(sizes, BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, stat)
+        .map(|(a, b)| [a, b])
+}
+
+/// The summary of `cases` (named `names`), which share samplers, budgets and seeds.
+pub fn summarize(names: &[String], cases: &[StudyResult]) -> Summary {
+    let Some(first) = cases.first() else {
+        return Summary {
+            cases: Vec::new(),
+            slopes: Vec::new(),
+            ratios: Vec::new(),
+        };
+    };
+    let config = &first.config;
+    let sizes: Vec<usize> = cases.iter().map(|c| c.config.seeds as usize).collect();
+    let mut slopes = Vec::new();
+    for &sampler in &config.samplers {
+        for region in Region::ALL {
+            let fits: Vec<Vec<&Row>> = cases
+                .iter()
+                .map(|c| fitted(&c.rows, sampler, region))
+                .collect();
+            let per_case: Vec<Option<f64>> = fits
+                .iter()
+                .map(|pts| fit_rows(pts, None).map(|f| f.slope))
+                .collect();
+            let mean = per_case
+                .iter()
+                .copied()
+                .sum::<Option<f64>>()
+                .map(|s| s / cases.len() as f64);
+            let interval = mean.and_then(|_| {
+                interval(&sizes, |idx| {
+                    fits.iter()
+                        .zip(idx)
+                        .map(|(pts, i)| fit_rows(pts, Some(i)).map_or(f64::NAN, |f| f.slope))
+                        .sum::<f64>()
+                        / cases.len() as f64
+                })
+            });
+            slopes.push(SlopeAcross {
+                sampler: sampler.name(),
+                region,
+                per_case,
+                mean,
+                interval,
+            });
+        }
+    }
+    let mut ratios = Vec::new();
+    let random = LightSampler::Random.name();
+    if config.samplers.contains(&LightSampler::Random) {
+        for &sampler in config
+            .samplers
+            .iter()
+            .filter(|&&s| s != LightSampler::Random)
+        {
+            for &n in &config.budgets {
+                for region in Region::ALL {
+                    let pairs: Vec<Option<(&Row, &Row)>> = cases
+                        .iter()
+                        .map(|c| {
+                            row(&c.rows, random, n, region)
+                                .zip(row(&c.rows, sampler.name(), n, region))
+                                .filter(|(b, r)| b.stats.mse > 0.0 && r.stats.mse > 0.0)
+                        })
+                        .collect();
+                    let per_case: Vec<Option<f64>> = pairs
+                        .iter()
+                        .map(|p| p.map(|(b, r)| b.stats.mse / r.stats.mse))
+                        .collect();
+                    let geomean = |values: &mut dyn Iterator<Item = f64>| {
+                        let (sum, count) =
+                            values.fold((0.0, 0usize), |(s, c), v| (s + v.ln(), c + 1));
+                        (sum / count.max(1) as f64).exp()
+                    };
+                    let geometric_mean = per_case
+                        .iter()
+                        .copied()
+                        .collect::<Option<Vec<f64>>>()
+                        .map(|v| geomean(&mut v.into_iter()));
+                    let interval = geometric_mean.and_then(|_| {
+                        interval(&sizes, |idx| {
+                            geomean(&mut pairs.iter().zip(idx).map(|(p, i)| {
+                                p.map_or(f64::NAN, |(b, r)| {
+                                    mean_at(&b.seed_mse, Some(i)) / mean_at(&r.seed_mse, Some(i))
+                                })
+                            }))
+                        })
+                    });
+                    ratios.push(RatioAcross {
+                        sampler: sampler.name(),
+                        n,
+                        region,
+                        per_case,
+                        geometric_mean,
+                        interval,
+                    });
+                }
+            }
+        }
+    }
+    Summary {
+        cases: names.to_vec(),
+        slopes,
+        ratios,
+    }
+}
+
+fn figure(v: Option<f64>, iv: Option<[f64; 2]>) -> String {
+    match (v, iv) {
+        (Some(v), Some([a, b])) => format!("{v:.3} [{a:.3}, {b:.3}]"),
+        (Some(v), None) => format!("{v:.3}"),
+        (None, _) => "-".into(),
+    }
+}
+
+fn opt(v: Option<f64>) -> String {
+    v.map_or(String::new(), |v| v.to_string())
+}
+
+impl Summary {
+    /// `summary.txt`: a section per case, then the figures across them.
+    pub fn table(&self, cases: &[StudyResult]) -> String {
+        let mut s = String::new();
+        let _ = writeln!(s, "variance study of {} cases", self.cases.len());
+        for (name, case) in self.cases.iter().zip(cases) {
+            let _ = writeln!(
+                s,
+                "\n== {name}: {} at {}×{} (report in {name}/) ==",
+                case.scene, case.config.base.width, case.config.base.height
+            );
+            let _ = writeln!(
+                s,
+                "  {:<10} {:<28} {:<28}",
+                "sampler", "slope whole [95%]", "slope penumbra [95%]"
+            );
+            for &sampler in &case.config.samplers {
+                let fit = |region: Region| {
+                    case.slopes
+                        .iter()
+                        .find(|x| x.sampler == sampler.name() && x.region == region)
+                        .map_or("-".into(), |x| {
+                            figure(x.fit.map(|f| f.slope), x.slope_interval)
+                        })
+                };
+                let _ = writeln!(
+                    s,
+                    "  {:<10} {:<28} {:<28}",
+                    sampler.name(),
+                    fit(Region::Whole),
+                    fit(Region::Penumbra)
+                );
+            }
+        }
+        let _ = writeln!(
+            s,
+            "\n== across the cases ==\n[low, high]: 95% intervals, bootstrap over each case's seeds (the cases held fixed)"
+        );
+        for region in [Region::Whole, Region::Penumbra] {
+            let _ = writeln!(
+                s,
+                "\n{} region: mean slope of log MSE against log N",
+                region.name()
+            );
+            for x in self.slopes.iter().filter(|x| x.region == region) {
+                let _ = writeln!(s, "  {:<10} {}", x.sampler, figure(x.mean, x.interval));
+            }
+            let mut samplers: Vec<&str> = Vec::new();
+            for x in self.ratios.iter().filter(|x| x.region == region) {
+                if !samplers.contains(&x.sampler) {
+                    samplers.push(x.sampler);
+                }
+            }
+            if samplers.is_empty() {
+                continue;
+            }
+            let _ = writeln!(
+                s,
+                "{} region: random's MSE / the sampler's, geometric mean over the cases",
+                region.name()
+            );
+            for sampler in samplers {
+                let cells: Vec<String> = self
+                    .ratios
+                    .iter()
+                    .filter(|x| x.region == region && x.sampler == sampler)
+                    .map(|x| format!("N={} {}", x.n, figure(x.geometric_mean, x.interval)))
+                    .collect();
+                let _ = writeln!(s, "  {:<10} {}", sampler, cells.join("  "));
+            }
+        }
+        s
+    }
+
+    /// `summary.csv`: one row per figure (slope or ratio), sampler, N and region.
+    pub fn csv(&self) -> String {
+        let mut s = String::from("figure,sampler,n,region,value,low,high");
+        for c in &self.cases {
+            let _ = write!(s, ",{c}");
+        }
+        s.push('\n');
+        let mut line = |kind: &str,
+                        sampler: &str,
+                        n: String,
+                        region: Region,
+                        v: Option<f64>,
+                        iv: Option<[f64; 2]>,
+                        per: &[Option<f64>]| {
+            let _ = write!(
+                s,
+                "{kind},{sampler},{n},{},{},{},{}",
+                region.name(),
+                opt(v),
+                opt(iv.map(|i| i[0])),
+                opt(iv.map(|i| i[1]))
+            );
+            for p in per {
+                let _ = write!(s, ",{}", opt(*p));
+            }
+            s.push('\n');
+        };
+        for x in &self.slopes {
+            line(
+                "slope",
+                x.sampler,
+                String::new(),
+                x.region,
+                x.mean,
+                x.interval,
+                &x.per_case,
+            );
+        }
+        for x in &self.ratios {
+            line(
+                "error_reduction",
+                x.sampler,
+                x.n.to_string(),
+                x.region,
+                x.geometric_mean,
+                x.interval,
+                &x.per_case,
+            );
+        }
+        s
+    }
+
+    /// Writes `summary.txt`, `summary.csv` and `summary.json` into `dir`.
+    pub fn write(&self, cases: &[StudyResult], dir: &Path) -> Result<Vec<PathBuf>> {
+        let json = serde_json::to_string_pretty(self).context("cannot encode the summary")? + "\n";
+        let mut written = Vec::new();
+        for (name, body) in [
+            ("summary.txt", self.table(cases)),
+            ("summary.csv", self.csv()),
+            ("summary.json", json),
+        ] {
+            let path = dir.join(name);
+            crate::output::image_file::write_atomically(&path, |w| {
+                std::io::Write::write_all(w, body.as_bytes())?;
+                Ok(())
+            })?;
+            written.push(path);
+        }
+        Ok(written)
+    }
+}
+
+/// The files a study of several cases writes: per case its report under `NAME/`, then the
+/// summary at the top.
+pub fn file_names(names: &[String], per_case: &[String]) -> Vec<String> {
+    let mut out = Vec::new();
+    for name in names {
+        out.extend(per_case.iter().map(|f| format!("{name}/{f}")));
+    }
+    out.extend(["summary.txt", "summary.csv", "summary.json"].map(String::from));
+    out
+}
