@@ -18,5 +18,6 @@ mod docs_commands;
 mod schema;
 mod trace_pixel;
 mod trace_pixel_exports;
+mod variance_shards;
 mod view_browser;
 mod view_http;
