@@ -1,8 +1,8 @@
 //! The `raywave` command. `main` owns the exit code: 0 on success, 2 for a usage error (clap),
 //! 3 when `raywave bench --compare` finds a regression or `raywave diff --fail-above` a figure
-//! past its threshold, 1 for anything else, printed once with its cause chain; 130 after SIGINT
-//! and 143 after SIGTERM (`output::write`), but 0 when `raywave view` is stopped by them, its
-//! normal end. The command line itself is in `cli/`, one file per command.
+//! past its threshold, 4 when `raywave bench --until-decided` ends undecided at its budget, 1
+//! for anything else, printed once with its cause chain; 130 after SIGINT and 143 after
+//! SIGTERM (`output::write`), but 0 when `raywave view` is stopped by them, its normal end. The command line itself is in `cli/`, one file per command.
 
 mod cli;
 
@@ -52,7 +52,8 @@ fn main() -> ExitCode {
         Command::Variance(args) => cli::variance::run(&args),
         Command::View(args) => cli::view::run(&args),
         Command::TracePixel(args) => cli::trace_pixel::run(&args),
-        // Exit 3 when --compare finds a regression (raywave::bench::EXIT_REGRESSION).
+        // Exit 3 when --compare finds a regression (raywave::bench::EXIT_REGRESSION), 4 when
+        // --until-decided ends undecided (EXIT_UNDECIDED).
         Command::Bench(args) => match cli::bench::run(&args, matches.subcommand_matches("bench")) {
             Ok(code) => return ExitCode::from(code),
             Err(e) => Err(e),

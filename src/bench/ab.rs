@@ -23,14 +23,22 @@
 //! The interval is distribution-free (`statistics::median_interval_rank`): for n paired ratios
 //! sorted, the median lies between the k-th and the (n − k + 1)-th with probability ≥ 95%, k the
 //! largest with P(Binomial(n, ½) < k) ≤ 2.5%. It needs n ≥ 6.
+//!
+//! With `--until-decided` the rounds go on until the verdict is decided, judged at planned
+//! looks with narrower levels (`sequential`), within `--max-rounds` and `--max-time`.
 
-use crate::output::statistics::{MIN_FOR_INTERVAL, median, median_with_interval};
+use super::sequential::{self, Budget, LookPlan};
+use super::{EXIT_REGRESSION, EXIT_UNDECIDED};
+use crate::output::statistics::{MIN_FOR_INTERVAL, median, median_with_interval_at};
 use crate::render::engine::Engine;
 use crate::render::error::UsageError;
 use anyhow::{Context, Result, bail};
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 use std::process::Command;
+use std::time::Instant;
+
+pub use super::ab_report::report;
 
 /// The fewest rounds that give a 95% interval of the median.
 pub const MIN_ROUNDS: u32 = MIN_FOR_INTERVAL as u32;
@@ -48,8 +56,10 @@ pub struct AbOptions {
     pub engines: Vec<Engine>,
     /// Worker threads (`None`: each build's default, all cores).
     pub threads: Option<u32>,
-    /// Timed rounds per engine (at least [`MIN_ROUNDS`]).
+    /// Timed rounds per engine (at least [`MIN_ROUNDS`]); unused with `until_decided`.
     pub rounds: u32,
+    /// Rounds until each engine's verdict is decided, within this budget, instead of `rounds`.
+    pub until_decided: Option<Budget>,
     /// Untimed rounds first.
     pub warmup: u32,
     /// Regression threshold in percent.
@@ -70,6 +80,8 @@ pub struct EngineAb {
     /// The ray counts (camera, shadow, reflection, total) of this build and the other in the
     /// first round where they differed: the builds then did different work.
     pub different_work: Option<(String, String)>,
+    /// With `--until-decided`: the looks taken, the rounds used and why they stopped.
+    pub sequential: Option<sequential::Outcome>,
 }
 
 /// How a ratio's interval sits against the threshold.
@@ -85,14 +97,14 @@ pub enum Verdict {
     Undecided,
 }
 
-/// A ratio's summary: median, 95% interval, verdict.
+/// A ratio's summary: median, interval, verdict.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RatioSummary {
     /// Median of the per-round ratios this / other.
     pub median: f64,
-    /// The 95% interval of that median.
+    /// The low end of that median's interval (95%; with `--until-decided`, the look's level).
     pub low: f64,
-    /// The 95% interval of that median.
+    /// The high end of that median's interval.
     pub high: f64,
     /// Against the threshold.
     pub verdict: Verdict,
@@ -108,15 +120,33 @@ impl EngineAb {
             .collect()
     }
 
-    /// The ratios' median, interval and verdict at `threshold_pct`.
+    /// The ratios' median, 95% interval and verdict at `threshold_pct`; with `--until-decided`,
+    /// the last look's instead (at its level and the threshold it was judged at), or an
+    /// unbounded undecided interval when no look was taken.
     pub fn summary(&self, threshold_pct: f64) -> RatioSummary {
-        summarize(&self.ratios(), threshold_pct)
+        match &self.sequential {
+            None => summarize(&self.ratios(), threshold_pct),
+            Some(outcome) => outcome.looks.last().map_or(
+                RatioSummary {
+                    median: median(&self.ratios()),
+                    low: f64::NEG_INFINITY,
+                    high: f64::INFINITY,
+                    verdict: Verdict::Undecided,
+                },
+                |look| look.summary,
+            ),
+        }
     }
 }
 
 /// Median, 95% interval and verdict of per-round ratios.
 pub fn summarize(ratios: &[f64], threshold_pct: f64) -> RatioSummary {
-    let (median, low, high) = median_with_interval(ratios);
+    summarize_at(ratios, threshold_pct, 0.05)
+}
+
+/// Median, (1 − `alpha`) interval and verdict of per-round ratios.
+pub fn summarize_at(ratios: &[f64], threshold_pct: f64, alpha: f64) -> RatioSummary {
+    let (median, low, high) = median_with_interval_at(ratios, alpha);
     let slow = 1.0 + threshold_pct / 100.0;
     let verdict = if low > slow {
         Verdict::Slower
@@ -228,118 +258,157 @@ fn time_one(
     Ok((seconds, counts))
 }
 
-/// Runs the rounds; `progress` is called after each run with (runs done, runs in all).
+/// The two builds and a scratch directory for their files.
+struct Builds<'a> {
+    options: &'a AbOptions,
+    this: PathBuf,
+    scratch: tempfile::TempDir,
+}
+
+impl Builds<'_> {
+    /// Round `round` (counted from 0, warm-up included) of `engine`: this build's seconds and
+    /// the other's. Ray counts that differ are noted in `result`; `tick` follows each run.
+    fn round(
+        &self,
+        engine: Engine,
+        round: u32,
+        result: &mut EngineAb,
+        tick: &mut dyn FnMut(),
+    ) -> Result<(f64, f64)> {
+        // Alternate which build goes first, so that neither always runs on a warmer or cooler
+        // machine.
+        let order = if round.is_multiple_of(2) {
+            [&self.this, &self.options.other]
+        } else {
+            [&self.options.other, &self.this]
+        };
+        let mut times = [(0.0, String::new()), (0.0, String::new())];
+        for (slot, binary) in order.into_iter().enumerate() {
+            times[slot] = time_one(binary, self.options, engine, self.scratch.path())?;
+            tick();
+        }
+        let (mine, theirs) = if round.is_multiple_of(2) {
+            (&times[0], &times[1])
+        } else {
+            (&times[1], &times[0])
+        };
+        if mine.1 != theirs.1 && result.different_work.is_none() {
+            result.different_work = Some((mine.1.clone(), theirs.1.clone()));
+        }
+        Ok((mine.0, theirs.0))
+    }
+}
+
+/// Runs the rounds; `progress` is called after each run with (runs done, runs in all; with
+/// `until_decided`, all that `max_rounds` allows).
 pub fn run(options: &AbOptions, progress: &dyn Fn(u64, u64)) -> Result<Vec<EngineAb>> {
-    if options.rounds < MIN_ROUNDS {
+    let timed = match options.until_decided {
+        None => ("--rounds", options.rounds),
+        Some(budget) => ("--max-rounds", budget.max_rounds),
+    };
+    if timed.1 < MIN_ROUNDS {
         return Err(UsageError(format!(
-            "--rounds {}: a 95% interval of the median needs at least {MIN_ROUNDS} rounds",
-            options.rounds
+            "{} {}: a 95% interval of the median needs at least {MIN_ROUNDS} rounds",
+            timed.0, timed.1
         ))
         .into());
     }
     check_executable(&options.other)?;
-    let this = std::env::current_exe().context("cannot find this build's own binary")?;
-    let scratch = tempfile::tempdir().context("cannot make a scratch directory")?;
-    let total = options.engines.len() as u64 * u64::from(options.warmup + options.rounds) * 2;
+    let builds = Builds {
+        options,
+        this: std::env::current_exe().context("cannot find this build's own binary")?,
+        scratch: tempfile::tempdir().context("cannot make a scratch directory")?,
+    };
+    let engines = options.engines.len();
+    let total = engines as u64 * u64::from(options.warmup + timed.1) * 2;
     let mut done = 0;
+    let mut tick = || {
+        done += 1;
+        progress(done, total);
+    };
+    let start = Instant::now();
     let mut results = Vec::new();
-    for &engine in &options.engines {
+    for (i, &engine) in options.engines.iter().enumerate() {
         let mut result = EngineAb {
             engine,
             this: Vec::new(),
             other: Vec::new(),
             different_work: None,
+            sequential: None,
         };
-        for round in 0..options.warmup + options.rounds {
-            // Alternate which build goes first, so that neither always runs on a warmer or
-            // cooler machine.
-            let order = if round % 2 == 0 {
-                [&this, &options.other]
-            } else {
-                [&options.other, &this]
-            };
-            let mut times = [(0.0, String::new()), (0.0, String::new())];
-            for (slot, binary) in order.into_iter().enumerate() {
-                times[slot] = time_one(binary, options, engine, scratch.path())?;
-                done += 1;
-                progress(done, total);
-            }
-            let (mine, theirs) = if round % 2 == 0 {
-                (&times[0], &times[1])
-            } else {
-                (&times[1], &times[0])
-            };
-            if mine.1 != theirs.1 && result.different_work.is_none() {
-                result.different_work = Some((mine.1.clone(), theirs.1.clone()));
-            }
-            if round >= options.warmup {
-                result.this.push(mine.0);
-                result.other.push(theirs.0);
-            }
+        let engine_start = Instant::now();
+        for round in 0..options.warmup {
+            builds.round(engine, round, &mut result, &mut tick)?;
         }
+        let Some(budget) = options.until_decided else {
+            for round in options.warmup..options.warmup + options.rounds {
+                let (mine, theirs) = builds.round(engine, round, &mut result, &mut tick)?;
+                result.this.push(mine);
+                result.other.push(theirs);
+            }
+            results.push(result);
+            continue;
+        };
+        // The time left is shared equally by this engine and those after it; one that decides
+        // early leaves its share to the rest.
+        let deadline = budget.max_time.map(|t| {
+            let left = (start + t).saturating_duration_since(engine_start);
+            engine_start + left / (engines - i) as u32
+        });
+        let mut round = options.warmup;
+        let outcome = sequential::decide(
+            &LookPlan::new(budget.max_rounds),
+            options.threshold_pct,
+            &mut |at| {
+                if let Some(end) = deadline
+                    && !reachable(engine_start, round, at.next_look - at.rounds, end)
+                {
+                    return Ok(None);
+                }
+                let (mine, theirs) = builds.round(engine, round, &mut result, &mut tick)?;
+                round += 1;
+                result.this.push(mine);
+                result.other.push(theirs);
+                Ok(Some(mine / theirs))
+            },
+        )?;
+        result.sequential = Some(outcome);
         results.push(result);
     }
     Ok(results)
 }
 
-/// The verdict table.
-pub fn report(options: &AbOptions, results: &[EngineAb]) -> String {
-    let t = options.threshold_pct;
-    let mut out = format!(
-        "this build / {} · {} rounds after {} warm-up, alternating · threshold {t}%\n\
-         {:<10} {:>25} {:>25} {:>8} {:>18}  verdict\n",
-        options.other.display(),
-        options.rounds,
-        options.warmup,
-        "engine",
-        "this: median (min–max)",
-        "other: median (min–max)",
-        "ratio",
-        "95% interval",
-    );
-    for r in results {
-        let s = r.summary(t);
-        let spread = |xs: &[f64]| {
-            let (lo, hi) = xs
-                .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
-                    (a.min(x), b.max(x))
-                });
-            format!("{:.4} s ({:.3}–{:.3})", median(xs), lo, hi)
-        };
-        let verdict = match s.verdict {
-            Verdict::Slower => format!("slower by more than {t}%: a regression"),
-            Verdict::Faster => format!("faster by more than {t}%"),
-            Verdict::Within => format!("no change beyond {t}%"),
-            Verdict::Undecided => {
-                "undecided: the interval crosses the threshold; run more rounds".to_string()
-            }
-        };
-        out += &format!(
-            "{:<10} {:>25} {:>25} {:>8.4} {:>18}  {verdict}\n",
-            r.engine.name(),
-            spread(&r.this),
-            spread(&r.other),
-            s.median,
-            format!("[{:.4}, {:.4}]", s.low, s.high),
-        );
-        if let Some((mine, theirs)) = &r.different_work {
-            out += &format!(
-                "  warning: the builds traced different rays with {} (camera, shadow, \
-                 reflection, total: this {mine}, other {theirs}): the ratio compares \
-                 different work\n",
-                r.engine.name()
-            );
-        }
+/// Whether `rounds` more rounds can end by `end`, at the pace of the `done` rounds run since
+/// `since` (any number while none has run, unless `end` has passed). A look that cannot be
+/// reached is not started: its rounds would be spent without a verdict.
+fn reachable(since: Instant, done: u32, rounds: u32, end: Instant) -> bool {
+    let now = Instant::now();
+    if now >= end {
+        return false;
     }
-    out
+    if done == 0 {
+        return true;
+    }
+    let pace = now.duration_since(since) / done;
+    pace.checked_mul(rounds)
+        .and_then(|ahead| now.checked_add(ahead))
+        .is_some_and(|finish| finish <= end)
 }
 
-/// True when some engine's verdict is a regression.
-pub fn regressed(options: &AbOptions, results: &[EngineAb]) -> bool {
-    results
+/// The process exit code: [`EXIT_REGRESSION`] when some engine's verdict is a regression, else
+/// [`EXIT_UNDECIDED`] when `--until-decided` left some engine undecided at its budget, else 0.
+pub fn exit_code(options: &AbOptions, results: &[EngineAb]) -> u8 {
+    let verdicts: Vec<Verdict> = results
         .iter()
-        .any(|r| r.summary(options.threshold_pct).verdict == Verdict::Slower)
+        .map(|r| r.summary(options.threshold_pct).verdict)
+        .collect();
+    if verdicts.contains(&Verdict::Slower) {
+        EXIT_REGRESSION
+    } else if options.until_decided.is_some() && verdicts.contains(&Verdict::Undecided) {
+        EXIT_UNDECIDED
+    } else {
+        0
+    }
 }
 
 #[cfg(test)]

@@ -15,12 +15,14 @@
 //! ```
 
 pub mod ab;
+mod ab_report;
 pub(crate) mod adopt;
 pub mod compare;
 pub(crate) mod export;
 pub mod list;
 pub(crate) mod measure;
 pub(crate) mod report;
+pub mod sequential;
 pub mod sweep;
 
 use crate::output::bench_record::{self as record, BenchRecord, SceneId, Setup};
@@ -36,6 +38,10 @@ pub use report::report;
 
 /// Exit code of `raywave bench --compare` when a headline figure regressed.
 pub const EXIT_REGRESSION: u8 = 3;
+
+/// Exit code of `raywave bench --against OTHER --until-decided` when no engine regressed but
+/// one was still undecided at the budget (`--max-rounds` or `--max-time`).
+pub const EXIT_UNDECIDED: u8 = 4;
 
 /// Default `--threshold`, in percent: see docs/BENCHMARKING.md for the noise it is chosen from.
 pub const DEFAULT_THRESHOLD_PCT: f64 = 40.0;

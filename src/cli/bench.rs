@@ -7,6 +7,7 @@ use anyhow::Result;
 use clap::parser::ValueSource;
 use clap::{ArgAction, ArgMatches, Args, Subcommand, ValueEnum};
 use raywave::bench::ab::{self, AbOptions, MIN_ROUNDS};
+use raywave::bench::sequential;
 use raywave::bench::sweep::{Sweep, record_name};
 use raywave::bench::{BenchOptions, DEFAULT_RUNS, DEFAULT_THRESHOLD_PCT, EXIT_REGRESSION, list};
 use raywave::output::OutputPlan;
@@ -83,6 +84,23 @@ pub struct BenchArgs {
     #[arg(long, default_value_t = 20, requires = "against",
           value_parser = clap::value_parser!(u32).range(i64::from(MIN_ROUNDS)..=10_000))]
     pub rounds: u32,
+    /// With --against: instead of --rounds, keep alternating until each engine's verdict is
+    /// decided, judged at planned looks (by default after 9, 14, 21, ..., 200 rounds) with
+    /// each look's interval widened so that the looks together keep the 5% error of one 95%
+    /// interval; exit 3 as above, 0 when decided otherwise, 4 (undecided at the budget) when
+    /// --max-rounds or --max-time runs out first.
+    #[arg(long, requires = "against", conflicts_with = "rounds")]
+    pub until_decided: bool,
+    /// The last look's rounds with --until-decided, per engine.
+    #[arg(long, value_name = "N", default_value_t = sequential::DEFAULT_MAX_ROUNDS,
+          requires = "until_decided",
+          value_parser = clap::value_parser!(u32).range(i64::from(MIN_ROUNDS)..=10_000))]
+    pub max_rounds: u32,
+    /// Time limit of --until-decided, warm-up included (10m, 90s, 1h30m): no look is started
+    /// that the pace so far says cannot end in time [default: none].
+    #[arg(long, value_name = "DURATION", requires = "until_decided",
+          value_parser = super::values::duration)]
+    pub max_time: Option<std::time::Duration>,
     /// Also write the record as JSON to FILE (`-` for stdout); one point only.
     #[arg(long, value_name = "FILE")]
     pub json: Option<PathBuf>,
@@ -268,7 +286,8 @@ fn output_plan(args: &BenchArgs, points: &[raywave::bench::sweep::Point]) -> Out
 
 /// Runs the bench or one of its subcommands; the exit code is 3
 /// (`raywave::bench::EXIT_REGRESSION`) when `--compare`, `--against` or `bench compare` finds
-/// a regression, else 0. `matches` are bench's own.
+/// a regression, 4 (`EXIT_UNDECIDED`) when `--until-decided` ends undecided at its budget,
+/// else 0. `matches` are bench's own.
 pub fn run(args: &BenchArgs, matches: Option<&ArgMatches>) -> Result<u8> {
     match &args.action {
         Some(BenchAction::Compare(c)) => {
@@ -358,6 +377,10 @@ pub fn run(args: &BenchArgs, matches: Option<&ArgMatches>) -> Result<u8> {
         },
         threads: args.threads.first().copied(),
         rounds: args.rounds,
+        until_decided: args.until_decided.then_some(sequential::Budget {
+            max_rounds: args.max_rounds,
+            max_time: args.max_time,
+        }),
         warmup: args.warmup,
         threshold_pct: args.threshold.unwrap_or(AB_THRESHOLD_PCT),
         quiet: args.quiet,
@@ -373,9 +396,5 @@ pub fn run(args: &BenchArgs, matches: Option<&ArgMatches>) -> Result<u8> {
     })?;
     bar.finish_and_clear();
     raywave::output::terminal::print(&ab::report(&options, &results))?;
-    Ok(if ab::regressed(&options, &results) {
-        EXIT_REGRESSION
-    } else {
-        0
-    })
+    Ok(ab::exit_code(&options, &results))
 }

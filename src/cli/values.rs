@@ -26,6 +26,18 @@ where
     })
 }
 
+/// A positive duration in humantime's spelling (`10m`, `90s`, `1h 30m`), refused otherwise
+/// with what was expected (clap names the flag).
+pub fn duration(text: &str) -> Result<std::time::Duration, String> {
+    match humantime::parse_duration(text) {
+        Ok(d) if !d.is_zero() => Ok(d),
+        Ok(_) => Err(format!("expected a positive duration, found `{text}`")),
+        Err(e) => Err(format!(
+            "expected a duration such as 10m, 90s or 1h30m, found `{text}` ({e})"
+        )),
+    }
+}
+
 /// A colour component of `--background` and `--ambient`: finite and not negative.
 pub fn colour_component() -> impl TypedValueParser<Value = f32> {
     float("a finite non-negative colour component", |x: f32| {

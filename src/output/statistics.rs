@@ -21,33 +21,57 @@ pub fn median(xs: &[f64]) -> f64 {
 /// The fewest values that give a 95% interval of the median (see [`median_interval_rank`]).
 pub const MIN_FOR_INTERVAL: usize = 6;
 
-/// The 1-based rank k of the lower end of a 95% interval of the median of n values: for n
-/// values sorted, the median lies between the k-th and the (n − k + 1)-th with probability at
-/// least 95%, k the largest with P(Binomial(n, ½) < k) ≤ 2.5% (the sign test's interval; it
-/// assumes nothing of the distribution). `None` below [`MIN_FOR_INTERVAL`].
+/// The 1-based rank k of the lower end of a 95% interval of the median of n values
+/// ([`median_interval_rank_at`] with `alpha` 0.05). `None` below [`MIN_FOR_INTERVAL`].
 pub fn median_interval_rank(n: usize) -> Option<usize> {
-    // P(X ≤ j) for X ~ Binomial(n, ½), accumulated in f64 (exact enough for n in the
-    // thousands: the terms are ratios of binomial coefficients times 2^-n).
-    let mut k = 0;
-    let mut term = 0.5f64.powi(n as i32); // P(X = j), from j = 0
+    median_interval_rank_at(n, 0.05)
+}
+
+/// The 1-based rank k of the lower end of a (1 − `alpha`) interval of the median of n values:
+/// for n values sorted, the median lies between the k-th and the (n − k + 1)-th with
+/// probability at least 1 − `alpha`, k the largest with P(Binomial(n, ½) < k) ≤ `alpha`/2 (the
+/// sign test's interval; it assumes nothing of the distribution but independent values).
+/// `None` when even the extremes do not reach that level (n below [`min_for_interval_at`]).
+pub fn median_interval_rank_at(n: usize, alpha: f64) -> Option<usize> {
+    debug_assert!(alpha > 0.0 && alpha < 1.0, "alpha {alpha}");
+    let tail = alpha / 2.0;
+    // P(X = j) for X ~ Binomial(n, ½), from j = 0, carried as a logarithm: 2^-n itself is 0
+    // in f64 past n = 1074, and the terms that matter (near the tail) are not.
+    let mut ln_term = -(n as f64) * std::f64::consts::LN_2;
     let mut below = 0.0; // P(X < j)
-    for j in 0..=n {
-        if below + term > 0.025 {
+    let mut k = 0;
+    for j in 0..n {
+        let term = ln_term.exp();
+        if below + term > tail {
             break;
         }
         below += term;
         k = j + 1;
-        term *= (n - j) as f64 / (j + 1) as f64;
+        ln_term += ((n - j) as f64 / (j + 1) as f64).ln();
     }
     (k >= 1).then_some(k)
+}
+
+/// The fewest values that give a (1 − `alpha`) interval of the median: the smallest n whose
+/// extremes already hold it (2^-n ≤ `alpha`/2).
+pub fn min_for_interval_at(alpha: f64) -> usize {
+    (1..)
+        .find(|&n| median_interval_rank_at(n, alpha).is_some())
+        .unwrap_or(usize::MAX)
 }
 
 /// The median of `xs` and its 95% interval ([`median_interval_rank`]); the interval is
 /// (−∞, ∞) with fewer than [`MIN_FOR_INTERVAL`] values. NaN values are ignored.
 pub fn median_with_interval(xs: &[f64]) -> (f64, f64, f64) {
+    median_with_interval_at(xs, 0.05)
+}
+
+/// The median of `xs` and its (1 − `alpha`) interval ([`median_interval_rank_at`]); the
+/// interval is (−∞, ∞) with too few values for that level. NaN values are ignored.
+pub fn median_with_interval_at(xs: &[f64], alpha: f64) -> (f64, f64, f64) {
     let mut v: Vec<f64> = xs.iter().copied().filter(|x| !x.is_nan()).collect();
     v.sort_by(f64::total_cmp);
-    let (low, high) = match median_interval_rank(v.len()) {
+    let (low, high) = match median_interval_rank_at(v.len(), alpha) {
         Some(k) => (v[k - 1], v[v.len() - k]),
         None => (f64::NEG_INFINITY, f64::INFINITY),
     };
@@ -128,6 +152,53 @@ mod tests {
             let k = median_interval_rank(n).unwrap();
             assert!(below(n, k) <= 0.025, "n = {n}, k = {k}");
             assert!(below(n, k + 1) > 0.025, "n = {n}, k + 1 = {}", k + 1);
+        }
+    }
+
+    /// Other levels by the same rule, against the exact sums: the Bonferroni levels of
+    /// `bench --until-decided` (5% over up to 12 looks) among them.
+    #[test]
+    fn the_interval_rank_at_other_levels() {
+        assert_eq!(min_for_interval_at(0.05), MIN_FOR_INTERVAL);
+        for alpha in [0.2, 0.1, 0.01, 0.05 / 9.0, 0.05 / 12.0, 0.001] {
+            let first = min_for_interval_at(alpha);
+            // The extremes of n values hold the median with probability 1 − 2·2^-n.
+            assert!(2f64.powi(-(first as i32)) <= alpha / 2.0, "alpha {alpha}");
+            assert!(
+                2f64.powi(-(first as i32 - 1)) > alpha / 2.0,
+                "alpha {alpha}"
+            );
+            assert_eq!(median_interval_rank_at(first - 1, alpha), None);
+            for n in first..100 {
+                let k = median_interval_rank_at(n, alpha).unwrap();
+                assert!(
+                    below(n, k) <= alpha / 2.0,
+                    "alpha {alpha}, n = {n}, k = {k}"
+                );
+                assert!(
+                    below(n, k + 1) > alpha / 2.0,
+                    "alpha {alpha}, n = {n}, k + 1"
+                );
+            }
+        }
+        // A narrower level gives a wider interval from the same values.
+        let xs: Vec<f64> = (0..40).map(|i| (i * 13 % 40) as f64).collect();
+        let (_, lo95, hi95) = median_with_interval(&xs);
+        let (_, lo99, hi99) = median_with_interval_at(&xs, 0.01);
+        assert!(lo99 < lo95 && hi95 < hi99, "{lo99} {lo95} {hi95} {hi99}");
+    }
+
+    /// Past n = 1074, 2^-n is 0 in f64: the rank must still come from the tail's terms. The
+    /// normal approximation n/2 − 1.96·√n/2 is within a rank or two there.
+    #[test]
+    fn the_interval_rank_of_many_values() {
+        for n in [1_000usize, 2_000, 5_000, 10_000] {
+            let k = median_interval_rank(n).unwrap() as f64;
+            let normal = n as f64 / 2.0 - 1.959964 * (n as f64).sqrt() / 2.0;
+            assert!(
+                (k - normal).abs() < 2.0,
+                "n = {n}: rank {k}, normal {normal}"
+            );
         }
     }
 

@@ -121,3 +121,160 @@ fn a_missing_or_unusable_other_build_is_a_usage_error() {
     let out = raywave(dir.path(), &["bench", "--rounds", "8"]);
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
 }
+
+/// A stand-in build whose render time alternates between a microsecond and a thousand
+/// seconds from one run to the next: the ratios alternate far above and far below 1, so no
+/// interval of their median ever clears the threshold and `--until-decided` must end undecided.
+fn seesaw_build(dir: &Path, rays: &str) -> PathBuf {
+    let path = dir.join("seesaw");
+    let script = format!(
+        "#!/bin/sh\nn=$(cat \"$0.count\" 2>/dev/null || echo 0)\necho $((n + 1)) > \"$0.count\"\n\
+         if [ $((n % 2)) -eq 0 ]; then s=0.000001; else s=1000; fi\n\
+         while [ $# -gt 0 ]; do\n  if [ \"$1\" = --stats-json ]; then \
+         printf '{{\"seconds\": %s, \"rays\": {rays}}}' \"$s\" > \"$2\"; fi\n  shift\ndone\n"
+    );
+    std::fs::write(&path, script).unwrap();
+    std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o755)).unwrap();
+    path
+}
+
+/// `bench --against OTHER --until-decided` at 8×8, wavefront only, no warm-up, plus `extra`.
+fn until_decided(dir: &Path, other: &Path, extra: &[&str]) -> std::process::Output {
+    let mut args = vec![
+        "bench",
+        "--against",
+        other.to_str().unwrap(),
+        "--until-decided",
+        "--size",
+        "8",
+        "8",
+        "--warmup",
+        "0",
+        "--engine",
+        "wavefront",
+        "-q",
+    ];
+    args.extend(extra);
+    raywave(dir, &args)
+}
+
+/// The rounds the report says the engine used (`N rounds used; ...`).
+fn rounds_used(table: &str) -> u32 {
+    let at = table.find(" rounds used").expect(table);
+    let start = table[..at].rfind(char::is_whitespace).unwrap() + 1;
+    table[start..at].parse().expect(table)
+}
+
+#[test]
+fn until_decided_stops_at_the_first_look_that_decides() {
+    let dir = tempfile::tempdir().unwrap();
+    let rays = real_rays(dir.path());
+    // A regression at the default plan's first look, 9 rounds (5% over 9 looks: the fewest
+    // rounds whose extremes hold the median with 99.44%, 2·2^-9 ≤ 0.56%).
+    let out = until_decided(dir.path(), &fake_build(dir.path(), 1e-6, &rays), &[]);
+    assert_eq!(out.status.code(), Some(3), "{}", stderr(&out));
+    let table = stdout(&out);
+    assert!(table.contains("a regression"), "{table}");
+    assert!(table.contains("looks at 9 (slower); decided"), "{table}");
+    assert_eq!(rounds_used(&table), 9, "{table}");
+    // Faster is decided too: exit 0.
+    let out = until_decided(dir.path(), &fake_build(dir.path(), 1000.0, &rays), &[]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    assert!(
+        stdout(&out).contains("faster by more than 5%"),
+        "{}",
+        stdout(&out)
+    );
+}
+
+#[test]
+fn until_decided_ends_undecided_at_the_budget_with_exit_4() {
+    let dir = tempfile::tempdir().unwrap();
+    let rays = real_rays(dir.path());
+    let seesaw = seesaw_build(dir.path(), &rays);
+    let out = until_decided(dir.path(), &seesaw, &["--max-rounds", "14"]);
+    assert_eq!(out.status.code(), Some(4), "{}", stderr(&out));
+    let table = stdout(&out);
+    assert!(table.contains("undecided at the budget"), "{table}");
+    assert!(table.contains("--max-rounds 14 reached"), "{table}");
+    assert_eq!(rounds_used(&table), 14, "{table}");
+    // Out of time long before 10 000 rounds: stopped by --max-time, still exit 4.
+    let started = std::time::Instant::now();
+    let out = until_decided(
+        dir.path(),
+        &seesaw,
+        &["--max-rounds", "10000", "--max-time", "2s"],
+    );
+    assert_eq!(out.status.code(), Some(4), "{}", stderr(&out));
+    let table = stdout(&out);
+    assert!(
+        table.contains("--max-time 2s left too little time for the next look"),
+        "{table}"
+    );
+    assert!(rounds_used(&table) < 10_000, "{table}");
+    // The pace rule stops before a look it cannot reach; a round or two may overrun.
+    assert!(started.elapsed().as_secs_f64() < 10.0, "{table}");
+}
+
+/// This build against itself: no verdict is certain on a shared machine (a sub-millisecond
+/// frame's noise may even call one "slower"), so the test asks only that the exit code is one
+/// of the documented ones and agrees with the report, which names the rounds used.
+#[test]
+fn until_decided_against_itself_reports_its_rounds_and_a_documented_code() {
+    let dir = tempfile::tempdir().unwrap();
+    let this = Path::new(env!("CARGO_BIN_EXE_raywave"));
+    let out = until_decided(dir.path(), this, &["--max-rounds", "9"]);
+    let table = stdout(&out);
+    let expected = if table.contains("a regression") {
+        3
+    } else if table.contains("undecided at the budget") {
+        4
+    } else {
+        0
+    };
+    assert_eq!(out.status.code(), Some(expected), "{table}{}", stderr(&out));
+    assert!((1..=9).contains(&rounds_used(&table)), "{table}");
+    assert!(
+        table.contains("until decided (at most 9 rounds)"),
+        "{table}"
+    );
+}
+
+#[test]
+fn until_decided_flags_are_checked() {
+    let dir = tempfile::tempdir().unwrap();
+    let this = env!("CARGO_BIN_EXE_raywave");
+    for (args, says) in [
+        (
+            &["--against", this, "--until-decided", "--max-rounds", "5"][..],
+            "--max-rounds",
+        ),
+        (&["--until-decided"], "--against"),
+        (&["--max-rounds", "50"], "--until-decided"),
+        (&["--max-time", "10m"], "--until-decided"),
+        (
+            &["--against", this, "--until-decided", "--rounds", "30"],
+            "--rounds",
+        ),
+        (
+            &[
+                "--against",
+                this,
+                "--until-decided",
+                "--max-time",
+                "ten minutes",
+            ],
+            "expected a duration such as 10m",
+        ),
+        (
+            &["--against", this, "--until-decided", "--max-time", "0s"],
+            "expected a positive duration",
+        ),
+    ] {
+        let mut all = vec!["bench"];
+        all.extend(args);
+        let out = raywave(dir.path(), &all);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
+        assert!(stderr(&out).contains(says), "{args:?}: {}", stderr(&out));
+    }
+}

@@ -201,6 +201,15 @@ fn the_shortening_replaces_adds_and_keeps_sweep_points_apart() {
         out.join(" "),
         "variance --seeds 2 --out x --size 16 16 --reference-samples 64 --mask-samples 16"
     );
+    // The A/B mode against this build, in its fewest rounds: `--max-rounds` until decided.
+    let out = shorten(&["bench", "--against", "x", "--until-decided"], quick);
+    assert_eq!(
+        out[1..]
+            .join(" ")
+            .replace(env!("CARGO_BIN_EXE_raywave"), "THIS"),
+        "--against THIS --until-decided --max-rounds 6 --warmup 0 --size 24 24 \
+         --shadow-samples 4"
+    );
     for as_written in [
         &["bench", "compare", "a", "b"][..],
         &["bench", "list"],

@@ -90,7 +90,8 @@ fn subcommand(args: &[String]) -> &str {
 /// `args` with QUICK's values for its subcommand. Every occurrence of a flag is shortened (a
 /// bench sweep repeats `--size`: the k-th size is made 8k pixels wider, so that its points stay
 /// distinct). A `bench --against OTHER` runs against this build itself (an A/A comparison), in
-/// its fewest rounds and without `--runs` (which the A/B mode does not take). `bench compare`,
+/// its fewest rounds (`--max-rounds` with `--until-decided`) and without `--runs` (which the A/B
+/// mode does not take). `bench compare`,
 /// `bench list` and `variance --clean-cache` take no image flags and run as written.
 pub fn shorten(args: &[&str], quick: &Quick) -> Vec<String> {
     let mut out: Vec<String> = args.iter().map(|w| w.to_string()).collect();
@@ -102,7 +103,12 @@ pub fn shorten(args: &[&str], quick: &Quick) -> Vec<String> {
     }
     if let Some(i) = out.iter().position(|w| w == "--against") {
         out[i + 1] = env!("CARGO_BIN_EXE_raywave").to_string();
-        out.extend(["--rounds", "6", "--warmup", "0"].map(String::from));
+        let rounds = if out.iter().any(|w| w == "--until-decided") {
+            "--max-rounds"
+        } else {
+            "--rounds"
+        };
+        out.extend([rounds, "6", "--warmup", "0"].map(String::from));
     }
     let ab = out.iter().any(|w| w == "--against");
     for (s, flag, values) in quick {
@@ -160,12 +166,14 @@ pub fn run_in_page_order(page: &Page) -> usize {
         let out = raywave(dir.path(), &flags);
         let (stdout, stderr) = (stdout(&out), stderr(&out));
         let code = out.status.code();
-        // A comparison of sub-millisecond renders may call noise a regression (exit 3); it must
-        // still have compared.
+        // A comparison of sub-millisecond renders may call noise a regression (exit 3), or leave
+        // it undecided at --until-decided's budget (exit 4); it must still have compared.
+        let until_decided = args.iter().any(|a| a == "--until-decided");
         let compared = code == Some(3)
             && (args.iter().any(|a| a == "--compare" || a == "compare")
                 && stdout.contains("verdict")
-                || args.iter().any(|a| a == "--against") && stdout.contains("95% interval"));
+                || args.iter().any(|a| a == "--against") && stdout.contains("interval"))
+            || code == Some(4) && until_decided && stdout.contains("undecided at the budget");
         assert!(
             code == Some(0) || compared,
             "{}: `{command}` (run as `raywave {}`) exited {code:?}:\n{stdout}\n{stderr}",

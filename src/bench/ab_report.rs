@@ -1,0 +1,137 @@
+//! The text of `raywave bench --against`: the verdict table, and with `--until-decided` the
+//! plan of looks and each engine's rounds and looks.
+
+use super::ab::{AbOptions, EngineAb, Verdict};
+use super::sequential::{self, Budget, LookPlan, Stop};
+use crate::output::statistics::median;
+use std::time::Duration;
+
+/// `--max-time`'s value as typed back (`10m`, `1h 30m`).
+fn duration_text(d: Duration) -> String {
+    humantime::format_duration(Duration::from_secs(d.as_secs().max(1))).to_string()
+}
+
+/// The verdict table.
+pub fn report(options: &AbOptions, results: &[EngineAb]) -> String {
+    let t = options.threshold_pct;
+    let (rounds, plan, level) = match options.until_decided {
+        None => (
+            format!("{} rounds", options.rounds),
+            String::new(),
+            "95% interval".to_string(),
+        ),
+        Some(budget) => {
+            let plan = LookPlan::new(budget.max_rounds);
+            let looks: Vec<String> = plan.looks.iter().map(u32::to_string).collect();
+            (
+                format!(
+                    "until decided (at most {} rounds{})",
+                    budget.max_rounds,
+                    budget
+                        .max_time
+                        .map(|d| format!(", {}", duration_text(d)))
+                        .unwrap_or_default()
+                ),
+                format!(
+                    " · looks at {} rounds, each a {}% interval ({}% split over {} looks)",
+                    looks.join(", "),
+                    round_pct(plan.confidence_pct()),
+                    sequential::ALPHA * 100.0,
+                    plan.split,
+                ),
+                "interval".to_string(),
+            )
+        }
+    };
+    let mut out = format!(
+        "this build / {} · {rounds} after {} warm-up, alternating · threshold {t}%{plan}\n\
+         {:<10} {:>25} {:>25} {:>8} {:>18}  verdict\n",
+        options.other.display(),
+        options.warmup,
+        "engine",
+        "this: median (min–max)",
+        "other: median (min–max)",
+        "ratio",
+        level,
+    );
+    for r in results {
+        let s = r.summary(t);
+        let spread = |xs: &[f64]| {
+            if xs.is_empty() {
+                return "no rounds".to_string();
+            }
+            let (lo, hi) = xs
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+                    (a.min(x), b.max(x))
+                });
+            format!("{:.4} s ({:.3}–{:.3})", median(xs), lo, hi)
+        };
+        let verdict = match (s.verdict, &r.sequential) {
+            (Verdict::Slower, _) => format!("slower by more than {t}%: a regression"),
+            (Verdict::Faster, _) => format!("faster by more than {t}%"),
+            (Verdict::Within, _) => format!("no change beyond {t}%"),
+            (Verdict::Undecided, None) => {
+                "undecided: the interval crosses the threshold; run more rounds".to_string()
+            }
+            (Verdict::Undecided, Some(_)) => "undecided at the budget".to_string(),
+        };
+        out += &format!(
+            "{:<10} {:>25} {:>25} {:>8.4} {:>18}  {verdict}\n",
+            r.engine.name(),
+            spread(&r.this),
+            spread(&r.other),
+            s.median,
+            format!("[{:.4}, {:.4}]", s.low, s.high),
+        );
+        if let (Some(outcome), Some(budget)) = (&r.sequential, options.until_decided) {
+            out += &format!("  {}\n", looks_line(outcome, budget));
+        }
+        if let Some((mine, theirs)) = &r.different_work {
+            out += &format!(
+                "  warning: the builds traced different rays with {} (camera, shadow, \
+                 reflection, total: this {mine}, other {theirs}): the ratio compares \
+                 different work\n",
+                r.engine.name()
+            );
+        }
+    }
+    out
+}
+
+/// A level in percent without trailing zeros: 95, 99.44.
+fn round_pct(pct: f64) -> String {
+    let text = format!("{pct:.2}");
+    text.trim_end_matches('0').trim_end_matches('.').to_string()
+}
+
+/// One engine's rounds and looks: `14 rounds used; looks at 9 (undecided), 14 (slower)`.
+fn looks_line(outcome: &sequential::Outcome, budget: Budget) -> String {
+    let looks: Vec<String> = outcome
+        .looks
+        .iter()
+        .map(|l| {
+            let v = match l.summary.verdict {
+                Verdict::Slower => "slower",
+                Verdict::Faster => "faster",
+                Verdict::Within => "within",
+                Verdict::Undecided => "undecided",
+            };
+            format!("{} ({v})", l.rounds)
+        })
+        .collect();
+    let looks = if looks.is_empty() {
+        "no look taken".to_string()
+    } else {
+        format!("looks at {}", looks.join(", "))
+    };
+    let why = match outcome.stop {
+        Stop::Decided => "decided".to_string(),
+        Stop::MaxRounds => format!("--max-rounds {} reached", budget.max_rounds),
+        Stop::Budget => format!(
+            "--max-time {} left too little time for the next look",
+            budget.max_time.map(duration_text).unwrap_or_default()
+        ),
+    };
+    format!("{} rounds used; {looks}; {why}", outcome.rounds)
+}
