@@ -1,13 +1,17 @@
 //! Command tests: the built binary run as a user runs it: the command line and its errors,
 //! `bench` (records, verdicts, A/B), `diff`, `trace-pixel` and its exports (on
 //! scenes/trace_demo.obj, `trace_demo/`), `view` over HTTP and in a browser, the JSON
-//! Schemas of its output, and every command the documentation shows. One test binary; each
-//! file is a module (docs/TESTING.md).
+//! Schemas of its output, every command the documentation shows, and the batch systems that
+//! run a sharded study (`batch_*`: a real Slurm cluster, GNU parallel, the Kubernetes Jobs of
+//! docs/scaling/). One test binary; each file is a module (docs/TESTING.md).
 
 #[path = "../common/mod.rs"]
 mod common;
 mod trace_demo;
 
+mod batch_k8s;
+mod batch_parallel;
+mod batch_slurm;
 mod bench_ab;
 mod bench_cmd;
 mod bench_verdict;

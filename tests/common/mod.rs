@@ -4,16 +4,21 @@
 //! bias tests' lights and settings), `analytic` (the closed-form penumbra scene), `strategies`
 //! (proptest inputs), `random` (seeded inputs from `rand`), `bin` (running the binary in a
 //! scratch directory), `hostile` (the hostile-input catalogue's harness), `view` (`raywave view`
-//! on a free port, and raw HTTP requests to it).
+//! on a free port, and raw HTTP requests to it), `slurm` (a single-node Slurm cluster in a temp
+//! dir), `gnu_parallel` (a command run once per shard), `skip` (a test that lacks an outside
+//! tool: skipped, or failed in CI).
 #![allow(dead_code, unused_imports)]
 
 pub mod analytic;
 pub mod bin;
 pub mod docs;
+pub mod gnu_parallel;
 pub mod hostile;
 pub mod random;
 pub mod rays;
 pub mod scenes;
+pub mod skip;
+pub mod slurm;
 pub mod strategies;
 pub mod view;
 
