@@ -1,34 +1,65 @@
 //! GNU parallel as a one-machine batch system for raywave's shards (`common::gnu_parallel`):
-//! a command template runs once per shard index, and a shard that fails makes the whole run
-//! fail with its exit code, the shards still running stopped.
+//! a study of two scenes, its references prepared first, run as four shards at once and merged,
+//! gives the single process's figures; and a shard that fails makes the whole run fail with
+//! its exit code, the shards still running stopped.
 //!
 //! Needs Debian's `parallel` (`.ci/run` installs it). Without it the test prints SKIPPED and
 //! passes, unless CI is set: then it fails.
 
 use crate::common;
+use crate::variance_shards::{assert_same_figures, ok, study_dir};
 
-use common::bin::files_in;
+use common::bin::{files_in, raywave, stdout};
 use common::gnu_parallel::run_shards;
 use common::skip::skip_or_fail;
 
 #[test]
-fn every_shard_runs_with_its_index_and_a_failed_one_fails_the_run() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = match run_shards("echo {} > shard-{}", 4, dir.path()) {
+fn a_study_sharded_four_ways_by_gnu_parallel_merges_into_the_single_process_report() {
+    let dir = study_dir();
+    let d = dir.path();
+    let exe = env!("CARGO_BIN_EXE_raywave");
+    ok(&raywave(
+        d,
+        &[
+            "variance",
+            "--study",
+            "study.toml",
+            "--out",
+            "single",
+            "-q",
+            "--no-cache",
+        ],
+    ));
+    ok(&raywave(
+        d,
+        &[
+            "variance",
+            "prepare",
+            "--study",
+            "study.toml",
+            "--cache",
+            "cache",
+            "-q",
+        ],
+    ));
+    let template = format!(
+        "{exe} variance --study study.toml --shard {{}}/4 --cache cache --out parts --threads 1 -q"
+    );
+    let out = match run_shards(&template, 4, d) {
         Ok(out) => out,
         Err(why) => return skip_or_fail(&why),
     };
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{}: {stderr}", out.status);
-    assert_eq!(
-        files_in(dir.path()),
-        ["shard-0", "shard-1", "shard-2", "shard-3"]
-    );
-    for i in 0..4 {
-        let text = std::fs::read_to_string(dir.path().join(format!("shard-{i}"))).unwrap();
-        assert_eq!(text.trim(), i.to_string(), "shard-{i}");
-    }
+    ok(&out);
+    let merged = raywave(d, &["variance", "merge", "parts", "--out", "merged"]);
+    ok(&merged);
+    let said = stdout(&merged);
+    assert!(said.contains("merged  4 shards, 18 jobs"), "{said}");
+    assert!(said.contains("references 0 rendered by a shard"), "{said}");
+    assert_same_figures(&d.join("single"), &d.join("merged"));
+}
 
+#[test]
+fn a_failed_shard_fails_the_run() {
     // Shard 2 fails at once; the others would write their file a few seconds later, but
     // `--halt now,fail=1` stops them first.
     let dir = tempfile::tempdir().unwrap();

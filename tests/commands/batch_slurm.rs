@@ -1,7 +1,8 @@
 //! A real Slurm cluster (`common::slurm`: munged, slurmctld and slurmd in a temp dir) runs a
-//! job array: every task runs, in its working directory, with its own SLURM_ARRAY_TASK_ID,
-//! two at a time on a two-CPU node; and `sbatch --wait` returns non-zero when a task failed or
-//! was killed, which is how a batch run of raywave's shards notices a shard that died.
+//! variance study as a job array: `sbatch --array=0-3 --wait`, task I running shard I/4 on the
+//! references `variance prepare` rendered ahead, then `variance merge` gives the single
+//! process's figures. `sbatch --wait` returns non-zero when a task failed or was killed, and
+//! the merge of what the others left names the shard that died.
 //!
 //! Needs Debian's `slurm-wlm` and `munge` (`.ci/run` installs them). When the cluster cannot
 //! start, the test says why, with the daemons' logs: it prints SKIPPED and passes, unless CI is
@@ -9,7 +10,8 @@
 
 use crate::common;
 
-use common::bin::files_in;
+use crate::variance_shards::{assert_same_figures, ok, study_dir};
+use common::bin::{files_in, raywave, stderr, stdout};
 use common::skip::skip_or_fail;
 use common::slurm::SlurmCluster;
 use std::path::{Path, PathBuf};
@@ -37,28 +39,64 @@ fn script(tmp: &Path, name: &str, body: &str) -> (PathBuf, PathBuf) {
     (path, work)
 }
 
+/// The array script of a study's shards: task I runs shard I/4 of `study.toml` in its working
+/// directory, on the cache the shards share; with `die_at`, that task exits 7 first.
+fn shards_script(tmp: &Path, name: &str, die_at: Option<u32>) -> (PathBuf, PathBuf) {
+    let exe = env!("CARGO_BIN_EXE_raywave");
+    let die = die_at.map_or(String::new(), |i| {
+        format!("[ \"$SLURM_ARRAY_TASK_ID\" = {i} ] && exit 7\n")
+    });
+    script(
+        tmp,
+        name,
+        &format!(
+            "set -e\n{die}exec {exe} variance --study study.toml --shard \"$SLURM_ARRAY_TASK_ID/4\" \\
+             --cache cache --out parts --threads 1 -q\n"
+        ),
+    )
+}
+
+/// Copies the study of `variance_shards` (the file and its scenes) into `work`.
+fn study_into(work: &Path) {
+    let study = study_dir();
+    for e in std::fs::read_dir(study.path()).unwrap() {
+        let e = e.unwrap();
+        std::fs::copy(e.path(), work.join(e.file_name())).unwrap();
+    }
+}
+
 #[test]
-fn an_array_job_runs_every_task_in_its_workdir_two_at_a_time() {
+fn a_study_submitted_as_an_array_job_merges_into_the_single_process_report() {
     let tmp = tempfile::tempdir().unwrap();
     let Some(cluster) = cluster(tmp.path()) else {
         return;
     };
-    // Each task marks itself running, then waits (up to 30 s) until it sees as many marks
-    // as the node runs tasks at once, and writes its index and the marks it saw. The first
-    // task to start sees a second mark only if a second task runs beside it.
-    let at_once = cluster.cpus().min(2);
-    let (path, work) = script(
-        tmp.path(),
-        "array.sh",
-        &format!(
-            "set -e
-touch \"running-$SLURM_ARRAY_TASK_ID\"
-i=0
-while [ \"$(ls running-* | wc -l)\" -lt {at_once} ] && [ $i -lt 300 ]; do sleep 0.1; i=$((i+1)); done
-echo \"$SLURM_ARRAY_TASK_ID $(ls running-* | wc -l)\" > \"task-$SLURM_ARRAY_TASK_ID\"
-"
-        ),
-    );
+    let (path, work) = shards_script(tmp.path(), "shards.sh", None);
+    study_into(&work);
+    ok(&raywave(
+        &work,
+        &[
+            "variance",
+            "--study",
+            "study.toml",
+            "--out",
+            "single",
+            "-q",
+            "--no-cache",
+        ],
+    ));
+    ok(&raywave(
+        &work,
+        &[
+            "variance",
+            "prepare",
+            "--study",
+            "study.toml",
+            "--cache",
+            "cache",
+            "-q",
+        ],
+    ));
     let out = cluster.sbatch_array_wait(&path, 0..4, &work).unwrap();
     let logs = || format!("{}{}", cluster.task_logs(), cluster.log_tails());
     assert!(
@@ -68,21 +106,16 @@ echo \"$SLURM_ARRAY_TASK_ID $(ls running-* | wc -l)\" > \"task-$SLURM_ARRAY_TASK
         String::from_utf8_lossy(&out.stderr),
         logs()
     );
-    let mut expected: Vec<String> = (0..4).map(|i| format!("running-{i}")).collect();
-    expected.extend((0..4).map(|i| format!("task-{i}")));
-    assert_eq!(files_in(&work), expected, "{}", logs());
-    for i in 0..4 {
-        let text = std::fs::read_to_string(work.join(format!("task-{i}"))).unwrap();
-        let words: Vec<&str> = text.split_whitespace().collect();
-        assert_eq!(words[0], i.to_string(), "task-{i} holds {text:?}");
-        let seen: u32 = words[1].parse().unwrap();
-        assert!(
-            seen >= at_once,
-            "task {i} saw {seen} task(s) running, not {at_once}: the node ran the array's \
-             tasks one at a time\n{}",
-            logs()
-        );
-    }
+    let merged = raywave(&work, &["variance", "merge", "parts", "--out", "merged"]);
+    ok(&merged);
+    let said = stdout(&merged);
+    assert!(
+        said.contains("merged  4 shards, 18 jobs"),
+        "{said}\n{}",
+        logs()
+    );
+    assert!(said.contains("references 0 rendered by a shard"), "{said}");
+    assert_same_figures(&work.join("single"), &work.join("merged"));
 }
 
 #[test]
@@ -91,12 +124,10 @@ fn a_task_that_fails_or_is_killed_fails_sbatch_wait() {
     let Some(cluster) = cluster(tmp.path()) else {
         return;
     };
-    // Task 2 fails; the others run to their end and write their files.
-    let (path, work) = script(
-        tmp.path(),
-        "fails.sh",
-        "[ \"$SLURM_ARRAY_TASK_ID\" = 2 ] && exit 7\ntouch \"task-$SLURM_ARRAY_TASK_ID\"\n",
-    );
+    // Shard 2 dies; the others run to their end and write their parts, and the merge names
+    // the shard that is missing.
+    let (path, work) = shards_script(tmp.path(), "fails.sh", Some(2));
+    study_into(&work);
     let out = cluster.sbatch_array_wait(&path, 0..4, &work).unwrap();
     assert_eq!(
         out.status.code(),
@@ -104,7 +135,22 @@ fn a_task_that_fails_or_is_killed_fails_sbatch_wait() {
         "sbatch --wait returns the failed task's exit code\n{}",
         cluster.task_logs()
     );
-    assert_eq!(files_in(&work), ["task-0", "task-1", "task-3"]);
+    assert_eq!(
+        files_in(&work.join("parts")),
+        [
+            "shard-0-of-4.part",
+            "shard-1-of-4.part",
+            "shard-3-of-4.part"
+        ]
+    );
+    let merged = raywave(&work, &["variance", "merge", "parts", "--out", "merged"]);
+    assert_eq!(merged.status.code(), Some(1));
+    assert!(
+        stderr(&merged).contains("shard 2/4 is missing"),
+        "{}",
+        stderr(&merged)
+    );
+    assert!(!work.join("merged").exists());
     // Task 1 dies of a signal, as a shard killed by the kernel or an operator would.
     let (path, work) = script(
         tmp.path(),

@@ -22,7 +22,7 @@ mask_samples = 16
 "#;
 
 /// A scratch directory with the study file and its two scenes.
-fn study_dir() -> tempfile::TempDir {
+pub(crate) fn study_dir() -> tempfile::TempDir {
     let dir = tempfile::tempdir().unwrap();
     for name in ["cornell_box.obj", "two_lights.obj"] {
         std::fs::copy(scenes().join(name), dir.path().join(name)).unwrap();
@@ -31,7 +31,7 @@ fn study_dir() -> tempfile::TempDir {
     dir
 }
 
-fn ok(out: &std::process::Output) {
+pub(crate) fn ok(out: &std::process::Output) {
     assert!(
         out.status.success(),
         "exit {:?}\nstdout:\n{}\nstderr:\n{}",
@@ -102,6 +102,35 @@ fn shards(dir: &Path, extra: &[&str]) {
     }
 }
 
+/// Asserts that the reports of [`STUDY`] in `single` and `merged` hold the same figures: each
+/// case's results.json but for its timings, its perceived-error and spectrum tables, its
+/// contact sheet and a heat map, and the whole summary across the cases.
+pub(crate) fn assert_same_figures(single: &Path, merged: &Path) {
+    for case in ["cornell_box", "two_lights"] {
+        let (a, b) = (single.join(case), merged.join(case));
+        assert_eq!(figures(&a), figures(&b), "{case}: results.json");
+        for file in [
+            "perceived.csv",
+            "spectra.csv",
+            "contact_sheet.png",
+            "heat_sobol_N16.png",
+        ] {
+            assert!(
+                bytes(&a.join(file)) == bytes(&b.join(file)),
+                "{case}/{file} differs"
+            );
+        }
+    }
+    // The summary across the scenes holds no timing: the whole file is the same.
+    for file in ["summary.json", "summary.csv"] {
+        assert_eq!(
+            String::from_utf8(bytes(&single.join(file))).unwrap(),
+            String::from_utf8(bytes(&merged.join(file))).unwrap(),
+            "{file}"
+        );
+    }
+}
+
 #[test]
 fn a_four_way_sharded_study_merges_into_the_single_process_report() {
     let dir = study_dir();
@@ -124,29 +153,7 @@ fn a_four_way_sharded_study_merges_into_the_single_process_report() {
     let said = stdout(&merged);
     assert!(said.contains("merged  4 shards, 18 jobs, 1 host"), "{said}");
     assert!(said.contains("across the cases"), "{said}");
-    for case in ["cornell_box", "two_lights"] {
-        let (a, b) = (d.join("single").join(case), d.join("merged").join(case));
-        assert_eq!(figures(&a), figures(&b), "{case}: results.json");
-        for file in [
-            "perceived.csv",
-            "spectra.csv",
-            "contact_sheet.png",
-            "heat_sobol_N16.png",
-        ] {
-            assert!(
-                bytes(&a.join(file)) == bytes(&b.join(file)),
-                "{case}/{file} differs"
-            );
-        }
-    }
-    // The summary across the scenes holds no timing: the whole file is the same.
-    for file in ["summary.json", "summary.csv"] {
-        assert_eq!(
-            String::from_utf8(bytes(&d.join("single").join(file))).unwrap(),
-            String::from_utf8(bytes(&d.join("merged").join(file))).unwrap(),
-            "{file}"
-        );
-    }
+    assert_same_figures(&d.join("single"), &d.join("merged"));
     let summary: Value = serde_json::from_slice(&bytes(&d.join("merged/summary.json"))).unwrap();
     let slope = summary["slopes"]
         .as_array()
