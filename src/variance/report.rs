@@ -249,6 +249,20 @@ impl StudyResult {
             "[low, high]: 95% intervals (MSE, efficiency, slopes, budgets: bootstrap over the \
              seeds; time: the median's sign-test interval, from 6 seeds)"
         );
+        let mut hosts: Vec<&str> = Vec::new();
+        for r in &self.rows {
+            if !hosts.contains(&r.host.as_str()) {
+                hosts.push(&r.host);
+            }
+        }
+        if hosts.len() > 1 {
+            let _ = writeln!(
+                s,
+                "timed on {} hosts ({}): each row's times and efficiencies are its host's (results.csv, column host)",
+                hosts.len(),
+                hosts.join(", ")
+            );
+        }
         for (i, region) in Region::ALL.iter().enumerate() {
             if self.region_pixels[i] == 0 {
                 let _ = writeln!(
@@ -370,7 +384,7 @@ impl StudyResult {
              excluded_from_fit,seconds,seconds_low,seconds_high,rays,rays_per_second,\
              efficiency,efficiency_low,efficiency_high,efficiency_vs_random,\
              efficiency_vs_random_low,efficiency_vs_random_high,error_reduction,\
-             error_reduction_low,error_reduction_high\n",
+             error_reduction_low,error_reduction_high,host\n",
         );
         let iv = |i: Option<[f64; 2]>| match i {
             Some([a, b]) => format!("{a:e},{b:e}"),
@@ -379,7 +393,7 @@ impl StudyResult {
         for r in &self.rows {
             let _ = writeln!(
                 s,
-                "{},{},{},{},{:e},{},{:e},{:e},{:e},{},{:e},{},{},{:e},{:e},{},{},{},{},{}",
+                "{},{},{},{},{:e},{},{:e},{:e},{:e},{},{:e},{},{},{:e},{:e},{},{},{},{},{},{}",
                 r.sampler,
                 r.n,
                 r.region.name(),
@@ -403,7 +417,8 @@ impl StudyResult {
                 r.error_reduction
                     .map(|v| format!("{v:e}"))
                     .unwrap_or_default(),
-                iv(r.error_reduction_interval)
+                iv(r.error_reduction_interval),
+                r.host
             );
         }
         s

@@ -260,3 +260,51 @@ fn doctored_records_do_not_validate() {
         );
     }
 }
+
+/// The study file's schema (docs/schema/study.schema.json): the checked-in file is the one
+/// `StudyFile` generates, a study file the tests run (read by Python's own TOML parser)
+/// validates, and one with a misspelt key, a seed count below two or a size of one number
+/// does not.
+#[test]
+fn the_study_file_schema_is_the_generated_one_and_judges_study_files() {
+    let name = "study.schema.json";
+    let generated = raywave::variance::study_file::schema();
+    let path = schema_dir().join(name);
+    if std::env::var_os("RAYWAVE_UPDATE_SCHEMA").is_some_and(|v| v == "1") {
+        std::fs::write(&path, &generated).unwrap();
+    }
+    assert!(
+        std::fs::read_to_string(&path).unwrap_or_default() == generated,
+        "docs/schema/{name} differs from the schema `StudyFile` generates: run \
+         `RAYWAVE_UPDATE_SCHEMA=1 cargo test --release --test commands schema::` and review the diff"
+    );
+    let Some(python) = python() else { return };
+    let toml = |text: &str| -> Value {
+        let out = std::process::Command::new(python)
+            .args([
+                "-c",
+                "import json, sys, tomllib; print(json.dumps(tomllib.loads(sys.argv[1])))",
+            ])
+            .arg(text)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        serde_json::from_slice(&out.stdout).unwrap()
+    };
+    assert_valid(python, name, &toml(crate::variance_shards::STUDY));
+    for bad in [
+        "budget = [4]",
+        "seeds = 1",
+        "sizes = [[8]]",
+        "samplers = [\"randm\"]",
+    ] {
+        assert!(
+            !violations(python, name, &toml(bad)).is_empty(),
+            "{bad} validates against docs/schema/{name}"
+        );
+    }
+}

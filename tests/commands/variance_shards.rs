@@ -11,7 +11,7 @@ use serde_json::Value;
 use std::path::Path;
 
 /// A study of two scenes, small enough to run in a second.
-const STUDY: &str = r#"
+pub(crate) const STUDY: &str = r#"
 scenes = ["cornell_box.obj", "two_lights.obj"]
 samplers = ["random", "stratified", "sobol"]
 budgets = [1, 4, 16]
