@@ -211,7 +211,7 @@ fn with_progress<T>(
 ) -> Result<T> {
     let bar = progress_bar(
         0,
-        "{spinner} {prefix} [{bar:30}] {human_pos}/{human_len} rays, {msg} ({elapsed}, eta {eta})",
+        "{spinner} {prefix} [{bar:30}] ~{human_pos}/{human_len} rays, {msg} ({elapsed}, eta {eta})",
         options.quiet,
     );
     bar.set_prefix(prefix);
@@ -270,7 +270,9 @@ pub fn run(args: &VarianceArgs) -> Result<()> {
     if let Some(shard) = args.shard {
         let part = options.out.join(raywave::variance::part::file_name(shard));
         plan.output_in_new_dir("--out", &part).check()?;
-        let prefix = format!("variance shard {shard}");
+        let identity = raywave::variance::plan::identity(&cases, options.engine.name());
+        let jobs = identity.assignment(shard.count)[shard.index as usize].len();
+        let prefix = format!("variance shard {shard}, {jobs} jobs");
         let (path, jobs) = with_progress(&options, prefix, |render, hooks| {
             pool.install(|| run_shard(&options, &cases, shard, render, hooks))
         })?;
@@ -285,7 +287,11 @@ pub fn run(args: &VarianceArgs) -> Result<()> {
         plan = plan.output_in_new_dir("--out", &options.out.join(name));
     }
     plan.check()?;
-    let outcome = with_progress(&options, "variance".into(), |render, hooks| {
+    let jobs = raywave::variance::plan::identity(&cases, options.engine.name())
+        .jobs()
+        .len();
+    let prefix = format!("variance, {jobs} jobs");
+    let outcome = with_progress(&options, prefix, |render, hooks| {
         pool.install(|| study(&options, &cases, render, hooks))
     })?;
     let cached = outcome
