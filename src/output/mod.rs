@@ -19,6 +19,7 @@ pub mod image_file;
 pub mod machine;
 pub mod memory;
 pub mod render_record;
+pub mod shard;
 pub mod statistics;
 pub mod terminal;
 pub(crate) mod write;
