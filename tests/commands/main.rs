@@ -10,6 +10,7 @@ mod trace_demo;
 
 mod bench_ab;
 mod bench_cmd;
+mod bench_shards;
 mod bench_verdict;
 mod cli;
 mod cli_errors;
