@@ -379,12 +379,9 @@ pub fn run(args: &BenchArgs, matches: Option<&ArgMatches>) -> Result<u8> {
             let options = m.options();
             let text = merge::merge(&options)?.text(m.quiet);
             // Standard output may carry an export; the report then goes to stderr.
-            if options
-                .exports
-                .flags()
-                .iter()
-                .any(|(_, p)| p.as_os_str() == "-")
-            {
+            let plan = (options.exports.flags().into_iter())
+                .fold(OutputPlan::new(), |plan, (flag, p)| plan.output(flag, p));
+            if plan.uses_stdout() {
                 eprint!("{text}");
             } else {
                 raywave::output::terminal::print(&text)?;

@@ -11,6 +11,7 @@ mod trace_demo;
 mod bench_ab;
 mod bench_cmd;
 mod bench_shards;
+mod bench_trackers;
 mod bench_verdict;
 mod cli;
 mod cli_errors;
