@@ -289,8 +289,14 @@ pub fn read_part(path: &Path) -> Result<Part> {
 /// The first way `part` contradicts itself, if any.
 fn inconsistency(part: &Part) -> Option<String> {
     let Shard { index, count } = part.shard;
-    if count == 0 || index >= count {
-        return Some(format!("shard {index}/{count}, expected I < N"));
+    if count == 0 || index >= count || count > crate::output::shard::MAX_SHARDS {
+        return Some(format!(
+            "shard {index}/{count}, expected I < N <= {}",
+            crate::output::shard::MAX_SHARDS
+        ));
+    }
+    if part.sweep.points.is_empty() {
+        return Some("a sweep of no points, expected at least one".into());
     }
     let expected = part.shard.items(&part.sweep.costs());
     if part.points != expected {
