@@ -13,16 +13,23 @@
 //! compare -> verdict (median change past the threshold AND intervals apart); write --save
 //!   (never over the record it regressed against), --json and the exports; return the outcome
 //! ```
+//!
+//! With `--shard I/N` only this shard's points of the sweep are timed (split by estimated
+//! cost, shard.rs) and written to one part file; `raywave bench merge` (merge.rs) puts the
+//! parts back together.
 
 pub mod ab;
 mod ab_report;
 pub(crate) mod adopt;
 pub mod compare;
-pub(crate) mod export;
+pub(crate) mod continuous;
+pub mod export;
 pub mod list;
 pub(crate) mod measure;
+pub mod merge;
 pub(crate) mod report;
 pub mod sequential;
+pub mod shard;
 pub mod sweep;
 
 use crate::output::bench_record::{self as record, BenchRecord, SceneId, Setup};
@@ -85,6 +92,12 @@ pub struct BenchOptions {
     pub export_csv: Option<PathBuf>,
     /// Write every point's headline figures as a Markdown table to this file.
     pub export_markdown: Option<PathBuf>,
+    /// Write every point's headline figures in Bencher Metric Format to this file.
+    pub export_bmf: Option<PathBuf>,
+    /// Write every point's headline figures as github-action-benchmark's JSON to this file.
+    pub export_github_action_benchmark: Option<PathBuf>,
+    /// Time only this shard's points and write them to a part file in this directory.
+    pub shard: Option<(crate::output::shard::Shard, PathBuf)>,
     /// The flags given on the command line (clap ids: `size`, `threads`, `engine`, ...):
     /// with `--compare`, every other setting comes from the record.
     pub explicit: Vec<String>,
@@ -101,6 +114,8 @@ pub struct Outcome {
     pub saved: Vec<PathBuf>,
     /// The comparison and the record compared with, if asked for.
     pub comparison: Option<(compare::Comparison, BenchRecord)>,
+    /// With `--shard`: the part file written, and the shard and point count of the sweep.
+    pub part: Option<(PathBuf, crate::output::shard::Shard, usize)>,
 }
 
 impl Outcome {
@@ -241,6 +256,41 @@ pub fn run(args: &BenchOptions, hooks: &Hooks) -> Result<Outcome> {
         });
     }
 
+    // A shard times only its share of the sweep, split by every point's estimated cost.
+    let build = crate::output::build_info::current();
+    let simd = crate::simd_path_for(args.lanes).to_string();
+    let sweep_points = plans.len();
+    let shard_run = match &args.shard {
+        Some((which, dir)) => {
+            let identity = shard::SweepIdentity {
+                raywave: env!("CARGO_PKG_VERSION").to_string(),
+                build: build.clone(),
+                simd: simd.clone(),
+                engines: args.engines.iter().map(|e| e.name().to_string()).collect(),
+                runs: args.runs,
+                warmup: args.warmup,
+                points: plans
+                    .iter()
+                    .map(|p| shard::SweepPoint {
+                        label: p.point.label.clone(),
+                        setup: p.setup.clone(),
+                        cost: shard::cost(&p.setup, args.runs, args.warmup),
+                    })
+                    .collect(),
+            };
+            let mine = which.items(&identity.costs());
+            plans = plans
+                .into_iter()
+                .enumerate()
+                .filter(|(i, _)| mine.contains(i))
+                .map(|(_, p)| p)
+                .collect();
+            Some((*which, dir, identity, mine))
+        }
+        None => None,
+    };
+    let started = (shard::now_millis(), std::time::Instant::now());
+
     if let Some(w) = report::load_warning() {
         (hooks.notice)(&format!("warning: {w}"));
     }
@@ -254,7 +304,6 @@ pub fn run(args: &BenchOptions, hooks: &Hooks) -> Result<Outcome> {
         (hooks.progress)(n, total, "");
     };
     (hooks.progress)(0, total, "");
-    let build = crate::output::build_info::current();
     let mut records = Vec::new();
     for plan in &plans {
         let engines = measure::measure(
@@ -282,7 +331,7 @@ pub fn run(args: &BenchOptions, hooks: &Hooks) -> Result<Outcome> {
                 os: std::env::consts::OS.to_string(),
                 arch: std::env::consts::ARCH.to_string(),
             },
-            simd: crate::simd_path_for(args.lanes).to_string(),
+            simd: simd.clone(),
             setup: plan.setup.clone(),
             runs: args.runs,
             warmup: args.warmup,
@@ -328,20 +377,37 @@ pub fn run(args: &BenchOptions, hooks: &Hooks) -> Result<Outcome> {
         export::write(p, &format!("{}\n", serde_json::to_string_pretty(record)?))?;
     }
     let labels: Vec<String> = plans.iter().map(|p| p.point.label.clone()).collect();
-    if let Some(p) = &args.export_json {
-        export::write(p, &export::json(&records)?)?;
+    export::Exports {
+        json: args.export_json.clone(),
+        csv: args.export_csv.clone(),
+        markdown: args.export_markdown.clone(),
+        bmf: args.export_bmf.clone(),
+        github_action_benchmark: args.export_github_action_benchmark.clone(),
     }
-    if let Some(p) = &args.export_csv {
-        export::write(p, &export::csv(&records, &labels))?;
-    }
-    if let Some(p) = &args.export_markdown {
-        export::write(p, &export::markdown(&records, &labels))?;
-    }
+    .write(&records, &labels, false)?;
+    let part = match shard_run {
+        Some((which, dir, sweep, points)) => {
+            let part = shard::Part {
+                sweep,
+                shard: which,
+                points,
+                labels: labels.clone(),
+                host: Machine::current(),
+                started: started.0,
+                finished: shard::now_millis(),
+                seconds: started.1.elapsed().as_secs_f64(),
+                records: records.clone(),
+            };
+            Some((shard::write_part(dir, &part)?, which, sweep_points))
+        }
+        None => None,
+    };
     Ok(Outcome {
         records,
         labels,
         saved,
         comparison: comparison.zip(baseline.map(|(_, before)| before)),
+        part,
     })
 }
 
@@ -360,6 +426,23 @@ impl Outcome {
             for path in &self.saved {
                 out.push_str(&format!("saved   {}\n", path.display()));
             }
+        }
+        if let (false, Some((path, which, of))) = (quiet, &self.part) {
+            let points = if self.labels.iter().all(|l| l.is_empty()) {
+                format!("{} point(s)", self.labels.len())
+            } else {
+                self.labels.join(", ")
+            };
+            out.push_str(&format!(
+                "shard   {which}: {} of the sweep's {of} point(s), split by estimated cost\n\
+                 wrote   {}\n",
+                if self.labels.is_empty() {
+                    "none".to_string()
+                } else {
+                    points
+                },
+                path.display()
+            ));
         }
         if let Some((c, before)) = &self.comparison {
             if !quiet {

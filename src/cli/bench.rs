@@ -1,5 +1,6 @@
 //! `raywave bench` flags, turned into `raywave::bench::BenchOptions`; `raywave bench compare
-//! A B` and `raywave bench list` for saved records.
+//! A B` and `raywave bench list` for saved records; `raywave bench merge` for the part files
+//! of `--shard`.
 
 use super::image::ImageArgs;
 use super::values::float;
@@ -8,11 +9,15 @@ use clap::parser::ValueSource;
 use clap::{ArgAction, ArgMatches, Args, Subcommand, ValueEnum};
 use raywave::bench::ab::{self, AbOptions, MIN_ROUNDS};
 use raywave::bench::sequential;
+use raywave::bench::export::Exports;
+use raywave::bench::merge::{self, MergeOptions};
+use raywave::bench::shard::part_name;
 use raywave::bench::sweep::{Sweep, record_name};
 use raywave::bench::{BenchOptions, DEFAULT_RUNS, DEFAULT_THRESHOLD_PCT, EXIT_REGRESSION, list};
 use raywave::output::OutputPlan;
 use raywave::output::bench_record::record_path;
 use raywave::output::memory::{self, RenderFootprint};
+use raywave::output::shard::Shard;
 use raywave::render::engine::{Engine, Hooks};
 use raywave::render::error::UsageError;
 use std::path::PathBuf;
@@ -113,6 +118,22 @@ pub struct BenchArgs {
     /// Write every point's headline figures to FILE as a Markdown table (`-` for stdout).
     #[arg(long, value_name = "FILE")]
     pub export_markdown: Option<PathBuf>,
+    /// Write every point's headline figures to FILE in Bencher Metric Format (`-` for stdout).
+    #[arg(long, value_name = "FILE", conflicts_with = "against")]
+    pub export_bmf: Option<PathBuf>,
+    /// Write every point's headline figures to FILE as github-action-benchmark's
+    /// `customBiggerIsBetter` JSON (`-` for stdout).
+    #[arg(long, value_name = "FILE", conflicts_with = "against")]
+    pub export_github_action_benchmark: Option<PathBuf>,
+    /// Time only shard I of N of the sweep's points (0-based; split by estimated cost) and
+    /// write them to DIR/bench-shard-I-of-N.json for `raywave bench merge`.
+    #[arg(long, value_name = "I/N", requires = "out",
+          conflicts_with_all = ["against", "save", "compare", "json", "export_json", "export_csv",
+          "export_markdown", "export_bmf", "export_github_action_benchmark"])]
+    pub shard: Option<Shard>,
+    /// The directory of --shard's part file (created if missing).
+    #[arg(long, value_name = "DIR", requires = "shard")]
+    pub out: Option<PathBuf>,
     /// Print only the comparison (or nothing but errors without --compare); no progress bar.
     #[arg(short, long)]
     pub quiet: bool,
@@ -147,6 +168,65 @@ pub enum BenchAction {
     Compare(CompareArgs),
     /// List the saved records: name, date, commit, scene, settings, threads, total medians.
     List(ListArgs),
+    /// Merge the part files of `raywave bench --shard I/N` into the sweep's reports, exports
+    /// and records; refuses missing, duplicated, damaged or mismatched parts.
+    Merge(MergeArgs),
+}
+
+/// Flags of `raywave bench merge`.
+#[derive(Args, Debug, Clone)]
+pub struct MergeArgs {
+    /// The part files (DIR/bench-shard-I-of-N.json), every shard of one sweep once.
+    #[arg(required = true, value_name = "PARTS")]
+    pub parts: Vec<PathBuf>,
+    /// Accept parts measured on different machines: every report, row and exported name
+    /// then carries its host, the points grouped by host.
+    #[arg(long)]
+    pub across_machines: bool,
+    /// Save each point as DIR/NAME+POINT.json (DIR/NAME.json for a sweep of one point).
+    #[arg(long, value_name = "NAME")]
+    pub save: Option<String>,
+    /// Directory of saved records.
+    #[arg(long, default_value = ".raywave-bench")]
+    pub dir: PathBuf,
+    /// Write every point's record to FILE as a JSON array (`-` for stdout).
+    #[arg(long, value_name = "FILE")]
+    pub export_json: Option<PathBuf>,
+    /// Write every point's headline figures to FILE as CSV (`-` for stdout).
+    #[arg(long, value_name = "FILE")]
+    pub export_csv: Option<PathBuf>,
+    /// Write every point's headline figures to FILE as a Markdown table (`-` for stdout).
+    #[arg(long, value_name = "FILE")]
+    pub export_markdown: Option<PathBuf>,
+    /// Write every point's headline figures to FILE in Bencher Metric Format (`-` for stdout).
+    #[arg(long, value_name = "FILE")]
+    pub export_bmf: Option<PathBuf>,
+    /// Write every point's headline figures to FILE as github-action-benchmark's
+    /// `customBiggerIsBetter` JSON (`-` for stdout).
+    #[arg(long, value_name = "FILE")]
+    pub export_github_action_benchmark: Option<PathBuf>,
+    /// Print only what was merged, not every point's report.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+impl MergeArgs {
+    /// The flags as the library's options.
+    fn options(&self) -> MergeOptions {
+        MergeOptions {
+            parts: self.parts.clone(),
+            exports: Exports {
+                json: self.export_json.clone(),
+                csv: self.export_csv.clone(),
+                markdown: self.export_markdown.clone(),
+                bmf: self.export_bmf.clone(),
+                github_action_benchmark: self.export_github_action_benchmark.clone(),
+            },
+            save: self.save.clone(),
+            dir: self.dir.clone(),
+            across_machines: self.across_machines,
+        }
+    }
 }
 
 /// Flags of `raywave bench compare`.
@@ -237,6 +317,9 @@ impl BenchArgs {
             export_json: self.export_json.clone(),
             export_csv: self.export_csv.clone(),
             export_markdown: self.export_markdown.clone(),
+            export_bmf: self.export_bmf.clone(),
+            export_github_action_benchmark: self.export_github_action_benchmark.clone(),
+            shard: self.shard.zip(self.out.clone()),
             explicit,
         }
     }
@@ -276,10 +359,18 @@ fn output_plan(args: &BenchArgs, points: &[raywave::bench::sweep::Point]) -> Out
         ("--export-json", &args.export_json),
         ("--export-csv", &args.export_csv),
         ("--export-markdown", &args.export_markdown),
+        ("--export-bmf", &args.export_bmf),
+        (
+            "--export-github-action-benchmark",
+            &args.export_github_action_benchmark,
+        ),
     ] {
         if let Some(p) = path {
             plan = plan.output(flag, p);
         }
+    }
+    if let (Some(shard), Some(dir)) = (args.shard, &args.out) {
+        plan = plan.output_in_new_dir("--out", &dir.join(part_name(shard)));
     }
     plan
 }
@@ -301,6 +392,19 @@ pub fn run(args: &BenchArgs, matches: Option<&ArgMatches>) -> Result<u8> {
                 eprintln!("warning: {w}");
             }
             raywave::output::terminal::print(&table)?;
+            return Ok(0);
+        }
+        Some(BenchAction::Merge(m)) => {
+            let options = m.options();
+            let text = merge::merge(&options)?.text(m.quiet);
+            // Standard output may carry an export; the report then goes to stderr.
+            let plan = (options.exports.flags().into_iter())
+                .fold(OutputPlan::new(), |plan, (flag, p)| plan.output(flag, p));
+            if plan.uses_stdout() {
+                eprint!("{text}");
+            } else {
+                raywave::output::terminal::print(&text)?;
+            }
             return Ok(0);
         }
         None => {}

@@ -20,7 +20,7 @@ pub struct Merged {
     /// The part files read.
     pub parts: Vec<PathBuf>,
     /// Shards in the study.
-    pub shards: u32,
+    pub shards: usize,
     /// Jobs in the study.
     pub jobs: usize,
     /// Per host: its name, the shards and jobs it ran, and its shards' summed wall time.

@@ -124,7 +124,7 @@ impl StudyIdentity {
     }
 
     /// The job numbers of each of `count` shards.
-    pub fn assignment(&self, count: u32) -> Vec<Vec<usize>> {
+    pub fn assignment(&self, count: usize) -> Vec<Vec<usize>> {
         crate::output::shard::partition(&self.costs(), count)
     }
 

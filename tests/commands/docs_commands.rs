@@ -213,6 +213,13 @@ fn the_shortening_replaces_adds_and_keeps_sweep_points_apart() {
     for as_written in [
         &["bench", "compare", "a", "b"][..],
         &["bench", "list"],
+        &[
+            "bench",
+            "merge",
+            "parts/bench-shard-0-of-2.json",
+            "--export-bmf",
+            "b.json",
+        ],
         &["variance", "--clean-cache"],
     ] {
         assert_eq!(shorten(as_written, quick), as_written);
@@ -285,5 +292,79 @@ fn the_checker_refuses_what_ci_does_not_run() {
     ] {
         let words: Vec<&str> = good.split_whitespace().collect();
         assert_eq!(check_cargo(&words), Ok(()), "`{good}`");
+    }
+}
+
+/// docs/examples/bench-regression.yml, the pull-request gate BENCHMARKING.md shows: valid
+/// YAML (when python3 has PyYAML), run on pull requests, building the base and the head and
+/// timing one against the other, failing on exit 3 and only warning on 4; its export step
+/// runs here with this build (shortened), so its flags cannot rot.
+#[test]
+fn the_ci_workflow_example_gates_on_a_regression_and_its_exports_run() {
+    let path = Path::new(ROOT).join("docs/examples/bench-regression.yml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let page = include_str!("../../docs/BENCHMARKING.md");
+    assert!(
+        page.contains("examples/bench-regression.yml"),
+        "BENCHMARKING.md does not link it"
+    );
+    let parsed = std::process::Command::new("python3")
+        .args([
+            "-c",
+            "import sys, yaml, json; print(json.dumps(yaml.safe_load(sys.stdin)))",
+        ])
+        .stdin(std::fs::File::open(&path).unwrap())
+        .output();
+    match parsed {
+        Ok(out) if out.status.success() => {
+            let yaml: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+            // YAML 1.1 reads the key `on` as true.
+            let on = yaml.get("on").or_else(|| yaml.get("true")).unwrap();
+            assert!(on.get("pull_request").is_some(), "{on}");
+            let steps = yaml["jobs"]["against-base"]["steps"].as_array().unwrap();
+            let runs: Vec<&str> = steps.iter().filter_map(|s| s["run"].as_str()).collect();
+            for needle in [
+                "cargo build --release --locked --manifest-path base/Cargo.toml",
+                "cargo build --release --locked --manifest-path head/Cargo.toml",
+                "--against base/target/release/raywave",
+            ] {
+                assert!(
+                    runs.iter().any(|r| r.contains(needle)),
+                    "no step runs `{needle}`"
+                );
+            }
+            let gate = runs.iter().find(|r| r.contains("--against")).unwrap();
+            assert!(gate.contains("3) ") && gate.contains("exit 3"), "{gate}");
+            assert!(gate.contains("4) ") && gate.contains("::warning"), "{gate}");
+        }
+        _ => println!("SKIPPED the YAML check: no python3 with PyYAML"),
+    }
+    // The export step, with this build, at a tiny size.
+    let export = text
+        .split("run: |")
+        .find(|block| block.contains("--export-bmf"))
+        .unwrap()
+        .lines()
+        .take_while(|l| !l.trim().starts_with("cat "))
+        .collect::<Vec<_>>()
+        .join("\n");
+    let command = commands(&format!("```sh\n{export}\n```\n")).join(" ");
+    let words: Vec<&str> = command.split_whitespace().collect();
+    assert_eq!(
+        words[..2],
+        ["head/target/release/raywave", "bench"],
+        "{command}"
+    );
+    let args = shorten(&words[1..], BENCHMARKING.quick);
+    let dir = tempfile::tempdir().unwrap();
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let out = common::bin::raywave(dir.path(), &args);
+    assert!(
+        out.status.success(),
+        "{command}: {}",
+        common::bin::stderr(&out)
+    );
+    for name in ["bmf.json", "gab.json", "bench.md"] {
+        assert!(dir.path().join(name).is_file(), "{command} wrote no {name}");
     }
 }

@@ -14,6 +14,8 @@ mod batch_parallel;
 mod batch_slurm;
 mod bench_ab;
 mod bench_cmd;
+mod bench_shards;
+mod bench_trackers;
 mod bench_verdict;
 mod cli;
 mod cli_errors;

@@ -96,7 +96,11 @@ fn assert_valid(python: &str, name: &str, instance: &Value) {
 #[test]
 fn the_checked_in_schemas_are_the_generated_ones() {
     let update = std::env::var_os("RAYWAVE_UPDATE_SCHEMA").is_some_and(|v| v == "1");
-    for (name, generated) in raywave::output::render_record::schemas() {
+    let shard = ("bench-shard.schema.json", raywave::bench::shard::schema());
+    for (name, generated) in raywave::output::render_record::schemas()
+        .into_iter()
+        .chain([shard])
+    {
         let path = schema_dir().join(name);
         if update {
             std::fs::create_dir_all(schema_dir()).unwrap();
@@ -305,6 +309,108 @@ fn the_study_file_schema_is_the_generated_one_and_judges_study_files() {
         assert!(
             !violations(python, name, &toml(bad)).is_empty(),
             "{bad} validates against docs/schema/{name}"
+        );
+    }
+}
+
+/// The first metric of a BMF file's first benchmark.
+fn first_metric(bmf: &mut Value) -> &mut Value {
+    let (_, measures) = bmf.as_object_mut().unwrap().iter_mut().next().unwrap();
+    let (_, metric) = measures.as_object_mut().unwrap().iter_mut().next().unwrap();
+    metric
+}
+
+/// A tiny sweep's part file (shard 0 of 2), its exports for the trackers, parsed.
+fn part_and_exports() -> (Value, Value, Value) {
+    let dir = tempfile::tempdir().unwrap();
+    let flags = "bench --size 16 12 --threads 1,2 --runs 6 --engine wavefront -q";
+    let read = |name: &str| -> Value {
+        serde_json::from_slice(&std::fs::read(dir.path().join(name)).unwrap()).unwrap()
+    };
+    let out = raywave(
+        dir.path(),
+        &words(&format!("{flags} --shard 0/2 --out parts")),
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let out = raywave(
+        dir.path(),
+        &words(&format!(
+            "{flags} --export-bmf bmf.json --export-github-action-benchmark gab.json"
+        )),
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    (
+        read("parts/bench-shard-0-of-2.json"),
+        read("bmf.json"),
+        read("gab.json"),
+    )
+}
+
+/// Real output validates against the checked-in schemas: the part file against its generated
+/// one, the exports against the schemas written from Bencher's reference and
+/// github-action-benchmark's README; doctored output does not.
+#[test]
+fn part_files_and_tracker_exports_validate() {
+    let Some(python) = python() else { return };
+    let (part, bmf, gab) = part_and_exports();
+    assert_valid(python, "bench-shard.schema.json", &part);
+    assert_valid(python, "bencher-metric-format.schema.json", &bmf);
+    assert_valid(python, "github-action-benchmark.schema.json", &gab);
+    type Doctor = fn(&mut Value);
+    let bmf_doctored: [(&str, Doctor); 4] = [
+        ("a metric without a value", |b| {
+            first_metric(b).as_object_mut().unwrap().remove("value");
+        }),
+        ("a bound that is text", |b| {
+            first_metric(b)["lower_value"] = json!("12")
+        }),
+        ("a measure name longer than 64 characters", |b| {
+            let (_, measures) = b.as_object_mut().unwrap().iter_mut().next().unwrap();
+            measures["m".repeat(65)] = json!({"value": 1.0});
+        }),
+        ("a benchmark that is a number", |b| b["x"] = json!(3)),
+    ];
+    let mut b = bmf.clone();
+    assert!(first_metric(&mut b)["upper_value"].is_number());
+    for (what, doctor) in bmf_doctored {
+        let mut b = bmf.clone();
+        doctor(&mut b);
+        assert!(
+            !violations(python, "bencher-metric-format.schema.json", &b).is_empty(),
+            "BMF with {what} validated"
+        );
+    }
+    let gab_doctored: [(&str, Doctor); 4] = [
+        ("no entries", |g| *g = json!([])),
+        ("an entry without a unit", |g| {
+            g[0].as_object_mut().unwrap().remove("unit");
+        }),
+        ("a value that is text", |g| g[0]["value"] = json!("fast")),
+        ("a range that is a number", |g| g[0]["range"] = json!(3)),
+    ];
+    for (what, doctor) in gab_doctored {
+        let mut g = gab.clone();
+        doctor(&mut g);
+        assert!(
+            !violations(python, "github-action-benchmark.schema.json", &g).is_empty(),
+            "github-action-benchmark JSON with {what} validated"
+        );
+    }
+    let part_doctored: [(&str, Doctor); 3] = [
+        ("another format", |p| p["format"] = json!("raywave-bench")),
+        ("a checksum that is not FNV-1a", |p| {
+            p["checksum"] = json!("md5:0123")
+        }),
+        ("no records", |p| {
+            p["payload"].as_object_mut().unwrap().remove("records");
+        }),
+    ];
+    for (what, doctor) in part_doctored {
+        let mut p = part.clone();
+        doctor(&mut p);
+        assert!(
+            !violations(python, "bench-shard.schema.json", &p).is_empty(),
+            "a part file with {what} validated"
         );
     }
 }

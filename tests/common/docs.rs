@@ -91,12 +91,13 @@ fn subcommand(args: &[String]) -> &str {
 /// bench sweep repeats `--size`: the k-th size is made 8k pixels wider, so that its points stay
 /// distinct). A `bench --against OTHER` runs against this build itself (an A/A comparison), in
 /// its fewest rounds (`--max-rounds` with `--until-decided`) and without `--runs` (which the A/B
-/// mode does not take). `bench compare`,
-/// `bench list` and `variance --clean-cache` take no image flags and run as written.
+/// mode does not take). `bench compare`, `bench list`, `bench merge` and `variance
+/// --clean-cache` take no image flags and run as written.
 pub fn shorten(args: &[&str], quick: &Quick) -> Vec<String> {
     let mut out: Vec<String> = args.iter().map(|w| w.to_string()).collect();
     let sub = subcommand(&out).to_string();
-    let as_written = (sub == "bench" && matches!(args.get(1).copied(), Some("compare" | "list")))
+    let as_written = (sub == "bench"
+        && matches!(args.get(1).copied(), Some("compare" | "list" | "merge")))
         || (sub == "variance" && args.contains(&"--clean-cache"));
     if as_written {
         return out;

@@ -1,0 +1,186 @@
+//! Exports for continuous-benchmarking services, so that a CI job can track raywave's rays/s
+//! commit after commit: `--export-bmf` (Bencher Metric Format, for `bencher run --adapter
+//! json`) and `--export-github-action-benchmark` (the JSON of github-action-benchmark's
+//! `customBiggerIsBetter` tool). Each holds every headline figure of every point and engine:
+//! the median and the bounds of its 95% interval.
+//!
+//! ```text
+//! name     = SCENE WxH+sS+tT ENGINE FIGURE [@ HOST]    e.g. "cornell_box 512x512+s16+t2 wavefront total"
+//! BMF      { name: { MEASURE: { value: median, lower_value: low, upper_value: high } } }
+//!          MEASURE = rays-per-second (total) or rays-per-thread-second (a stage)
+//! github-action-benchmark
+//!          [ { name, unit: "rays/s" | "rays/thread-s", value: median,
+//!              range: "± H" (H the larger distance from the median to an interval bound),
+//!              extra: the interval's bounds, runs, min, max, host, commit } ]
+//! ```
+//!
+//! Without an interval (fewer than 6 runs) the bounds and `range` are left out; the formats
+//! make them optional.
+
+use crate::output::bench_record::{BenchRecord, FigureSummary};
+use crate::render::settings::ShadowMode;
+use anyhow::{Result, bail};
+use serde::Serialize;
+use std::collections::BTreeMap;
+
+/// One measure's value in Bencher Metric Format.
+#[derive(Serialize)]
+struct Metric {
+    value: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    lower_value: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    upper_value: Option<f64>,
+}
+
+/// One entry of github-action-benchmark's custom JSON.
+#[derive(Serialize)]
+struct Entry {
+    name: String,
+    unit: String,
+    value: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    range: Option<String>,
+    extra: String,
+}
+
+/// The scene's short name: a built-in scene's name, else the file name without extension.
+fn scene_name(source: &str) -> String {
+    if let Some(inner) = source
+        .strip_prefix("<built-in ")
+        .and_then(|s| s.strip_suffix('>'))
+    {
+        return inner.to_string();
+    }
+    std::path::Path::new(source)
+        .file_stem()
+        .map_or_else(|| source.to_string(), |s| s.to_string_lossy().into_owned())
+}
+
+/// The name a tracker keeps a headline figure under: the scene, the values a sweep may vary
+/// (size, shadow points, threads), the engine and the figure; ` @ HOST` when `by_host`.
+pub(crate) fn figure_name(r: &BenchRecord, engine: &str, figure: &str, by_host: bool) -> String {
+    let s = &r.setup.settings;
+    let shadows = match s.shadows {
+        ShadowMode::Soft => format!("s{}", s.shadow_samples),
+        mode => format!("shadows-{}", mode.name()),
+    };
+    let mut name = format!(
+        "{} {}x{}+{shadows}+t{} {engine} {figure}",
+        scene_name(&r.setup.scene.source),
+        s.width,
+        s.height,
+        r.setup.threads
+    );
+    if by_host {
+        name.push_str(&format!(" @ {}", r.machine.hostname));
+    }
+    name
+}
+
+/// Every headline figure of every record, with its name.
+fn figures(records: &[BenchRecord], by_host: bool) -> Vec<(String, &BenchRecord, &FigureSummary)> {
+    let mut out = Vec::new();
+    for r in records {
+        for e in &r.engines {
+            for f in &e.summary {
+                out.push((figure_name(r, &e.engine, &f.figure, by_host), r, f));
+            }
+        }
+    }
+    out
+}
+
+/// The measure a figure goes under in Bencher: one per unit.
+fn measure(f: &FigureSummary) -> &'static str {
+    if f.unit == "rays/s" {
+        "rays-per-second"
+    } else {
+        "rays-per-thread-second"
+    }
+}
+
+/// The records in Bencher Metric Format; two figures with one name (two machines of one host
+/// name, say) are an error rather than one overwriting the other.
+pub(crate) fn bmf(records: &[BenchRecord], by_host: bool) -> Result<String> {
+    let mut out = BTreeMap::new();
+    for (name, _, f) in figures(records, by_host) {
+        let (lower_value, upper_value) = match (f.low, f.high) {
+            (Some(low), Some(high)) => (Some(low), Some(high)),
+            _ => (None, None),
+        };
+        let metric = Metric {
+            value: f.median,
+            lower_value,
+            upper_value,
+        };
+        let measures = BTreeMap::from([(measure(f), metric)]);
+        if out.insert(name.clone(), measures).is_some() {
+            bail!(
+                "two figures share the benchmark name `{name}`: give each machine its own host name"
+            );
+        }
+    }
+    Ok(format!("{}\n", serde_json::to_string_pretty(&out)?))
+}
+
+/// The records as github-action-benchmark's `customBiggerIsBetter` input (rates: bigger is
+/// better); one entry per headline figure, in record order.
+pub(crate) fn github_action_benchmark(records: &[BenchRecord], by_host: bool) -> Result<String> {
+    let mut out = Vec::new();
+    let mut names = std::collections::HashSet::new();
+    for (name, r, f) in figures(records, by_host) {
+        if !names.insert(name.clone()) {
+            bail!(
+                "two figures share the benchmark name `{name}`: give each machine its own host name"
+            );
+        }
+        let (range, interval) = match (f.low, f.high) {
+            (Some(low), Some(high)) => (
+                Some(format!("± {}", (high - f.median).max(f.median - low))),
+                format!("95% interval of the median: [{low}, {high}] {}", f.unit),
+            ),
+            _ => (
+                None,
+                format!(
+                    "no 95% interval of the median: {} run(s) < {}",
+                    f.runs,
+                    crate::output::statistics::MIN_FOR_INTERVAL
+                ),
+            ),
+        };
+        out.push(Entry {
+            name,
+            unit: f.unit.clone(),
+            value: f.median,
+            range,
+            extra: format!(
+                "{interval}\n{} runs, min {}, max {}\nhost {} ({})\nraywave {}, commit {}",
+                f.runs,
+                f.min,
+                f.max,
+                r.machine.hostname,
+                r.machine.cpu,
+                r.raywave,
+                r.build.short_commit()
+            ),
+        });
+    }
+    Ok(format!("{}\n", serde_json::to_string_pretty(&out)?))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn scene_names_are_short() {
+        assert_eq!(
+            scene_name("<built-in cornell_box_reflective_spheres>"),
+            "cornell_box_reflective_spheres"
+        );
+        assert_eq!(scene_name("scenes/cornell_box.obj"), "cornell_box");
+        assert_eq!(scene_name("/tmp/x/scene.obj"), "scene");
+        assert_eq!(scene_name("-"), "-");
+    }
+}

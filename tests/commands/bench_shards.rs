@@ -1,0 +1,517 @@
+//! `raywave bench --shard I/N --out DIR` and `raywave bench merge`: a tiny sweep run as 3
+//! shards (and as 2) and merged equals the sweep run whole in everything that does not depend
+//! on timing (points, settings, ray counts, figure names); the split is by cost; a shard
+//! without points still writes its file; merge refuses missing, duplicated, truncated,
+//! damaged and mismatched parts (other sweep, other build, other shard count, other machine
+//! unless --across-machines), and outputs that are inputs; bad --shard values are usage errors.
+//! Tiny images: no timing is asserted.
+
+use crate::common;
+
+use common::bin::{files_in, raywave, stderr, stdout, words};
+use serde_json::{Value, json};
+use std::path::Path;
+use std::process::Output;
+
+/// The sweep every test shards: 2 sizes × 2 thread counts, 4 points.
+pub(crate) const SWEEP: &str = "bench --size 16 16 --size 24 16 --threads 1,2 --runs 6 --shadow-samples 2 --engine wavefront -q";
+
+/// `raywave` with `line` (split at spaces) in `dir`.
+pub(crate) fn run(dir: &Path, line: &str) -> Output {
+    raywave(dir, &words(line))
+}
+
+pub(crate) fn ok(out: &Output) {
+    assert!(
+        out.status.success(),
+        "exit {:?}\n{}\n{}",
+        out.status.code(),
+        stdout(out),
+        stderr(out)
+    );
+}
+
+/// Exit 1 with every needle in the error; returns the error.
+fn refused(out: &Output, needles: &[&str]) -> String {
+    let err = stderr(out);
+    assert_eq!(out.status.code(), Some(1), "{}\n{err}", stdout(out));
+    for n in needles {
+        assert!(err.contains(n), "missing `{n}` in:\n{err}");
+    }
+    err
+}
+
+/// Runs every shard of `SWEEP` split in `n` into `dir/parts`; returns the part paths, relative.
+fn shards(dir: &Path, n: usize) -> Vec<String> {
+    (0..n)
+        .map(|i| {
+            ok(&run(dir, &format!("{SWEEP} --shard {i}/{n} --out parts")));
+            format!("parts/bench-shard-{i}-of-{n}.json")
+        })
+        .collect()
+}
+
+pub(crate) fn read(dir: &Path, name: &str) -> Value {
+    let text = std::fs::read_to_string(dir.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
+    serde_json::from_str(&text).unwrap_or_else(|e| panic!("{name}: {e}"))
+}
+
+/// The first column of a CSV export, one per row.
+fn csv_points(dir: &Path, name: &str) -> Vec<String> {
+    let text = std::fs::read_to_string(dir.join(name)).unwrap();
+    text.lines()
+        .skip(1)
+        .map(|l| l.split(',').next().unwrap().to_string())
+        .collect()
+}
+
+/// What of a record does not depend on timing: setup (scene hash, settings, threads), run
+/// counts, and per engine its ray counts and the names of its headline figures.
+fn deterministic(record: &Value) -> Value {
+    let mut setup = record["setup"].clone();
+    setup["scene"]["source"] = Value::Null;
+    let engines: Vec<Value> = record["engines"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| {
+            let figures: Vec<&Value> = e["summary"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|f| &f["figure"])
+                .collect();
+            let runs: Vec<&Value> = e["runs"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|r| &r["rays"])
+                .collect();
+            json!({"engine": e["engine"], "rays": e["median"]["rays"], "run_rays": runs, "figures": figures})
+        })
+        .collect();
+    json!({"setup": setup, "runs": record["runs"], "warmup": record["warmup"], "engines": engines})
+}
+
+/// Every export that does not depend on timing's presentation, into `dir`.
+fn exports(dir: &str) -> String {
+    format!(
+        "--export-json {dir}/points.json --export-csv {dir}/rows.csv --export-bmf {dir}/bmf.json \
+         --export-github-action-benchmark {dir}/gab.json"
+    )
+}
+
+#[test]
+fn three_shards_merged_equal_the_sweep_run_whole() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::create_dir(d.join("whole")).unwrap();
+    std::fs::create_dir(d.join("merged")).unwrap();
+    ok(&run(d, &format!("{SWEEP} {}", exports("whole"))));
+    let parts = shards(d, 3);
+    let merged = run(
+        d,
+        &format!("bench merge {} {}", parts.join(" "), exports("merged")),
+    );
+    ok(&merged);
+    let text = stdout(&merged);
+    for needle in [
+        "point   16x16+t1",
+        "wavefront  total",
+        "merged  3 shard(s), 4 point(s) of one sweep, measured on 1 host(s)",
+        "0/3 parts/bench-shard-0-of-3.json: 24x16+t1",
+        "summed over the shards",
+        "elapsed from the first start to the last end",
+    ] {
+        assert!(text.contains(needle), "missing `{needle}` in:\n{text}");
+    }
+    // Points in sweep order, as the sweep run whole lists them.
+    let points = csv_points(d, "whole/rows.csv");
+    assert_eq!(csv_points(d, "merged/rows.csv"), points);
+    let mut distinct = points.clone();
+    distinct.dedup();
+    assert_eq!(distinct, ["16x16+t1", "16x16+t2", "24x16+t1", "24x16+t2"]);
+    let whole = read(d, "whole/points.json");
+    let merged = read(d, "merged/points.json");
+    let (whole, merged) = (whole.as_array().unwrap(), merged.as_array().unwrap());
+    assert_eq!(whole.len(), 4);
+    assert_eq!(merged.len(), 4);
+    for (w, m) in whole.iter().zip(merged) {
+        assert_eq!(deterministic(w), deterministic(m));
+    }
+    // The trackers' names are the same, whichever way the sweep ran.
+    let names = |v: &Value| -> Vec<String> { v.as_object().unwrap().keys().cloned().collect() };
+    assert_eq!(
+        names(&read(d, "whole/bmf.json")),
+        names(&read(d, "merged/bmf.json"))
+    );
+    let gab_names = |v: &Value| -> Vec<Value> {
+        v.as_array()
+            .unwrap()
+            .iter()
+            .map(|e| e["name"].clone())
+            .collect()
+    };
+    assert_eq!(
+        gab_names(&read(d, "whole/gab.json")),
+        gab_names(&read(d, "merged/gab.json"))
+    );
+}
+
+#[test]
+fn two_shards_split_by_cost_and_merge_in_sweep_order() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let parts = shards(d, 2);
+    // Costs, width · height · (1 + 1 light · 2 points) · 7 runs / threads: 16x16+t1 5376,
+    // 16x16+t2 2688, 24x16+t1 8064, 24x16+t2 4032. Longest first to the least loaded:
+    // 24x16+t1 → 0; 16x16+t1 → 1; 24x16+t2 → 1 (5376 < 8064); 16x16+t2 → 0 (8064 < 9408).
+    // By count it would be two and two in sweep order; by cost shard 0 gets the dearest.
+    let labels = |i: usize| read(d, &parts[i])["payload"]["labels"].clone();
+    assert_eq!(labels(0), json!(["16x16+t2", "24x16+t1"]));
+    assert_eq!(labels(1), json!(["16x16+t1", "24x16+t2"]));
+    let part = read(d, &parts[0]);
+    assert_eq!(part["format"], "raywave-bench-shard");
+    assert_eq!(part["payload"]["shard"], json!({"index": 0, "count": 2}));
+    assert_eq!(part["payload"]["points"], json!([1, 2]));
+    assert_eq!(
+        part["payload"]["sweep"]["points"].as_array().unwrap().len(),
+        4
+    );
+    assert!(part["payload"]["host"]["cpu"].is_string());
+    assert!(part["payload"]["host"]["hostname"].is_string());
+    assert_eq!(part["payload"]["records"].as_array().unwrap().len(), 2);
+    // Given in any order, merged in sweep order.
+    let out = run(
+        d,
+        &format!(
+            "bench merge {} {} --export-csv rows.csv -q",
+            parts[1], parts[0]
+        ),
+    );
+    ok(&out);
+    let mut points = csv_points(d, "rows.csv");
+    points.dedup();
+    assert_eq!(points, ["16x16+t1", "16x16+t2", "24x16+t1", "24x16+t2"]);
+    // Quiet: only what was merged.
+    assert!(!stdout(&out).contains("point   "), "{}", stdout(&out));
+    assert!(
+        stdout(&out).starts_with("merged  2 shard(s)"),
+        "{}",
+        stdout(&out)
+    );
+    // No temporary file left beside the parts.
+    assert_eq!(
+        files_in(&d.join("parts")),
+        ["bench-shard-0-of-2.json", "bench-shard-1-of-2.json"]
+    );
+}
+
+#[test]
+fn a_shard_without_points_still_writes_its_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let parts = shards(d, 5);
+    let empty = read(d, &parts[4]);
+    assert_eq!(empty["payload"]["points"], json!([]));
+    assert_eq!(empty["payload"]["records"], json!([]));
+    let out = run(
+        d,
+        &format!("bench merge {} --export-csv rows.csv -q", parts.join(" ")),
+    );
+    ok(&out);
+    assert!(stdout(&out).contains("4/5 parts/bench-shard-4-of-5.json: no points"));
+    let mut points = csv_points(d, "rows.csv");
+    points.dedup();
+    assert_eq!(points.len(), 4);
+}
+
+/// FNV-1a, 64-bit: the part files' checksum, written here from its definition.
+fn fnv1a(bytes: &[u8]) -> String {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for &b in bytes {
+        h ^= u64::from(b);
+        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    format!("{h:016x}")
+}
+
+/// Rewrites the part `name` with `doctor` applied to its payload and a checksum that matches
+/// (a part made by another build, sweep or machine, not a damaged one).
+fn doctor(dir: &Path, name: &str, doctor: impl FnOnce(&mut Value)) {
+    let mut part = read(dir, name);
+    doctor(&mut part["payload"]);
+    let payload = serde_json::to_string(&part["payload"]).unwrap();
+    let text = format!(
+        "{{\"format\":\"raywave-bench-shard\",\"version\":1,\"checksum\":\"fnv1a64:{}\",\"payload\":{payload}}}",
+        fnv1a(payload.as_bytes())
+    );
+    std::fs::write(dir.join(name), text).unwrap();
+}
+
+#[test]
+fn a_doctored_part_with_its_checksum_redone_is_read() {
+    // The reader hashes the payload's bytes as they are, whatever their layout: the
+    // refusals below are for what was changed, not for the layout.
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let parts = shards(d, 2);
+    doctor(d, &parts[1], |_| {});
+    ok(&run(d, &format!("bench merge {} -q", parts.join(" "))));
+}
+
+#[test]
+fn merge_refuses_missing_duplicated_and_damaged_parts() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let parts = shards(d, 3);
+    let merge = |args: &str| run(d, &format!("bench merge {args} -q --export-csv rows.csv"));
+    refused(
+        &merge(&format!("{} {}", parts[0], parts[2])),
+        &["shard(s) 1/3 missing", &parts[0], &parts[2], "--shard 1/3"],
+    );
+    refused(
+        &merge(&format!(
+            "{} {} {} {}",
+            parts[0], parts[1], parts[1], parts[2]
+        )),
+        &["shard 1/3 is given twice", &parts[1]],
+    );
+    std::fs::copy(d.join(&parts[1]), d.join("copy.json")).unwrap();
+    refused(
+        &merge(&format!("{} {} copy.json {}", parts[0], parts[1], parts[2])),
+        &["shard 1/3 is given twice", &parts[1], "copy.json"],
+    );
+    // Truncated: not whole JSON.
+    let text = std::fs::read_to_string(d.join(&parts[1])).unwrap();
+    std::fs::write(d.join("cut.json"), &text[..text.len() / 2]).unwrap();
+    refused(
+        &merge(&format!("{} cut.json {}", parts[0], parts[2])),
+        &["cut.json: not a whole bench shard file", "truncated"],
+    );
+    // Damaged: still JSON, but not the bytes that were hashed.
+    let damaged = text.replacen("\"runs\": 6,", "\"runs\": 7,", 1);
+    assert_ne!(damaged, text);
+    std::fs::write(d.join("damaged.json"), damaged).unwrap();
+    refused(
+        &merge(&format!("{} damaged.json {}", parts[0], parts[2])),
+        &["damaged.json: checksum mismatch"],
+    );
+    // Not a part at all.
+    std::fs::write(d.join("other.json"), r#"{"format": 2, "engines": []}"#).unwrap();
+    refused(
+        &merge("other.json"),
+        &["other.json: not a whole bench shard file"],
+    );
+    refused(&merge("nothing.json"), &["nothing.json"]);
+    assert!(
+        !d.join("rows.csv").exists(),
+        "a refused merge wrote its export"
+    );
+}
+
+#[test]
+fn merge_refuses_parts_of_other_sweeps_builds_and_splits() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let parts = shards(d, 2);
+    // Another sweep: the same split of a sweep with other run counts.
+    ok(&run(
+        d,
+        &format!(
+            "{} --shard 1/2 --out other",
+            SWEEP.replace("--runs 6", "--runs 7")
+        ),
+    ));
+    refused(
+        &run(
+            d,
+            &format!("bench merge {} other/bench-shard-1-of-2.json", parts[0]),
+        ),
+        &[
+            "are shards of different sweeps",
+            &parts[0],
+            "other/bench-shard-1-of-2.json",
+            "runs: 6 in",
+        ],
+    );
+    // Another scene: the same flags on a scene whose text differs.
+    std::fs::copy(
+        common::bin::scenes().join("cornell_box.obj"),
+        d.join("a.obj"),
+    )
+    .unwrap();
+    ok(&run(d, &format!("{SWEEP} a.obj --shard 0/2 --out scene")));
+    ok(&run(d, &format!("{SWEEP} a.obj --shard 1/2 --out scene")));
+    refused(
+        &run(
+            d,
+            &format!("bench merge {} scene/bench-shard-1-of-2.json", parts[0]),
+        ),
+        &["are shards of different sweeps", "scene.text_hash"],
+    );
+    // Another build.
+    std::fs::copy(d.join(&parts[1]), d.join("build.json")).unwrap();
+    doctor(d, "build.json", |p| {
+        p["sweep"]["build"]["commit"] = json!("0123456789abcdef0123456789abcdef01234567");
+        for r in p["records"].as_array_mut().unwrap() {
+            r["build"]["commit"] = json!("0123456789abcdef0123456789abcdef01234567");
+        }
+    });
+    refused(
+        &run(d, &format!("bench merge {} build.json", parts[0])),
+        &[
+            "come from different raywave builds",
+            "build.json",
+            "commit: ",
+        ],
+    );
+    // Another split of the same sweep: the counts disagree.
+    ok(&run(d, &format!("{SWEEP} --shard 1/3 --out three")));
+    refused(
+        &run(
+            d,
+            &format!("bench merge {} three/bench-shard-1-of-3.json", parts[0]),
+        ),
+        &["disagree on the number of shards", "0/2", "1/3"],
+    );
+    // A part whose points are not its shard's share contradicts itself.
+    std::fs::copy(d.join(&parts[1]), d.join("points.json")).unwrap();
+    doctor(d, "points.json", |p| p["points"] = json!([0, 1]));
+    refused(
+        &run(d, &format!("bench merge {} points.json", parts[0])),
+        &["points.json: inconsistent bench shard file"],
+    );
+}
+
+#[test]
+fn parts_of_two_machines_merge_only_across_machines_grouped_by_host() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let parts = shards(d, 2);
+    doctor(d, &parts[1], |p| {
+        p["host"]["hostname"] = json!("elsewhere");
+        p["host"]["cpu"] = json!("Other CPU");
+        for r in p["records"].as_array_mut().unwrap() {
+            r["machine"]["hostname"] = json!("elsewhere");
+            r["machine"]["cpu"] = json!("Other CPU");
+        }
+    });
+    let both = parts.join(" ");
+    refused(
+        &run(d, &format!("bench merge {both} --export-csv rows.csv")),
+        &[
+            "measured on 2 machines",
+            "elsewhere (Other CPU)",
+            "--across-machines",
+        ],
+    );
+    assert!(!d.join("rows.csv").exists());
+    let out = run(
+        d,
+        &format!(
+            "bench merge {both} --across-machines --export-csv rows.csv --export-bmf bmf.json --export-markdown table.md"
+        ),
+    );
+    ok(&out);
+    let text = stdout(&out);
+    assert!(text.contains("host    elsewhere · Other CPU"), "{text}");
+    assert!(text.contains("measured on 2 host(s)"), "{text}");
+    // Grouped by host, hosts in the order of their first point: the other machine's (shard 1
+    // ran 16x16+t1, the sweep's first point), then this one's, each in sweep order.
+    let csv = std::fs::read_to_string(d.join("rows.csv")).unwrap();
+    let header = csv.lines().next().unwrap();
+    assert!(header.ends_with(",host"), "{header}");
+    let rows: Vec<(String, String)> = csv
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let cells: Vec<&str> = l.split(',').collect();
+            (cells[0].to_string(), cells[cells.len() - 1].to_string())
+        })
+        .collect();
+    let mut order: Vec<(String, String)> = rows.clone();
+    order.dedup();
+    let here = order[2].1.clone();
+    assert_ne!(here, "elsewhere");
+    assert_eq!(
+        order,
+        [
+            ("16x16+t1".to_string(), "elsewhere".to_string()),
+            ("24x16+t2".to_string(), "elsewhere".to_string()),
+            ("16x16+t2".to_string(), here.clone()),
+            ("24x16+t1".to_string(), here),
+        ]
+    );
+    let bmf = read(d, "bmf.json");
+    assert!(
+        bmf.as_object()
+            .unwrap()
+            .keys()
+            .any(|k| k.ends_with(" @ elsewhere")),
+        "{bmf}"
+    );
+    let table = std::fs::read_to_string(d.join("table.md")).unwrap();
+    assert!(table.starts_with("| host | point |"), "{table}");
+    assert!(table.contains("elsewhere: Other CPU"), "{table}");
+}
+
+#[test]
+fn merge_refuses_an_output_that_is_an_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let one = "bench --size 16 16 --runs 6 --shadow-samples 2 --engine wavefront -q";
+    ok(&run(d, &format!("{one} --shard 0/2 --out parts")));
+    ok(&run(d, &format!("{one} --shard 1/2 --out parts")));
+    let before = std::fs::read(d.join("parts/bench-shard-0-of-2.json")).unwrap();
+    let parts = "parts/bench-shard-0-of-2.json parts/bench-shard-1-of-2.json";
+    for outputs in [
+        "--export-json parts/bench-shard-0-of-2.json",
+        "--export-bmf parts/bench-shard-1-of-2.json",
+        // A sweep of one point saves NAME.json: here the part itself.
+        "--dir parts --save bench-shard-0-of-2",
+    ] {
+        let out = run(d, &format!("bench merge {parts} {outputs}"));
+        assert_eq!(out.status.code(), Some(2), "{outputs}: {}", stderr(&out));
+        assert!(
+            stderr(&out).contains("is the same file as the input PARTS"),
+            "{}",
+            stderr(&out)
+        );
+    }
+    assert_eq!(
+        std::fs::read(d.join("parts/bench-shard-0-of-2.json")).unwrap(),
+        before
+    );
+    // Saved elsewhere, the single point keeps its plain name.
+    let out = run(d, &format!("bench merge {parts} --dir records --save one"));
+    ok(&out);
+    assert_eq!(files_in(&d.join("records")), ["one.json"]);
+}
+
+#[test]
+fn bad_shard_flags_are_usage_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    for (flags, needle) in [
+        ("--shard 0/0 --out p", "N is 0"),
+        ("--shard 4/4 --out p", "shard 4 does not exist"),
+        ("--shard x/4 --out p", "expected I/N"),
+        ("--shard=-1/4 --out p", "expected I/N"),
+        ("--shard 0/2", "--out <DIR>"),
+        ("--out p", "--shard <I/N>"),
+        ("--shard 0/2 --out p --save s", "cannot be used with"),
+        (
+            "--shard 0/2 --out p --export-csv a.csv",
+            "cannot be used with",
+        ),
+        ("--shard 0/2 --out p --compare base", "cannot be used with"),
+    ] {
+        let out = run(d, &format!("bench --size 16 16 --runs 6 {flags}"));
+        assert_eq!(out.status.code(), Some(2), "{flags}: {}", stderr(&out));
+        assert!(stderr(&out).contains(needle), "{flags}: {}", stderr(&out));
+    }
+    let out = run(d, "bench merge");
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(files_in(d).is_empty(), "{:?}", files_in(d));
+}
