@@ -131,7 +131,7 @@ pub struct StudyArgs {
     #[arg(long, default_value = ".raywave-cache")]
     pub cache: PathBuf,
     /// Always render the converged reference, ignoring and not writing the cache.
-    #[arg(long, conflicts_with_all = ["cache", "cache_limit"])]
+    #[arg(long, conflicts_with_all = ["cache", "cache_limit", "clean_cache"])]
     pub no_cache: bool,
     /// Bound on the cache's total size in MiB; the least recently used entries are removed
     /// above it.

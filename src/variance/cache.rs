@@ -14,8 +14,8 @@
 //!
 //! Shards of one study on several machines share the cache on a shared filesystem. An entry is
 //! rendered under an exclusive lock on its own `reference-KEY.lock` (`flock`, which NFS v4 and
-//! Lustre honour), so that the first shard to need it renders it while the others wait and then
-//! read it; a reader never sees half an entry, since an entry is written to a temporary file and
+//! Lustre honour, and removed by its holder before unlocking), so that the first shard to need
+//! it renders it while the others wait and then read it; a reader never sees half an entry, since an entry is written to a temporary file and
 //! renamed into place.
 //!
 //! Anything else found at an entry's path (short, long, another magic or format, other
@@ -54,6 +54,36 @@ pub struct Cache {
     pub dir: PathBuf,
     /// The entries' total size above which the least recently used are removed.
     pub limit_bytes: u64,
+}
+
+/// An entry's lock, held until dropped (see [`Cache::lock`]).
+pub struct EntryLock {
+    file: std::fs::File,
+    path: PathBuf,
+}
+
+impl Drop for EntryLock {
+    fn drop(&mut self) {
+        // Removed while still locked: a process waiting on this file finds its path gone (or
+        // a new file there) when it wakes, and locks the path again.
+        let _ = std::fs::remove_file(&self.path);
+        let _ = self.file.unlock();
+    }
+}
+
+/// Whether `path` still names the open `file` (the same device and inode).
+#[cfg(unix)]
+fn same_file(file: &std::fs::File, path: &Path) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    match (file.metadata(), std::fs::metadata(path)) {
+        (Ok(a), Ok(b)) => a.dev() == b.dev() && a.ino() == b.ino(),
+        _ => false,
+    }
+}
+
+#[cfg(not(unix))]
+fn same_file(_: &std::fs::File, path: &Path) -> bool {
+    path.exists()
 }
 
 /// What a lookup found.
@@ -119,29 +149,41 @@ impl Cache {
         self.dir.join(format!("reference-{key:016x}.lock"))
     }
 
-    /// Takes the exclusive lock on `key`'s entry, held until the returned file is dropped;
+    /// Takes the exclusive lock on `key`'s entry, held until the returned guard is dropped;
     /// calls `waiting` first when another process holds it, then blocks until it is released.
     /// An error means the filesystem cannot lock (the caller goes on without the lock).
-    pub fn lock(&self, key: u64, waiting: impl FnOnce(&Path)) -> Result<std::fs::File> {
+    ///
+    /// The lock file lives only while it is held: the holder removes it before unlocking, so a
+    /// cache directory holds no lock files between runs. A process that wakes up holding the
+    /// lock on a file that was removed meanwhile (its path now names a new file, or none) lets
+    /// it go and locks the path again.
+    pub fn lock(&self, key: u64, waiting: impl FnOnce(&Path)) -> Result<EntryLock> {
         let path = self.lock_path(key);
         std::fs::create_dir_all(&self.dir)
             .with_context(|| format!("cannot create {}", self.dir.display()))?;
-        let file = std::fs::File::options()
-            .create(true)
-            .truncate(false)
-            .write(true)
-            .open(&path)
-            .with_context(|| format!("cannot open the lock file {}", path.display()))?;
-        match file.try_lock() {
-            Ok(()) => Ok(file),
-            Err(std::fs::TryLockError::WouldBlock) => {
-                waiting(&path);
-                file.lock()
-                    .with_context(|| format!("cannot lock {}", path.display()))?;
-                Ok(file)
+        let mut waiting = Some(waiting);
+        loop {
+            let file = std::fs::File::options()
+                .create(true)
+                .truncate(false)
+                .write(true)
+                .open(&path)
+                .with_context(|| format!("cannot open the lock file {}", path.display()))?;
+            match file.try_lock() {
+                Ok(()) => {}
+                Err(std::fs::TryLockError::WouldBlock) => {
+                    if let Some(w) = waiting.take() {
+                        w(&path);
+                    }
+                    file.lock()
+                        .with_context(|| format!("cannot lock {}", path.display()))?;
+                }
+                Err(std::fs::TryLockError::Error(e)) => {
+                    return Err(e).with_context(|| format!("cannot lock {}", path.display()));
+                }
             }
-            Err(std::fs::TryLockError::Error(e)) => {
-                Err(e).with_context(|| format!("cannot lock {}", path.display()))
+            if same_file(&file, &path) {
+                return Ok(EntryLock { file, path });
             }
         }
     }
