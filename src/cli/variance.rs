@@ -271,7 +271,7 @@ pub fn run(args: &VarianceArgs) -> Result<()> {
         let part = options.out.join(raywave::variance::part::file_name(shard));
         plan.output_in_new_dir("--out", &part).check()?;
         let identity = raywave::variance::plan::identity(&cases, options.engine.name());
-        let jobs = identity.assignment(shard.count)[shard.index as usize].len();
+        let jobs = identity.assignment(shard.count)[shard.index].len();
         let prefix = format!("variance shard {shard}, {jobs} jobs");
         let (path, jobs) = with_progress(&options, prefix, |render, hooks| {
             pool.install(|| run_shard(&options, &cases, shard, render, hooks))

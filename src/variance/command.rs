@@ -448,7 +448,7 @@ pub fn run_shard(
     let cache = open_cache(options, hooks.notice);
     let identity = identity(cases, options.engine.name());
     let assignment = identity.assignment(shard.count);
-    let selected = &assignment[shard.index as usize];
+    let selected = &assignment[shard.index];
     let started = unix_now();
     let ran = run_selected(cases, &identity, selected, cache.as_ref(), render, hooks)?;
     let mut part = Part {

@@ -118,9 +118,9 @@ pub fn merge(inputs: &[PathBuf], out: &Path, notice: &(dyn Fn(&str) + Sync)) -> 
             );
         }
     }
-    let mut by_index: Vec<Option<&PathBuf>> = vec![None; count as usize];
+    let mut by_index: Vec<Option<&PathBuf>> = vec![None; count];
     for (path, p) in &parts {
-        let slot = &mut by_index[p.shard.index as usize];
+        let slot = &mut by_index[p.shard.index];
         if let Some(other) = slot {
             bail!(
                 "{} and {} are both shard {}: expected each shard once",
@@ -151,7 +151,7 @@ pub fn merge(inputs: &[PathBuf], out: &Path, notice: &(dyn Fn(&str) + Sync)) -> 
     let assignment = identity.assignment(count);
     let all = identity.jobs();
     for (path, p) in &parts {
-        let expected = &assignment[p.shard.index as usize];
+        let expected = &assignment[p.shard.index];
         let results: Vec<_> = p.results.iter().map(|r| r.job()).collect();
         let wanted: Vec<_> = expected.iter().map(|&j| all[j]).collect();
         if &p.jobs != expected || results != wanted {
