@@ -102,6 +102,15 @@ pub fn file_names(samplers: &[LightSampler], budgets: &[u32], heatmap_n: u32) ->
     names
 }
 
+/// Writes `body` to `path` atomically; returns the path.
+pub(crate) fn write_text(path: &Path, body: &str) -> Result<PathBuf> {
+    crate::output::image_file::write_atomically(path, |w| {
+        std::io::Write::write_all(w, body.as_bytes())?;
+        Ok(())
+    })?;
+    Ok(path.to_path_buf())
+}
+
 /// The commit this binary was built from and whether its tree was dirty (embedded by build.rs).
 fn build_commit() -> (String, Option<bool>) {
     let build = crate::output::build_info::current();
@@ -514,12 +523,7 @@ impl StudyResult {
         std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
         let mut written = Vec::new();
         let text = |name: &str, body: String, written: &mut Vec<PathBuf>| -> Result<()> {
-            let path = dir.join(name);
-            crate::output::image_file::write_atomically(&path, |w| {
-                std::io::Write::write_all(w, body.as_bytes())?;
-                Ok(())
-            })?;
-            written.push(path);
+            written.push(write_text(&dir.join(name), &body)?);
             Ok(())
         };
         text("table.txt", self.table(), &mut written)?;

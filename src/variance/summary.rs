@@ -326,12 +326,7 @@ impl Summary {
             ("summary.csv", self.csv()),
             ("summary.json", json),
         ] {
-            let path = dir.join(name);
-            crate::output::image_file::write_atomically(&path, |w| {
-                std::io::Write::write_all(w, body.as_bytes())?;
-                Ok(())
-            })?;
-            written.push(path);
+            written.push(super::report::write_text(&dir.join(name), &body)?);
         }
         Ok(written)
     }

@@ -7,9 +7,9 @@
 //! passes, unless CI is set: then it fails.
 
 use crate::common;
-use crate::variance_shards::{assert_same_figures, ok, study_dir};
+use crate::variance_shards::{merge_matches_single, ok, single_and_prepared, study_dir};
 
-use common::bin::{files_in, raywave, stdout};
+use common::bin::files_in;
 use common::gnu_parallel::run_shards;
 use common::skip::skip_or_fail;
 
@@ -18,30 +18,7 @@ fn a_study_sharded_four_ways_by_gnu_parallel_merges_into_the_single_process_repo
     let dir = study_dir();
     let d = dir.path();
     let exe = env!("CARGO_BIN_EXE_raywave");
-    ok(&raywave(
-        d,
-        &[
-            "variance",
-            "--study",
-            "study.toml",
-            "--out",
-            "single",
-            "-q",
-            "--no-cache",
-        ],
-    ));
-    ok(&raywave(
-        d,
-        &[
-            "variance",
-            "prepare",
-            "--study",
-            "study.toml",
-            "--cache",
-            "cache",
-            "-q",
-        ],
-    ));
+    single_and_prepared(d);
     let template = format!(
         "{exe} variance --study study.toml --shard {{}}/4 --cache cache --out parts --threads 1 -q"
     );
@@ -50,12 +27,13 @@ fn a_study_sharded_four_ways_by_gnu_parallel_merges_into_the_single_process_repo
         Err(why) => return skip_or_fail(&why),
     };
     ok(&out);
-    let merged = raywave(d, &["variance", "merge", "parts", "--out", "merged"]);
-    ok(&merged);
-    let said = stdout(&merged);
-    assert!(said.contains("merged  4 shards, 18 jobs"), "{said}");
-    assert!(said.contains("references 0 rendered by a shard"), "{said}");
-    assert_same_figures(&d.join("single"), &d.join("merged"));
+    merge_matches_single(
+        d,
+        &[
+            "merged  4 shards, 18 jobs",
+            "references 0 rendered by a shard",
+        ],
+    );
 }
 
 #[test]

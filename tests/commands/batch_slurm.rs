@@ -10,8 +10,8 @@
 
 use crate::common;
 
-use crate::variance_shards::{assert_same_figures, ok, study_dir};
-use common::bin::{files_in, raywave, stderr, stdout};
+use crate::variance_shards::{merge_matches_single, single_and_prepared, study_dir};
+use common::bin::{files_in, raywave, stderr};
 use common::skip::skip_or_fail;
 use common::slurm::SlurmCluster;
 use std::path::{Path, PathBuf};
@@ -73,30 +73,7 @@ fn a_study_submitted_as_an_array_job_merges_into_the_single_process_report() {
     };
     let (path, work) = shards_script(tmp.path(), "shards.sh", None);
     study_into(&work);
-    ok(&raywave(
-        &work,
-        &[
-            "variance",
-            "--study",
-            "study.toml",
-            "--out",
-            "single",
-            "-q",
-            "--no-cache",
-        ],
-    ));
-    ok(&raywave(
-        &work,
-        &[
-            "variance",
-            "prepare",
-            "--study",
-            "study.toml",
-            "--cache",
-            "cache",
-            "-q",
-        ],
-    ));
+    single_and_prepared(&work);
     let out = cluster.sbatch_array_wait(&path, 0..4, &work).unwrap();
     let logs = || format!("{}{}", cluster.task_logs(), cluster.log_tails());
     assert!(
@@ -106,16 +83,13 @@ fn a_study_submitted_as_an_array_job_merges_into_the_single_process_report() {
         String::from_utf8_lossy(&out.stderr),
         logs()
     );
-    let merged = raywave(&work, &["variance", "merge", "parts", "--out", "merged"]);
-    ok(&merged);
-    let said = stdout(&merged);
-    assert!(
-        said.contains("merged  4 shards, 18 jobs"),
-        "{said}\n{}",
-        logs()
+    merge_matches_single(
+        &work,
+        &[
+            "merged  4 shards, 18 jobs",
+            "references 0 rendered by a shard",
+        ],
     );
-    assert!(said.contains("references 0 rendered by a shard"), "{said}");
-    assert_same_figures(&work.join("single"), &work.join("merged"));
 }
 
 #[test]

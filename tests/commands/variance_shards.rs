@@ -6,7 +6,7 @@
 
 use crate::common;
 
-use common::bin::{raywave, scenes, stderr, stdout};
+use common::bin::{raywave, scenes, stderr, stdout, words};
 use serde_json::Value;
 use std::path::Path;
 
@@ -131,29 +131,44 @@ pub(crate) fn assert_same_figures(single: &Path, merged: &Path) {
     }
 }
 
+/// Runs the study of [`STUDY`] in `d` in one process into `single/`, and renders its
+/// references into `cache/` (`variance prepare`), as a batch run would before its shards.
+pub(crate) fn single_and_prepared(d: &Path) {
+    ok(&raywave(
+        d,
+        &words("variance --study study.toml --out single -q --no-cache"),
+    ));
+    ok(&raywave(
+        d,
+        &words("variance prepare --study study.toml --cache cache -q"),
+    ));
+}
+
+/// Merges `d/parts` into `d/merged`, checks that the merge says each of `said`, and that its
+/// figures are those of `d/single`.
+pub(crate) fn merge_matches_single(d: &Path, said: &[&str]) {
+    let merged = raywave(d, &words("variance merge parts --out merged"));
+    ok(&merged);
+    let out = stdout(&merged);
+    for s in said {
+        assert!(out.contains(s), "expected {s:?} in:\n{out}");
+    }
+    assert_same_figures(&d.join("single"), &d.join("merged"));
+}
+
 #[test]
 fn a_four_way_sharded_study_merges_into_the_single_process_report() {
     let dir = study_dir();
     let d = dir.path();
     ok(&raywave(
         d,
-        &[
-            "variance",
-            "--study",
-            "study.toml",
-            "--out",
-            "single",
-            "-q",
-            "--no-cache",
-        ],
+        &words("variance --study study.toml --out single -q --no-cache"),
     ));
     shards(d, &["--no-cache"]);
-    let merged = raywave(d, &["variance", "merge", "parts", "--out", "merged"]);
-    ok(&merged);
-    let said = stdout(&merged);
-    assert!(said.contains("merged  4 shards, 18 jobs, 1 host"), "{said}");
-    assert!(said.contains("across the cases"), "{said}");
-    assert_same_figures(&d.join("single"), &d.join("merged"));
+    merge_matches_single(
+        d,
+        &["merged  4 shards, 18 jobs, 1 host", "across the cases"],
+    );
     let summary: Value = serde_json::from_slice(&bytes(&d.join("merged/summary.json"))).unwrap();
     let slope = summary["slopes"]
         .as_array()
