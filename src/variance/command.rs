@@ -493,7 +493,10 @@ pub fn prepare(
 ) -> Result<Vec<(String, bool)>> {
     options.validate()?;
     if options.no_cache {
-        bail!("`raywave variance prepare` fills the cache: --no-cache leaves it nothing to do");
+        return Err(UsageError(
+            "`raywave variance prepare` fills the cache: --no-cache leaves it nothing to do".into(),
+        )
+        .into());
     }
     let Some(cache) = open_cache(options, hooks.notice) else {
         bail!(

@@ -118,6 +118,21 @@ pub fn read(path: &Path, options: &mut VarianceOptions) -> Result<()> {
         .iter()
         .map(|s| (s != "builtin").then(|| dir.join(s)))
         .collect::<Vec<Option<PathBuf>>>();
+    for (name, scene) in file.scenes.iter().zip(&options.scenes) {
+        if let Some(scene) = scene
+            && !scene.is_file()
+        {
+            let quoted = format!("\"{name}\"");
+            let line = text
+                .lines()
+                .position(|l| l.contains(&quoted))
+                .map_or(String::new(), |i| format!(":{}", i + 1));
+            anyhow::bail!(
+                "{shown}{line}: scene {quoted} is not a file (looked for {}): expected a scene file, relative to the study file, or \"builtin\"",
+                scene.display()
+            );
+        }
+    }
     if let Some(v) = file.samplers {
         options.samplers = v;
     }
@@ -166,6 +181,7 @@ mod tests {
         let dir = tempfile::tempdir()?;
         let path = dir.path().join("study.toml");
         std::fs::write(&path, text)?;
+        std::fs::write(dir.path().join("a.obj"), "")?;
         let mut options = VarianceOptions::default();
         read(&path, &mut options)?;
         Ok(options)
@@ -200,6 +216,10 @@ mod tests {
             ("sizes = [[8]]\n", ":1:"),
             ("budgets = []\n", "`budgets` is empty"),
             ("seeds = \n", ":1:"),
+            (
+                "seeds = 4\nscenes = [\"builtin\", \"nowhere.obj\"]\n",
+                ":2: scene \"nowhere.obj\" is not a file",
+            ),
         ] {
             let e = format!("{:#}", read_text(text).unwrap_err());
             assert!(
