@@ -168,30 +168,44 @@ pub fn read(path: &Path) -> Result<Part> {
     if !meta.is_file() {
         anyhow::bail!("{shown}: expected a part file, found a directory or device");
     }
-    let mut bytes = Vec::new();
-    std::fs::File::open(path)
-        .and_then(|f| f.take(meta.len()).read_to_end(&mut bytes))
-        .with_context(|| format!("cannot read the part {shown}"))?;
-    if bytes.len() < HEADER_LEN || &bytes[..8] != MAGIC {
-        anyhow::bail!(
+    let not_a_part = || {
+        anyhow::anyhow!(
             "{shown}: not a raywave study part (expected a file written by `raywave variance --shard`, starting {:?})",
             String::from_utf8_lossy(MAGIC).trim_end()
-        );
+        )
+    };
+    let mut file =
+        std::fs::File::open(path).with_context(|| format!("cannot read the part {shown}"))?;
+    let mut header = [0u8; HEADER_LEN];
+    if meta.len() < HEADER_LEN as u64 {
+        return Err(not_a_part());
     }
-    let u64_at = |i: usize| u64::from_le_bytes(bytes[i..i + 8].try_into().unwrap_or_default());
+    file.read_exact(&mut header)
+        .with_context(|| format!("cannot read the part {shown}"))?;
+    if &header[..8] != MAGIC {
+        return Err(not_a_part());
+    }
+    let u64_at = |i: usize| u64::from_le_bytes(header[i..i + 8].try_into().unwrap_or_default());
     let (length, sum) = (u64_at(8), u64_at(16));
-    let found = (bytes.len() - HEADER_LEN) as u64;
+    let found = meta.len() - HEADER_LEN as u64;
     if found != length {
         anyhow::bail!(
             "{shown}: truncated or padded: the header says {length} bytes of results, the file holds {found}; was it cut off mid-write or mid-copy? Run its shard again"
         );
     }
-    let payload = &bytes[HEADER_LEN..];
-    if fnv(payload) != sum {
+    let mut payload = Vec::new();
+    file.take(length)
+        .read_to_end(&mut payload)
+        .with_context(|| format!("cannot read the part {shown}"))?;
+    if payload.len() as u64 != length {
+        anyhow::bail!("{shown}: it shrank while being read");
+    }
+    if fnv(&payload) != sum {
         anyhow::bail!(
             "{shown}: corrupt: its checksum does not match its contents; run its shard again"
         );
     }
+    let payload = payload.as_slice();
     let part: Part = ciborium::from_reader(payload)
         .with_context(|| format!("{shown}: its results cannot be decoded"))?;
     Ok(part)

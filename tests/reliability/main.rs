@@ -13,4 +13,5 @@ mod hostile_inputs;
 mod hostile_outputs;
 mod hostile_outputs_commands;
 mod hostile_records;
+mod hostile_shards;
 mod interrupt;
