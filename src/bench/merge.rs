@@ -82,7 +82,12 @@ pub struct Merged {
 /// Reads and checks the parts, then saves and exports the merged sweep as asked.
 pub fn merge(args: &MergeOptions) -> Result<Merged> {
     let mut parts = Vec::new();
-    for path in &args.parts {
+    let paths = crate::output::shard::expand_parts(
+        &args.parts,
+        |n| n.starts_with("bench-shard-") && n.ends_with(".json"),
+        "bench shard parts (bench-shard-I-of-N.json)",
+    )?;
+    for path in &paths {
         parts.push((path.clone(), read_part(path)?));
     }
     let Some((first_path, first)) = parts.first() else {

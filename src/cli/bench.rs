@@ -176,7 +176,8 @@ pub enum BenchAction {
 /// Flags of `raywave bench merge`.
 #[derive(Args, Debug, Clone)]
 pub struct MergeArgs {
-    /// The part files (DIR/bench-shard-I-of-N.json), every shard of one sweep once.
+    /// The part files (DIR/bench-shard-I-of-N.json), or directories holding them: every shard
+    /// of one sweep once.
     #[arg(required = true, value_name = "PARTS")]
     pub parts: Vec<PathBuf>,
     /// Accept parts measured on different machines: every report, row and exported name

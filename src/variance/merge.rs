@@ -86,6 +86,15 @@ pub fn merge(inputs: &[PathBuf], out: &Path, notice: &(dyn Fn(&str) + Sync)) -> 
         }
     }
     let paths = part::expand(inputs)?;
+    for path in &paths {
+        if path.parent().is_some_and(|dir| same_place(out, dir)) {
+            bail!(
+                "--out {} holds the part {}: expected a directory of its own for the report, so that no part is overwritten",
+                out.display(),
+                path.display()
+            );
+        }
+    }
     let mut parts: Vec<(PathBuf, Part)> = Vec::new();
     for path in &paths {
         if let Some((earlier, _)) = parts.iter().find(|(p, _)| same_place(p, path)) {

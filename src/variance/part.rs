@@ -214,25 +214,5 @@ pub fn read(path: &Path) -> Result<Part> {
 /// The part files named by `inputs`: each file as given, and each directory's `*.part` files
 /// in name order.
 pub fn expand(inputs: &[PathBuf]) -> Result<Vec<PathBuf>> {
-    let mut out = Vec::new();
-    for input in inputs {
-        if input.is_dir() {
-            let mut found: Vec<PathBuf> = std::fs::read_dir(input)
-                .with_context(|| format!("cannot list {}", input.display()))?
-                .filter_map(|e| e.ok().map(|e| e.path()))
-                .filter(|p| p.extension().is_some_and(|e| e == "part") && p.is_file())
-                .collect();
-            if found.is_empty() {
-                anyhow::bail!(
-                    "{}: expected shard parts (*.part) in this directory, found none",
-                    input.display()
-                );
-            }
-            found.sort();
-            out.extend(found);
-        } else {
-            out.push(input.clone());
-        }
-    }
-    Ok(out)
+    crate::output::shard::expand_parts(inputs, |n| n.ends_with(".part"), "shard parts (*.part)")
 }
