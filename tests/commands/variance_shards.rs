@@ -333,6 +333,17 @@ fn merge_refuses_parts_that_are_missing_repeated_cut_short_corrupt_or_foreign() 
         "{}",
         stderr(&out)
     );
+    // The parts named one by one, the report sent beside them.
+    let out = raywave(
+        d,
+        &["variance", "merge", &p(0), &p(1), &p(2), "--out", "parts"],
+    );
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        stderr(&out).contains("--out parts holds the part parts/shard-0-of-3.part"),
+        "{}",
+        stderr(&out)
+    );
     assert_eq!(std::fs::read_dir(d.join("parts")).unwrap().count(), 3);
     // And the parts as they are merge.
     ok(&raywave(
