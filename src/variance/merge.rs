@@ -25,6 +25,8 @@ pub struct Merged {
     pub jobs: usize,
     /// Per host: its name, the shards and jobs it ran, and its shards' summed wall time.
     pub hosts: Vec<(String, usize, usize, f64)>,
+    /// Per shard, in index order: its part, host, jobs and wall time.
+    pub shard_times: Vec<(PathBuf, String, usize, f64)>,
     /// Seconds from the first shard's start to the last one's end.
     pub elapsed: f64,
     /// How many times a shard rendered a case's converged reference (not from the cache).
@@ -45,8 +47,20 @@ impl Merged {
                 format!("{name} ({shards} shards, {jobs} jobs, {wall:.1} s)")
             })
             .collect();
+        let shards: String = self
+            .shard_times
+            .iter()
+            .enumerate()
+            .map(|(i, (path, host, jobs, wall))| {
+                format!(
+                    "  {i}/{} {}: {jobs} jobs on {host}, {wall:.1} s\n",
+                    self.shards,
+                    path.display()
+                )
+            })
+            .collect();
         format!(
-            "merged  {} shards, {} jobs, {} host{}: {}\nwall    {summed:.1} s summed over the shards, {:.1} s from the first start to the last end ({:.2}× speed-up)\nreferences {} rendered by a shard, {} read from the cache\n",
+            "{shards}merged  {} shards, {} jobs, {} host{}: {}\nwall    {summed:.1} s summed over the shards, {:.1} s from the first start to the last end ({:.2}× speed-up)\nreferences {} rendered by a shard, {} read from the cache\n",
             self.shards,
             self.jobs,
             self.hosts.len(),
@@ -236,6 +250,15 @@ pub fn merge(inputs: &[PathBuf], out: &Path, notice: &(dyn Fn(&str) + Sync)) -> 
             None => hosts.push((p.host.hostname.clone(), 1, p.jobs.len(), wall)),
         }
     }
+    let mut by_shard: Vec<&(PathBuf, Part)> = parts.iter().collect();
+    by_shard.sort_by_key(|(_, p)| p.shard.index);
+    let shard_times = by_shard
+        .iter()
+        .map(|(path, p)| {
+            let wall = (p.host.finished - p.host.started).max(0.0);
+            (path.clone(), p.host.hostname.clone(), p.jobs.len(), wall)
+        })
+        .collect();
     let start = parts
         .iter()
         .map(|(_, p)| p.host.started)
@@ -250,6 +273,7 @@ pub fn merge(inputs: &[PathBuf], out: &Path, notice: &(dyn Fn(&str) + Sync)) -> 
         shards: count,
         jobs: identity.jobs().len(),
         hosts,
+        shard_times,
         elapsed: (end - start).max(0.0),
         references_rendered: rendered,
         references_cached: parts.iter().map(|(_, p)| p.cases.len()).sum::<usize>() - rendered,
