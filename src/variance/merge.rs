@@ -60,7 +60,7 @@ impl Merged {
             })
             .collect();
         format!(
-            "{shards}merged  {} shards, {} jobs, {} host{}: {}\nwall    {summed:.1} s summed over the shards, {:.1} s from the first start to the last end ({:.2}× speed-up)\nreferences {} rendered by a shard, {} read from the cache\n",
+            "{shards}merged  {} shards, {} jobs, {} host{}: {}\nwall    {summed:.1} s summed over the shards, {:.1} s from the first start to the last end ({:.2} shards at once on average)\nreferences {} rendered by a shard, {} read from the cache\n",
             self.shards,
             self.jobs,
             self.hosts.len(),
