@@ -189,10 +189,10 @@ pub fn merge(inputs: &[PathBuf], out: &Path, notice: &(dyn Fn(&str) + Sync)) -> 
     }
     create_out(out)?;
     let cases = identity.cases.len();
-    let mut facts: Vec<Option<(CaseFacts, String, usize, &PathBuf)>> = vec![None; cases];
+    let mut facts: Vec<Option<(CaseFacts, String, usize, PathBuf)>> = vec![None; cases];
     let mut results: Vec<Vec<JobResult>> = vec![Vec::new(); cases];
     let mut rendered = 0;
-    for (path, p) in &parts {
+    for (path, p) in parts.iter_mut() {
         for (c, source, f) in &p.cases {
             let Some(slot) = facts.get_mut(*c) else {
                 bail!(
@@ -212,11 +212,12 @@ pub fn merge(inputs: &[PathBuf], out: &Path, notice: &(dyn Fn(&str) + Sync)) -> 
                 ),
                 // The reference counts as cached only when every shard read it from the cache.
                 Some((known, ..)) => known.reference_cached &= f.reference_cached,
-                None => *slot = Some((f.clone(), source.clone(), p.host.threads, path)),
+                None => *slot = Some((f.clone(), source.clone(), p.host.threads, path.clone())),
             }
             rendered += usize::from(!f.reference_cached);
         }
-        for r in p.results.iter().cloned() {
+        // Moved, not copied: the parts' results are not needed after this.
+        for r in std::mem::take(&mut p.results) {
             let r = JobResult::from(r);
             results[r.job.case].push(r);
         }
@@ -271,7 +272,7 @@ pub fn merge(inputs: &[PathBuf], out: &Path, notice: &(dyn Fn(&str) + Sync)) -> 
         outcome,
         parts: paths,
         shards: count,
-        jobs: identity.jobs().len(),
+        jobs: all.len(),
         hosts,
         shard_times,
         elapsed: (end - start).max(0.0),

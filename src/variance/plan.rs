@@ -74,10 +74,16 @@ fn build() -> (String, Option<String>) {
         info.commit,
         crate::simd_path()
     );
+    // Read and hashed once per process: the command line and the study both ask.
+    static EXECUTABLE: std::sync::OnceLock<String> = std::sync::OnceLock::new();
     let executable = (info.dirty != Some(false)).then(|| {
-        std::env::current_exe()
-            .and_then(std::fs::read)
-            .map_or_else(|_| "unreadable".to_string(), |b| content_hash(&b))
+        EXECUTABLE
+            .get_or_init(|| {
+                std::env::current_exe()
+                    .and_then(std::fs::read)
+                    .map_or_else(|_| "unreadable".to_string(), |b| content_hash(&b))
+            })
+            .clone()
     });
     (build, executable)
 }
