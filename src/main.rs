@@ -2,7 +2,8 @@
 //! 3 when `raywave bench --compare` finds a regression or `raywave diff --fail-above` a figure
 //! past its threshold, 4 when `raywave bench --until-decided` ends undecided at its budget, 1
 //! for anything else, printed once with its cause chain; 130 after SIGINT and 143 after
-//! SIGTERM (`output::write`), but 0 when `raywave view` is stopped by them, its normal end. The command line itself is in `cli/`, one file per command.
+//! SIGTERM (`output::write`; `raywave view` after answering the requests in hand). The command
+//! line itself is in `cli/`, one file per command.
 
 mod cli;
 
@@ -30,7 +31,8 @@ fn main() -> ExitCode {
         }
     };
     // SIGINT/SIGTERM: remove unfinished temporary files, exit 130/143. `raywave view` writes no
-    // files and stops on them by design: it handles them itself and exits 0.
+    // files and stops on them by design: it handles them itself, finishing the requests in
+    // hand, and exits 130/143 too.
     if !matches!(cli.command, Command::View(_))
         && let Err(e) = raywave::output::install_signal_cleanup()
     {
@@ -50,7 +52,11 @@ fn main() -> ExitCode {
         Command::Info => cli::info::run(),
         Command::Meshgen(args) => cli::meshgen::run(&args),
         Command::Variance(args) => cli::variance::run(&args),
-        Command::View(args) => cli::view::run(&args),
+        // Exit 130 after SIGINT and 143 after SIGTERM, once the requests in hand are answered.
+        Command::View(args) => match cli::view::run(&args) {
+            Ok(code) => return ExitCode::from(code),
+            Err(e) => Err(e),
+        },
         Command::TracePixel(args) => cli::trace_pixel::run(&args),
         // Exit 3 when --compare finds a regression (raywave::bench::EXIT_REGRESSION), 4 when
         // --until-decided ends undecided (EXIT_UNDECIDED).

@@ -25,8 +25,6 @@ pub(crate) struct State {
     pub comparisons: Comparisons,
     /// The worker threads renders run on.
     pub pool: Arc<rayon::ThreadPool>,
-    /// The port served (for the Host check).
-    pub port: u16,
     /// The scene's geometry as JSON, made once.
     pub scene_json: Vec<u8>,
 }

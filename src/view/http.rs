@@ -1,9 +1,8 @@
 //! The HTTP vocabulary the handlers share: the error every bad request becomes (a status and a
-//! message, sent as JSON), replies, request bodies read under a size limit, and query strings.
+//! message, sent as JSON), replies, and query strings.
 
 use crate::render::quote::quote;
 use serde::Serialize;
-use std::io::Read;
 
 /// The largest request body accepted: settings and comparison requests are a few hundred bytes.
 pub(crate) const MAX_BODY_BYTES: usize = 64 * 1024;
@@ -17,6 +16,8 @@ pub struct ApiError {
     pub message: String,
     /// The methods the path allows, for a 405's `Allow` header.
     pub allow: Option<&'static str>,
+    /// Seconds to wait before trying again, for a 429's or 503's `Retry-After` header.
+    pub retry_after: Option<u32>,
 }
 
 impl ApiError {
@@ -36,6 +37,7 @@ impl ApiError {
             status,
             message: message.into(),
             allow: None,
+            retry_after: None,
         }
     }
 
@@ -49,6 +51,15 @@ impl ApiError {
                 quote(path)
             ),
             allow: Some(allow),
+            retry_after: None,
+        }
+    }
+
+    /// A `status` (429 or 503) that asks the client to try again in `seconds`.
+    pub fn retry(status: u16, seconds: u32, message: impl Into<String>) -> Self {
+        ApiError {
+            retry_after: Some(seconds),
+            ..ApiError::status(status, message)
         }
     }
 }
@@ -66,6 +77,10 @@ pub(crate) struct Reply {
     pub cacheable: bool,
     /// `Allow`, for 405.
     pub allow: Option<&'static str>,
+    /// `Retry-After` in seconds, for 429 and 503.
+    pub retry_after: Option<u32>,
+    /// `Set-Cookie`: the access token, when the page was opened with it.
+    pub set_cookie: Option<String>,
 }
 
 impl Reply {
@@ -88,6 +103,8 @@ impl Reply {
             body,
             cacheable: false,
             allow: None,
+            retry_after: None,
+            set_cookie: None,
         }
     }
 }
@@ -110,35 +127,10 @@ impl From<ApiError> for Reply {
             body,
             cacheable: false,
             allow: e.allow,
+            retry_after: e.retry_after,
+            set_cookie: None,
         }
     }
-}
-
-/// Reads a body of at most [`MAX_BODY_BYTES`]: a larger declared length is refused before
-/// reading, and a body that turns out longer (chunked, or a lying header) after reading one byte
-/// past the limit.
-pub(crate) fn read_body(
-    declared: Option<usize>,
-    reader: &mut dyn Read,
-) -> Result<Vec<u8>, ApiError> {
-    let too_large = || {
-        ApiError::status(
-            413,
-            format!("request body too large: expected at most {MAX_BODY_BYTES} bytes"),
-        )
-    };
-    if declared.is_some_and(|n| n > MAX_BODY_BYTES) {
-        return Err(too_large());
-    }
-    let mut body = Vec::new();
-    reader
-        .take(MAX_BODY_BYTES as u64 + 1)
-        .read_to_end(&mut body)
-        .map_err(|e| ApiError::bad(format!("cannot read the request body: {e}")))?;
-    if body.len() > MAX_BODY_BYTES {
-        return Err(too_large());
-    }
-    Ok(body)
 }
 
 /// A query string's `name=value` pairs, with every name checked against `allowed` (an unknown
@@ -186,19 +178,6 @@ pub(crate) fn number<T: std::str::FromStr>(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn bodies_over_the_limit_are_413_declared_or_not() {
-        let big = vec![b' '; MAX_BODY_BYTES + 1];
-        assert_eq!(
-            read_body(Some(big.len()), &mut &big[..])
-                .unwrap_err()
-                .status,
-            413
-        );
-        assert_eq!(read_body(None, &mut &big[..]).unwrap_err().status, 413);
-        assert_eq!(read_body(Some(3), &mut &b"abc"[..]).unwrap(), b"abc");
-    }
 
     #[test]
     fn queries_are_checked() {

@@ -1,11 +1,15 @@
-//! `raywave view`: the lab's debug window in the browser. A local web server (127.0.0.1 only,
-//! every asset compiled into the binary) serves one page that shows the render, coarse to fine,
-//! the scene in 3D with the render's camera, one pixel's ray tree over the scene, a comparison of
-//! two light samplers against the converged reference, and the rays per second by kind.
+//! `raywave view`: the lab's debug window in the browser. A local web server (loopback by
+//! default, every asset compiled into the binary, every request carrying the access token)
+//! serves one page that shows the render, coarse to fine, the scene in 3D with the render's
+//! camera, one pixel's ray tree over the scene, a comparison of two light samplers against the
+//! converged reference, and the rays per second by kind.
 //!
 //! ```text
-//! server.rs      binding, worker threads, the routing table, stopping on SIGINT/SIGTERM
-//! http.rs        errors as 4xx/5xx JSON, replies, bodies under a size limit, query strings
+//! server.rs      binding, the connection limit, a thread per connection, stopping on signals
+//! connection.rs  one request read under its limits (time, head, body), its reply written
+//! routes.rs      the Host, Origin and token checks, the routing table
+//! token.rs       the access token: generated or given, checked in constant time, its cookie
+//! http.rs        errors as 4xx/5xx JSON, replies, query strings
 //! api.rs         the handlers
 //! request.rs     the settings a page sends (JSON) -> RenderSettings, checked
 //! jobs.rs        progressive render jobs on one render thread
@@ -18,16 +22,21 @@
 pub(crate) mod api;
 pub(crate) mod assets;
 pub(crate) mod compare;
+pub(crate) mod connection;
 pub(crate) mod http;
 pub(crate) mod jobs;
 pub mod request;
+pub(crate) mod routes;
 pub(crate) mod scene_json;
-pub(crate) mod server;
+pub mod server;
+pub mod token;
 pub(crate) mod tree;
 
 use anyhow::Result;
 use request::Resolved;
+use std::net::{IpAddr, SocketAddr};
 use std::sync::Arc;
+use token::Access;
 
 /// What `raywave view` was started with.
 pub struct ViewOptions {
@@ -39,18 +48,25 @@ pub struct ViewOptions {
     pub threads: Option<u32>,
     /// The wavefront engine's camera samples per tile.
     pub batch_size: usize,
+    /// The address to listen on (loopback unless `--bind` says otherwise).
+    pub bind: IpAddr,
     /// The port (0: any free one).
     pub port: u16,
+    /// The token every request must carry, or none.
+    pub access: Access,
+    /// Connections open at once; past it, 503.
+    pub max_connections: usize,
 }
 
 /// Binds, prints the URL with `say`, and serves until SIGINT or SIGTERM; returns the signal's
-/// name.
-pub fn run(options: ViewOptions, say: &dyn Fn(&str) -> Result<()>) -> Result<&'static str> {
-    let server = server::Server::bind(options.port)?;
+/// number.
+pub fn run(options: ViewOptions, say: &dyn Fn(&str) -> Result<()>) -> Result<i32> {
+    let server = server::Server::bind(options.bind, options.port)?;
     let pool = Arc::new(crate::render::engine::thread_pool(options.threads)?);
     let scene = Arc::new(options.scene);
     let jobs = jobs::Jobs::start(scene.clone(), pool.clone(), options.batch_size)
         .map_err(|e| anyhow::anyhow!("cannot start the render thread: {e}"))?;
+    let port = server.addr.port();
     let state = Arc::new(api::State {
         scene_json: api::scene_json(&scene, &options.base),
         scene,
@@ -58,11 +74,29 @@ pub fn run(options: ViewOptions, say: &dyn Fn(&str) -> Result<()>) -> Result<&'s
         jobs,
         comparisons: compare::Comparisons::default(),
         pool,
-        port: server.port,
     });
     say(&format!(
-        "raywave view: http://127.0.0.1:{}/ (Ctrl-C stops it)\n",
-        server.port
+        "raywave view: {} (Ctrl-C stops it)\n",
+        url(server.addr, &options.access)
     ))?;
-    server.serve(state)
+    let gate = routes::Gate {
+        access: options.access,
+        loopback: options.bind.is_loopback(),
+        port,
+    };
+    server.serve(state, gate, options.max_connections)
+}
+
+/// The page's URL, with the token: on every interface, the loopback one.
+pub fn url(addr: SocketAddr, access: &Access) -> String {
+    let host = match addr.ip() {
+        IpAddr::V4(ip) if ip.is_unspecified() => "127.0.0.1".to_string(),
+        IpAddr::V6(ip) if ip.is_unspecified() => "[::1]".to_string(),
+        IpAddr::V4(ip) => ip.to_string(),
+        IpAddr::V6(ip) => format!("[{ip}]"),
+    };
+    match access {
+        Access::Token(token) => format!("http://{host}:{}/?token={}", addr.port(), token.as_str()),
+        Access::Open => format!("http://{host}:{}/", addr.port()),
+    }
 }

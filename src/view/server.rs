@@ -1,291 +1,199 @@
-//! The HTTP server: tiny_http on 127.0.0.1, a few worker threads taking requests, the routing
-//! table, and a clean stop on SIGINT or SIGTERM (the workers finish the request in hand, the
-//! listener closes, `serve` returns).
+//! The server: one thread accepts connections, each admitted connection gets a thread of its
+//! own for one request (connection.rs bounds its time and size), and a stop on SIGINT or
+//! SIGTERM lets the requests in hand finish.
 //!
 //! ```text
-//! GET  /                              the page          GET /assets/NAME   its scripts and style
-//! GET  /api/scene                     geometry, camera, settings, choices
-//! POST /api/render                    settings -> a progressive job (supersedes the last)
-//! GET  /api/render/{job}              status, levels, rays/s by kind
-//! GET  /api/render/{job}/{level}.png  one level's image
-//! GET  /api/pixel?job=J&x=X&y=Y       the pixel's ray tree (x, y from the top-left)
-//! POST /api/compare                   two samplers against the converged reference
-//! GET  /api/compare/{id}/{name}.png   its images
+//! accept ──(fewer than max_connections open)──> thread: read request -> routes::answer -> reply, close
+//!        └─(at the limit)──> refuser thread (bounded queue): 503 + Retry-After, close
+//! SIGINT/SIGTERM -> stop accepting -> wait for the open connections (at most DRAIN_TIME) -> return
 //! ```
+//!
+//! A thread per connection, bounded by the connection limit, and a deadline per request: a slow
+//! client holds one thread for at most the request time and never blocks another's request.
+//! (tiny_http, used before, spawns a thread per connection without a bound and has no read
+//! timeout; an async server would add a runtime to every build for a page with a few requests
+//! a second.)
 
-use super::api::{self, State};
-use super::assets;
-use super::http::{ApiError, Reply, read_body};
+use super::api::State;
+use super::connection::{self, REQUEST_TIME, ReadError, Request};
+use super::http::{ApiError, Reply};
+use super::routes::{self, Gate};
 use anyhow::{Context, Result};
+use std::net::{IpAddr, Ipv4Addr, Ipv6Addr, SocketAddr, TcpListener, TcpStream};
 use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::Duration;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::mpsc::{Receiver, SyncSender, TrySendError};
+use std::time::{Duration, Instant};
 
-/// Request-handling threads: enough that a slow comparison does not hold up the page's polls.
-pub(crate) const WORKERS: usize = 4;
+/// The connections open at once by default; past it, new ones get a 503.
+pub const DEFAULT_MAX_CONNECTIONS: usize = 256;
+
+/// How long a stop waits for the requests in hand.
+const DRAIN_TIME: Duration = Duration::from_secs(30);
+
+/// Connections over the limit waiting for their 503; past this they are closed unanswered.
+const REFUSE_QUEUE: usize = 64;
 
 /// A bound server.
 pub(crate) struct Server {
-    http: Arc<tiny_http::Server>,
-    /// The port it listens on.
-    pub port: u16,
+    listener: TcpListener,
+    /// The address it listens on (the port filled in).
+    pub addr: SocketAddr,
 }
 
 impl Server {
-    /// Listens on 127.0.0.1:`port` (0: a free port the system chooses).
-    pub(crate) fn bind(port: u16) -> Result<Server> {
-        let addr = format!("127.0.0.1:{port}");
-        let http = tiny_http::Server::http(&addr)
-            .map_err(|e| anyhow::anyhow!("{e}"))
-            .with_context(|| format!("cannot listen on {addr}"))?;
-        let port = http
-            .server_addr()
-            .to_ip()
-            .map(|a| a.port())
-            .context("the server has no IP address")?;
-        Ok(Server {
-            http: Arc::new(http),
-            port,
-        })
+    /// Listens on `ip`:`port` (port 0: a free one the system chooses).
+    pub(crate) fn bind(ip: IpAddr, port: u16) -> Result<Server> {
+        let wanted = SocketAddr::new(ip, port);
+        let listener =
+            TcpListener::bind(wanted).with_context(|| format!("cannot listen on {wanted}"))?;
+        let addr = listener.local_addr().context("the server has no address")?;
+        Ok(Server { listener, addr })
     }
 
-    /// Serves until SIGINT or SIGTERM; returns the signal's name.
-    pub(crate) fn serve(self, state: Arc<State>) -> Result<&'static str> {
+    /// Serves until SIGINT or SIGTERM; returns the signal.
+    pub(crate) fn serve(
+        self,
+        state: Arc<State>,
+        gate: Gate,
+        max_connections: usize,
+    ) -> Result<i32> {
         use signal_hook::consts::{SIGINT, SIGTERM};
-        let stop = Arc::new(AtomicBool::new(false));
         let mut signals = signal_hook::iterator::Signals::new([SIGINT, SIGTERM])
             .context("cannot install the signal handler")?;
         let handle = signals.handle();
-        let workers: Vec<_> = (0..WORKERS)
-            .map(|i| {
-                let (http, stop, state) = (self.http.clone(), stop.clone(), state.clone());
-                std::thread::Builder::new()
-                    .name(format!("http-{i}"))
-                    .spawn(move || worker(&http, &stop, &state))
-                    .context("cannot start the server's threads")
-            })
-            .collect::<Result<_>>()?;
-        let signal = signals.forever().next();
-        handle.close();
-        stop.store(true, Ordering::Relaxed);
-        for w in workers {
-            let _ = w.join();
-        }
-        Ok(match signal {
-            Some(SIGTERM) => "SIGTERM",
-            _ => "SIGINT",
-        })
-    }
-}
-
-fn worker(http: &tiny_http::Server, stop: &AtomicBool, state: &State) {
-    while !stop.load(Ordering::Relaxed) {
-        match http.recv_timeout(Duration::from_millis(100)) {
-            Ok(Some(request)) => respond(request, state),
-            Ok(None) => {}
-            Err(e) => {
-                eprintln!("warning: cannot receive a request: {e}");
-                std::thread::sleep(Duration::from_millis(100));
-            }
-        }
-    }
-}
-
-/// Answers one request; a panic in a handler becomes a 500, not a dead worker.
-fn respond(mut request: tiny_http::Request, state: &State) {
-    let method = request.method().as_str().to_string();
-    let url = request.url().to_string();
-    let declared = request.body_length();
-    let header = |name: &'static str| {
-        request
-            .headers()
-            .iter()
-            .find(|h| h.field.equiv(name))
-            .map(|h| h.value.as_str().to_string())
-    };
-    let (host, origin) = (header("Host"), header("Origin"));
-    let reply = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        route(
-            &method,
-            &url,
-            [host.as_deref(), origin.as_deref()],
-            declared,
-            request.as_reader(),
+        let (refuse, refused) = std::sync::mpsc::sync_channel(REFUSE_QUEUE);
+        std::thread::Builder::new()
+            .name("refuse".into())
+            .spawn(move || refuser(&refused, max_connections))
+            .context("cannot start the server's threads")?;
+        let shared = Arc::new(Shared {
             state,
-        )
-        .unwrap_or_else(Reply::from)
+            gate,
+            open: AtomicUsize::new(0),
+            max_connections,
+            stop: AtomicBool::new(false),
+        });
+        let acceptor = {
+            let shared = shared.clone();
+            std::thread::Builder::new()
+                .name("accept".into())
+                .spawn(move || accept(&self.listener, &shared, &refuse))
+                .context("cannot start the server's threads")?
+        };
+        let signal = signals.forever().next().unwrap_or(SIGINT);
+        handle.close();
+        shared.stop.store(true, Ordering::SeqCst);
+        // Wake the acceptor from accept(2) with a connection of our own.
+        let _ = TcpStream::connect_timeout(&wake_address(self.addr), Duration::from_secs(1));
+        let _ = acceptor.join();
+        let end = Instant::now() + DRAIN_TIME;
+        while shared.open.load(Ordering::SeqCst) > 0 && Instant::now() < end {
+            std::thread::sleep(Duration::from_millis(10));
+        }
+        Ok(signal)
+    }
+}
+
+/// What the connection threads share.
+struct Shared {
+    state: Arc<State>,
+    gate: Gate,
+    /// Connections being served now.
+    open: AtomicUsize,
+    max_connections: usize,
+    stop: AtomicBool,
+}
+
+/// One open connection's place under the limit, given back when its thread ends.
+struct Slot(Arc<Shared>);
+
+impl Drop for Slot {
+    fn drop(&mut self) {
+        self.0.open.fetch_sub(1, Ordering::SeqCst);
+    }
+}
+
+/// The address a connection to the server itself goes to: the bound one, or loopback when
+/// bound to every interface.
+fn wake_address(addr: SocketAddr) -> SocketAddr {
+    match addr.ip() {
+        IpAddr::V4(ip) if ip.is_unspecified() => (Ipv4Addr::LOCALHOST, addr.port()).into(),
+        IpAddr::V6(ip) if ip.is_unspecified() => (Ipv6Addr::LOCALHOST, addr.port()).into(),
+        _ => addr,
+    }
+}
+
+fn accept(listener: &TcpListener, shared: &Arc<Shared>, refuse: &SyncSender<TcpStream>) {
+    for stream in listener.incoming() {
+        if shared.stop.load(Ordering::SeqCst) {
+            return;
+        }
+        let stream = match stream {
+            Ok(s) => s,
+            Err(e) => {
+                // Out of file descriptors, or a connection reset while queued: go on.
+                eprintln!("warning: cannot accept a connection: {e}");
+                std::thread::sleep(Duration::from_millis(10));
+                continue;
+            }
+        };
+        let accepted = Instant::now();
+        if shared.open.fetch_add(1, Ordering::SeqCst) >= shared.max_connections {
+            shared.open.fetch_sub(1, Ordering::SeqCst);
+            if let Err(TrySendError::Full(_)) = refuse.try_send(stream) {
+                // Already refusing as fast as it can: close this one unanswered.
+            }
+            continue;
+        }
+        let slot = Slot(shared.clone());
+        let spawned = std::thread::Builder::new()
+            .name("http".into())
+            .spawn(move || serve_connection(stream, accepted, &slot.0, &slot));
+        if let Err(e) = spawned {
+            eprintln!("warning: cannot start a thread for a connection: {e}");
+        }
+    }
+}
+
+/// Reads the request, answers it, closes.
+fn serve_connection(mut stream: TcpStream, accepted: Instant, shared: &Shared, _slot: &Slot) {
+    let _ = stream.set_nodelay(true);
+    let (reply, head_only) = match connection::read_request(&mut stream, accepted, REQUEST_TIME) {
+        Err(ReadError::Closed) => return,
+        Err(ReadError::Refused(e)) => (Reply::from(e), false),
+        Ok(request) => (answer(&request, shared), request.method == "HEAD"),
+    };
+    connection::reply_and_close(stream, &reply, head_only);
+}
+
+/// The reply to a request; a panic in a handler becomes a 500, not a dead server.
+fn answer(request: &Request, shared: &Shared) -> Reply {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        routes::answer(request, &shared.state, &shared.gate)
     }))
     .unwrap_or_else(|_| {
         Reply::from(ApiError::status(
             500,
             "internal error while answering this request (see the server's log)",
         ))
-    });
-    let mut response = tiny_http::Response::from_data(reply.body).with_status_code(reply.status);
-    let mut add = |name: &str, value: &str| {
-        if let Ok(h) = tiny_http::Header::from_bytes(name.as_bytes(), value.as_bytes()) {
-            response.add_header(h);
-        }
-    };
-    add("Content-Type", reply.content_type);
-    add(
-        "Cache-Control",
-        if reply.cacheable {
-            "max-age=60"
-        } else {
-            "no-store"
-        },
-    );
-    add("X-Content-Type-Options", "nosniff");
-    if let Some(allow) = reply.allow {
-        add("Allow", allow);
-    }
-    // A client that hung up is not our error.
-    let _ = request.respond(response);
+    })
 }
 
-/// The routing table.
-fn route(
-    method: &str,
-    url: &str,
-    [host, origin]: [Option<&str>; 2],
-    declared: Option<usize>,
-    body: &mut dyn std::io::Read,
-    state: &State,
-) -> Result<Reply, ApiError> {
-    check_host(host, state.port)?;
-    check_origin(origin, state.port)?;
-    let (path, query) = url.split_once('?').unwrap_or((url, ""));
-    let segments: Vec<&str> = path.split('/').skip(1).collect();
-    let get = |allow: &'static str| {
-        if method == "GET" || method == "HEAD" {
-            Ok(())
-        } else {
-            Err(ApiError::method(method, path, allow))
-        }
-    };
-    let post = || {
-        if method == "POST" {
-            Ok(())
-        } else {
-            Err(ApiError::method(method, path, "POST"))
-        }
-    };
-    match segments.as_slice() {
-        [""] | ["index.html"] => {
-            get("GET")?;
-            assets::page()
-        }
-        ["assets", name] => {
-            get("GET")?;
-            assets::asset(name)
-        }
-        ["api", "scene"] => {
-            get("GET")?;
-            Ok(api::scene(state))
-        }
-        ["api", "render"] => {
-            post()?;
-            api::render(state, &read_body(declared, body)?)
-        }
-        ["api", "render", job] => {
-            get("GET")?;
-            api::render_status(state, job)
-        }
-        ["api", "render", job, level] => {
-            get("GET")?;
-            api::render_png(state, job, level)
-        }
-        ["api", "pixel"] => {
-            get("GET")?;
-            api::pixel(state, query)
-        }
-        ["api", "compare"] => {
-            post()?;
-            api::compare(state, &read_body(declared, body)?)
-        }
-        ["api", "compare", id, name] => {
-            get("GET")?;
-            api::compare_png(state, id, name)
-        }
-        _ => Err(ApiError::not_found(format!(
-            "no such path: {} (the page is at /, the API under /api/)",
-            crate::render::quote::quote(path)
-        ))),
-    }
-}
-
-/// Refuses requests addressed to another host name: a page elsewhere that resolves its own name
-/// to 127.0.0.1 (DNS rebinding) must not reach the API.
-fn check_host(host: Option<&str>, port: u16) -> Result<(), ApiError> {
-    let ok = host.is_some_and(|h| {
-        let name = h.strip_suffix(&format!(":{port}")).unwrap_or(h);
-        matches!(name, "127.0.0.1" | "localhost" | "[::1]")
-    });
-    if ok {
-        Ok(())
-    } else {
-        Err(ApiError::status(
-            421,
-            format!(
-                "unexpected Host `{}`: this server answers only to 127.0.0.1:{port} and localhost:{port}",
-                crate::render::quote::quote(host.unwrap_or(""))
-            ),
-        ))
-    }
-}
-
-/// Refuses requests that a page from another origin sent (browsers name the page's origin on
-/// every POST): such a page could otherwise start renders here.
-fn check_origin(origin: Option<&str>, port: u16) -> Result<(), ApiError> {
-    let Some(origin) = origin else {
-        return Ok(());
-    };
-    let ours = ["127.0.0.1", "localhost", "[::1]"]
-        .iter()
-        .any(|h| origin == format!("http://{h}:{port}"));
-    if ours {
-        Ok(())
-    } else {
-        Err(ApiError::status(
-            403,
-            format!(
-                "requests from `{}` are refused: only the page at http://127.0.0.1:{port}/ may call this API",
-                crate::render::quote::quote(origin)
-            ),
-        ))
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn only_local_host_names_are_served() {
-        assert!(check_host(Some("127.0.0.1:8080"), 8080).is_ok());
-        assert!(check_host(Some("localhost:8080"), 8080).is_ok());
-        assert!(check_host(Some("localhost"), 8080).is_ok());
-        assert_eq!(
-            check_host(Some("evil.example:8080"), 8080)
-                .unwrap_err()
-                .status,
-            421
-        );
-        assert_eq!(check_host(None, 8080).unwrap_err().status, 421);
-        assert!(check_origin(None, 8080).is_ok());
-        assert!(check_origin(Some("http://127.0.0.1:8080"), 8080).is_ok());
-        assert_eq!(
-            check_origin(Some("http://127.0.0.1:9090"), 8080)
-                .unwrap_err()
-                .status,
-            403
-        );
-        assert_eq!(
-            check_origin(Some("https://evil.example"), 8080)
-                .unwrap_err()
-                .status,
-            403
-        );
+/// Answers the connections over the limit with 503 and `Retry-After`, one at a time, each in a
+/// bounded time.
+fn refuser(queue: &Receiver<TcpStream>, max_connections: usize) {
+    let reply = Reply::from(ApiError::retry(
+        503,
+        1,
+        format!(
+            "this server is at its limit of {max_connections} open connections: try again in a second"
+        ),
+    ));
+    while let Ok(mut stream) = queue.recv() {
+        // Take what the client sent first, so that closing does not reset the connection
+        // before it reads the answer.
+        connection::linger(&mut stream, Duration::from_millis(20));
+        connection::reply_and_close(stream, &reply, false);
     }
 }

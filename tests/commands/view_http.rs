@@ -247,7 +247,7 @@ fn sigint_and_sigterm_stop_it_cleanly_even_mid_render() {
         );
         assert_eq!(r.status, 200, "{}", r.text());
         let (status, stderr) = server.stop(signal, Duration::from_secs(10));
-        assert_eq!(status.code(), Some(0), "{name}: {stderr}");
+        assert_eq!(status.code(), Some(128 + signal), "{name}: {stderr}");
         assert!(stderr.contains(&format!("stopped by {name}")), "{stderr}");
         assert!(!stderr.contains("panicked"), "{stderr}");
         // The port is free again.

@@ -1,6 +1,6 @@
 //! `raywave view` for the tests: the server started on a free port, plain HTTP/1.1 requests to
-//! it over a socket (so a test can send exactly the malformed request it means), and stopping
-//! it with a signal.
+//! it over a socket (so a test can send exactly the malformed request it means), with the
+//! access token it printed or without it, and stopping it with a signal.
 
 use std::io::{BufRead, BufReader, Read, Write};
 use std::net::TcpStream;
@@ -13,6 +13,10 @@ pub struct ViewServer {
     pub child: Child,
     /// Its port on 127.0.0.1.
     pub port: u16,
+    /// The access token in the URL it printed (None with `--no-token`).
+    pub token: Option<String>,
+    /// The URL it printed, token included.
+    pub printed_url: String,
 }
 
 /// One reply.
@@ -50,10 +54,17 @@ impl HttpReply {
 impl ViewServer {
     /// Starts `raywave view ARGS --port 0` and reads the URL it prints.
     pub fn start(args: &[&str]) -> ViewServer {
+        ViewServer::start_with(args, &[])
+    }
+
+    /// Starts `raywave view ARGS --port 0` with extra environment variables.
+    pub fn start_with(args: &[&str], env: &[(&str, &str)]) -> ViewServer {
         let mut child = Command::new(env!("CARGO_BIN_EXE_raywave"))
             .arg("view")
             .args(args)
             .args(["--port", "0"])
+            .env_remove("RAYWAVE_VIEW_TOKEN")
+            .envs(env.iter().copied())
             .stdin(Stdio::null())
             .stdout(Stdio::piped())
             .stderr(Stdio::piped())
@@ -63,22 +74,35 @@ impl ViewServer {
         BufReader::new(child.stdout.take().expect("stdout"))
             .read_line(&mut line)
             .expect("read the URL line");
-        let port = line
-            .split("http://127.0.0.1:")
-            .nth(1)
+        let printed_url = line
+            .split_whitespace()
+            .find(|w| w.starts_with("http://"))
+            .unwrap_or_else(|| panic!("no URL in the first line: {line:?}"))
+            .to_string();
+        let port = printed_url
+            .strip_prefix("http://127.0.0.1:")
             .and_then(|rest| rest.split('/').next())
             .and_then(|p| p.parse().ok())
-            .unwrap_or_else(|| panic!("no URL in the first line: {line:?}"));
-        ViewServer { child, port }
+            .unwrap_or_else(|| panic!("no 127.0.0.1 port in {printed_url:?}"));
+        let token = printed_url
+            .split_once("/?token=")
+            .map(|(_, t)| t.to_string());
+        ViewServer {
+            child,
+            port,
+            token,
+            printed_url,
+        }
     }
 
-    /// The page's URL.
+    /// The page's URL, with the token: what a user opens.
     pub fn url(&self) -> String {
-        format!("http://127.0.0.1:{}/", self.port)
+        self.printed_url.clone()
     }
 
-    /// Sends one request (`Connection: close`) and reads the whole reply. `headers` are extra
-    /// lines; a `Host` header is added unless one is given.
+    /// Sends one request (`Connection: close`) with the token (`Authorization: Bearer`, unless
+    /// `headers` carry an Authorization or Cookie of their own) and reads the whole reply.
+    /// `headers` are extra lines; a `Host` header is added unless one is given.
     pub fn request(
         &self,
         method: &str,
@@ -86,8 +110,25 @@ impl ViewServer {
         headers: &[(&str, &str)],
         body: &[u8],
     ) -> HttpReply {
-        let mut s = TcpStream::connect(("127.0.0.1", self.port)).expect("connect");
-        s.set_read_timeout(Some(Duration::from_secs(60))).unwrap();
+        let own = headers.iter().any(|(n, _)| {
+            n.eq_ignore_ascii_case("authorization") || n.eq_ignore_ascii_case("cookie")
+        });
+        let bearer = self.token.as_ref().map(|t| format!("Bearer {t}"));
+        let mut all: Vec<(&str, &str)> = headers.to_vec();
+        if let (false, Some(b)) = (own, bearer.as_deref()) {
+            all.push(("Authorization", b));
+        }
+        self.request_without_token(method, path, &all, body)
+    }
+
+    /// [`request`](Self::request) with exactly the headers given: no token added.
+    pub fn request_without_token(
+        &self,
+        method: &str,
+        path: &str,
+        headers: &[(&str, &str)],
+        body: &[u8],
+    ) -> HttpReply {
         let mut head = format!("{method} {path} HTTP/1.1\r\nConnection: close\r\n");
         if !headers.iter().any(|(n, _)| n.eq_ignore_ascii_case("host")) {
             head += &format!("Host: 127.0.0.1:{}\r\n", self.port);
@@ -99,12 +140,20 @@ impl ViewServer {
             head += &format!("Content-Length: {}\r\n", body.len());
         }
         head += "\r\n";
-        s.write_all(head.as_bytes()).unwrap();
+        let mut bytes = head.into_bytes();
+        bytes.extend_from_slice(body);
+        parse_reply(&self.raw(&bytes))
+    }
+
+    /// Sends `bytes` as they are and reads until the server closes.
+    pub fn raw(&self, bytes: &[u8]) -> Vec<u8> {
+        let mut s = TcpStream::connect(("127.0.0.1", self.port)).expect("connect");
+        s.set_read_timeout(Some(Duration::from_secs(60))).unwrap();
         // The server may answer (413) and close before taking the whole body.
-        let _ = s.write_all(body);
+        let _ = s.write_all(bytes);
         let mut raw = Vec::new();
         let _ = s.read_to_end(&mut raw);
-        parse_reply(&raw)
+        raw
     }
 
     /// GET.
@@ -170,7 +219,8 @@ impl Drop for ViewServer {
     }
 }
 
-fn parse_reply(raw: &[u8]) -> HttpReply {
+/// A raw reply's status, headers and body.
+pub fn parse_reply(raw: &[u8]) -> HttpReply {
     let split = raw
         .windows(4)
         .position(|w| w == b"\r\n\r\n")
@@ -187,38 +237,18 @@ fn parse_reply(raw: &[u8]) -> HttpReply {
         .map(|(n, v)| (n.trim().to_ascii_lowercase(), v.trim().to_string()))
         .collect();
     let body = &raw[split + 4..];
-    // Large bodies come chunked (tiny_http past 32 KiB on HTTP/1.1), as browsers accept.
-    let chunked = headers
-        .iter()
-        .any(|(n, v)| n == "transfer-encoding" && v.eq_ignore_ascii_case("chunked"));
+    // Every reply says its length (the server never sends chunked bodies).
+    if let Some((_, n)) = headers.iter().find(|(n, _)| n == "content-length") {
+        assert_eq!(
+            n.parse::<usize>().ok(),
+            Some(body.len()),
+            "Content-Length {n} against the body"
+        );
+    }
     HttpReply {
         status,
         headers,
-        body: if chunked {
-            dechunk(body)
-        } else {
-            body.to_vec()
-        },
-    }
-}
-
-/// A chunked body's data: each chunk is a hex length line, the bytes, CRLF; a 0 ends it.
-fn dechunk(mut raw: &[u8]) -> Vec<u8> {
-    let mut out = Vec::new();
-    loop {
-        let line_end = raw
-            .windows(2)
-            .position(|w| w == b"\r\n")
-            .expect("a chunk-size line");
-        let size_text = String::from_utf8_lossy(&raw[..line_end]);
-        let size = usize::from_str_radix(size_text.split(';').next().unwrap_or("").trim(), 16)
-            .unwrap_or_else(|_| panic!("a chunk size, not {size_text:?}"));
-        raw = &raw[line_end + 2..];
-        if size == 0 {
-            return out;
-        }
-        out.extend_from_slice(&raw[..size]);
-        raw = &raw[size + 2..];
+        body: body.to_vec(),
     }
 }
 
