@@ -442,4 +442,36 @@ mod tests {
         }
         assert!(head.ends_with("\r\n\r\n"));
     }
+
+    proptest::proptest! {
+        /// Any bytes, cut anywhere: a request or a refusal, never a panic, and a request's body
+        /// is exactly what its Content-Length says.
+        #[test]
+        fn any_bytes_in_any_pieces_are_read_or_refused(
+            bytes in proptest::collection::vec(proptest::prelude::any::<u8>(), 0..512),
+            prefix in proptest::prelude::prop_oneof![
+                proptest::prelude::Just(&b""[..]),
+                proptest::prelude::Just(&b"POST / HTTP/1.1\r\nContent-Length: 3\r\n"[..]),
+                proptest::prelude::Just(&b"GET / HTTP/1.1\r\n"[..]),
+            ],
+            cuts in proptest::collection::vec(0usize..600, 0..4),
+            stall in proptest::prelude::any::<bool>(),
+        ) {
+            let mut all = prefix.to_vec();
+            all.extend_from_slice(&bytes);
+            let mut cuts: Vec<usize> = cuts.into_iter().map(|c| c.min(all.len())).collect();
+            cuts.sort_unstable();
+            let mut pieces = Vec::new();
+            let mut from = 0;
+            for c in cuts.into_iter().chain([all.len()]) {
+                pieces.push(all[from..c].to_vec());
+                from = c;
+            }
+            let mut source = Pieces { pieces: pieces.into(), stall };
+            if let Ok(r) = read_request(&mut source, Instant::now(), Duration::from_secs(5)) {
+                let declared = r.one("content-length").unwrap().map_or(0, |v| v.trim().parse().unwrap());
+                proptest::prop_assert_eq!(r.body.len(), declared);
+            }
+        }
+    }
 }
