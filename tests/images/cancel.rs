@@ -75,15 +75,15 @@ fn a_cancelled_render_stops_within_a_unit_per_thread() {
             let bound = K + threads as u64 - 1;
             assert!(units > 4 * bound, "{engine:?}: {units} {what} are too few");
             let (result, done) = render_stopping_after(&prepared, threads, K);
-            assert!(
-                result.is_none(),
-                "{engine:?}, {threads} threads: a cancelled render returned an image"
-            );
             // One thread: exactly K, the unit that set the flag is the last one started.
             assert!(
                 (K..=bound).contains(&done),
                 "{engine:?}, {threads} threads: {done} of {units} {what} rendered after a \
                  cancel at {K}, expected {K}..={bound}"
+            );
+            assert!(
+                result.is_none(),
+                "{engine:?}, {threads} threads: a cancelled render returned an image"
             );
         }
     }
