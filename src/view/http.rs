@@ -17,6 +17,8 @@ pub struct ApiError {
     pub message: String,
     /// The methods the path allows, for a 405's `Allow` header.
     pub allow: Option<&'static str>,
+    /// Seconds to wait, for a 429's `Retry-After` header.
+    pub retry_after: Option<u32>,
 }
 
 impl ApiError {
@@ -36,6 +38,7 @@ impl ApiError {
             status,
             message: message.into(),
             allow: None,
+            retry_after: None,
         }
     }
 
@@ -49,6 +52,7 @@ impl ApiError {
                 quote(path)
             ),
             allow: Some(allow),
+            retry_after: None,
         }
     }
 }
@@ -66,6 +70,8 @@ pub(crate) struct Reply {
     pub cacheable: bool,
     /// `Allow`, for 405.
     pub allow: Option<&'static str>,
+    /// `Retry-After` in seconds, for 429.
+    pub retry_after: Option<u32>,
 }
 
 impl Reply {
@@ -88,6 +94,7 @@ impl Reply {
             body,
             cacheable: false,
             allow: None,
+            retry_after: None,
         }
     }
 }
@@ -110,6 +117,7 @@ impl From<ApiError> for Reply {
             body,
             cacheable: false,
             allow: e.allow,
+            retry_after: e.retry_after,
         }
     }
 }

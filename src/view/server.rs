@@ -140,6 +140,9 @@ fn respond(mut request: tiny_http::Request, state: &State) {
     if let Some(allow) = reply.allow {
         add("Allow", allow);
     }
+    if let Some(seconds) = reply.retry_after {
+        add("Retry-After", &seconds.to_string());
+    }
     // A client that hung up is not our error.
     let _ = request.respond(response);
 }

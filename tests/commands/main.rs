@@ -27,3 +27,4 @@ mod trace_pixel_exports;
 mod variance_shards;
 mod view_browser;
 mod view_http;
+mod view_jobs;

@@ -107,7 +107,10 @@ fn an_uncancelled_render_until_is_render_bit_for_bit() {
             .unwrap_or_else(|| panic!("{engine:?}: an unset flag cancelled the render"));
         assert_eq!(bits(&film), bits(&until), "{engine:?}: flag never set");
         assert_eq!(stats.counts, until_stats.counts, "{engine:?}");
-        assert_eq!(stats.clamped_pixels, until_stats.clamped_pixels, "{engine:?}");
+        assert_eq!(
+            stats.clamped_pixels, until_stats.clamped_pixels,
+            "{engine:?}"
+        );
         // A flag set by the last unit skips nothing: the image is whole, and returned.
         let (last, done) = render_stopping_after(&prepared, 2, units);
         assert_eq!(done, units, "{engine:?}");
@@ -116,6 +119,9 @@ fn an_uncancelled_render_until_is_render_bit_for_bit() {
         assert_eq!(bits(&film), bits(&last), "{engine:?}: flag set at the end");
         assert_eq!(stats.counts, last_stats.counts, "{engine:?}");
         // And the images are not empty: the check compares something.
-        assert!(stats.counts.shadow > 0 && stats.counts.reflection > 0, "{stats:?}");
+        assert!(
+            stats.counts.shadow > 0 && stats.counts.reflection > 0,
+            "{stats:?}"
+        );
     }
 }
