@@ -517,7 +517,10 @@ mod tests {
         }
         // Twenty starts at once, then the limit; eight jobs kept.
         let more: Vec<_> = (3..20).map(|_| jobs.submit(resolved()).unwrap()).collect();
-        assert_eq!(jobs.submit(resolved()).err(), Some(RateLimited { retry_after: 1 }));
+        assert_eq!(
+            jobs.submit(resolved()).err(),
+            Some(RateLimited { retry_after: 1 })
+        );
         assert_eq!(jobs.newest(), 20);
         assert!(
             more.iter()
