@@ -84,7 +84,8 @@ fn a_superseded_render_stops_within_a_tile_and_the_newer_one_finishes() {
 
     // Its pixels are gone: 410, naming the job that took its place.
     let r = server.get(&format!("/api/pixel?job={big}&x=512&y=512"));
-    assert_eq!(r.status, 410, "{}", r.text());
+    let start: String = r.text().chars().take(300).collect();
+    assert_eq!(r.status, 410, "{start}");
     assert_eq!(r.header("content-type"), Some("application/json"));
     assert_eq!(
         r.json()["error"],
