@@ -6,6 +6,8 @@
 //! Engine::render(scene, settings, batch, progress)            one image
 //! Engine::prepare(scene, settings, batch) -> Prepared         set-up once (BVH, tables) ...
 //!     Prepared::render(progress) -> (Film, RenderStats)       ... then render as often as asked
+//!     Prepared::render_until(progress, cancel)                 ... or until `cancel` is set:
+//!         -> Option<(Film, RenderStats)>                           None once a unit was skipped
 //! ```
 
 use crate::render::film::Film;
@@ -17,6 +19,7 @@ use crate::render::wavefront::Wavefront;
 use crate::render::wavefront::lanes::LaneWidth;
 use crate::render::wavefront::stats::RenderStats;
 use serde::{Deserialize, Serialize};
+use std::sync::atomic::AtomicBool;
 
 /// The renderers.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -169,16 +172,23 @@ impl Prepared<'_> {
     /// surface can still overflow f32; such pixels are clamped (see [`clamp_to_finite`]) and
     /// counted in `clamped_pixels`, for the caller to warn with [`clamped_warning`].
     pub fn render(&self, progress: &(dyn Fn() + Sync)) -> (Film, RenderStats) {
-        let (mut film, mut stats) = self.render_raw(progress);
-        stats.clamped_pixels = clamp_to_finite(&mut film) as u64;
-        (film, stats)
+        self.render_until(progress, &AtomicBool::new(false))
+            .expect("a render whose cancel flag is never set renders every unit")
     }
 
-    fn render_raw(&self, progress: &(dyn Fn() + Sync)) -> (Film, RenderStats) {
-        match self {
-            Prepared::Wavefront(w) => w.render(progress),
+    /// [`Prepared::render`] that stops early once `cancel` is set (by another thread, or by
+    /// `progress` itself): each worker reads the flag before each work unit and skips the unit
+    /// when it is set, so the call returns within about one unit per thread. `None` when a unit
+    /// was skipped; otherwise the image and statistics are `render`'s, bit for bit.
+    pub fn render_until(
+        &self,
+        progress: &(dyn Fn() + Sync),
+        cancel: &AtomicBool,
+    ) -> Option<(Film, RenderStats)> {
+        let (mut film, mut stats) = match self {
+            Prepared::Wavefront(w) => w.render_until(progress, cancel)?,
             Prepared::Reference(r) => {
-                let (film, counts) = r.render(progress);
+                let (film, counts) = r.render_until(progress, cancel)?;
                 (
                     film,
                     RenderStats {
@@ -187,7 +197,9 @@ impl Prepared<'_> {
                     },
                 )
             }
-        }
+        };
+        stats.clamped_pixels = clamp_to_finite(&mut film) as u64;
+        Some((film, stats))
     }
 }
 

@@ -25,6 +25,7 @@ use crate::render::spawn::{
 };
 use glam::Vec3;
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 /// Receives every ray the tracer casts, with what the pixel gets from it; `()` ignores them at
@@ -115,21 +116,40 @@ impl<'a> Reference<'a> {
 
     /// Renders the image on the current rayon pool; `on_row` is called after each row.
     pub fn render(&self, on_row: &(dyn Fn() + Sync)) -> (Film, RayCounts) {
+        self.render_until(on_row, &AtomicBool::new(false))
+            .expect("a render whose cancel flag is never set renders every row")
+    }
+
+    /// [`Reference::render`] that stops early once `cancel` is set: every worker reads the flag
+    /// before each row and skips the row when it is set, so the call returns within about one
+    /// row per thread. `None` when a row was skipped (the film is incomplete); an image that
+    /// got every row is the same, bit for bit, as `render`'s.
+    pub fn render_until(
+        &self,
+        on_row: &(dyn Fn() + Sync),
+        cancel: &AtomicBool,
+    ) -> Option<(Film, RayCounts)> {
         let (w, h) = (self.settings.width as usize, self.settings.height as usize);
         let mut film = Film::new(self.settings.width, self.settings.height);
+        // Set only on the skip path: a row costs one relaxed load more.
+        let skipped = AtomicBool::new(false);
         let counts = film
             .pixels
             .par_chunks_mut(w)
             .enumerate()
             .map(|(row, out)| {
                 let mut counts = RayCounts::default();
+                if cancel.load(Ordering::Relaxed) {
+                    skipped.store(true, Ordering::Relaxed);
+                    return counts;
+                }
                 self.pixels((row * w) as u32, out, &mut counts);
                 on_row();
                 counts
             })
             .reduce(RayCounts::default, |a, b| a + b);
         debug_assert_eq!(film.pixels.len(), w * h);
-        (film, counts)
+        (!skipped.into_inner()).then_some((film, counts))
     }
 
     /// [`Reference::render`] with the thread-time of each kind's work measured: camera = the

@@ -3,7 +3,7 @@
 
 use super::compare::{CompareRequest, Comparisons};
 use super::http::{ApiError, Reply, number, query};
-use super::jobs::{ENGINES, Jobs};
+use super::jobs::{ENGINES, Jobs, RENDER_BURST, RENDER_RATE, Status};
 use super::request::{Resolved, ViewSettings};
 use super::scene_json::{CameraFrame, SceneJson};
 use super::tree;
@@ -56,10 +56,21 @@ pub(crate) fn scene_json(scene: &Scene, base: &Resolved) -> Vec<u8> {
     .unwrap_or_default()
 }
 
-/// `POST /api/render`: starts a job.
+/// `POST /api/render`: starts a job, unless more than the rate limit's starts came in the
+/// last second (429 with `Retry-After`).
 pub(crate) fn render(state: &State, body: &[u8]) -> Result<Reply, ApiError> {
     let resolved = ViewSettings::parse(body)?.resolve(&state.base)?;
-    let job = state.jobs.submit(resolved);
+    let job = state.jobs.submit(resolved).map_err(|limited| ApiError {
+        retry_after: Some(limited.retry_after),
+        ..ApiError::status(
+            429,
+            format!(
+                "too many renders started: at most {RENDER_BURST} at once and {RENDER_RATE} a \
+                 second; retry in {} s",
+                limited.retry_after
+            ),
+        )
+    })?;
     Ok(with_frame(job.status(), &job.resolved))
 }
 
@@ -133,10 +144,45 @@ pub(crate) fn render_png(state: &State, job: &str, level: &str) -> Result<Reply,
     Ok(Reply::bytes("image/png", png.as_ref().clone()))
 }
 
-/// `GET /api/pixel?job=J&x=X&y=Y`: the ray tree of pixel (x, y) of job J's full-size image.
+/// `GET /api/pixel?job=J&x=X&y=Y`: the ray tree of pixel (x, y) of job J's full-size image;
+/// 410 for a job whose image will never be finished (superseded or failed), naming the job to
+/// ask instead.
 pub(crate) fn pixel(state: &State, q: &str) -> Result<Reply, ApiError> {
     let pairs = query(q, &["job", "x", "y"])?;
     let job = job_by_id(state, number(&pairs, "job")?)?;
+    let newest = state.jobs.newest();
+    match job.state() {
+        Status::Superseded => {
+            let by = job.superseded_by().unwrap_or(newest);
+            let ask = if newest == by {
+                format!("ask for job {by}'s pixels")
+            } else {
+                format!("ask for the newest job's pixels, job {newest}")
+            };
+            return Err(ApiError::status(
+                410,
+                format!(
+                    "job {} was superseded by job {by} before its image was finished: {ask}",
+                    job.id
+                ),
+            ));
+        }
+        Status::Failed(error) => {
+            let ask = if newest == job.id {
+                "start a new render and ask for its pixels".to_string()
+            } else {
+                format!("ask for job {newest}'s pixels")
+            };
+            return Err(ApiError::status(
+                410,
+                format!(
+                    "job {} failed before its image was finished ({error}): {ask}",
+                    job.id
+                ),
+            ));
+        }
+        Status::Queued | Status::Running | Status::Done => {}
+    }
     let (x, y): (u32, u32) = (number(&pairs, "x")?, number(&pairs, "y")?);
     let scene = super::jobs::with_camera(&state.scene, &job.resolved.camera);
     Ok(Reply::json(&tree::pixel_tree(

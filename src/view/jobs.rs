@@ -1,12 +1,17 @@
 //! Progressive render jobs, as the lab's `r` key renders: the image at 1/8, 1/4, 1/2 and full
 //! resolution, each level a PNG the page shows as soon as it exists. One render thread works
-//! through the jobs; a new job supersedes every older one, which stops at its next level (the
-//! engines cannot stop inside an image, and a level is short).
+//! through the jobs one at a time. A new job supersedes every older one: it takes the place of
+//! the job waiting, if any (the queue holds one), and sets the running job's cancel flag, which
+//! the engines read before each tile or row, so the running job stops within about one tile per
+//! thread and becomes `superseded`.
 //!
 //! ```text
-//! POST /api/render -> Jobs::submit -> channel -> render thread:
-//!     for level in 1/8, 1/4, 1/2, 1:  stop if superseded
-//!         Engine::prepare(scene with the job's camera, settings at the level's size).render
+//! POST /api/render -> rate limit (token bucket) -> Jobs::submit:
+//!     the waiting job, if any, is superseded; the running job's cancel flag is set
+//!     -> the one waiting place -> render thread:
+//!     for level in 1/8, 1/4, 1/2, 1:
+//!         Engine::prepare(scene with the job's camera, settings at the level's size)
+//!             .render_until(progress, cancel)  -> None: superseded, stop
 //!         -> PNG + ray counts and seconds -> JobState (read by GET /api/render/{id})
 //! ```
 
@@ -20,12 +25,21 @@ use crate::view::request::{Resolved, ViewSettings};
 use serde::Serialize;
 use std::collections::VecDeque;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
-use std::sync::mpsc::{Receiver, Sender};
-use std::sync::{Arc, Mutex};
-use std::time::Instant;
+use std::sync::{Arc, Condvar, Mutex, MutexGuard};
+use std::time::{Duration, Instant};
 
 /// How many finished jobs are kept for their images and pixels.
 pub(crate) const KEPT_JOBS: usize = 8;
+
+/// Render starts admitted at once: the bucket's size.
+pub(crate) const RENDER_BURST: u32 = 20;
+
+/// Render starts admitted per second, sustained: the bucket's refill rate. The page asks for
+/// at most about 5 a second (a setting changed, a view orbited), so it never meets the limit,
+/// and a burst of 20 covers a user who changes several settings at once. A job that is
+/// superseded costs its engine's set-up (a mesh's BVH) and a tile per thread; past 20 a second a
+/// client is a script, and the limit keeps it from holding the render thread in set-ups.
+pub(crate) const RENDER_RATE: f64 = 20.0;
 
 /// The divisors of the levels, coarse to fine.
 pub(crate) const LEVEL_DIVISORS: [u32; 4] = [8, 4, 2, 1];
@@ -88,7 +102,10 @@ pub(crate) struct Job {
     pub resolved: Resolved,
     /// The level sizes.
     pub sizes: Vec<[u32; 2]>,
-    superseded: AtomicBool,
+    /// Set when a newer job supersedes this one: the engines read it before each work unit.
+    cancel: AtomicBool,
+    /// The job that superseded this one (0: none).
+    superseded_by: AtomicU64,
     done_units: AtomicU64,
     total_units: AtomicU64,
     state: Mutex<JobState>,
@@ -103,7 +120,7 @@ struct JobState {
 impl Job {
     /// The status for the page.
     pub(crate) fn status(&self) -> JobStatus {
-        let state = self.state.lock().unwrap_or_else(|e| e.into_inner());
+        let state = self.lock();
         JobStatus {
             job: self.id,
             status: state.status.clone(),
@@ -117,14 +134,36 @@ impl Job {
         }
     }
 
+    /// Where it is now.
+    pub(crate) fn state(&self) -> Status {
+        self.lock().status.clone()
+    }
+
+    /// The job that superseded this one, once one has.
+    pub(crate) fn superseded_by(&self) -> Option<u64> {
+        Some(self.superseded_by.load(Ordering::Relaxed)).filter(|&id| id != 0)
+    }
+
     /// Level `k`'s PNG, once rendered.
     pub(crate) fn png(&self, k: usize) -> Option<Arc<Vec<u8>>> {
-        let state = self.state.lock().unwrap_or_else(|e| e.into_inner());
-        state.pngs.get(k).cloned()
+        self.lock().pngs.get(k).cloned()
+    }
+
+    fn lock(&self) -> MutexGuard<'_, JobState> {
+        self.state.lock().unwrap_or_else(|e| e.into_inner())
     }
 
     fn set_status(&self, status: Status) {
-        self.state.lock().unwrap_or_else(|e| e.into_inner()).status = status;
+        self.lock().status = status;
+    }
+
+    /// Marks the job superseded by `by` (unless a job did before) and tells its render, if
+    /// any, to stop.
+    fn supersede(&self, by: u64) {
+        let _ = self
+            .superseded_by
+            .compare_exchange(0, by, Ordering::Relaxed, Ordering::Relaxed);
+        self.cancel.store(true, Ordering::Relaxed);
     }
 }
 
@@ -141,11 +180,86 @@ pub(crate) fn level_sizes(width: u32, height: u32) -> Vec<[u32; 2]> {
     sizes
 }
 
-/// The jobs, and the channel to the render thread.
+/// The render thread's inbox: at most one job waiting (a newer one takes its place), and the
+/// job being rendered, whose cancel flag a newer job sets.
+#[derive(Default)]
+struct Inbox {
+    waiting: Option<Arc<Job>>,
+    running: Option<Arc<Job>>,
+    /// The render thread has stopped, or must.
+    closed: bool,
+}
+
+/// The inbox and the signal that a job is waiting, shared by [`Jobs`] and the render thread.
+#[derive(Default)]
+struct Queue {
+    inbox: Mutex<Inbox>,
+    ready: Condvar,
+}
+
+impl Queue {
+    fn lock(&self) -> MutexGuard<'_, Inbox> {
+        self.inbox.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// Stops the render thread: the running job is cancelled, the waiting one dropped.
+    fn close(&self) {
+        let mut inbox = self.lock();
+        inbox.closed = true;
+        if let Some(job) = &inbox.running {
+            job.cancel.store(true, Ordering::Relaxed);
+        }
+        self.ready.notify_all();
+    }
+}
+
+/// A render start refused by the rate limit.
+#[derive(Debug, PartialEq)]
+pub(crate) struct RateLimited {
+    /// Seconds until a start is admitted again (rounded up, at least 1).
+    pub retry_after: u32,
+}
+
+/// The rate limit on render starts: a token bucket of [`RENDER_BURST`] starts, refilled at
+/// [`RENDER_RATE`] a second. Hand-written: the crates that do this (governor) bring a clock
+/// and a keyed store the one bucket here has no use for.
+#[derive(Debug)]
+struct TokenBucket {
+    tokens: f64,
+    at: Instant,
+}
+
+impl TokenBucket {
+    fn full(now: Instant) -> TokenBucket {
+        TokenBucket {
+            tokens: RENDER_BURST as f64,
+            at: now,
+        }
+    }
+
+    /// Takes one token at `now`, or says how long until there is one.
+    fn take(&mut self, now: Instant) -> Result<(), RateLimited> {
+        let refill = now.saturating_duration_since(self.at).as_secs_f64() * RENDER_RATE;
+        self.tokens = (self.tokens + refill).min(RENDER_BURST as f64);
+        self.at = now;
+        if self.tokens >= 1.0 {
+            self.tokens -= 1.0;
+            Ok(())
+        } else {
+            let wait = Duration::from_secs_f64((1.0 - self.tokens) / RENDER_RATE);
+            Err(RateLimited {
+                retry_after: (wait.as_secs_f64().ceil() as u32).max(1),
+            })
+        }
+    }
+}
+
+/// The jobs, the render thread's inbox and the rate limit on new jobs.
 pub(crate) struct Jobs {
     next: AtomicU64,
     kept: Mutex<VecDeque<Arc<Job>>>,
-    queue: Mutex<Sender<Arc<Job>>>,
+    queue: Arc<Queue>,
+    bucket: Mutex<TokenBucket>,
 }
 
 impl Jobs {
@@ -156,27 +270,34 @@ impl Jobs {
         pool: Arc<rayon::ThreadPool>,
         batch_size: usize,
     ) -> std::io::Result<Arc<Jobs>> {
-        let (tx, rx) = std::sync::mpsc::channel();
-        let jobs = Arc::new(Jobs {
-            next: AtomicU64::new(1),
-            kept: Mutex::new(VecDeque::new()),
-            queue: Mutex::new(tx),
-        });
+        let queue = Arc::new(Queue::default());
+        let inbox = queue.clone();
         std::thread::Builder::new()
             .name("render".into())
-            .spawn(move || render_thread(rx, &scene, &pool, batch_size))?;
-        Ok(jobs)
+            .spawn(move || render_thread(&inbox, &scene, &pool, batch_size))?;
+        Ok(Arc::new(Jobs {
+            next: AtomicU64::new(1),
+            kept: Mutex::new(VecDeque::new()),
+            queue,
+            bucket: Mutex::new(TokenBucket::full(Instant::now())),
+        }))
     }
 
-    /// Queues a job; every older job is superseded.
-    pub(crate) fn submit(&self, resolved: Resolved) -> Arc<Job> {
+    /// Queues a job, unless the rate limit refuses it. It takes the place of the job waiting,
+    /// which is superseded without starting, and cancels the job running.
+    pub(crate) fn submit(&self, resolved: Resolved) -> Result<Arc<Job>, RateLimited> {
+        self.bucket
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .take(Instant::now())?;
         let id = self.next.fetch_add(1, Ordering::Relaxed);
         let sizes = level_sizes(resolved.settings.width, resolved.settings.height);
         let job = Arc::new(Job {
             id,
             resolved,
             sizes,
-            superseded: AtomicBool::new(false),
+            cancel: AtomicBool::new(false),
+            superseded_by: AtomicU64::new(0),
             done_units: AtomicU64::new(0),
             total_units: AtomicU64::new(0),
             state: Mutex::new(JobState {
@@ -186,23 +307,26 @@ impl Jobs {
             }),
         });
         let mut kept = self.kept.lock().unwrap_or_else(|e| e.into_inner());
-        for old in kept.iter() {
-            old.superseded.store(true, Ordering::Relaxed);
-        }
         kept.push_back(job.clone());
         while kept.len() > KEPT_JOBS {
             kept.pop_front();
         }
         drop(kept);
-        let sent = self
-            .queue
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .send(job.clone());
-        if sent.is_err() {
+        let mut inbox = self.queue.lock();
+        if inbox.closed {
             job.set_status(Status::Failed("the render thread has stopped".into()));
+            return Ok(job);
         }
-        job
+        if let Some(old) = inbox.waiting.replace(job.clone()) {
+            old.supersede(id);
+            old.set_status(Status::Superseded);
+        }
+        // Its status turns `superseded` when the render thread has stopped it.
+        if let Some(running) = &inbox.running {
+            running.supersede(id);
+        }
+        self.queue.ready.notify_one();
+        Ok(job)
     }
 
     /// The job `id`, while it is kept.
@@ -210,19 +334,45 @@ impl Jobs {
         let kept = self.kept.lock().unwrap_or_else(|e| e.into_inner());
         kept.iter().find(|j| j.id == id).cloned()
     }
+
+    /// The newest job's id (0 before the first).
+    pub(crate) fn newest(&self) -> u64 {
+        self.next.load(Ordering::Relaxed) - 1
+    }
 }
 
-fn render_thread(
-    rx: Receiver<Arc<Job>>,
-    scene: &Scene,
-    pool: &rayon::ThreadPool,
-    batch_size: usize,
-) {
-    while let Ok(job) = rx.recv() {
-        if job.superseded.load(Ordering::Relaxed) {
-            job.set_status(Status::Superseded);
-            continue;
-        }
+impl Drop for Jobs {
+    fn drop(&mut self) {
+        self.queue.close();
+    }
+}
+
+/// Closes the queue when the render thread ends, however it ends: a later job fails at once
+/// instead of waiting for a thread that is gone.
+struct CloseOnExit<'a>(&'a Queue);
+
+impl Drop for CloseOnExit<'_> {
+    fn drop(&mut self) {
+        self.0.close();
+    }
+}
+
+fn render_thread(queue: &Queue, scene: &Scene, pool: &rayon::ThreadPool, batch_size: usize) {
+    let _close = CloseOnExit(queue);
+    loop {
+        let job = {
+            let mut inbox = queue.lock();
+            loop {
+                if inbox.closed {
+                    return;
+                }
+                if let Some(job) = inbox.waiting.take() {
+                    inbox.running = Some(job.clone());
+                    break job;
+                }
+                inbox = queue.ready.wait(inbox).unwrap_or_else(|e| e.into_inner());
+            }
+        };
         job.set_status(Status::Running);
         // A panic in an engine must not take the viewer down: the job fails with the message.
         let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
@@ -242,6 +392,7 @@ fn render_thread(
             )),
         };
         job.set_status(status);
+        queue.lock().running = None;
     }
 }
 
@@ -259,7 +410,7 @@ pub(crate) fn with_camera<'a>(
     }
 }
 
-/// Renders every level; false when superseded before the last.
+/// Renders every level; false when superseded before the last was finished.
 fn render_levels(
     job: &Job,
     scene: &Scene,
@@ -268,7 +419,7 @@ fn render_levels(
 ) -> anyhow::Result<bool> {
     let scene = with_camera(scene, &job.resolved.camera);
     for &[width, height] in &job.sizes {
-        if job.superseded.load(Ordering::Relaxed) {
+        if job.cancel.load(Ordering::Relaxed) {
             return Ok(false);
         }
         let settings = crate::render::settings::RenderSettings {
@@ -281,14 +432,18 @@ fn render_levels(
         let (units, _) = prepared.work_units(&settings);
         job.done_units.store(0, Ordering::Relaxed);
         job.total_units.store(units, Ordering::Relaxed);
-        let (film, stats) = pool.install(|| {
-            prepared.render(&|| {
+        let rendered = pool.install(|| {
+            let progress = || {
                 job.done_units.fetch_add(1, Ordering::Relaxed);
-            })
+            };
+            prepared.render_until(&progress, &job.cancel)
         });
+        let Some((film, stats)) = rendered else {
+            return Ok(false);
+        };
         let seconds = start.elapsed().as_secs_f64();
         let png = png_bytes(&film.to_rgb8(ToneMap::Clamp))?;
-        let mut state = job.state.lock().unwrap_or_else(|e| e.into_inner());
+        let mut state = job.lock();
         state.levels.push(Level {
             width,
             height,
@@ -316,5 +471,86 @@ mod tests {
         );
         assert_eq!(level_sizes(3, 2), vec![[1, 1], [2, 1], [3, 2]]);
         assert_eq!(level_sizes(1, 1), vec![[1, 1]]);
+    }
+
+    fn resolved() -> Resolved {
+        let settings = crate::render::settings::RenderSettings::default();
+        Resolved {
+            settings,
+            engine: Engine::Wavefront,
+            camera: Scene::builtin_default().camera,
+        }
+    }
+
+    #[test]
+    fn one_job_waits_a_newer_one_replaces_it_and_cancels_the_running_one() {
+        // No render thread: the test plays its part on the queue.
+        let jobs = Jobs {
+            next: AtomicU64::new(1),
+            kept: Mutex::new(VecDeque::new()),
+            queue: Arc::new(Queue::default()),
+            bucket: Mutex::new(TokenBucket::full(Instant::now())),
+        };
+        let a = jobs.submit(resolved()).unwrap();
+        // The render thread takes it.
+        {
+            let mut inbox = jobs.queue.lock();
+            inbox.running = inbox.waiting.take();
+        }
+        let b = jobs.submit(resolved()).unwrap();
+        assert!(
+            a.cancel.load(Ordering::Relaxed),
+            "the running job is told to stop"
+        );
+        // It turns superseded when its render has stopped, which the render thread says.
+        assert_eq!(a.state(), Status::Queued);
+        assert_eq!(a.superseded_by(), Some(b.id));
+        let c = jobs.submit(resolved()).unwrap();
+        assert_eq!(b.state(), Status::Superseded, "the waiting job is replaced");
+        assert_eq!(b.superseded_by(), Some(c.id));
+        assert_eq!(a.superseded_by(), Some(b.id), "the first to supersede it");
+        assert!(!c.cancel.load(Ordering::Relaxed));
+        {
+            let inbox = jobs.queue.lock();
+            assert_eq!(inbox.waiting.as_ref().map(|j| j.id), Some(c.id));
+            assert_eq!(inbox.running.as_ref().map(|j| j.id), Some(a.id));
+        }
+        // Twenty starts at once, then the limit; eight jobs kept.
+        let more: Vec<_> = (3..20).map(|_| jobs.submit(resolved()).unwrap()).collect();
+        assert_eq!(
+            jobs.submit(resolved()).err(),
+            Some(RateLimited { retry_after: 1 })
+        );
+        assert_eq!(jobs.newest(), 20);
+        assert!(
+            more.iter()
+                .rev()
+                .skip(1)
+                .all(|j| j.state() == Status::Superseded)
+        );
+        assert!(jobs.get(12).is_none() && jobs.get(13).is_some());
+        assert_eq!(jobs.kept.lock().unwrap().len(), KEPT_JOBS);
+    }
+
+    #[test]
+    fn the_bucket_admits_a_burst_then_one_start_per_refill() {
+        let t0 = Instant::now();
+        let mut bucket = TokenBucket::full(t0);
+        for i in 0..20 {
+            assert_eq!(bucket.take(t0), Ok(()), "start {i} of the burst");
+        }
+        // Empty: the next token is 1/20 s away, which rounds up to a whole second.
+        assert_eq!(bucket.take(t0), Err(RateLimited { retry_after: 1 }));
+        let step = Duration::from_millis(50);
+        assert_eq!(bucket.take(t0 + step), Ok(()));
+        assert!(bucket.take(t0 + step).is_err());
+        assert!(bucket.take(t0 + step + step / 2).is_err());
+        assert_eq!(bucket.take(t0 + 2 * step), Ok(()));
+        // A long pause fills it to the burst, no further.
+        let later = t0 + Duration::from_secs(60);
+        for i in 0..20 {
+            assert_eq!(bucket.take(later), Ok(()), "start {i} after a pause");
+        }
+        assert!(bucket.take(later).is_err());
     }
 }

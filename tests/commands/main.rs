@@ -27,5 +27,6 @@ mod trace_pixel_exports;
 mod variance_shards;
 mod view_browser;
 mod view_http;
+mod view_jobs;
 mod view_load;
 mod view_token;

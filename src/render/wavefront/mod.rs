@@ -3,6 +3,7 @@
 //!
 //! ```text
 //! for each tile (rayon; a fixed range of pixels, independent of the thread count):
+//!     skip it if the render was cancelled (render_until: one flag load per tile)
 //!     generate   camera rays, one per (pixel, aa sample)          generate.rs
 //!     for bounce in 0..=max bounces, while rays are left:
 //!         intersect  closest hit of every ray                      intersect.rs
@@ -41,6 +42,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 use stats::{RenderStats, Stage};
 use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Camera samples per tile unless told otherwise (measured in docs/TRIED.md).
 pub const DEFAULT_BATCH_SIZE: usize = 4096;
@@ -136,8 +138,23 @@ impl<'a> Wavefront<'a> {
 
     /// Renders on the current rayon pool; `on_tile` is called after each tile.
     pub fn render(&self, on_tile: &(dyn Fn() + Sync)) -> (Film, RenderStats) {
+        self.render_until(on_tile, &AtomicBool::new(false))
+            .expect("a render whose cancel flag is never set renders every tile")
+    }
+
+    /// [`Wavefront::render`] that stops early once `cancel` is set: every worker reads the flag
+    /// before each tile and skips the tile when it is set, so the call returns within about
+    /// one tile per thread. `None` when a tile was skipped (the film is incomplete); an image
+    /// that got every tile is the same, bit for bit, as `render`'s, whatever the flag did.
+    pub fn render_until(
+        &self,
+        on_tile: &(dyn Fn() + Sync),
+        cancel: &AtomicBool,
+    ) -> Option<(Film, RenderStats)> {
         let s = self.ctx.settings;
         let mut film = Film::new(s.width, s.height);
+        // Set only on the skip path: the loop itself adds one relaxed load per tile.
+        let skipped = AtomicBool::new(false);
         let stats = film
             .pixels
             .par_chunks_mut(self.tile_pixels)
@@ -155,6 +172,10 @@ impl<'a> Wavefront<'a> {
                 },
                 |pooled, (tile, out)| {
                     let mut stats = RenderStats::default();
+                    if cancel.load(Ordering::Relaxed) {
+                        skipped.store(true, Ordering::Relaxed);
+                        return stats;
+                    }
                     self.render_tile(
                         (tile * self.tile_pixels) as u32,
                         out,
@@ -166,7 +187,7 @@ impl<'a> Wavefront<'a> {
                 },
             )
             .reduce(RenderStats::default, |a, b| a + b);
-        (film, stats)
+        (!skipped.into_inner()).then_some((film, stats))
     }
 
     /// Renders pixels `first..first + out.len()` into `out`: the architecture diagram.
