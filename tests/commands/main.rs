@@ -1,9 +1,9 @@
 //! Command tests: the built binary run as a user runs it: the command line and its errors,
 //! `bench` (records, verdicts, A/B), `diff`, `trace-pixel` and its exports (on
-//! scenes/trace_demo.obj, `trace_demo/`), `view` over HTTP and in a browser, the JSON
-//! Schemas of its output, every command the documentation shows, and the batch systems that
-//! run a sharded study (`batch_*`: a real Slurm cluster, GNU parallel, the Kubernetes Jobs of
-//! docs/scaling/). One test binary; each file is a module (docs/TESTING.md).
+//! scenes/trace_demo.obj, `trace_demo/`), `view` over HTTP, in a browser and its page's modules
+//! under node, the JSON Schemas of its output, every command the documentation shows, and the
+//! batch systems that run a sharded study (`batch_*`: a real Slurm cluster, GNU parallel, the
+//! Kubernetes Jobs of docs/scaling/). One test binary; each file is a module (docs/TESTING.md).
 
 #[path = "../common/mod.rs"]
 mod common;
@@ -27,3 +27,4 @@ mod trace_pixel_exports;
 mod variance_shards;
 mod view_browser;
 mod view_http;
+mod view_js;
