@@ -116,15 +116,19 @@ test('the render frame: corners one unit ahead, the fov across the longer side, 
 });
 
 // Every point inside the margin: |ndc| <= margin (up to rounding), in front of the near plane.
+// And centred: on each axis the extremes are equally far from the middle.
 function assertFramed(o, points, aspect, margin) {
   const m = viewProjection(o, aspect);
   let widest = 0;
+  const lo = [Infinity, Infinity], hi = [-Infinity, -Infinity];
   for (const p of points) {
     const q = project(m, p);
     assert.ok(onScreen(q), `point ${p} is off screen: ${JSON.stringify(q)}`);
     assert.ok(Math.abs(q.x) <= margin + 1e-9 && Math.abs(q.y) <= margin + 1e-9, `point ${p} outside the margin: ${JSON.stringify(q)}`);
     widest = Math.max(widest, Math.abs(q.x), Math.abs(q.y));
+    [q.x, q.y].forEach((v, k) => { lo[k] = Math.min(lo[k], v); hi[k] = Math.max(hi[k], v); });
   }
+  for (const k of [0, 1]) near(lo[k] + hi[k], 0, 1e-6, `centred on axis ${k} (${lo[k]} to ${hi[k]})`);
   return widest;
 }
 

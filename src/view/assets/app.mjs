@@ -64,7 +64,7 @@ function showStats(status) {
     body.appendChild(tr);
   });
   const p = progress(status);
-  $('progress-bar').style.width = `${(100 * p.fraction).toFixed(1)}%`;
+  $('progress-bar').style.width = `${Math.round(1000 * p.fraction) / 10}%`;
   $('progress-text').textContent = p.text;
 }
 

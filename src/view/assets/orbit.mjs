@@ -92,8 +92,9 @@ export function overviewAngles(c) {
  * screen when |x − s| <= (dist − z)·tan_x, where s is a sideways shift of the target. That is
  * dist >= z + (x − s)/tan_x and dist >= z − (x − s)/tan_x for every point: with A and B the
  * largest z + x/tan_x and z − x/tan_x, the least distance is (A + B)/2 at s = (A − B)·tan_x/2.
- * Likewise vertically; the larger distance keeps both axes inside. Points stay at least 5% of
- * the distance in front of the eye, clear of the near plane. */
+ * Likewise vertically; the larger distance keeps both axes inside, and each axis is then
+ * centred at that distance (`centred`). Points stay at least 5% of the distance in front of
+ * the eye, clear of the near plane. */
 export function fitOrbit(points, { yaw, pitch, fov, aspect = 1, margin = 0.9 }) {
   pitch = clampPitch(pitch);
   const { w, r, u } = basis(yaw, pitch);
@@ -107,14 +108,33 @@ export function fitOrbit(points, { yaw, pitch, fov, aspect = 1, margin = 0.9 }) 
       const d = sub(p, centre), z = dot(d, w), x = dot(d, along);
       a = Math.max(a, z + x / tan); b = Math.max(b, z - x / tan);
     }
-    return { dist: (a + b) / 2, shift: (a - b) * tan / 2 };
+    return { dist: (a + b) / 2 };
   };
-  const h = axis(r, tanX), v = axis(u, tanY);
-  let dist = Math.max(h.dist, v.dist, 1e-3);
+  let dist = Math.max(axis(r, tanX).dist, axis(u, tanY).dist, 1e-3);
   for (const p of points) dist = Math.max(dist, dot(sub(p, centre), w) / 0.95);
-  const target = add(centre, add(scale(r, h.shift), scale(u, v.shift)));
+  const target = add(centre, add(scale(r, centred(points, centre, w, r, dist)), scale(u, centred(points, centre, w, u, dist))));
   const radius = Math.max(1e-3, ...points.map(p => length(sub(p, target))));
   return { target, dist, yaw, pitch, fov, radius };
+}
+
+/** The shift s along `along` that centres `points` on screen for an eye `dist` from
+ * `centre` along `w`: where the largest and the smallest (x − s)/depth are opposite. Their
+ * sum falls as s grows, so bisection finds it. At the distance the axis itself needs this is
+ * the closed form's shift; on the other axis, with room to spare, it centres rather than
+ * leaving the points against one edge. */
+function centred(points, centre, w, along, dist) {
+  const xs = points.map(p => { const d = sub(p, centre); return [dot(d, along), dist - dot(d, w)]; });
+  const balance = s => {
+    let hi = -Infinity, lo = Infinity;
+    for (const [x, depth] of xs) { const t = (x - s) / depth; hi = Math.max(hi, t); lo = Math.min(lo, t); }
+    return hi + lo;
+  };
+  let a = Math.min(...xs.map(p => p[0])), b = Math.max(...xs.map(p => p[0]));
+  for (let k = 0; k < 100 && b - a > 1e-12 * (1 + Math.abs(a) + Math.abs(b)); k++) {
+    const m = (a + b) / 2;
+    if (balance(m) > 0) a = m; else b = m;
+  }
+  return (a + b) / 2;
 }
 
 /** What the 3D view opens with: the scene's bounds and the render camera's frame (eye and
