@@ -70,7 +70,7 @@ fn text_of(c: &Session, css: &str) -> String {
 /// table and in the 3D view.
 fn wait_tree(c: &Session, x: u32, y: u32, expected: Option<usize>) {
     let n = expected.map(|n| n.to_string());
-    let fits = |v: &str| n.as_deref().map_or(v != "" && v != "0", |n| v == n);
+    let fits = |v: &str| n.as_deref().map_or(!v.is_empty() && v != "0", |n| v == n);
     let count = wait_attr(c, "#tree", "data-segments", fits);
     assert_eq!(
         wait_attr(c, "#tree", "data-x", |v| !v.is_empty()),
