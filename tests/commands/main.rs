@@ -1,9 +1,9 @@
 //! Command tests: the built binary run as a user runs it: the command line and its errors,
 //! `bench` (records, verdicts, A/B), `diff`, `trace-pixel` and its exports (on
-//! scenes/trace_demo.obj, `trace_demo/`), `view` over HTTP and in a browser, the JSON
-//! Schemas of its output, every command the documentation shows, and the batch systems that
-//! run a sharded study (`batch_*`: a real Slurm cluster, GNU parallel, the Kubernetes Jobs of
-//! docs/scaling/). One test binary; each file is a module (docs/TESTING.md).
+//! scenes/trace_demo.obj, `trace_demo/`), `view` over HTTP, in a browser and its page's modules
+//! under node, the JSON Schemas of its output, every command the documentation shows, and the
+//! batch systems that run a sharded study (`batch_*`: a real Slurm cluster, GNU parallel, the
+//! Kubernetes Jobs of docs/scaling/). One test binary; each file is a module (docs/TESTING.md).
 
 #[path = "../common/mod.rs"]
 mod common;
@@ -28,5 +28,6 @@ mod variance_shards;
 mod view_browser;
 mod view_http;
 mod view_jobs;
+mod view_js;
 mod view_load;
 mod view_token;

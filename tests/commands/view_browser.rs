@@ -1,7 +1,11 @@
 //! `raywave view` in a real browser: headless Chromium (WebGL through SwiftShader) driven by
-//! chromedriver over WebDriver (the W3C protocol's JSON over plain HTTP, sent with ureq). The page loads, the progressive render arrives level by level,
-//! a click on a known pixel draws that pixel's ray tree in the 3D view, a changed setting
-//! renders again, and the comparison mode shows its images.
+//! chromedriver over WebDriver (webdriver.rs). On the built-in lab box: the page opens with the
+//! 3D view framed on the scene and the render camera; the progressive render arrives level by
+//! level, with its progress; the render canvas equals `raywave render`'s PNG pixel for pixel
+//! for three settings (pixels.rs); a click, or `t` over the render, draws that pixel's ray tree
+//! and `Escape` clears it; `r` renders again; a bad setting is refused with a message; an orbit
+//! with "re-render as I orbit" renders from the 3D camera once the hand stops; the comparison
+//! mode shows its images.
 //!
 //! Needs Debian's `chromium` and `chromium-driver` (`.ci/run` installs them). Without them the
 //! test prints SKIPPED and passes, unless CI is set: then it fails.
@@ -11,223 +15,24 @@
 //! its tree is the camera ray and one shadow ray per light point: 1 + 1 with hard shadows,
 //! 1 + 4 with 4 soft-shadow points.
 //!
-//! RAYWAVE_VIEW_SCREENSHOT=FILE.png saves a screenshot of the page at the end.
+//! RAYWAVE_VIEW_SCREENSHOT=FILE.png saves a screenshot of the page with a render and a ray tree
+//! (a relative path is from the package root; docs/images/viewer.png is made so).
+
+mod pixels;
+mod webdriver;
 
 use crate::common;
-
-use base64::Engine as _;
+use crate::common::skip::skip_or_fail;
 use common::view::ViewServer;
 use serde_json::{Value, json};
-use std::net::TcpListener;
-use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
+use std::path::PathBuf;
 use std::time::{Duration, Instant};
+use webdriver::{Driver, ELEMENT, Session, find};
 
 /// How long any one thing may take to appear on the page.
 const WAIT: Duration = Duration::from_secs(45);
-
-fn find(names: &[&str]) -> Option<PathBuf> {
-    let path = std::env::var_os("PATH")?;
-    names.iter().find_map(|name| {
-        std::env::split_paths(&path)
-            .map(|dir| dir.join(name))
-            .find(|p| p.is_file())
-    })
-}
-
-/// chromedriver on a free port; killed when dropped.
-struct Driver {
-    child: Child,
-    port: u16,
-}
-
-impl Driver {
-    fn start(binary: &Path) -> Driver {
-        let port = TcpListener::bind(("127.0.0.1", 0))
-            .and_then(|l| l.local_addr())
-            .expect("a free port")
-            .port();
-        // Its own process group, so that dropping it ends the browsers it started too.
-        use std::os::unix::process::CommandExt;
-        let child = Command::new(binary)
-            .arg(format!("--port={port}"))
-            .process_group(0)
-            .stdin(Stdio::null())
-            .stdout(Stdio::null())
-            .stderr(Stdio::null())
-            .spawn()
-            .expect("start chromedriver");
-        let start = Instant::now();
-        while std::net::TcpStream::connect(("127.0.0.1", port)).is_err() {
-            assert!(
-                start.elapsed() < Duration::from_secs(20),
-                "chromedriver did not listen on port {port}"
-            );
-            std::thread::sleep(Duration::from_millis(50));
-        }
-        Driver { child, port }
-    }
-}
-
-impl Drop for Driver {
-    fn drop(&mut self) {
-        // SAFETY: kill(2) on the process group of our own child.
-        unsafe { libc::kill(-(self.child.id() as i32), libc::SIGKILL) };
-        let _ = self.child.wait();
-    }
-}
-
-/// The W3C WebDriver protocol's key for an element reference.
-const ELEMENT: &str = "element-6066-11e4-a52e-4f735466cecf";
-
-/// One WebDriver session with chromedriver on loopback: each command is a JSON request over
-/// plain HTTP (ureq), its answer the reply's `value`. Only the commands this test uses.
-struct Session {
-    agent: ureq::Agent,
-    url: String,
-}
-
-impl Session {
-    fn new(driver: &Driver, chromium: &Path, profile: &Path) -> Session {
-        let agent: ureq::Agent = ureq::Agent::config_builder()
-            .http_status_as_error(false)
-            .timeout_global(Some(Duration::from_secs(120)))
-            .build()
-            .into();
-        let mut session = Session {
-            agent,
-            url: format!("http://127.0.0.1:{}", driver.port),
-        };
-        let capabilities = json!({"alwaysMatch": {"goog:chromeOptions": {
-            "binary": chromium,
-            "args": [
-                "--headless=new", "--no-sandbox",
-                // WebGL without a GPU.
-                "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
-                "--disable-quic", "--no-first-run", "--disable-background-networking",
-                "--disable-component-update", "--disable-sync", "--disable-dev-shm-usage",
-                "--window-size=1400,1300",
-                format!("--user-data-dir={}", profile.display()),
-            ],
-        }}});
-        let created = session
-            .command(
-                "POST",
-                "/session",
-                Some(json!({"capabilities": capabilities})),
-            )
-            .expect("a WebDriver session");
-        let id = created["sessionId"].as_str().expect("a session id");
-        session.url = format!("{}/session/{id}", session.url);
-        session
-    }
-
-    /// Sends one command; its `value`, or the WebDriver error as text.
-    fn command(&self, method: &str, path: &str, body: Option<Value>) -> Result<Value, String> {
-        let url = format!("{}{path}", self.url);
-        let reply = match (method, body) {
-            ("GET", _) => self.agent.get(&url).call(),
-            ("DELETE", _) => self.agent.delete(&url).call(),
-            (_, body) => self.agent.post(&url).send_json(body.unwrap_or(json!({}))),
-        };
-        let mut reply = reply.map_err(|e| format!("{method} {path}: {e}"))?;
-        let ok = reply.status().is_success();
-        let json: Value = reply
-            .body_mut()
-            .read_json()
-            .map_err(|e| format!("{method} {path}: {e}"))?;
-        let value = json["value"].clone();
-        if ok {
-            Ok(value)
-        } else {
-            Err(format!("{method} {path}: {value}"))
-        }
-    }
-
-    fn run(&self, method: &str, path: &str, body: Option<Value>) -> Value {
-        self.command(method, path, body)
-            .unwrap_or_else(|e| panic!("{e}"))
-    }
-
-    fn goto(&self, url: &str) {
-        self.run("POST", "/url", Some(json!({"url": url})));
-    }
-
-    fn title(&self) -> String {
-        self.run("GET", "/title", None)
-            .as_str()
-            .unwrap_or_default()
-            .to_string()
-    }
-
-    /// The first element `css` selects, if any.
-    fn find(&self, css: &str) -> Option<String> {
-        let found = self.command(
-            "POST",
-            "/element",
-            Some(json!({"using": "css selector", "value": css})),
-        );
-        found
-            .ok()
-            .and_then(|v| v[ELEMENT].as_str().map(String::from))
-    }
-
-    fn find_all(&self, css: &str) -> usize {
-        let found = self.run(
-            "POST",
-            "/elements",
-            Some(json!({"using": "css selector", "value": css})),
-        );
-        found.as_array().map_or(0, Vec::len)
-    }
-
-    fn attr(&self, element: &str, name: &str) -> Option<String> {
-        let value = self.command("GET", &format!("/element/{element}/attribute/{name}"), None);
-        value.ok().and_then(|v| v.as_str().map(String::from))
-    }
-
-    fn text(&self, element: &str) -> String {
-        let value = self.command("GET", &format!("/element/{element}/text"), None);
-        value
-            .ok()
-            .and_then(|v| v.as_str().map(String::from))
-            .unwrap_or_default()
-    }
-
-    fn click(&self, element: &str) {
-        self.run("POST", &format!("/element/{element}/click"), None);
-    }
-
-    /// A left click `x`, `y` CSS pixels from the centre of `element`.
-    fn click_at(&self, element: &str, x: i64, y: i64) {
-        let pointer = json!({"type": "pointer", "id": "mouse", "parameters": {"pointerType": "mouse"},
-        "actions": [
-            {"type": "pointerMove", "origin": {ELEMENT: element}, "x": x, "y": y, "duration": 0},
-            {"type": "pointerDown", "button": 0},
-            {"type": "pointerUp", "button": 0},
-        ]});
-        self.run("POST", "/actions", Some(json!({"actions": [pointer]})));
-    }
-
-    fn execute(&self, script: &str, args: Vec<Value>) -> Value {
-        self.run(
-            "POST",
-            "/execute/sync",
-            Some(json!({"script": script, "args": args})),
-        )
-    }
-
-    fn screenshot(&self) -> Vec<u8> {
-        let text = self.run("GET", "/screenshot", None);
-        base64::engine::general_purpose::STANDARD
-            .decode(text.as_str().unwrap_or_default())
-            .expect("a base64 screenshot")
-    }
-
-    fn close(self) {
-        self.run("DELETE", "", None);
-    }
-}
+/// WebDriver's code of the Escape key.
+const ESCAPE: &str = "\u{E00C}";
 
 /// Waits until `css`'s attribute `name` satisfies `ok`, and returns it.
 fn wait_attr(c: &Session, css: &str, name: &str, ok: impl Fn(&str) -> bool) -> String {
@@ -240,7 +45,7 @@ fn wait_attr(c: &Session, css: &str, name: &str, ok: impl Fn(&str) -> bool) -> S
                 return last.unwrap_or_default();
             }
         }
-        std::thread::sleep(Duration::from_millis(50));
+        std::thread::sleep(Duration::from_millis(30));
     }
     let error = c.find("#error").map(|e| c.text(&e)).unwrap_or_default();
     panic!("{css}[{name}] is {last:?} after {WAIT:?}; the page's error line: {error:?}");
@@ -257,57 +62,296 @@ fn wait_render(c: &Session, previous: u64) -> u64 {
     job.parse().unwrap_or_default()
 }
 
-fn click_centre_and_count(c: &Session, expected: usize) {
-    // The render is shown 512 CSS pixels wide for a 64-pixel image, 8 per pixel: half a pixel
-    // right of and below its centre is the middle of pixel (32, 32).
-    let element = c.find("#render").expect("the render");
-    c.click_at(&element, 4, 4);
-    let n = expected.to_string();
-    wait_attr(c, "#tree", "data-segments", |v| v == n);
-    assert_eq!(wait_attr(c, "#tree", "data-x", |v| !v.is_empty()), "32");
-    assert_eq!(wait_attr(c, "#tree", "data-y", |v| !v.is_empty()), "32");
-    // The 3D view drew them.
-    wait_attr(c, "#view3d", "data-segments", |v| v == n);
+fn text_of(c: &Session, css: &str) -> String {
+    c.text(&c.find(css).unwrap_or_else(|| panic!("no {css}")))
 }
 
-fn set_value(c: &Session, name: &str, value: &str) {
+/// Waits for the tree of pixel (x, y) with `expected` segments (any count when None), in the
+/// table and in the 3D view.
+fn wait_tree(c: &Session, x: u32, y: u32, expected: Option<usize>) {
+    let n = expected.map(|n| n.to_string());
+    let fits = |v: &str| n.as_deref().map_or(!v.is_empty() && v != "0", |n| v == n);
+    let count = wait_attr(c, "#tree", "data-segments", fits);
+    assert_eq!(
+        wait_attr(c, "#tree", "data-x", |v| !v.is_empty()),
+        x.to_string()
+    );
+    assert_eq!(
+        wait_attr(c, "#tree", "data-y", |v| !v.is_empty()),
+        y.to_string()
+    );
+    assert_eq!(c.find_all("#segments tbody tr").to_string(), count);
+    wait_attr(c, "#view3d", "data-segments", |v| v == count);
+}
+
+// The render is shown 512 CSS pixels wide for a 64-pixel image, 8 per pixel: (4, 4) from its
+// centre is the middle of pixel (32, 32).
+fn click_centre_and_count(c: &Session, expected: usize) {
+    c.click_at(&c.find("#render").expect("the render"), 4, 4);
+    wait_tree(c, 32, 32, Some(expected));
+}
+
+fn set_value(c: &Session, css: &str, value: &str) {
     c.execute(
         "const el = document.querySelector(arguments[0]); el.value = arguments[1];",
-        vec![name.into(), value.into()],
+        vec![css.into(), value.into()],
     );
 }
 
-fn drive(c: &Session, url: &str, screenshot: Option<PathBuf>) {
-    c.goto(url);
+/// Sets the settings form's fields and sends the change, as a user's edit does.
+fn set_settings(c: &Session, fields: &[(&str, &str)]) {
+    for (name, value) in fields {
+        set_value(c, &format!("#settings [name={name}]"), value);
+    }
+    c.execute(
+        "document.getElementById('settings').dispatchEvent(new Event('change'));
+         document.activeElement.blur();",
+        vec![],
+    );
+}
+
+/// The 3D view opened framed: every corner of the scene's bounds and of the render camera's
+/// frame (the server's) projects inside the canvas, and together they fill it, centred.
+fn assert_fitted(c: &Session, server: &ViewServer, job: u64) {
+    let scene = server.get("/api/scene").json();
+    let [lo, hi] = [0, 1].map(|k| scene["scene"]["bounds"][k].clone());
+    let mut points = Vec::new();
+    for k in 0..8 {
+        let pick = |axis: usize| if k >> axis & 1 == 1 { &hi } else { &lo }[axis].clone();
+        points.push(json!([pick(0), pick(1), pick(2)]));
+    }
+    let status = server.get(&format!("/api/render/{job}")).json();
+    let frame = &status["frame"];
+    points.push(frame["eye"].clone());
+    points.extend(
+        frame["corners"]
+            .as_array()
+            .expect("corners")
+            .iter()
+            .cloned(),
+    );
+    // The page's own frame of the scene camera is the server's.
+    let page_frame = c.execute(
+        "const s = window.raywave.app.sceneCamera; return window.raywave.renderFrame(s, 64, 64);",
+        vec![],
+    );
+    let flat = |v: &Value| -> Vec<f64> {
+        let mut out = v["eye"].as_array().unwrap().to_vec();
+        out.extend(
+            v["corners"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .flat_map(|c| c.as_array().unwrap().clone()),
+        );
+        out.iter().map(|x| x.as_f64().unwrap()).collect()
+    };
+    for (a, b) in flat(&page_frame).iter().zip(flat(frame)) {
+        assert!(
+            (a - b).abs() < 1e-5,
+            "the page's frame {page_frame} is not the server's {frame}"
+        );
+    }
+    let projected = c.execute(
+        "return window.raywave.app.view.project(arguments[0]);",
+        vec![Value::Array(points.clone())],
+    );
+    let (mut lo, mut hi) = ([f64::MAX; 2], [f64::MIN; 2]);
+    for (p, q) in points
+        .iter()
+        .zip(projected.as_array().expect("projected points"))
+    {
+        let [x, y, w] = ["x", "y", "w"].map(|k| q[k].as_f64().unwrap_or(f64::NAN));
+        assert!(
+            w > 0.0 && x.abs() <= 1.0 && y.abs() <= 1.0,
+            "{p} is off the 3D view: {q}"
+        );
+        for (k, v) in [x, y].into_iter().enumerate() {
+            lo[k] = lo[k].min(v);
+            hi[k] = hi[k].max(v);
+        }
+    }
+    let (centre, half) = (
+        [0, 1].map(|k| (lo[k] + hi[k]) / 2.0),
+        [0, 1].map(|k| (hi[k] - lo[k]) / 2.0),
+    );
+    assert!(
+        centre.iter().all(|m| m.abs() < 0.1) && half.iter().any(|h| *h > 0.8),
+        "the scene and the camera are not framed: centre {centre:?}, half extent {half:?}"
+    );
+}
+
+/// The progress line and bar of a finished job: the server's work units of its last level.
+fn assert_progress(c: &Session, server: &ViewServer, job: u64) {
+    let status = server.get(&format!("/api/render/{job}")).json();
+    let [done, total] = [0, 1].map(|k| status["progress"][k].as_u64().expect("progress"));
+    assert!(total > 0 && done == total, "{status}");
+    assert_eq!(
+        text_of(c, "#progress-text"),
+        format!("level 4 of 4: {done}/{total} tiles")
+    );
+    let width = c.execute(
+        "return document.getElementById('progress-bar').style.width;",
+        vec![],
+    );
+    assert_eq!(width, "100%");
+}
+
+fn drive(c: &Session, server: &ViewServer, screenshot: Option<PathBuf>) {
+    c.goto(&server.url());
     assert_eq!(c.title(), "raywave view");
     let webgl = wait_attr(c, "#view3d", "data-webgl", |v| !v.is_empty());
     assert_eq!(webgl, "ok", "WebGL is not available in this browser");
+    // The token is out of the address bar once the page has it.
+    let href = c.execute("return location.href;", vec![]);
+    assert!(
+        !href.as_str().unwrap_or_default().contains("token="),
+        "{href}"
+    );
+    // The keys are listed.
+    assert_eq!(
+        text_of(c, "#keys")
+            .lines()
+            .map(|l| l.split(' ').next().unwrap_or_default())
+            .collect::<Vec<_>>(),
+        ["r", "t", "Escape"]
+    );
 
-    // The progressive render: 64×64 comes as 8, 16, 32 and 64 pixels wide.
+    // The progressive render: 64×64 comes as 8, 16, 32 and 64 pixels wide, into a canvas of
+    // each level's size.
     let job = wait_render(c, 0);
     assert_eq!(
         wait_attr(c, "#render", "data-levels", |v| !v.is_empty()),
         "4"
     );
-    let natural = c.execute(
-        "return document.getElementById('render').naturalWidth;",
+    let canvas = c.execute(
+        "const r = document.getElementById('render'); return [r.width, r.height];",
         vec![],
     );
-    assert_eq!(natural, 64);
-    // Rays per second, one row per level.
+    assert_eq!(canvas, json!([64, 64]));
     assert_eq!(c.find_all("#stats tbody tr"), 4);
+    assert_progress(c, server, job);
+    assert_fitted(c, server, job);
+    pixels::assert_canvas_is_cli_render(c, &["--bounces", "0", "--shadows", "hard"]);
 
+    // A click, then the keys: Escape clears, t traces under the pointer, r renders again.
     click_centre_and_count(c, 2);
+    c.key(ESCAPE);
+    wait_attr(c, "#tree", "data-segments", |v| v == "0");
+    wait_attr(c, "#view3d", "data-segments", |v| v == "0");
+    let render = c.find("#render").expect("the render");
+    c.move_to(&render, 4 + 8 * 4, 4 - 8 * 2);
+    c.key("t");
+    wait_tree(c, 36, 30, Some(2));
+    c.key("r");
+    let job = wait_render(c, job);
 
-    // A changed setting renders again: 4 soft-shadow points per light.
-    set_value(c, "#settings [name=shadows]", "soft");
-    set_value(c, "#settings [name=shadow_samples]", "4");
-    c.execute(
-        "document.getElementById('settings').dispatchEvent(new Event('change'));",
-        vec![],
+    // A bad setting is refused with a message, and nothing is rendered.
+    set_settings(c, &[("width", "0")]);
+    wait_attr(c, "#settings [name=width]", "aria-invalid", |_| true);
+    assert_eq!(text_of(c, "#error"), "width must be in 1..=2048, found 0");
+    set_settings(c, &[("width", "64")]);
+
+    // Soft shadows, stratified: 4 points per light.
+    set_settings(
+        c,
+        &[
+            ("shadows", "soft"),
+            ("shadow_samples", "4"),
+            ("sampler", "stratified"),
+        ],
     );
-    wait_render(c, job);
+    let job = wait_render(c, job);
+    pixels::assert_canvas_is_cli_render(
+        c,
+        &[
+            "--bounces",
+            "0",
+            "--shadows",
+            "soft",
+            "--shadow-samples",
+            "4",
+            "--sampler",
+            "stratified",
+        ],
+    );
     click_centre_and_count(c, 5);
+
+    // Two bounces; t over the middle mirror sphere, pixel (32, 48), shows its reflections.
+    set_settings(c, &[("bounces", "2")]);
+    let job = wait_render(c, job);
+    pixels::assert_canvas_is_cli_render(
+        c,
+        &[
+            "--bounces",
+            "2",
+            "--shadows",
+            "soft",
+            "--shadow-samples",
+            "4",
+            "--sampler",
+            "stratified",
+        ],
+    );
+    c.move_to(&render, 4, 4 + 8 * 16);
+    c.key("t");
+    wait_tree(c, 32, 48, None);
+    let kinds = c.execute("return [...document.querySelectorAll('#segments tbody tr td:nth-child(3)')].map(t => t.textContent);", vec![]);
+    assert!(
+        kinds
+            .as_array()
+            .is_some_and(|k| k.contains(&json!("reflection"))),
+        "{kinds}"
+    );
+    if let Some(path) = screenshot {
+        let tmp = path.with_extension("png.tmp");
+        std::fs::write(&tmp, c.screenshot()).unwrap();
+        std::fs::rename(&tmp, &path).unwrap();
+        eprintln!("screenshot: {}", path.display());
+    }
+
+    // Re-render as I orbit: one drag of several moves is one render, from the 3D camera.
+    c.click(&c.find("#follow").expect("the orbit option"));
+    let view = c.find("#view3d").expect("the 3D view");
+    let mut drag = vec![
+        json!({"type": "pointerMove", "origin": {ELEMENT: view.as_str()}, "x": 0, "y": 0, "duration": 0}),
+        json!({"type": "pointerDown", "button": 0}),
+    ];
+    for k in 1..=5 {
+        drag.push(
+            json!({"type": "pointerMove", "origin": "pointer", "x": 12, "y": 3, "duration": 0}),
+        );
+        drag.push(json!({"type": "pause", "duration": 30 + k}));
+    }
+    drag.push(json!({"type": "pointerUp", "button": 0}));
+    c.pointer(drag);
+    let orbit_job = wait_render(c, job);
+    assert_eq!(orbit_job, job + 1, "one render for one drag");
+    let camera = &server.get(&format!("/api/render/{orbit_job}")).json()["settings"]["camera"];
+    let view_camera = c.execute("return window.raywave.app.view.camera();", vec![]);
+    for key in ["position", "look_at"] {
+        for k in 0..3 {
+            let (a, b) = (
+                camera[key][k].as_f64().unwrap(),
+                view_camera[key][k].as_f64().unwrap(),
+            );
+            assert!(
+                (a - b).abs() < 1e-4,
+                "{key}: the job's camera {camera} is not the view's {view_camera}"
+            );
+        }
+    }
+    assert_ne!(
+        camera["position"],
+        json!([0.0, 0.0, 8.0]),
+        "the scene camera, not the view's"
+    );
+    // Nothing more once the hand has stopped.
+    std::thread::sleep(Duration::from_millis(400));
+    assert_eq!(
+        wait_attr(c, "#render", "data-job", |_| true),
+        orbit_job.to_string()
+    );
 
     // The comparison: the reference, two renders, two heat maps and the spectra, all loaded.
     set_value(c, "#compare-form [name=size]", "16");
@@ -319,16 +363,6 @@ fn drive(c: &Session, url: &str, screenshot: Option<PathBuf>) {
         vec![],
     );
     assert_eq!(sizes, json!([16, 16, 16, 16, 16, 640]));
-
-    if let Some(path) = screenshot {
-        // The ray tree and the comparison in view.
-        c.execute(
-            "document.getElementById('tree-panel').scrollIntoView();",
-            vec![],
-        );
-        std::fs::write(&path, c.screenshot()).unwrap();
-        eprintln!("screenshot: {}", path.display());
-    }
 }
 
 #[test]
@@ -337,11 +371,7 @@ fn the_page_renders_traces_and_compares_in_chromium() {
         find(&["chromium", "chromium-browser"]),
         find(&["chromedriver"]),
     ) else {
-        if std::env::var_os("CI").is_some() {
-            panic!("CI is set but chromium or chromedriver is missing (.ci/run installs them)");
-        }
-        println!("SKIPPED: chromium or chromedriver is not installed");
-        return;
+        return skip_or_fail("chromium or chromedriver is missing (.ci/run installs them)");
     };
     let start = Instant::now();
     let server = ViewServer::start(&["--size", "64", "64", "--bounces", "0", "--shadows", "hard"]);
@@ -349,7 +379,7 @@ fn the_page_renders_traces_and_compares_in_chromium() {
     let profile = tempfile::tempdir().unwrap();
     let screenshot = std::env::var_os("RAYWAVE_VIEW_SCREENSHOT").map(PathBuf::from);
     let session = Session::new(&driver, &chromium, profile.path());
-    drive(&session, &server.url(), screenshot);
+    drive(&session, &server, screenshot);
     session.close();
     eprintln!("browser test: {:.1} s", start.elapsed().as_secs_f64());
 }

@@ -25,8 +25,16 @@ fn every_endpoint_answers() {
             .starts_with("text/html")
     );
     assert!(page.text().contains("<title>raywave view</title>"));
-    for asset in ["gl.js", "app.js", "compare.js"] {
-        let r = server.get(&format!("/assets/{asset}"));
+    // The page loads app.mjs as a module; it imports the others.
+    assert!(
+        page.text()
+            .contains(r#"<script type="module" src="/assets/app.mjs">"#)
+    );
+    let app = server.get("/assets/app.mjs").text();
+    for asset in [
+        "app", "gl", "compare", "orbit", "math", "tree", "settings", "token", "render", "debounce",
+    ] {
+        let r = server.get(&format!("/assets/{asset}.mjs"));
         assert_eq!(r.status, 200, "{asset}");
         assert!(
             r.header("content-type")
@@ -34,10 +42,14 @@ fn every_endpoint_answers() {
                 .starts_with("text/javascript")
         );
         assert!(
-            page.text().contains(&format!("/assets/{asset}")),
-            "{asset} is used"
+            r.text().contains("export ") || asset == "app",
+            "{asset} is a module"
         );
     }
+    assert!(
+        app.contains("from './gl.mjs'"),
+        "app.mjs imports the others"
+    );
     assert_eq!(server.get("/assets/style.css").status, 200);
 
     let scene = server.get("/api/scene").json();
@@ -197,7 +209,7 @@ fn bad_requests_get_their_4xx_and_a_message() {
         ("GET", "/".into(), vec![("Host", "evil.example")], b"", 421, "unexpected Host"),
         ("POST", "/api/render".into(), vec![("Host", "evil.example")], b"{}", 421, "unexpected Host"),
         ("GET", "/api/scene".into(), vec![("Origin", "http://evil.example")], b"", 403, "are refused"),
-        ("GET", "/assets/app.js".into(), vec![("Origin", "http://evil.example")], b"", 403, "are refused"),
+        ("GET", "/assets/app.mjs".into(), vec![("Origin", "http://evil.example")], b"", 403, "are refused"),
     ];
     for (method, path, headers, body, status, message) in cases {
         let r = server.request(method, &path, &headers, body);

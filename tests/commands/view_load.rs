@@ -100,7 +100,7 @@ fn two_hundred_clients_at_once_are_all_served() {
             let (gate, bearer) = (gate.clone(), bearer.clone());
             std::thread::spawn(move || {
                 gate.wait();
-                let path = ["/api/scene", "/assets/gl.js", "/"][i % 3];
+                let path = ["/api/scene", "/assets/gl.mjs", "/"][i % 3];
                 // A 503 asks to come back after Retry-After seconds; nothing else may fail.
                 for _ in 0..5 {
                     let r = get(port, path, &bearer);
@@ -186,7 +186,7 @@ fn ten_thousand_requests_leave_threads_and_memory_where_they_were() {
         "/api/scene".to_string(),
         format!("/api/render/{job}"),
         format!("/api/render/{job}/1.png"),
-        "/assets/app.js".to_string(),
+        "/assets/app.mjs".to_string(),
         "/api/nope".to_string(),
     ];
     // Warm up: the allocator's arenas and the first replies' buffers.

@@ -30,7 +30,7 @@ fn the_page_takes_the_token_once_and_keeps_it_in_a_cookie() {
     for path in [
         "/",
         "/index.html",
-        "/assets/app.js",
+        "/assets/app.mjs",
         "/api/scene",
         "/api/render/1",
     ] {
@@ -61,7 +61,7 @@ fn the_page_takes_the_token_once_and_keeps_it_in_a_cookie() {
     assert_eq!(page.header("referrer-policy"), Some("no-referrer"));
     // Later requests carry the cookie alone.
     let jar = format!("theme=dark; raywave_token_{port}={token}");
-    for path in ["/", "/assets/app.js", "/api/scene"] {
+    for path in ["/", "/assets/app.mjs", "/api/scene"] {
         let r = server.request_without_token("GET", path, &[("Cookie", &jar)], b"");
         assert_eq!(r.status, 200, "{path}: {}", r.text());
         assert_eq!(
