@@ -24,6 +24,7 @@ const app = {
   poll: null,
   shownLevel: 0,     // the finest level of the job on screen (1-based)
   pointer: null,     // the pointer over the render, in client coordinates, or null
+  traces: 0,         // traces asked for (the latest is the one shown)
 };
 
 function showError(text) { $('error').textContent = text || ''; }
@@ -156,6 +157,7 @@ function showTree(tree) {
 }
 
 function clearTree() {
+  app.traces++;
   $('segments').querySelector('tbody').innerHTML = '';
   $('tree-json').textContent = '';
   $('tree-title').textContent = '';
@@ -177,7 +179,12 @@ async function trace(cx, cy) {
   m.hidden = false;
   m.style.left = `${(p.x + 0.5) / w * rect.width}px`;
   m.style.top = `${(p.y + 0.5) / h * rect.height}px`;
-  try { showTree(await api(`/api/pixel?job=${app.job.job}&x=${p.x}&y=${p.y}`)); } catch (e) { showError(e.message); }
+  // Only the latest trace is shown: an earlier one that answers late is dropped.
+  const asked = ++app.traces;
+  try {
+    const tree = await api(`/api/pixel?job=${app.job.job}&x=${p.x}&y=${p.y}`);
+    if (asked === app.traces) showTree(tree);
+  } catch (e) { if (asked === app.traces) showError(e.message); }
 }
 
 function onKey(event) {
