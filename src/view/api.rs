@@ -60,10 +60,10 @@ pub(crate) fn scene_json(scene: &Scene, base: &Resolved) -> Vec<u8> {
 /// last second (429 with `Retry-After`).
 pub(crate) fn render(state: &State, body: &[u8]) -> Result<Reply, ApiError> {
     let resolved = ViewSettings::parse(body)?.resolve(&state.base)?;
-    let job = state.jobs.submit(resolved).map_err(|limited| ApiError {
-        retry_after: Some(limited.retry_after),
-        ..ApiError::status(
+    let job = state.jobs.submit(resolved).map_err(|limited| {
+        ApiError::retry(
             429,
+            limited.retry_after,
             format!(
                 "too many renders started: at most {RENDER_BURST} at once and {RENDER_RATE} a \
                  second; retry in {} s",

@@ -34,11 +34,15 @@ pub(crate) struct Gate {
 
 /// Answers `request`: the checks, then the handler. Errors become their JSON reply.
 pub(crate) fn answer(request: &Request, state: &State, gate: &Gate) -> Reply {
+    let (path, query) = request
+        .target
+        .split_once('?')
+        .unwrap_or((&request.target, ""));
     let mut cookie = None;
-    let mut reply = check(request, gate)
+    let mut reply = check(request, path, query, gate)
         .and_then(|set_cookie| {
             cookie = set_cookie;
-            route(request, state)
+            route(request, path, query, state)
         })
         .unwrap_or_else(Reply::from);
     if reply.status == 200 {
@@ -48,14 +52,15 @@ pub(crate) fn answer(request: &Request, state: &State, gate: &Gate) -> Reply {
 }
 
 /// The Host, Origin and token checks; the cookie to set when the page came with the token.
-fn check(request: &Request, gate: &Gate) -> Result<Option<String>, ApiError> {
+fn check(
+    request: &Request,
+    path: &str,
+    query: &str,
+    gate: &Gate,
+) -> Result<Option<String>, ApiError> {
     let host = request.one("host")?;
     check_host(host, gate)?;
     check_origin(request.one("origin")?, host.unwrap_or(""))?;
-    let (path, query) = request
-        .target
-        .split_once('?')
-        .unwrap_or((&request.target, ""));
     gate.access.check(
         &Presented {
             path,
@@ -68,12 +73,8 @@ fn check(request: &Request, gate: &Gate) -> Result<Option<String>, ApiError> {
 }
 
 /// The routing table.
-fn route(request: &Request, state: &State) -> Result<Reply, ApiError> {
+fn route(request: &Request, path: &str, query: &str, state: &State) -> Result<Reply, ApiError> {
     let method = request.method.as_str();
-    let (path, query) = request
-        .target
-        .split_once('?')
-        .unwrap_or((&request.target, ""));
     let segments: Vec<&str> = path.split('/').skip(1).collect();
     let get = |allow: &'static str| {
         if method == "GET" || method == "HEAD" {

@@ -10,7 +10,7 @@
 
 use crate::common;
 
-use common::view::{ViewServer, parse_reply};
+use common::view::{ViewServer, parse_reply, send};
 use std::io::{Read, Write};
 use std::net::TcpStream;
 use std::sync::Arc;
@@ -66,15 +66,7 @@ fn bearer(server: &ViewServer) -> String {
 
 /// One GET with the token, on a connection of its own.
 fn get(port: u16, path: &str, bearer: &str) -> common::view::HttpReply {
-    let mut s = TcpStream::connect(("127.0.0.1", port)).expect("connect");
-    s.set_read_timeout(Some(Duration::from_secs(30))).unwrap();
-    let head = format!(
-        "GET {path} HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nAuthorization: {bearer}\r\nConnection: close\r\n\r\n"
-    );
-    s.write_all(head.as_bytes()).expect("send");
-    let mut raw = Vec::new();
-    s.read_to_end(&mut raw).expect("read the reply");
-    parse_reply(&raw)
+    send(port, "GET", path, &[("Authorization", bearer)], b"")
 }
 
 /// A line of /proc/PID/status, as a number (the first word after the name).

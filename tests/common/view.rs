@@ -129,31 +129,12 @@ impl ViewServer {
         headers: &[(&str, &str)],
         body: &[u8],
     ) -> HttpReply {
-        let mut head = format!("{method} {path} HTTP/1.1\r\nConnection: close\r\n");
-        if !headers.iter().any(|(n, _)| n.eq_ignore_ascii_case("host")) {
-            head += &format!("Host: 127.0.0.1:{}\r\n", self.port);
-        }
-        for (n, v) in headers {
-            head += &format!("{n}: {v}\r\n");
-        }
-        if !body.is_empty() || method == "POST" {
-            head += &format!("Content-Length: {}\r\n", body.len());
-        }
-        head += "\r\n";
-        let mut bytes = head.into_bytes();
-        bytes.extend_from_slice(body);
-        parse_reply(&self.raw(&bytes))
+        send(self.port, method, path, headers, body)
     }
 
     /// Sends `bytes` as they are and reads until the server closes.
     pub fn raw(&self, bytes: &[u8]) -> Vec<u8> {
-        let mut s = TcpStream::connect(("127.0.0.1", self.port)).expect("connect");
-        s.set_read_timeout(Some(Duration::from_secs(60))).unwrap();
-        // The server may answer (413) and close before taking the whole body.
-        let _ = s.write_all(bytes);
-        let mut raw = Vec::new();
-        let _ = s.read_to_end(&mut raw);
-        raw
+        send_raw(self.port, bytes)
     }
 
     /// GET.
@@ -217,6 +198,43 @@ impl Drop for ViewServer {
         let _ = self.child.kill();
         let _ = self.child.wait();
     }
+}
+
+/// Sends one request with exactly `headers` (and a `Host` unless they give one) to the server
+/// on 127.0.0.1:`port`, `Connection: close`, and reads the whole reply. A free function, for
+/// threads that outlive no [`ViewServer`] borrow.
+pub fn send(
+    port: u16,
+    method: &str,
+    path: &str,
+    headers: &[(&str, &str)],
+    body: &[u8],
+) -> HttpReply {
+    let mut head = format!("{method} {path} HTTP/1.1\r\nConnection: close\r\n");
+    if !headers.iter().any(|(n, _)| n.eq_ignore_ascii_case("host")) {
+        head += &format!("Host: 127.0.0.1:{port}\r\n");
+    }
+    for (n, v) in headers {
+        head += &format!("{n}: {v}\r\n");
+    }
+    if !body.is_empty() || method == "POST" {
+        head += &format!("Content-Length: {}\r\n", body.len());
+    }
+    head += "\r\n";
+    let mut bytes = head.into_bytes();
+    bytes.extend_from_slice(body);
+    parse_reply(&send_raw(port, &bytes))
+}
+
+/// Sends `bytes` as they are to 127.0.0.1:`port` and reads until the server closes.
+pub fn send_raw(port: u16, bytes: &[u8]) -> Vec<u8> {
+    let mut s = TcpStream::connect(("127.0.0.1", port)).expect("connect");
+    s.set_read_timeout(Some(Duration::from_secs(60))).unwrap();
+    // The server may answer (413) and close before taking the whole body.
+    let _ = s.write_all(bytes);
+    let mut raw = Vec::new();
+    let _ = s.read_to_end(&mut raw);
+    raw
 }
 
 /// A raw reply's status, headers and body.
