@@ -38,9 +38,9 @@ use std::time::Duration;
 pub trait TraceLog {
     /// A camera ray (bounce 0) or mirror ray that hits nothing: the ray returns `background`.
     fn path_miss(&mut self, _key: &SampleKey, _ray: &Ray, _background: Vec3) {}
-    /// A camera or mirror ray's closest hit, the surface there and its material, and the
-    /// hit's own term `ambient` = ambient ⊙ kd (the ray returns it plus kr ⊙ its mirror ray's
-    /// colour plus its light points' terms).
+    /// A camera or mirror ray's closest hit, the surface there and its material (a textured
+    /// one with kd the texel there), and the hit's own term `ambient` = ambient ⊙ kd (the ray
+    /// returns it plus kr ⊙ its mirror ray's colour plus its light points' terms).
     fn path_hit(
         &mut self,
         _key: &SampleKey,
@@ -252,7 +252,16 @@ impl<'a> Reference<'a> {
         // One reading ends this ray's work and starts what follows (the few operations of
         // the ambient term go with it).
         let mut start = clock.since(kind, start);
-        let material = self.scene.material_of(hit.prim);
+        // A textured material's kd is the texel at the hit: the material as it is there.
+        let textured;
+        let mut material = self.scene.material_of(hit.prim);
+        if material.texture.is_some() {
+            textured = Material {
+                diffuse: self.scene.diffuse_at(hit.prim, surface.point),
+                ..*material
+            };
+            material = &textured;
+        }
         let mut color = Vec3::from_array(self.settings.ambient) * material.diffuse;
         log.path_hit(&key, ray, &hit, &surface, material, color);
         if material.is_reflective() && key.bounce < self.settings.bounces {

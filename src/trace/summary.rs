@@ -93,6 +93,18 @@ pub fn summary(tree: &RayTree) -> String {
                     v3(seg.origin)
                 );
                 if let Some(h) = &seg.hit
+                    && let Some(lookup) = &h.texture
+                {
+                    let _ = writeln!(
+                        s,
+                        "{indent}  (texture {} at s {:.4}, t {:.4}: kd {})",
+                        lookup.name,
+                        lookup.st[0],
+                        lookup.st[1],
+                        rgb(h.diffuse)
+                    );
+                }
+                if let Some(h) = &seg.hit
                     && h.shadow_points_not_cast > 0
                 {
                     let _ = writeln!(

@@ -24,7 +24,7 @@
 
 use super::tree::{
     BlockerInfo, PixelRef, PrimitiveRef, PrimitiveShape, RayTree, SCHEMA_ID, Segment, SegmentKind,
-    ShadowInfo, SurfaceInfo, TraceSettings,
+    ShadowInfo, SurfaceInfo, TextureLookup, TraceSettings,
 };
 use crate::render::geometry::{Accel, Hit, Ray};
 use crate::render::per_kind::RayCounts;
@@ -306,6 +306,10 @@ impl TraceLog for Recorder<'_> {
         ambient: Vec3,
     ) {
         let primitive = primitive_ref(self.scene, hit.prim);
+        let texture = material.texture.map(|k| TextureLookup {
+            name: self.scene.textures[k as usize].name.clone(),
+            st: self.scene.texture_coords(hit.prim, surface.point),
+        });
         let per_sample = self.per_sample;
         let record = self.path(key, ray, Vec3::ZERO);
         let beta = Vec3::from_array(record.segment.throughput);
@@ -318,6 +322,8 @@ impl TraceLog for Recorder<'_> {
             point: surface.point.to_array(),
             normal: surface.normal.to_array(),
             shadow_points_not_cast: 0,
+            diffuse: material.diffuse.to_array(),
+            texture,
         });
     }
 

@@ -191,6 +191,22 @@ pub struct SurfaceInfo {
     /// Light points that were below this hit's tangent plane (or on the light's own plane): no
     /// shadow ray is cast to them and they add nothing.
     pub shadow_points_not_cast: u32,
+    /// The diffuse colour kd used here (linear): the material's, or on a textured material the
+    /// texel colour at `texture`'s coordinates.
+    pub diffuse: [f32; 3],
+    /// Where a textured material was looked up; none for a material without a texture.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub texture: Option<TextureLookup>,
+}
+
+/// The texture lookup at a hit on a textured material.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct TextureLookup {
+    /// The texture's name as the scene file gives it.
+    pub name: String,
+    /// The texture coordinates (s, t) at the hit, interpolated from its triangle's corners
+    /// ((0, 0) off a triangle with coordinates).
+    pub st: [f32; 2],
 }
 
 /// A shadow ray's light point and outcome.

@@ -8,12 +8,16 @@
 pub mod meshgen;
 mod parse;
 mod read;
+pub mod texture;
+mod texture_file;
 
 pub use parse::{
-    ParseError, ParseOptions, RPI_RING_SEGMENTS, SceneError, Warning, parse_scene_str,
-    parse_scene_str_with,
+    ParseError, ParseOptions, RPI_RING_SEGMENTS, SceneError, Warning, parse_scene_in,
+    parse_scene_str, parse_scene_str_with,
 };
 pub use read::{MAX_SCENE_BYTES, STDIN_NAME, read_capped, read_scene_bytes};
+pub use texture::Texture;
+pub use texture_file::MAX_TEXTURE_TEXELS;
 
 use glam::Vec3;
 use std::path::Path;
@@ -22,11 +26,17 @@ use std::path::Path;
 pub const NO_HIT: u32 = u32::MAX;
 
 /// The lab's material: diffuse, reflective and emitted colours plus a glossiness that narrows
-/// (g = 0) or widens (g = 1) the highlight through the exponent 5 / (g + 0.01).
+/// (g = 0) or widens (g = 1) the highlight through the exponent 5 / (g + 0.01); RPI's may take
+/// its diffuse colour from a texture.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Material {
-    /// Diffuse colour kd (also scales the fixed 0.2 ambient term).
+    /// Diffuse colour kd (also scales the fixed 0.2 ambient term). With a texture, the texture's
+    /// average colour, which stands for it where one colour must (shading reads the texture:
+    /// [`Scene::diffuse_at`]).
     pub diffuse: Vec3,
+    /// Index into `Scene::textures` of the texture that gives kd point by point (RPI's
+    /// `texture_file`), if any.
+    pub texture: Option<u32>,
     /// Mirror colour kr; non-zero spawns reflection rays.
     pub reflective: Vec3,
     /// Emitted colour ke; a face with non-zero emission is an area light.
@@ -39,6 +49,7 @@ impl Default for Material {
     fn default() -> Self {
         Material {
             diffuse: Vec3::ZERO,
+            texture: None,
             reflective: Vec3::ZERO,
             emitted: Vec3::ZERO,
             glossiness: 0.0,
@@ -202,8 +213,13 @@ pub struct Scene {
     pub source: String,
     /// Materials in declaration order.
     pub materials: Vec<Material>,
+    /// Textures (RPI's `texture_file`), read when the scene was parsed.
+    pub textures: Vec<Texture>,
     /// All triangles (quads and polygons fan-triangulated; a quad a b c d splits along a–c).
     pub triangles: Vec<Triangle>,
+    /// The texture coordinates (s, t) of each triangle's corners v0, v0 + e1, v0 + e2, in
+    /// `triangles` order: empty when no face has any (`vt`), and (0, 0) for a corner without.
+    pub texcoords: Vec<[[f32; 2]; 3]>,
     /// Analytic spheres.
     pub spheres: Vec<Sphere>,
     /// Emissive faces.
@@ -220,7 +236,8 @@ pub struct Scene {
     pub camera_from_file: bool,
     /// `background_color` from the file, if any.
     pub background: Option<Vec3>,
-    /// Non-fatal findings (unknown keywords, textures), each naming file:line.
+    /// Non-fatal findings (unknown keywords, textured faces without coordinates), each naming
+    /// file:line.
     pub warnings: Vec<Warning>,
 }
 
@@ -237,7 +254,12 @@ impl Scene {
     }
 
     /// Parses a scene file's bytes; `file` names it in errors.
-    fn from_bytes(bytes: &[u8], file: &str, options: &ParseOptions) -> Result<Scene, SceneError> {
+    fn from_bytes(
+        bytes: &[u8],
+        file: &str,
+        options: &ParseOptions,
+        base: Option<&Path>,
+    ) -> Result<Scene, SceneError> {
         let text = std::str::from_utf8(bytes).map_err(|e| {
             let valid = &bytes[..e.valid_up_to()];
             ParseError {
@@ -246,7 +268,7 @@ impl Scene {
                 file: file.to_string(),
             }
         })?;
-        Ok(parse_scene_str_with(text, file, options)?)
+        Ok(parse_scene_in(text, file, options, base)?)
     }
 
     /// The built-in default: the lab's Cornell box with three mirror spheres.
@@ -275,12 +297,13 @@ impl Scene {
     }
 }
 
-/// A scene and the bytes it was parsed from (what caches and bench records key on).
+/// A scene and the bytes it was made from (what caches and bench records key on).
 #[derive(Clone, Debug)]
 pub struct SceneFile {
     /// The parsed scene, its warnings included.
     pub scene: Scene,
-    /// The file's bytes, or [`BUILTIN_CORNELL_BOX`]'s.
+    /// The file's bytes, or [`BUILTIN_CORNELL_BOX`]'s, followed by each texture's name and
+    /// linear texels, so that a changed texture changes every key made from them.
     pub bytes: Vec<u8>,
 }
 
@@ -295,8 +318,20 @@ pub fn load_scene(path: Option<&Path>, options: &ParseOptions) -> Result<SceneFi
             bytes: BUILTIN_CORNELL_BOX.as_bytes().to_vec(),
         });
     };
-    let (bytes, file) = read_scene_bytes(path)?;
-    let scene = Scene::from_bytes(&bytes, &file, options)?;
+    let (mut bytes, file) = read_scene_bytes(path)?;
+    // Texture names are relative to the scene file's folder (the current one for stdin).
+    let base = (path.as_os_str() != "-").then(|| path.parent()).flatten();
+    let scene = Scene::from_bytes(&bytes, &file, options, base)?;
+    for texture in &scene.textures {
+        bytes.extend_from_slice(b"\0texture\0");
+        bytes.extend_from_slice(texture.name.as_bytes());
+        bytes.push(0);
+        for texel in &texture.texels {
+            for c in texel.to_array() {
+                bytes.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+    }
     Ok(SceneFile { scene, bytes })
 }
 

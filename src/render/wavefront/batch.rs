@@ -189,6 +189,9 @@ pub struct HitBatch {
     pub offset: Vec<f32>,
     /// Material index (0 for a miss, unused).
     pub material: Vec<u32>,
+    /// kd at the hit on a textured material (`texels::fill`); not kept for other hits, and
+    /// empty for a scene without textures.
+    pub diffuse: Vec3Column,
     /// Σ lights Σ points Shade/N of the visible light points (red, green, blue).
     pub direct: Vec3Column,
 }

@@ -14,6 +14,7 @@ use super::batch::{HitBatch, RayBatch};
 use super::bvh::MeshBvh;
 use super::context::Context;
 use super::simd::{self, RayColumns};
+use super::texels;
 use crate::render::scene::{NO_HIT, Scene};
 use crate::render::spawn::face_the_ray;
 use glam::Vec3;
@@ -92,5 +93,8 @@ pub fn closest(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch) {
         (nx[i], ny[i], nz[i]) = (hit.normal.x, hit.normal.y, hit.normal.z);
         offset[i] = hit.offset;
         material[i] = m;
+    }
+    if ctx.textured {
+        texels::fill(ctx, hits, n);
     }
 }

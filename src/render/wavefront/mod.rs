@@ -7,6 +7,7 @@
 //!     generate   camera rays, one per (pixel, aa sample)          generate.rs
 //!     for bounce in 0..=max bounces, while rays are left:
 //!         intersect  closest hit of every ray                      intersect.rs
+//!         texels     kd at hits on textured materials              texels.rs
 //!         shadow     shadow rays, occlusion, Shade sums             shadow.rs
 //!         film       radiance += throughput · (0.2·kd + direct)     film.rs
 //!         reflect    mirror rays into the next batch                reflect.rs
@@ -31,6 +32,7 @@ pub mod shade;
 pub mod shadow;
 pub mod simd;
 pub mod stats;
+pub mod texels;
 
 use crate::render::film::Film;
 use crate::render::per_kind::RayKind;

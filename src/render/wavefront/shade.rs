@@ -29,6 +29,9 @@ pub struct MaterialTerms {
     pub shininess: f32,
     /// kr ≠ 0: spawns mirror rays and has a highlight.
     pub is_reflective: bool,
+    /// The texture kd comes from, point by point (`Material::texture`): `diffuse` and `ambient`
+    /// above then hold the average, and each hit takes [`MaterialTerms::with_diffuse`].
+    pub texture: Option<u32>,
 }
 
 impl MaterialTerms {
@@ -42,6 +45,18 @@ impl MaterialTerms {
             specular: 0.8 * m.reflective,
             shininess: m.shininess(),
             is_reflective: m.is_reflective(),
+            texture: m.texture,
+        }
+    }
+
+    /// The terms with kd = `diffuse` under the ambient light `ambient`: a textured material at
+    /// one hit, computed as [`MaterialTerms::new`] computes them.
+    #[inline]
+    pub fn with_diffuse(&self, diffuse: Vec3, ambient: Vec3) -> MaterialTerms {
+        MaterialTerms {
+            diffuse,
+            ambient: ambient * diffuse,
+            ..*self
         }
     }
 }

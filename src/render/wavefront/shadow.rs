@@ -181,7 +181,7 @@ fn fused<V: Lanes>(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch) -> u64 {
             continue;
         }
         let hit = hits.surface(i);
-        let m = &ctx.materials[hits.material[i] as usize];
+        let m = &*ctx.terms(hits, i);
         let (normal, to_eye) = (hits.normal.get(i), -rays.direction.get(i));
         let mut sum = (hits.direct.x[i], hits.direct.y[i], hits.direct.z[i]);
         for (li, light) in ctx.lights.iter().enumerate() {
@@ -434,7 +434,7 @@ fn shade_ray(
     n_dot_l: f32,
     light_color: Vec3,
 ) -> Vec3 {
-    let m = &ctx.materials[hits.material[i] as usize];
+    let m = &*ctx.terms(hits, i);
     shade_terms(
         m,
         hits.normal.get(i),
@@ -460,7 +460,7 @@ fn shade<V: Lanes>(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch, queue: &
             && queue.light[q] == queue.light[end - 1]
         {
             let i = queue.path[q] as usize;
-            let m = &ctx.materials[hits.material[i] as usize];
+            let m = &*ctx.terms(hits, i);
             // Distances are kept only under a light model with fall-off (`ShadowQueue::dist`).
             let falloffs: Option<V::Array> = (!queue.dist.is_empty()).then(|| {
                 let mut f = V::Array::default();

@@ -27,6 +27,7 @@ impl Parser<'_> {
         let mut scene = Scene {
             source: self.file.to_string(),
             materials: self.materials,
+            textures: self.textures,
             background: self.background,
             camera_from_file: self.camera.is_some(),
             face_count: self.faces.len(),
@@ -34,11 +35,36 @@ impl Parser<'_> {
             ..Scene::default()
         };
         let mut warnings = self.warnings;
+        // One entry per triangle once any face has texture coordinates; none before.
+        let textured_faces = self.faces.iter().any(|f| !f.st.is_empty());
+        // Textured materials already warned about a primitive without coordinates.
+        let mut warned = vec![false; scene.materials.len()];
+        let mut untextured =
+            |warnings: &mut Vec<Warning>, material: u32, line: usize, what: &str| {
+                let m = material as usize;
+                if scene.materials[m].texture.is_none() || warned[m] {
+                    return;
+                }
+                warned[m] = true;
+                warnings.push(Warning {
+                file: self.file.to_string(),
+                line,
+                message: format!(
+                    "material {m} has a texture but this {what} has no texture coordinates (`vt` \
+                     after its vertices): it takes the texel at (0, 0), as in RPI (reported once \
+                     per material)"
+                ),
+            });
+            };
         for (face_index, face) in self.faces.iter().enumerate() {
             let face_id = face_index as u32;
             if face.corners.len() == 4 {
                 scene.quad_count += 1;
             }
+            if face.st.is_empty() {
+                untextured(&mut warnings, face.material, face.line, "face");
+            }
+            let st = |k: usize| face.st.get(k).copied().flatten().unwrap_or([0.0, 0.0]);
             let polygon_normal = newell_normal(&face.corners).normalize();
             let a = face.corners[0];
             let mut fan = Vec::new();
@@ -56,6 +82,9 @@ impl Parser<'_> {
                     });
                 }
                 fan.push((a, e1, e2));
+                if textured_faces {
+                    scene.texcoords.push([st(0), st(k), st(k + 1)]);
+                }
                 scene.triangles.push(Triangle {
                     v0: a,
                     e1,
@@ -74,6 +103,9 @@ impl Parser<'_> {
                     scene.materials[face.material as usize].emitted,
                 ));
             }
+        }
+        for (sphere, line) in &self.spheres {
+            untextured(&mut warnings, sphere.material, *line, "sphere");
         }
         scene.spheres = self.spheres.iter().map(|(s, _)| *s).collect();
         scene.warnings = warnings;

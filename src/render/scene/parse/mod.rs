@@ -9,14 +9,17 @@
 //! The few choices the command line makes about geometry (how finely an RPI ring is cut into
 //! quads) come in as [`ParseOptions`], since the file is read before the render settings exist.
 
+use super::texture::Texture;
 use super::{Camera, Material, Scene, Sphere};
 use crate::render::quote::quote;
 use assemble::newell_normal;
 use glam::Vec3;
 use std::fmt;
+use std::path::Path;
 
 mod assemble;
 mod rpi;
+mod textures;
 
 /// A fatal problem in a scene file.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -96,6 +99,8 @@ impl Default for ParseOptions {
 /// A polygon as read, before triangulation.
 struct Face {
     corners: Vec<Vec3>,
+    /// Texture coordinates of each corner's vertex (`vt`), or empty when none has any.
+    st: Vec<Option<[f32; 2]>>,
     material: u32,
     line: usize,
 }
@@ -110,7 +115,13 @@ struct CameraBlock {
 struct Parser<'a> {
     file: &'a str,
     options: ParseOptions,
+    /// The folder `texture_file` names are relative to (`None`: the current directory).
+    base: Option<&'a Path>,
     vertices: Vec<Vec3>,
+    /// Texture coordinates of each vertex (`vt` after its `v`), in `vertices` order.
+    vertex_st: Vec<Option<[f32; 2]>>,
+    /// Textures read so far, in `texture_file` order (a file named twice is read once).
+    textures: Vec<Texture>,
     materials: Vec<Material>,
     /// The `m i` selection and the line it was made on (checked against the materials at the end).
     active_material: Option<(u32, usize)>,
@@ -132,11 +143,23 @@ pub fn parse_scene_str(text: &str, file: &str) -> Result<Scene, ParseError> {
     parse_scene_str_with(text, file, &ParseOptions::default())
 }
 
-/// Parses scene text; `file` is used in messages only.
+/// Parses scene text; `file` is used in messages only, and `texture_file` names are relative to
+/// the current directory.
 pub fn parse_scene_str_with(
     text: &str,
     file: &str,
     options: &ParseOptions,
+) -> Result<Scene, ParseError> {
+    parse_scene_in(text, file, options, None)
+}
+
+/// Parses scene text whose `texture_file` names are relative to `base` (the scene file's
+/// folder; `None`: the current directory); `file` is used in messages only.
+pub fn parse_scene_in(
+    text: &str,
+    file: &str,
+    options: &ParseOptions,
+    base: Option<&Path>,
 ) -> Result<Scene, ParseError> {
     // Editors on Windows start UTF-8 files with a byte-order mark; it is not part of the first
     // keyword (left in, it turned the first `material` into an unknown keyword).
@@ -144,7 +167,10 @@ pub fn parse_scene_str_with(
     let mut p = Parser {
         file,
         options: *options,
+        base,
         vertices: Vec::new(),
+        vertex_st: Vec::new(),
+        textures: Vec::new(),
         materials: Vec::new(),
         active_material: None,
         material_refs: Vec::new(),
@@ -319,7 +345,9 @@ impl Parser<'_> {
             "v" => {
                 let v = self.vec3(line, "v", args)?;
                 self.vertices.push(v);
+                self.vertex_st.push(None);
             }
+            "vt" => self.texture_coords(line, args)?,
             "f" => self.face(line, args)?,
             "s" if args.len() <= 1 => {} // OBJ smoothing group (`s off`, `s 1`): no meaning here.
             "s" => {
@@ -369,7 +397,12 @@ impl Parser<'_> {
             "material" => self.materials.push(Material::default()),
             "diffuse" => {
                 let c = self.colour(line, keyword, args)?;
-                self.current_material(line, keyword)?.diffuse = c;
+                let material = self.current_material(line, keyword)?;
+                if material.texture.is_some() {
+                    self.warn(line, "`diffuse` ignored: the material's texture gives its diffuse colour (RPI's materials have one or the other)".into());
+                } else {
+                    material.diffuse = c;
+                }
             }
             "reflective" => {
                 let c = self.colour(line, keyword, args)?;
@@ -395,10 +428,18 @@ impl Parser<'_> {
                 }
                 self.current_material(line, keyword)?.glossiness = g;
             }
-            "texture_file" => {
-                let name = quote(args.first().copied().unwrap_or(""));
-                self.current_material(line, keyword)?.diffuse = Vec3::splat(0.5);
-                self.warn(line, format!("textures are not supported: `{name}` replaced by a neutral grey diffuse 0.5"));
+            "texture_file" => self.texture_file(line, args)?,
+            "transmitted" => {
+                // RPI's refraction colour, for its photon mapper: nothing a ray tracer of
+                // mirrors renders, so only a non-zero one is worth a word.
+                let c = self.colour(line, keyword, args)?;
+                self.current_material(line, keyword)?;
+                if c != Vec3::ZERO {
+                    self.warn(
+                        line,
+                        "transmission is not rendered: `transmitted` ignored".into(),
+                    );
+                }
             }
             "background_color" => {
                 self.background = Some(self.colour(line, keyword, args)?);
@@ -417,7 +458,7 @@ impl Parser<'_> {
                 let rest = args.join(" ");
                 self.camera_line(&rest, line)?;
             }
-            "vt" | "vn" | "vp" | "g" | "o" | "usemtl" | "mtllib" => {}
+            "vn" | "vp" | "g" | "o" | "usemtl" | "mtllib" => {}
             other => self.warn(
                 line,
                 format!("unknown keyword `{}`: line skipped", quote(other)),
@@ -437,6 +478,7 @@ impl Parser<'_> {
             ));
         }
         let mut corners = Vec::with_capacity(args.len());
+        let mut st = Vec::with_capacity(args.len());
         for token in args {
             let first = token.split('/').next().unwrap_or("");
             let index: i64 = first.parse().map_err(|_| {
@@ -457,16 +499,22 @@ impl Parser<'_> {
                 ));
             }
             corners.push(self.vertices[(resolved - 1) as usize]);
+            st.push(self.vertex_st[(resolved - 1) as usize]);
+        }
+        if st.iter().all(Option::is_none) {
+            st.clear();
         }
         let material = self.active_material(line, "face")?;
-        self.push_face(line, corners, material)
+        self.push_face(line, corners, st, material)
     }
 
-    /// Adds a polygon, refusing one without area.
+    /// Adds a polygon (with its corners' texture coordinates, or none), refusing one without
+    /// area.
     fn push_face(
         &mut self,
         line: usize,
         corners: Vec<Vec3>,
+        st: Vec<Option<[f32; 2]>>,
         material: u32,
     ) -> Result<(), ParseError> {
         // Relative to the face's own size, so that a scene scaled by 1e-6 or 1e6 keeps its faces:
@@ -487,6 +535,7 @@ impl Parser<'_> {
         }
         self.faces.push(Face {
             corners,
+            st,
             material,
             line,
         });

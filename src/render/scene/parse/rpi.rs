@@ -73,7 +73,7 @@ impl Parser<'_> {
                     corners.pop();
                 }
                 self.ring_points.extend_from_slice(&corners);
-                self.push_face(line, corners, material)?;
+                self.push_face(line, corners, Vec::new(), material)?;
             }
         }
         self.rings += 1;
