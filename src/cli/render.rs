@@ -22,6 +22,7 @@ use raywave::render::camera::CameraRays;
 use raywave::render::engine::{Engine, Prepared, clamped_warning};
 use raywave::render::error::UsageError;
 use raywave::render::film::{Film, ToneMap};
+use raywave::render::quote::escape;
 use raywave::render::scene::Scene;
 use raywave::render::settings::options::{BackgroundSource, Effective};
 use raywave::render::settings::{LightModel, ShadowMode};
@@ -398,6 +399,21 @@ fn summary(scene: &Scene, effective: &Effective, run: &RunInfo, report: &Report)
             "lab default"
         }
     );
+    for t in &scene.textures {
+        let outside = if t.outside_folder {
+            " (outside the scene file's folder)"
+        } else {
+            ""
+        };
+        let _ = writeln!(
+            out,
+            "texture {}: {}×{} texels from {}{outside}",
+            escape(&t.name),
+            t.width,
+            t.height,
+            escape(&t.path.display().to_string())
+        );
+    }
     let _ = writeln!(
         out,
         "render  {}×{}, {} bounces, shadows {shadows}, {} aa sample(s), seed {}, {} faces",

@@ -98,7 +98,58 @@ struct FailsEarly {
     stderr: &'static [&'static str],
 }
 
+/// A textured quad over `tex.ppm`, the texture named on line 2.
+const TEXTURED: &str = "material\ntexture_file tex.ppm\nv 0 0 0\nvt 0 0\nv 1 0 0\nvt 1 0\n\
+v 1 1 0\nvt 1 1\nm 0\nf 1 2 3\n";
+
 const FAILS_EARLY: &[FailsEarly] = &[
+    // A texture that is missing, not a PPM, truncated, empty or too large is an error at its
+    // scene line, and the render's output is never started.
+    FailsEarly {
+        setup: &[File("t.obj", TEXTURED)],
+        args: "t.obj --size 8 8",
+        code: 1,
+        stderr: &["t.obj:2:", "tex.ppm", "cannot read"],
+    },
+    FailsEarly {
+        setup: &[
+            File("t.obj", TEXTURED),
+            File("tex.ppm", "P2\n1 1\n255\n0\n"),
+        ],
+        args: "t.obj --size 8 8 -o out.png",
+        code: 1,
+        stderr: &["t.obj:2:", "`P3` or `P6`", "PGM"],
+    },
+    FailsEarly {
+        setup: &[
+            File("t.obj", TEXTURED),
+            File("tex.ppm", "P3\n2 2\n255\n1 2 3\n"),
+        ],
+        args: "t.obj --size 8 8",
+        code: 1,
+        stderr: &["t.obj:2:", "truncated"],
+    },
+    FailsEarly {
+        setup: &[File("t.obj", TEXTURED), File("tex.ppm", "P3\n0 0\n255\n")],
+        args: "t.obj --size 8 8",
+        code: 1,
+        stderr: &["t.obj:2:", "0×0"],
+    },
+    FailsEarly {
+        setup: &[
+            File("t.obj", TEXTURED),
+            File("tex.ppm", "P6\n65536 65536\n255\n"),
+        ],
+        args: "t.obj --size 8 8",
+        code: 1,
+        stderr: &["t.obj:2:", "65536×65536", "refused before reading"],
+    },
+    FailsEarly {
+        setup: &[File("t.obj", TEXTURED), Dir("tex.ppm")],
+        args: "t.obj --size 8 8",
+        code: 1,
+        stderr: &["t.obj:2:", "directory"],
+    },
     // A parse error names file and line and the word it could not read.
     FailsEarly {
         setup: &[File("bad.obj", BAD_SCENE)],

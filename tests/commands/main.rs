@@ -22,6 +22,7 @@ mod cli_errors;
 mod diff;
 mod docs_commands;
 mod schema;
+mod textures;
 mod trace_pixel;
 mod trace_pixel_exports;
 mod variance_shards;

@@ -133,16 +133,25 @@ pub fn shorten(args: &[&str], quick: &Quick) -> Vec<String> {
     out
 }
 
+/// Copies the folder `from` to `to`, subfolders (RPI's scenes, textures) included.
+fn copy_tree(from: &Path, to: &Path) {
+    std::fs::create_dir(to).unwrap();
+    for entry in std::fs::read_dir(from).unwrap() {
+        let path = entry.unwrap().path();
+        let target = to.join(path.file_name().unwrap());
+        if path.is_dir() {
+            copy_tree(&path, &target);
+        } else {
+            std::fs::copy(&path, target).unwrap();
+        }
+    }
+}
+
 /// Runs every raywave command of `page` in page order in one scratch directory (holding a copy
 /// of scenes/ and, as `scene.obj`, the bundled Cornell box); returns how many ran.
 pub fn run_in_page_order(page: &Page) -> usize {
     let dir = tempfile::tempdir().unwrap();
-    let copy = dir.path().join("scenes");
-    std::fs::create_dir(&copy).unwrap();
-    for entry in std::fs::read_dir(scenes()).unwrap() {
-        let from = entry.unwrap().path();
-        std::fs::copy(&from, copy.join(from.file_name().unwrap())).unwrap();
-    }
+    copy_tree(&scenes(), &dir.path().join("scenes"));
     std::fs::copy(
         scenes().join("cornell_box.obj"),
         dir.path().join("scene.obj"),

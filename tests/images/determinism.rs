@@ -102,6 +102,47 @@ fn engines() -> Vec<Option<&'static str>> {
     }
 }
 
+/// The textured scenes (the asymmetric test box and RPI's two) give the same bits on 1, 2 and
+/// 3 threads in both engines, and without mirrors the two engines give the same bits.
+#[test]
+fn textured_scenes_do_not_depend_on_the_thread_count() {
+    use raywave::render::engine::Engine;
+    for name in [
+        "textured_box.obj",
+        "rpi/textured_plane_reflective_sphere.obj",
+        "rpi/reflective_ring.obj",
+    ] {
+        let scene = Scene::load(&scene_path(name)).unwrap();
+        assert!(!scene.textures.is_empty(), "{name}: no texture read");
+        for engine in [Engine::Wavefront, Engine::Reference] {
+            let on = |threads: usize, settings: &RenderSettings| {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .unwrap();
+                let (film, _) = pool.install(|| engine.render(&scene, settings, 64, &|| {}));
+                film.pixels
+                    .iter()
+                    .map(|c| [c.x.to_bits(), c.y.to_bits(), c.z.to_bits()])
+                    .collect::<Vec<_>>()
+            };
+            let settings = soft_settings(5);
+            let one = on(1, &settings);
+            assert_eq!(one, on(2, &settings), "{name} {engine:?}: 1 vs 2 threads");
+            assert_eq!(one, on(3, &settings), "{name} {engine:?}: 1 vs 3 threads");
+        }
+        let flat = RenderSettings {
+            bounces: 0,
+            ..soft_settings(5)
+        };
+        assert_eq!(
+            Engine::Wavefront.render(&scene, &flat, 64, &|| {}).0,
+            Engine::Reference.render(&scene, &flat, 64, &|| {}).0,
+            "{name}: the engines differ without mirrors"
+        );
+    }
+}
+
 #[test]
 fn binary_same_seed_same_bytes_and_threads_do_not_matter() {
     let dir = tempfile::tempdir().unwrap();

@@ -17,4 +17,5 @@ mod point_set_lanes;
 mod shading_pixels;
 mod shadow_casters;
 mod spawn;
+mod texels;
 mod wavefront_kernels;

@@ -486,7 +486,7 @@ proptest! {
         g in prop_oneof![Just(0.0f32), Just(1.0f32), 0.0f32..1.0, -0.5f32..0.0],
         n in vec3(HALF), e in vec3(HALF), l in vec3(HALF), lc in vec3(HALF),
     ) {
-        let m = Material { diffuse: kd.abs(), reflective: kr.abs(), emitted: ke.abs(), glossiness: g };
+        let m = Material { diffuse: kd.abs(), texture: None, reflective: kr.abs(), emitted: ke.abs(), glossiness: g };
         let terms = MaterialTerms::new(&m, Vec3::splat(raywave::render::shading::AMBIENT));
         let (n, e, l) = (n.normalize_or(Vec3::Z), e.normalize_or(Vec3::Z), l.normalize_or(Vec3::Z));
         let ndl = n.dot(l);
@@ -507,7 +507,7 @@ proptest! {
         dead_bits in prop_oneof![Just(0u32), any::<u32>()],
         falloffs in prop_oneof![Just(vec![1.0f32; 16]), proptest::collection::vec(0.001f32..100.0, 16)],
     ) {
-        let m = Material { diffuse: kd.abs(), reflective: kr.abs(), emitted: ke.abs(), glossiness: g };
+        let m = Material { diffuse: kd.abs(), texture: None, reflective: kr.abs(), emitted: ke.abs(), glossiness: g };
         let case = ShadeCase { m, n, e, ls, lc, weight, blocked_bits, dead_bits, falloffs };
         // shade8 is the 8-lane kernel; shade_lanes the same source at 8 and at 16 lanes.
         check_shade(&case, 8, |at, rays| shade8(at, rays).map(|c| c.to_vec()))?;

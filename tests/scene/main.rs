@@ -8,3 +8,4 @@ mod common;
 mod scene_errors;
 mod scene_fuzz;
 mod scene_parse;
+mod scene_textures;

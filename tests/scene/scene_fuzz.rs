@@ -34,10 +34,15 @@ fn check(bytes: &[u8]) -> Result<(), TestCaseError> {
     Ok(())
 }
 
+/// The bytes of every bundled scene file: `scenes/*.obj` and RPI's in `scenes/rpi/`.
 fn bundled() -> Vec<Vec<u8>> {
-    let mut scenes: Vec<Vec<u8>> = std::fs::read_dir(common::bin::scenes())
-        .unwrap()
-        .map(|e| std::fs::read(e.unwrap().path()).unwrap())
+    let root = common::bin::scenes();
+    let mut scenes: Vec<Vec<u8>> = [root.clone(), root.join("rpi")]
+        .iter()
+        .flat_map(|dir| std::fs::read_dir(dir).unwrap())
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "obj"))
+        .map(|p| std::fs::read(p).unwrap())
         .collect();
     scenes.sort();
     scenes
@@ -77,6 +82,8 @@ const TOKENS: &[&str] = &[
     "r 0 0 0 1 0 1\n",
     "material\n",
     "emitted 1 1 1\n",
+    "vt 0.5 0.5\n",
+    "texture_file textures/asymmetric.ppm\n",
     "PerspectiveCamera {",
     "angle 180",
     "\u{feff}",
