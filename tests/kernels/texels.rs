@@ -48,7 +48,7 @@ fn check(scene: &Scene, hits_in: &[(u32, Vec3)]) {
     let mut hits = HitBatch::default();
     let n = hits_in.len();
     hits.resize(n);
-    hits.point.resize(n, 0.0);
+    hits.terms = ctx.materials.clone();
     for (i, &(prim, p)) in hits_in.iter().enumerate() {
         hits.prim[i] = prim;
         hits.point.set(i, p);
@@ -62,7 +62,8 @@ fn check(scene: &Scene, hits_in: &[(u32, Vec3)]) {
         if prim == NO_HIT || scene.material_of(prim).texture.is_none() {
             continue;
         }
-        let (lanes, scalar) = (hits.diffuse.get(i), scene.diffuse_at(prim, p));
+        let lanes = hits.terms[hits.material[i] as usize].diffuse;
+        let scalar = scene.diffuse_at(prim, p);
         assert_eq!(
             lanes.to_array().map(f32::to_bits),
             scalar.to_array().map(f32::to_bits),

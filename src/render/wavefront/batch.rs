@@ -6,6 +6,7 @@
 //! Buffers are allocated once per worker and reused (`clear` keeps the capacity), so the memory
 //! of a render is bounded by the batch size, not by the image.
 
+use super::shade::MaterialTerms;
 use crate::render::geometry::Ray;
 use crate::render::spawn::{ShadowRay, SurfaceHit};
 use glam::Vec3;
@@ -187,11 +188,14 @@ pub struct HitBatch {
     pub normal: Vec3Column,
     /// How far off the surface secondary rays start (`spawn::SurfaceHit::offset`).
     pub offset: Vec<f32>,
-    /// Material index (0 for a miss, unused).
+    /// Index into `terms` of the hit's shading terms (0 for a miss, unused): its material's
+    /// index, or on a textured material the entry made for this hit.
     pub material: Vec<u32>,
-    /// kd at the hit on a textured material (`texels::fill`); not kept for other hits, and
-    /// empty for a scene without textures.
-    pub diffuse: Vec3Column,
+    /// The shading terms `material` indexes: the context's materials (`Context::materials`), then
+    /// one entry per hit on a textured material, with kd the texel there (`texels::fill`). Every
+    /// stage reads a hit's material through this table, so untextured scenes pay nothing per
+    /// hit for textures.
+    pub terms: Vec<MaterialTerms>,
     /// Σ lights Σ points Shade/N of the visible light points (red, green, blue).
     pub direct: Vec3Column,
 }

@@ -1,7 +1,6 @@
 //! What every stage reads: the scene, the settings, and per-render tables derived from them
 //! once (material and light terms, the strata grid, the acceleration choice).
 
-use super::batch::HitBatch;
 use super::bvh::MeshBvh;
 use super::lanes::LaneWidth;
 use super::shade::MaterialTerms;
@@ -17,7 +16,6 @@ use crate::render::spawn::{
     SurfaceHit, light_offset, sphere_hit, triangle_hit, triangle_offset, triangle_plane,
 };
 use glam::Vec3;
-use std::borrow::Cow;
 
 /// At or above this many triangles, rays go through the engine's 8-wide BVH (`bvh::MeshBvh`);
 /// below it, the 8-wide kernels test every primitive. It equals the reference's `BVH_MIN_TRIANGLES`, so both
@@ -237,17 +235,6 @@ impl<'a> Context<'a> {
                     .expect("the table samplers have a stream"),
                 count: self.points_per_light,
             },
-        }
-    }
-
-    /// The shading terms at hit `i`: its material's, with kd the texel there (`hits.diffuse`)
-    /// on a textured material.
-    #[inline]
-    pub fn terms(&self, hits: &HitBatch, i: usize) -> Cow<'_, MaterialTerms> {
-        let m = &self.materials[hits.material[i] as usize];
-        match m.texture {
-            None => Cow::Borrowed(m),
-            Some(_) => Cow::Owned(m.with_diffuse(hits.diffuse.get(i), self.ambient)),
         }
     }
 

@@ -18,7 +18,7 @@ pub fn accumulate(ctx: &Context, rays: &RayBatch, hits: &HitBatch, radiance: &mu
         let term = if hits.prim[i] == NO_HIT {
             background
         } else {
-            ctx.terms(hits, i).ambient + hits.direct.get(i)
+            hits.terms[hits.material[i] as usize].ambient + hits.direct.get(i)
         };
         radiance.add(rays.slot[i] as usize, rays.throughput.get(i) * term);
     }

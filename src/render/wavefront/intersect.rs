@@ -94,6 +94,8 @@ pub fn closest(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch) {
         offset[i] = hit.offset;
         material[i] = m;
     }
+    hits.terms.clear();
+    hits.terms.extend_from_slice(&ctx.materials);
     if ctx.textured {
         texels::fill(ctx, hits, n);
     }

@@ -16,7 +16,7 @@ pub fn mirror_rays(ctx: &Context, rays: &RayBatch, hits: &HitBatch, next: &mut R
         if hits.prim[i] == NO_HIT {
             continue;
         }
-        let m = &ctx.materials[hits.material[i] as usize];
+        let m = &hits.terms[hits.material[i] as usize];
         if !m.is_reflective {
             continue;
         }

@@ -181,7 +181,7 @@ fn fused<V: Lanes>(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch) -> u64 {
             continue;
         }
         let hit = hits.surface(i);
-        let m = &*ctx.terms(hits, i);
+        let m = &hits.terms[hits.material[i] as usize];
         let (normal, to_eye) = (hits.normal.get(i), -rays.direction.get(i));
         let mut sum = (hits.direct.x[i], hits.direct.y[i], hits.direct.z[i]);
         for (li, light) in ctx.lights.iter().enumerate() {
@@ -274,7 +274,7 @@ fn fused_hard<V: Lanes>(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch) -> 
                     falloff(model, s.dist)
                 };
                 let light_color = light.color * fall;
-                let c = shade_ray(ctx, rays, hits, i, s.ray.direction, s.n_dot_l, light_color);
+                let c = shade_ray(rays, hits, i, s.ray.direction, s.n_dot_l, light_color);
                 hits.direct.add(i, c * weight);
             }
         }
@@ -426,7 +426,6 @@ fn add_in_order<V: Lanes>(sum: (f32, f32, f32), c: &[V::Array; 3]) -> (f32, f32,
 /// colour `light_color` (fall-off included), before the 1/N weight.
 #[inline(always)]
 fn shade_ray(
-    ctx: &Context,
     rays: &RayBatch,
     hits: &HitBatch,
     i: usize,
@@ -434,7 +433,7 @@ fn shade_ray(
     n_dot_l: f32,
     light_color: Vec3,
 ) -> Vec3 {
-    let m = &*ctx.terms(hits, i);
+    let m = &hits.terms[hits.material[i] as usize];
     shade_terms(
         m,
         hits.normal.get(i),
@@ -460,7 +459,7 @@ fn shade<V: Lanes>(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch, queue: &
             && queue.light[q] == queue.light[end - 1]
         {
             let i = queue.path[q] as usize;
-            let m = &*ctx.terms(hits, i);
+            let m = &hits.terms[hits.material[i] as usize];
             // Distances are kept only under a light model with fall-off (`ShadowQueue::dist`).
             let falloffs: Option<V::Array> = (!queue.dist.is_empty()).then(|| {
                 let mut f = V::Array::default();
@@ -496,7 +495,7 @@ fn shade<V: Lanes>(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch, queue: &
             let fall = queue.dist.get(q).map_or(1.0, |&d| falloff(model, d));
             let light_color = ctx.lights[queue.light[q] as usize].color * fall;
             let (l, n_dot_l) = (queue.direction.get(q), queue.n_dot_l[q]);
-            let c = shade_ray(ctx, rays, hits, i, l, n_dot_l, light_color) * weight;
+            let c = shade_ray(rays, hits, i, l, n_dot_l, light_color) * weight;
             hits.direct.add(i, c);
         }
         q += 1;

@@ -1,6 +1,7 @@
 //! Stage 2b, texels: the diffuse colour kd at every hit on a textured material, 8 hits at a
-//! time. Runs only when the scene has a textured material, after the intersect stage has put
-//! every hit point back on its surface.
+//! time, made into shading terms of the hit's own (`HitBatch::terms`). Runs only when the scene
+//! has a textured material, after the intersect stage has put every hit point back on its
+//! surface.
 //!
 //! ```text
 //! gather   per lane: the triangle (v0, e1, e2), its corners' (s, t) and the texture's size
@@ -23,10 +24,10 @@ use crate::render::scene::texture::Texture;
 use crate::render::scene::{NO_HIT, Scene, Triangle};
 use glam::Vec3;
 
-/// Fills `hits.diffuse` for the hits `0..n` on textured materials (the others are left as they
-/// were: shading reads the column only for textured materials).
+/// Gives every hit `0..n` on a textured material terms of its own: kd the texel at the hit,
+/// appended to `hits.terms` (which starts as the context's materials) and pointed to by
+/// `hits.material`.
 pub fn fill(ctx: &Context, hits: &mut HitBatch, n: usize) {
-    hits.diffuse.resize(n, 0.0);
     let mut i0 = 0;
     while i0 < n {
         let lanes = (n - i0).min(LANES);
@@ -44,8 +45,11 @@ pub fn fill(ctx: &Context, hits: &mut HitBatch, n: usize) {
                 .map(|c| std::array::from_fn(|k| c[i0 + k.min(lanes - 1)]));
             let kd = diffuse8(ctx.scene, &prims, &point, mask);
             for k in (0..lanes).filter(|&k| mask >> k & 1 == 1) {
-                hits.diffuse
-                    .set(i0 + k, Vec3::new(kd[0][k], kd[1][k], kd[2][k]));
+                let i = i0 + k;
+                let base = &ctx.materials[hits.material[i] as usize];
+                let kd = Vec3::new(kd[0][k], kd[1][k], kd[2][k]);
+                hits.terms.push(base.with_diffuse(kd, ctx.ambient));
+                hits.material[i] = (hits.terms.len() - 1) as u32;
             }
         }
         i0 += LANES;
