@@ -1,6 +1,6 @@
 //! Helpers shared by the integration tests (each kind's `tests/KIND/main.rs` declares it with
 //! `#[path = "../common/mod.rs"] mod common;`, and its files `use crate::common;`), one file per
-//! idea: `rays` (constructors and the edge-case table), `scenes` (bare and bundled scenes, the
+//! idea: `rays` (constructors and the edge-case table), `scenes` (bare, bundled and RPI scenes, the
 //! bias tests' lights and settings), `analytic` (the closed-form penumbra scene), `strategies`
 //! (proptest inputs), `random` (seeded inputs from `rand`), `bin` (running the binary in a
 //! scratch directory), `hostile` (the hostile-input catalogue's harness), `view` (`raywave view`
@@ -24,4 +24,4 @@ pub mod view;
 
 pub use random::{Draw, TestRng, seeded};
 pub use rays::{edge_rays, ray, triangle};
-pub use scenes::{PENTAGON, SQUARE, bundled_scenes, scene_of, soft_settings};
+pub use scenes::{PENTAGON, SQUARE, bundled_scenes, rpi_scenes, scene_of, soft_settings};

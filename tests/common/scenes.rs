@@ -43,16 +43,31 @@ pub fn scene_of(triangles: Vec<Triangle>, spheres: Vec<Sphere>) -> Scene {
 
 /// Every bundled `scenes/*.obj`, by file name, in name order (a scene added there is covered).
 pub fn bundled_scenes() -> Vec<(String, Scene)> {
-    let mut paths: Vec<_> = std::fs::read_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes"))
-        .expect("scenes/ exists")
+    let scenes = scenes_in("scenes");
+    assert!(
+        scenes.len() >= 5,
+        "expected the lab's scenes, found {:?}",
+        scenes.iter().map(|(n, _)| n).collect::<Vec<_>>()
+    );
+    scenes
+}
+
+/// RPI's own scenes, `scenes/rpi/*.obj` (its textured ones), by file name, in name order.
+pub fn rpi_scenes() -> Vec<(String, Scene)> {
+    let scenes = scenes_in("scenes/rpi");
+    assert!(!scenes.is_empty(), "expected RPI's scenes in scenes/rpi");
+    scenes
+}
+
+/// The `.obj` files of the repository's folder `dir`, parsed, by file name in name order.
+fn scenes_in(dir: &str) -> Vec<(String, Scene)> {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(dir);
+    let mut paths: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
         .map(|e| e.expect("dir entry").path())
         .filter(|p| p.extension().is_some_and(|e| e == "obj"))
         .collect();
     paths.sort();
-    assert!(
-        paths.len() >= 5,
-        "expected the lab's scenes, found {paths:?}"
-    );
     paths
         .iter()
         .map(|p| {

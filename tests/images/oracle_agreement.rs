@@ -19,7 +19,7 @@ use crate::oracle;
 use common::bundled_scenes;
 
 use glam::{DVec3, Vec3};
-use oracle::{ILL_CONDITIONED, Oracle, OracleImage, TOLERANCE, scaled};
+use oracle::{ILL_CONDITIONED, Oracle, OracleImage, TOLERANCE, scaled, scaled_under};
 use raywave::render::film::Film;
 use raywave::render::per_kind::RayCounts;
 use raywave::render::reference::Reference;
@@ -32,12 +32,12 @@ use std::time::Instant;
 /// The scales of the matrix: three orders of magnitude either way.
 const SCALES: [f32; 5] = [1e-3, 1e-1, 1.0, 10.0, 1e3];
 /// The largest fraction of a case's pixels the ambiguity rule may exclude.
-const MAX_EXCLUDED: f64 = 0.02;
+pub(crate) const MAX_EXCLUDED: f64 = 0.02;
 /// Image size of the matrix: small enough for 120 cases, large enough for the 2% cap to bite.
 const SIZE: (u32, u32) = (128, 128);
 
 /// The lab's three shadow modes with 5 bounces (mirror chains are where the shared bug is).
-fn modes() -> Vec<(&'static str, RenderSettings)> {
+pub(crate) fn modes() -> Vec<(&'static str, RenderSettings)> {
     let base = RenderSettings {
         width: SIZE.0,
         height: SIZE.1,
@@ -71,27 +71,27 @@ fn modes() -> Vec<(&'static str, RenderSettings)> {
 }
 
 /// The reference renderer's linear image.
-fn reference(scene: &Scene, s: &RenderSettings) -> Film {
+pub(crate) fn reference(scene: &Scene, s: &RenderSettings) -> Film {
     let (film, _): (Film, RayCounts) = Reference::new(scene, s).render(&|| {});
     film
 }
 
 /// The wavefront engine's linear image.
-fn wavefront(scene: &Scene, s: &RenderSettings) -> Film {
+pub(crate) fn wavefront(scene: &Scene, s: &RenderSettings) -> Film {
     Wavefront::new(scene, s, DEFAULT_BATCH_SIZE)
         .render(&|| {})
         .0
 }
 
 /// One engine's disagreement with the oracle on the pixels the oracle does not exclude.
-struct Disagreement {
-    count: usize,
+pub(crate) struct Disagreement {
+    pub(crate) count: usize,
     worst: usize,
     worst_error: f64,
 }
 
 /// Compares an engine's film with the oracle's image; `None` when every compared pixel agrees.
-fn disagreement(film: &Film, oracle: &OracleImage) -> Option<Disagreement> {
+pub(crate) fn disagreement(film: &Film, oracle: &OracleImage) -> Option<Disagreement> {
     assert_eq!((film.width, film.height), (oracle.width, oracle.height));
     let mut out = Disagreement {
         count: 0,
@@ -134,9 +134,9 @@ fn describe(
     )
 }
 
-/// Fails when the ambiguity rule excludes more than `MAX_EXCLUDED` of the image.
-fn check_exclusions(case: &str, image: &OracleImage) -> Option<String> {
-    let limit = (MAX_EXCLUDED * image.pixels.len() as f64).floor() as usize;
+/// Fails when the ambiguity rule excludes more than the fraction `cap` of the image.
+fn check_exclusions(case: &str, image: &OracleImage, cap: f64) -> Option<String> {
+    let limit = (cap * image.pixels.len() as f64).floor() as usize;
     (image.excluded() > limit).then(|| {
         format!(
             "{case}: the ambiguity rule excludes {} pixels, more than {limit} ({:?})",
@@ -148,7 +148,18 @@ fn check_exclusions(case: &str, image: &OracleImage) -> Option<String> {
 
 /// Runs one case against both engines, returning its failures and its table line.
 fn run_case(case: &str, scene: &Scene, s: &RenderSettings, image: &OracleImage) -> Vec<String> {
-    let mut failures: Vec<String> = check_exclusions(case, image).into_iter().collect();
+    run_capped_case(case, scene, s, image, MAX_EXCLUDED)
+}
+
+/// [`run_case`] with its own cap on the fraction of pixels the rule may exclude.
+fn run_capped_case(
+    case: &str,
+    scene: &Scene,
+    s: &RenderSettings,
+    image: &OracleImage,
+    cap: f64,
+) -> Vec<String> {
+    let mut failures: Vec<String> = check_exclusions(case, image, cap).into_iter().collect();
     let mut line = format!("{case:<58} excluded {:>3}", image.excluded());
     for (engine, film) in [
         ("reference", reference(scene, s)),
@@ -194,22 +205,29 @@ fn check_oracle_scale(case: &str, image: &OracleImage, unit: &OracleImage) -> Op
 
 #[test]
 fn every_scene_mode_and_scale_matches_the_oracle() {
+    matrix(bundled_scenes(), modes(), MAX_EXCLUDED);
+}
+
+/// Every scene in every mode at every scale of `SCALES` against the oracle, each case allowed
+/// to exclude the fraction `cap` of its pixels; fails with every failure found. Prints a line
+/// per case and the time taken.
+pub(crate) fn matrix(scenes: Vec<(String, Scene)>, modes: Vec<(&str, RenderSettings)>, cap: f64) {
     let start = Instant::now();
     let mut failures = Vec::new();
     let mut excluded = (0usize, 0usize);
-    for (name, scene) in bundled_scenes() {
-        for (mode, settings) in modes() {
-            let unit = Oracle::new(&scene, &settings).render();
+    for (name, scene) in scenes {
+        for (mode, settings) in &modes {
+            let unit = Oracle::new(&scene, settings).render();
             for scale in SCALES {
                 let case = format!("{name} {mode} scale {scale:e}");
-                let scene = scaled(&scene, scale);
+                let scene = scaled_under(&scene, scale, settings.light_model);
                 let image = if scale == 1.0 {
                     unit.clone()
                 } else {
-                    Oracle::new(&scene, &settings).render()
+                    Oracle::new(&scene, settings).render()
                 };
                 failures.extend(check_oracle_scale(&case, &image, &unit));
-                failures.extend(run_case(&case, &scene, &settings, &image));
+                failures.extend(run_capped_case(&case, &scene, settings, &image, cap));
                 excluded.0 += image.excluded();
                 excluded.1 += image.pixels.len();
             }
@@ -235,11 +253,16 @@ fn every_scene_mode_and_scale_matches_the_oracle() {
 /// can therefore pass the matrix.
 #[test]
 fn the_rule_leaves_room_for_rounding() {
+    rounding_matrix(bundled_scenes(), modes());
+}
+
+/// The check of `the_rule_leaves_room_for_rounding` on these scenes and modes.
+pub(crate) fn rounding_matrix(scenes: Vec<(String, Scene)>, modes: Vec<(&str, RenderSettings)>) {
     let mut failures = Vec::new();
-    for (name, scene) in bundled_scenes() {
-        for (mode, settings) in modes() {
-            let exact = Oracle::new(&scene, &settings).render();
-            let rounded = Oracle::new(&scene, &settings).with_rounding(2e-7);
+    for (name, scene) in scenes {
+        for (mode, settings) in &modes {
+            let exact = Oracle::new(&scene, settings).render();
+            let rounded = Oracle::new(&scene, settings).with_rounding(2e-7);
             let (mut worst, mut count) = ((0, 0.0), 0);
             for (i, p) in exact.pixels.iter().enumerate() {
                 if p.excluded.is_some() {

@@ -1,6 +1,7 @@
 //! An independent oracle for the lab's image: the model of docs/SHADING.md evaluated in f64, with
 //! its own camera, its own ray–sphere and ray–triangle tests, its own recursion and its own Shade.
-//! It reads the parsed `Scene` (input data) and draws the engines' random numbers through
+//! It reads the parsed `Scene` (input data) and the texture files it names (with its own PPM
+//! reader, `texture.rs`), and draws the engines' random numbers through
 //! `raywave::render::sampling`, so its images compare pixel for pixel; nothing else of the engines is
 //! used. Slow (every ray tests every primitive of the clusters it can reach) and meant to be
 //! obviously right.
@@ -12,7 +13,10 @@
 //! Shade(l) = 0.2·ke + Lc⊙kd·(n·l) + Lc⊙(0.8·kr)·max(0, e·r)^(5/(g + 0.01))·(n·l),
 //! r = normalize(2(n·l)n − l), e = −ray direction. Lc is the light's colour 0.2·ke·area (lab), or
 //! ke·area/(π·d²), d the distance to the light point (RPI: no 0.2). The ambient light comes from the settings;
-//! the surface's own emission 0.2·ke does not depend on it or on the light model.
+//! the surface's own emission 0.2·ke does not depend on it or on the light model. A textured
+//! material's kd is its texture's wrapped bilinear lookup (`texture.rs`) at the hit's (s, t):
+//! the triangle's corner coordinates weighted by the hit's barycentrics, (0, 0) on a sphere or
+//! a face without coordinates.
 //!
 //! # Exact semantics
 //! Camera rays count hits at t > 0. A secondary ray starts exactly at its hit point and never
@@ -39,16 +43,19 @@
 //!    nothing), within 1e-5·r of a sphere's silhouette, meeting a one-sided face at
 //!    |cos| < 1e-5; two hits of different primitives within 1e-5·L of each other, or exactly
 //!    tied unless both belong to one polygon; a hit or a blocker within 1e-5·L of the ray's
-//!    origin or of its light point; or |n·l| < 1e-5 where that light sample is worth more than
-//!    `TOLERANCE`/8 (a surface's own emission rides on that decision);
+//!    origin or of its light point; |n·l| < 1e-5 where that light sample is worth more than
+//!    `TOLERANCE`/8 (a surface's own emission rides on that decision); or a textured hit whose
+//!    s or t is within 1e-5 of a whole number (times its triangle's largest corner coordinate,
+//!    if above 1), where the lookup jumps from the last texel to the first (`texture::near_wrap`
+//!    argues the units);
 //! 2. **it is ill-conditioned**: re-rendering it with every camera ray turned by
 //!    `CAMERA_JITTER` = 1e-6 rad (four times: ±right, ±up) moves some channel by more than
 //!    `CONDITIONING` = 2.5e-4. An f32 engine's camera rays and hit points are off by a few ulps
 //!    (1e-7 to 2e-7 relative), several times less than what a 1e-6 turn does to the path, so a
 //!    pixel that moves less than 2.5e-4 under the turn moves less than 1e-4 (the comparison
-//!    tolerance) under their error. This catches deep mirror chains and steep highlights whose
-//!    f32 error is amplified, and discontinuities within 1e-6 (edges, silhouettes, shadow
-//!    boundaries seen through mirrors). `Oracle::with_rounding` checks the claim: the oracle with
+//!    tolerance) under their error. This catches deep mirror chains, steep highlights and
+//!    textures magnified under strong light, whose f32 error is amplified, and discontinuities
+//!    within 1e-6 (edges, silhouettes, shadow boundaries seen through mirrors). `Oracle::with_rounding` checks the claim: the oracle with
 //!    a 2e-7 error on every camera direction and hit point stays within 1e-4 on every pixel the
 //!    rule keeps (tests/images/oracle_agreement.rs); with 5e-7, 5 of the ~390,000 kept pixels of
 //!    the bundled scenes at scale 1 do not, so the margin is real but not large.
@@ -64,6 +71,9 @@ use raywave::render::sampling::{CAMERA_LIGHT, PointSet, SampleKey, pixel_offset}
 use raywave::render::scene::{Camera, LightShape, Scene};
 use raywave::render::settings::{LightModel, RenderSettings, ShadowMode};
 
+pub mod texture;
+use texture::Image;
+
 /// Relative margin below which a discrete decision is called ambiguous.
 pub const DECISION_MARGIN: f64 = 1e-5;
 /// Relative margin below which a decision is taken to sit exactly on its boundary.
@@ -77,6 +87,8 @@ pub const TOLERANCE: f64 = 1e-4;
 
 /// The reason given for pixels that the conditioning check excludes.
 pub const ILL_CONDITIONED: &str = "ill-conditioned under a 1e-6 turn";
+/// The reason given for pixels with a texture coordinate close to where the lookup wraps.
+pub const TEXTURE_WRAP: &str = "texture coordinate near a whole number";
 
 /// The lab's weight of a surface's own emission inside Shade (docs/SHADING.md).
 const EMISSION: f64 = 0.2;
@@ -104,6 +116,19 @@ struct Tri {
     face: u32,
 }
 
+impl Tri {
+    /// The barycentric coordinates (b1, b2) of `p` (p = v0 + b1·e1 + b2·e2 in the plane),
+    /// from the areas of the sub-triangles.
+    fn barycentric(&self, p: DVec3) -> (f64, f64) {
+        let q = p - self.v0;
+        let area2 = self.e1.cross(self.e2).dot(self.n);
+        (
+            q.cross(self.e2).dot(self.n) / area2,
+            self.e1.cross(q).dot(self.n) / area2,
+        )
+    }
+}
+
 /// A sphere in f64.
 #[derive(Clone, Copy, Debug)]
 struct Ball {
@@ -115,10 +140,13 @@ struct Ball {
 /// A material in f64.
 #[derive(Clone, Copy, Debug)]
 struct Mat {
+    /// The diffuse colour; a textured material's is replaced by the texel at each hit.
     kd: DVec3,
     kr: DVec3,
     ke: DVec3,
     exponent: f64,
+    /// The texture kd comes from (an index into `Oracle::textures`).
+    texture: Option<usize>,
 }
 
 /// A light in f64: how (u, v) maps onto it, its hard-shadow point and its colour Lc.
@@ -257,6 +285,10 @@ pub struct Oracle<'a> {
     triangles: Vec<Tri>,
     balls: Vec<Ball>,
     materials: Vec<Mat>,
+    /// The materials' textures, read from their files.
+    textures: Vec<Image>,
+    /// (s, t) at each triangle's corners v0, v0 + e1, v0 + e2; empty when the file has none.
+    texcoords: Vec<[[f64; 2]; 3]>,
     lamps: Vec<Lamp>,
     clusters: Vec<Cluster>,
     /// The scene's size: its bounding-box diagonal. Every absolute tolerance is a fraction of it.
@@ -334,7 +366,19 @@ impl<'a> Oracle<'a> {
                 kr: wide(m.reflective),
                 ke: wide(m.emitted),
                 exponent: 5.0 / (m.glossiness as f64 + 0.01),
+                texture: m.texture.map(|k| k as usize),
             })
+            .collect();
+        // The texture files are input data: read again here, by the oracle's own reader.
+        let textures = scene
+            .textures
+            .iter()
+            .map(|t| Image::read(&t.path).unwrap_or_else(|e| panic!("the oracle cannot read {e}")))
+            .collect();
+        let texcoords = scene
+            .texcoords
+            .iter()
+            .map(|c| c.map(|[s, t]| [s as f64, t as f64]))
             .collect();
         let lamps = scene
             .lights
@@ -420,6 +464,8 @@ impl<'a> Oracle<'a> {
             triangles,
             balls,
             materials,
+            textures,
+            texcoords,
             lamps,
             clusters,
             size,
@@ -544,7 +590,7 @@ impl<'a> Oracle<'a> {
             return wide(Vec3::from_array(s.background));
         };
         let mut x = ray.o + hit.t * ray.d;
-        let (mut n, material) = if hit.prim < self.triangles.len() {
+        let (mut n, mut material) = if hit.prim < self.triangles.len() {
             let t = &self.triangles[hit.prim];
             if self.rounding > 0.0 {
                 let v = noise(x);
@@ -561,6 +607,10 @@ impl<'a> Oracle<'a> {
         };
         if s.two_sided && hit.prim < self.triangles.len() && n.dot(ray.d) > 0.0 {
             n = -n;
+        }
+        if let Some(k) = material.texture {
+            let [u, v] = self.texture_coords(hit.prim, x, k, check);
+            material.kd = self.textures[k].lookup(u, v);
         }
         let mut color = wide(Vec3::from_array(s.ambient)) * material.kd;
         if material.kr != DVec3::ZERO && key.bounce < s.bounces {
@@ -779,11 +829,7 @@ impl<'a> Oracle<'a> {
         if t <= 0.0 || (!self.settings.two_sided && !front && cos >= DECISION_MARGIN) {
             return None;
         }
-        // Barycentric coordinates of the plane point, from the areas of the sub-triangles.
-        let q = ray.o + t * ray.d - tri.v0;
-        let area2 = tri.e1.cross(tri.e2).dot(tri.n);
-        let b1 = q.cross(tri.e2).dot(tri.n) / area2;
-        let b2 = tri.e1.cross(q).dot(tri.n) / area2;
+        let (b1, b2) = tri.barycentric(ray.o + t * ray.d);
         let bary = [b1, b2, 1.0 - b1 - b2];
         let inside = bary.into_iter().fold(f64::INFINITY, f64::min);
         if inside < -DECISION_MARGIN {
@@ -879,11 +925,24 @@ fn noise(v: DVec3) -> DVec3 {
     DVec3::new(next(), next(), next())
 }
 
+/// [`scaled`] for a render under `model`: under RPI's model, whose light colour falls off as
+/// 1/d², the lights' colours are multiplied by s² too, so that the image must not change either.
+pub fn scaled_under(scene: &Scene, s: f32, model: LightModel) -> Scene {
+    let mut out = scaled(scene, s);
+    if model == LightModel::Rpi {
+        for l in &mut out.lights {
+            l.color *= s * s;
+        }
+    }
+    out
+}
+
 /// The scene scaled by `s` about the origin: vertices, edges, sphere centres and radii, light
-/// shapes and centroids, the camera's position and point of interest; areas by s². Normals and
-/// the field of view are unchanged. Light colours Lc stay as they are: under the lab's model
-/// Lc = 0.2·ke·area would grow by s², but scaling is a test of geometry, so radiometry is held
-/// fixed and the image must not change.
+/// shapes and centroids, the camera's position and point of interest; areas by s². Normals,
+/// the field of view and the texture coordinates (per triangle corner, not positions: the
+/// texture stays where it was on each face) are unchanged. Light colours Lc stay as they are:
+/// under the lab's model Lc = 0.2·ke·area would grow by s², but scaling is a test of geometry,
+/// so radiometry is held fixed and the image must not change.
 pub fn scaled(scene: &Scene, s: f32) -> Scene {
     let mut out = scene.clone();
     for t in &mut out.triangles {
