@@ -178,3 +178,21 @@ fn bad_texture_coordinates_are_errors_at_their_line() {
         &["extra `b.ppm`"],
     );
 }
+
+#[test]
+fn the_bytes_caches_key_on_change_with_the_texture() {
+    let dir = tempfile::tempdir().unwrap();
+    write_ppm(&dir.path().join("rb.ppm"), RED_BLUE);
+    let path = scene_file(dir.path(), "rb.ppm", "");
+    let first = load_scene(Some(&path), &Default::default()).unwrap().bytes;
+    let text = std::fs::read(&path).unwrap();
+    assert!(first.starts_with(&text) && first.len() > text.len());
+    // The same scene file over another texture: what the variance cache and bench records
+    // key on must change.
+    write_ppm(
+        &dir.path().join("rb.ppm"),
+        b"P3\n2 1\n255\n255 0 0 0 0 254\n",
+    );
+    let second = load_scene(Some(&path), &Default::default()).unwrap().bytes;
+    assert_ne!(first, second);
+}

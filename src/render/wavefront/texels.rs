@@ -76,25 +76,38 @@ pub fn diffuse8(
     point: &[[f32; LANES]; 3],
     mask: u32,
 ) -> [[f32; LANES]; 3] {
-    // Gather: each lane's triangle, corners' coordinates and texture.
-    let mut tri = [UNIT; LANES];
-    let mut st = [[[0.0f32; 2]; 3]; LANES];
+    // Gather, lane by lane: the triangle (a unit one off a triangle with coordinates), its
+    // corners' (s, t) and the texture's size, as [component][lane] arrays.
+    let mut corner = [[[0.0f32; LANES]; 3]; 3]; // v0, e1, e2
+    let mut st = [[[0.0f32; LANES]; 2]; 3]; // corner, s|t
+    let mut size = [[1.0f32; LANES]; 2]; // width, height
     let mut texture: [Option<&Texture>; LANES] = [None; LANES];
     for k in (0..LANES).filter(|&k| mask >> k & 1 == 1) {
         let p = prims[k] as usize;
-        if let Some(corners) = scene.texcoords.get(p) {
-            tri[k] = scene.triangles[p];
-            st[k] = *corners;
+        let (tri, uv) = match scene.texcoords.get(p) {
+            Some(uv) => (&scene.triangles[p], uv),
+            None => (&UNIT, &[[0.0; 2]; 3]),
+        };
+        for a in 0..3 {
+            corner[0][a][k] = tri.v0[a];
+            corner[1][a][k] = tri.e1[a];
+            corner[2][a][k] = tri.e2[a];
         }
-        let m = scene.material_of(prims[k]);
-        texture[k] = m.texture.map(|t| &scene.textures[t as usize]);
+        for (n, uv) in uv.iter().enumerate() {
+            st[n][0][k] = uv[0];
+            st[n][1][k] = uv[1];
+        }
+        let tex = scene
+            .material_of(prims[k])
+            .texture
+            .map(|t| &scene.textures[t as usize]);
+        if let Some(tex) = tex {
+            size[0][k] = tex.width as f32;
+            size[1][k] = tex.height as f32;
+        }
+        texture[k] = tex;
     }
-    let lane = |f: &dyn Fn(usize) -> f32| f32x8::from_fn(f);
-    let (v0, e1, e2) = (
-        [0, 1, 2].map(|a| lane(&|k| tri[k].v0[a])),
-        [0, 1, 2].map(|a| lane(&|k| tri[k].e1[a])),
-        [0, 1, 2].map(|a| lane(&|k| tri[k].e2[a])),
-    );
+    let [v0, e1, e2] = corner.map(|c| c.map(f32x8::from_array));
     let p = point.map(f32x8::from_array);
     // `texture::barycentrics`, lane by lane.
     let q = [p[0] - v0[0], p[1] - v0[1], p[2] - v0[2]];
@@ -107,11 +120,10 @@ pub fn diffuse8(
     let b0 = f32x8::ONE - b1 - b2;
     // `texture::interpolate`.
     let [s, t] = [0, 1].map(|c| {
-        let corner = |n: usize| lane(&|k| st[k][n][c]);
-        b0 * corner(0) + b1 * corner(1) + b2 * corner(2)
+        let at = |n: usize| f32x8::from_array(st[n][c]);
+        b0 * at(0) + b1 * at(1) + b2 * at(2)
     });
-    let width = lane(&|k| texture[k].map_or(1.0, |t| t.width as f32));
-    let height = lane(&|k| texture[k].map_or(1.0, |t| t.height as f32));
+    let [width, height] = size.map(f32x8::from_array);
     let (x, dx) = footprint8(s, width);
     let (y, dy) = footprint8(t, height);
     // Gather the four texels of each lane (`Texture::lookup`'s c1..c4).
