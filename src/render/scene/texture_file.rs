@@ -7,6 +7,7 @@
 //! the parser puts the scene's file and line in front.
 
 use super::texture::Texture;
+use crate::render::quote::escape;
 use image::ImageDecoder;
 use image::codecs::pnm::{PnmDecoder, PnmSubtype};
 use std::fs::File;
@@ -42,7 +43,8 @@ pub(crate) fn resolve(name: &str, base: Option<&Path>) -> (PathBuf, bool) {
 
 /// Reads the texture `name` at `path`. The error is a sentence naming the path.
 pub(crate) fn read_texture(name: &str, path: &Path) -> Result<Texture, String> {
-    let shown = path.display();
+    // The path comes from the scene file: its control characters are shown escaped.
+    let shown = escape(&path.display().to_string());
     let meta = std::fs::metadata(path).map_err(|e| format!("cannot read {shown}: {e}"))?;
     if !meta.is_file() {
         let kind = if meta.is_dir() {
