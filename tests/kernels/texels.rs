@@ -133,12 +133,8 @@ fn points_that_are_not_finite_take_texel_zero_in_both() {
         let lanes = diffuse8(&scene, &[0; 8], &[[p.x; 8], [p.y; 8], [p.z; 8]], 0xff);
         let scalar = scene.diffuse_at(0, p);
         assert_eq!(scalar, scene.textures[0].texel(0, 0), "{bad}");
-        for k in 0..8 {
-            assert_eq!(
-                [lanes[0][k], lanes[1][k], lanes[2][k]],
-                scalar.to_array(),
-                "{bad}"
-            );
+        for (k, ((r, g), b)) in lanes[0].iter().zip(&lanes[1]).zip(&lanes[2]).enumerate() {
+            assert_eq!([*r, *g, *b], scalar.to_array(), "{bad}: lane {k}");
         }
     }
 }

@@ -88,10 +88,10 @@ pub fn diffuse8(
             Some(uv) => (&scene.triangles[p], uv),
             None => (&UNIT, &[[0.0; 2]; 3]),
         };
-        for a in 0..3 {
-            corner[0][a][k] = tri.v0[a];
-            corner[1][a][k] = tri.e1[a];
-            corner[2][a][k] = tri.e2[a];
+        for (c, v) in corner.iter_mut().zip([tri.v0, tri.e1, tri.e2]) {
+            for a in 0..3 {
+                c[a][k] = v[a];
+            }
         }
         for (n, uv) in uv.iter().enumerate() {
             st[n][0][k] = uv[0];
