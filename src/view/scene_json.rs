@@ -165,6 +165,23 @@ mod tests {
     }
 
     #[test]
+    fn a_textured_material_is_drawn_in_its_textures_average_colour() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/textured_box.obj");
+        let scene = Scene::load(std::path::Path::new(path)).unwrap();
+        let json = SceneJson::new(&scene);
+        let textured = scene.materials.iter().position(|m| m.texture.is_some()).unwrap();
+        let average = scene.textures[0].average;
+        // The mean of the texture's linear texels, not black (its material has no `diffuse`).
+        assert!(average.min_element() > 0.1, "{average}");
+        let t = scene
+            .triangles
+            .iter()
+            .position(|t| t.material as usize == textured)
+            .unwrap();
+        assert_eq!(json.colors[3 * t..3 * t + 3], average.to_array());
+    }
+
+    #[test]
     fn the_frame_corners_are_the_corner_pixels_directions() {
         let cam = Camera::default();
         let frame = CameraFrame::new(&cam, 4, 2);
