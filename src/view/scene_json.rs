@@ -169,7 +169,11 @@ mod tests {
         let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/textured_box.obj");
         let scene = Scene::load(std::path::Path::new(path)).unwrap();
         let json = SceneJson::new(&scene);
-        let textured = scene.materials.iter().position(|m| m.texture.is_some()).unwrap();
+        let textured = scene
+            .materials
+            .iter()
+            .position(|m| m.texture.is_some())
+            .unwrap();
         let average = scene.textures[0].average;
         // The mean of the texture's linear texels, not black (its material has no `diffuse`).
         assert!(average.min_element() > 0.1, "{average}");

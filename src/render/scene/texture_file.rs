@@ -4,13 +4,18 @@
 //! must be a regular file (not a directory, a FIFO or a device), the header must be a PPM's, and
 //! its width × height must be at least 1 and at most [`MAX_TEXTURE_TEXELS`]. A short or
 //! malformed body is the decoder's error. Every error says what was expected and what was found;
-//! the parser puts the scene's file and line in front.
+//! the parser puts the scene's file and line in front. A build without the `textures` feature
+//! (the renderer alone, as the instruction-count gate builds it) reads no texture and says so.
 
 use super::texture::Texture;
 use crate::render::quote::escape;
+#[cfg(feature = "textures")]
 use image::ImageDecoder;
+#[cfg(feature = "textures")]
 use image::codecs::pnm::{PnmDecoder, PnmSubtype};
+#[cfg(feature = "textures")]
 use std::fs::File;
+#[cfg(feature = "textures")]
 use std::io::{BufReader, Read};
 use std::path::{Component, Path, PathBuf};
 
@@ -41,7 +46,19 @@ pub(crate) fn resolve(name: &str, base: Option<&Path>) -> (PathBuf, bool) {
     (std::fs::canonicalize(&path).unwrap_or(path), escapes)
 }
 
+/// Without the `textures` feature (a renderer-only build) no texture is read: the error says
+/// why.
+#[cfg(not(feature = "textures"))]
+pub(crate) fn read_texture(_name: &str, path: &Path) -> Result<Texture, String> {
+    Err(format!(
+        "cannot read {}: this build of raywave reads no textures (built without the `textures` \
+         feature)",
+        escape(&path.display().to_string())
+    ))
+}
+
 /// Reads the texture `name` at `path`. The error is a sentence naming the path.
+#[cfg(feature = "textures")]
 pub(crate) fn read_texture(name: &str, path: &Path) -> Result<Texture, String> {
     // The path comes from the scene file: its control characters are shown escaped.
     let shown = escape(&path.display().to_string());
@@ -111,6 +128,7 @@ pub(crate) fn read_texture(name: &str, path: &Path) -> Result<Texture, String> {
 }
 
 /// Reads until `buf` is full or the input ends; the count read.
+#[cfg(feature = "textures")]
 fn read_up_to(reader: &mut impl Read, buf: &mut [u8]) -> std::io::Result<usize> {
     let mut got = 0;
     while got < buf.len() {
@@ -122,7 +140,7 @@ fn read_up_to(reader: &mut impl Read, buf: &mut [u8]) -> std::io::Result<usize> 
     Ok(got)
 }
 
-#[cfg(test)]
+#[cfg(all(test, feature = "textures"))]
 mod tests {
     use super::*;
     use glam::Vec3;
