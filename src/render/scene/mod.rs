@@ -303,7 +303,7 @@ pub struct SceneFile {
     /// The parsed scene, its warnings included.
     pub scene: Scene,
     /// The file's bytes, or [`BUILTIN_CORNELL_BOX`]'s, followed by each texture's name and
-    /// linear texels, so that a changed texture changes every key made from them.
+    /// digest (`Texture::digest`), so that a changed texture changes every key made from them.
     pub bytes: Vec<u8>,
 }
 
@@ -326,11 +326,7 @@ pub fn load_scene(path: Option<&Path>, options: &ParseOptions) -> Result<SceneFi
         bytes.extend_from_slice(b"\0texture\0");
         bytes.extend_from_slice(texture.name.as_bytes());
         bytes.push(0);
-        for texel in &texture.texels {
-            for c in texel.to_array() {
-                bytes.extend_from_slice(&c.to_le_bytes());
-            }
-        }
+        bytes.extend_from_slice(&texture.digest.to_le_bytes());
     }
     Ok(SceneFile { scene, bytes })
 }

@@ -40,6 +40,9 @@ pub struct Texture {
     /// The name leaves the scene file's folder (absolute, or climbing out through `..`):
     /// allowed, and the render's summary shows where it led.
     pub outside_folder: bool,
+    /// FNV-1a (64-bit) of the texture's size and samples as read: what caches and records key
+    /// on for it (`SceneFile::bytes`). 0 for a texture not read from a file.
+    pub digest: u64,
 }
 
 /// sRGB-encoded [0, 1] to linear: the IEC 61966-2-1 curve RPI's `srgb_to_linear` uses.
@@ -91,6 +94,7 @@ impl Texture {
                 (sum[2] / n) as f32,
             ),
             outside_folder: false,
+            digest: 0,
         }
     }
 
@@ -191,6 +195,7 @@ mod tests {
             texels,
             average: Vec3::ZERO,
             outside_folder: false,
+            digest: 0,
         }
     }
 

@@ -117,14 +117,23 @@ pub(crate) fn read_texture(name: &str, path: &Path) -> Result<Texture, String> {
     decoder.read_image(&mut bytes).map_err(|e| {
         format!("expected {width}×{height} RGB texels at {shown}, found a truncated or malformed body: {e}")
     })?;
+    let digest = {
+        use std::hash::Hasher;
+        let mut h = fnv::FnvHasher::default();
+        h.write(&width.to_le_bytes());
+        h.write(&height.to_le_bytes());
+        h.write(&bytes);
+        h.finish()
+    };
     let name = name.to_string();
     let path = path.to_path_buf();
-    Ok(if wide {
+    let texture = if wide {
         let sample = |k: usize| u16::from_ne_bytes([bytes[2 * k], bytes[2 * k + 1]]);
         Texture::from_srgb(name, path, width, height, sample, 65535.0)
     } else {
         Texture::from_srgb(name, path, width, height, |k| bytes[k] as u16, 255.0)
-    })
+    };
+    Ok(Texture { digest, ..texture })
 }
 
 /// Reads until `buf` is full or the input ends; the count read.
