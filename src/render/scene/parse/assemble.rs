@@ -39,22 +39,14 @@ impl Parser<'_> {
         let textured_faces = self.faces.iter().any(|f| !f.st.is_empty());
         // Textured materials already warned about a primitive without coordinates.
         let mut warned = vec![false; scene.materials.len()];
+        let file = self.file;
         let mut untextured =
             |warnings: &mut Vec<Warning>, material: u32, line: usize, what: &str| {
                 let m = material as usize;
-                if scene.materials[m].texture.is_none() || warned[m] {
-                    return;
+                if scene.materials[m].texture.is_some() && !std::mem::replace(&mut warned[m], true)
+                {
+                    warnings.push(no_coordinates(file, line, m, what));
                 }
-                warned[m] = true;
-                warnings.push(Warning {
-                file: self.file.to_string(),
-                line,
-                message: format!(
-                    "material {m} has a texture but this {what} has no texture coordinates (`vt` \
-                     after its vertices): it takes the texel at (0, 0), as in RPI (reported once \
-                     per material)"
-                ),
-            });
             };
         for (face_index, face) in self.faces.iter().enumerate() {
             let face_id = face_index as u32;
@@ -117,6 +109,19 @@ impl Parser<'_> {
         Ok(scene)
     }
 }
+/// The warning for the first primitive (`what`: a face or a sphere) of textured material `m`
+/// that has no texture coordinates.
+fn no_coordinates(file: &str, line: usize, m: usize, what: &str) -> Warning {
+    Warning {
+        file: file.to_string(),
+        line,
+        message: format!(
+            "material {m} has a texture but this {what} has no texture coordinates (`vt` after \
+             its vertices): it takes the texel at (0, 0), as in RPI (reported once per material)"
+        ),
+    }
+}
+
 /// The polygon's area-weighted normal (twice the area in length), robust for any planar polygon.
 pub(super) fn newell_normal(corners: &[Vec3]) -> Vec3 {
     let mut n = Vec3::ZERO;

@@ -399,7 +399,12 @@ impl Parser<'_> {
                 let c = self.colour(line, keyword, args)?;
                 let material = self.current_material(line, keyword)?;
                 if material.texture.is_some() {
-                    self.warn(line, "`diffuse` ignored: the material's texture gives its diffuse colour (RPI's materials have one or the other)".into());
+                    self.warn(
+                        line,
+                        "`diffuse` ignored: the material's texture gives its diffuse colour \
+                         (RPI's materials have one or the other)"
+                            .into(),
+                    );
                 } else {
                     material.diffuse = c;
                 }
