@@ -123,10 +123,17 @@ pub fn footprint(s: f32, n: u32) -> (u32, u32, f32) {
     let s = if s.is_finite() { s } else { 0.0 };
     let x = (s - s.floor()) * n as f32;
     let i = x.floor();
-    let d = x - i;
-    // x reaches n only when s − ⌊s⌋ rounds up to 1: that is s = 1, texel 0.
+    let (i1, i2) = texel_pair(i, n);
+    (i1, i2, x - i)
+}
+
+/// The two texels from ⌊x⌋ = `i` (0 ≤ i ≤ n) on an axis of `n`: i itself, except that i = n
+/// (x reaches n only when s − ⌊s⌋ rounds up to 1: that is s = 1) is texel 0; and the next one,
+/// clamped at the last.
+#[inline]
+pub fn texel_pair(i: f32, n: u32) -> (u32, u32) {
     let i1 = if i >= n as f32 { 0 } else { i as u32 };
-    (i1, (i1 + 1).min(n - 1), d)
+    (i1, (i1 + 1).min(n - 1))
 }
 
 /// The barycentric coordinates (b1, b2) of `p` in `tri` (p = v0 + b1·e1 + b2·e2 in its plane),

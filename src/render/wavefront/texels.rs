@@ -20,7 +20,7 @@
 use super::batch::HitBatch;
 use super::context::Context;
 use super::lanes::{LANES, Lanes, f32x8};
-use crate::render::scene::texture::Texture;
+use crate::render::scene::texture::{Texture, texel_pair};
 use crate::render::scene::{NO_HIT, Scene, Triangle};
 use glam::Vec3;
 
@@ -131,17 +131,8 @@ pub fn diffuse8(
     let mut c = [[[0.0f32; LANES]; 3]; 4];
     for k in (0..LANES).filter(|&k| mask >> k & 1 == 1) {
         let Some(tex) = texture[k] else { continue };
-        let i1 = if x[k] >= tex.width as f32 {
-            0
-        } else {
-            x[k] as u32
-        };
-        let j1 = if y[k] >= tex.height as f32 {
-            0
-        } else {
-            y[k] as u32
-        };
-        let (i2, j2) = ((i1 + 1).min(tex.width - 1), (j1 + 1).min(tex.height - 1));
+        let (i1, i2) = texel_pair(x[k], tex.width);
+        let (j1, j2) = texel_pair(y[k], tex.height);
         for (n, (i, j)) in [(i1, j1), (i1, j2), (i2, j1), (i2, j2)]
             .into_iter()
             .enumerate()
@@ -163,8 +154,8 @@ pub fn diffuse8(
     })
 }
 
-/// `texture::footprint` on 8 lanes, up to the integer texel: ⌊x⌋ (as a float; `n` where the
-/// wrapped coordinate rounded up to 1, which the caller maps to texel 0) and the fraction.
+/// `texture::footprint` on 8 lanes, up to the integer texel: ⌊x⌋ (as a float, for
+/// `texture::texel_pair`) and the fraction.
 #[inline]
 fn footprint8(s: f32x8, n: f32x8) -> (f32x8, f32x8) {
     let s = s.is_finite().select(s, f32x8::ZERO);
