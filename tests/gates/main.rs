@@ -1,11 +1,9 @@
 //! Gates: checks on the code itself rather than on what it renders. The instruction-count gate
 //! (`icount`: callgrind's counts of the hot kernels against committed baselines; its child
 //! workloads are the `raywave-icount-child` example, `icount_child.rs`), the layering rule
-//! (`layering`: only the lane layer names `wide`), the module map (`module_map`:
-//! docs/ARCHITECTURE.md's tree is `src/`) and the set-up block (`readme_setup`: `.ci/run` runs
-//! the README's two set-up commands as written).
+//! (`layering`: only the lane layer names `wide`) and the module map (`module_map`:
+//! docs/ARCHITECTURE.md's tree is `src/`).
 
 mod icount;
 mod layering;
 mod module_map;
-mod readme_setup;
