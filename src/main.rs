@@ -39,6 +39,9 @@ fn main() -> ExitCode {
         eprintln!("error: {e:#}");
         return ExitCode::from(1);
     }
+    // Outputs reach their files only when the command has succeeded: a run that fails part
+    // of the way changes none of them (output::write).
+    raywave::output::hold_outputs();
     // Lab and RPI flags accepted without effect: one line each, like the scene's warnings.
     for note in &normalized.notes {
         eprintln!("note: {note}");
@@ -47,31 +50,31 @@ fn main() -> ExitCode {
     for warning in cli::combos::meaningless(&cli.command, &|flag| normalized.typed(flag)) {
         eprintln!("warning: {warning}");
     }
-    let result = match cli.command {
-        Command::Render(args) => cli::render::run(&args),
-        Command::Info => cli::info::run(),
-        Command::Meshgen(args) => cli::meshgen::run(&args),
-        Command::Variance(args) => cli::variance::run(&args),
+    // Each command's own exit code when it succeeds (0 but for the ones noted).
+    let result: anyhow::Result<u8> = match cli.command {
+        Command::Render(args) => cli::render::run(&args).map(|()| 0),
+        Command::Info => cli::info::run().map(|()| 0),
+        Command::Meshgen(args) => cli::meshgen::run(&args).map(|()| 0),
+        Command::Variance(args) => cli::variance::run(&args).map(|()| 0),
         // Exit 130 after SIGINT and 143 after SIGTERM, once the requests in hand are answered.
-        Command::View(args) => match cli::view::run(&args) {
-            Ok(code) => return ExitCode::from(code),
-            Err(e) => Err(e),
-        },
-        Command::TracePixel(args) => cli::trace_pixel::run(&args),
+        Command::View(args) => cli::view::run(&args),
+        Command::TracePixel(args) => cli::trace_pixel::run(&args).map(|()| 0),
         // Exit 3 when --compare finds a regression (raywave::bench::EXIT_REGRESSION), 4 when
         // --until-decided ends undecided (EXIT_UNDECIDED).
-        Command::Bench(args) => match cli::bench::run(&args, matches.subcommand_matches("bench")) {
-            Ok(code) => return ExitCode::from(code),
-            Err(e) => Err(e),
-        },
+        Command::Bench(args) => cli::bench::run(&args, matches.subcommand_matches("bench")),
         // Exit 3 when the figure is past --fail-above (raywave::diff::EXIT_FAILED).
-        Command::Diff(args) => match cli::diff::run(&args) {
-            Ok(code) => return ExitCode::from(code),
-            Err(e) => Err(e),
-        },
+        Command::Diff(args) => cli::diff::run(&args),
+    };
+    // A run that failed changes no output; one that succeeded puts them all in place.
+    let result = match result {
+        Ok(code) => raywave::output::commit_outputs().map(|()| code),
+        Err(e) => {
+            raywave::output::discard_outputs();
+            Err(e)
+        }
     };
     match result {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(code) => ExitCode::from(code),
         Err(e) if e.downcast_ref::<UsageError>().is_some() => {
             eprintln!("error: {e:#}\n\nFor more information, try '--help'.");
             ExitCode::from(2)

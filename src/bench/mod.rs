@@ -101,6 +101,9 @@ pub struct BenchOptions {
     /// The flags given on the command line (clap ids: `size`, `threads`, `engine`, ...):
     /// with `--compare`, every other setting comes from the record.
     pub explicit: Vec<String>,
+    /// The command's inputs and outputs, checked before the call; held again against the
+    /// scene's textures once it is read.
+    pub plan: crate::output::OutputPlan,
 }
 
 /// What `run` measured and did: the records, where they were saved, and with `--compare` the
@@ -163,6 +166,7 @@ pub fn run(args: &BenchOptions, hooks: &Hooks) -> Result<Outcome> {
     for w in &scene.warnings {
         (hooks.notice)(&w.to_string());
     }
+    args.plan.check_scene_files("SCENE", &scene)?;
     let baseline = match &args.compare {
         Some(name) => {
             let path = record::record_path(&args.dir, name)?;

@@ -302,6 +302,7 @@ impl BenchArgs {
                 .map(|id| id.to_string())
                 .collect();
         }
+        let sweep_points = sweep.points();
         BenchOptions {
             scene: self.scene.clone().or_else(|| self.input.clone()),
             image: self.image.options(),
@@ -322,6 +323,7 @@ impl BenchArgs {
             export_github_action_benchmark: self.export_github_action_benchmark.clone(),
             shard: self.shard.zip(self.out.clone()),
             explicit,
+            plan: output_plan(self, &sweep_points),
         }
     }
 }
@@ -337,6 +339,9 @@ fn output_plan(args: &BenchArgs, points: &[raywave::bench::sweep::Point]) -> Out
     let mut plan = OutputPlan::new();
     if let Some(scene) = args.scene.as_ref().or(args.input.as_ref()) {
         plan = plan.input("SCENE", scene);
+    }
+    if let Some(other) = &args.against {
+        plan = plan.input("--against", other);
     }
     // `--compare X --save X` is the rolling baseline, by design: X is read whole before any
     // timing, and replaced only when this run did not regress against it.
@@ -411,7 +416,7 @@ pub fn run(args: &BenchArgs, matches: Option<&ArgMatches>) -> Result<u8> {
         None => {}
     }
     let options = args.options(matches);
-    output_plan(args, &options.sweep.points()).check()?;
+    options.plan.check()?;
     // Each timed run holds one film; refuse a size the machine cannot hold before any timing.
     let largest = options
         .sweep
@@ -471,6 +476,11 @@ pub fn run(args: &BenchArgs, matches: Option<&ArgMatches>) -> Result<u8> {
              --shadow-samples and one --threads"
         ))
         .into());
+    }
+    // The other build reads the scene itself; its textures are held against the outputs here.
+    if let Some(scene) = options.scene.as_ref().filter(|s| !raywave::output::is_stdio(s)) {
+        let scene = raywave::render::scene::load_scene(Some(scene), &options.image.parse_options())?;
+        options.plan.check_scene_files("SCENE", &scene.scene)?;
     }
     let options = AbOptions {
         other: other.clone(),

@@ -191,7 +191,7 @@ pub fn run(args: &DiffArgs) -> Result<u8> {
             "note     one image holds linear floats and the other 8/16-bit values: the stored values are compared as they are\n",
         );
     }
-    let region = region(args, &a)?;
+    let region = region(args, &a, &plan)?;
     let mut comparison = diff::compare(&a, &b, &region)?;
     let flip_map = if want_flip {
         Some(diff::add_flip(&mut comparison, &a, &b, &region)?)
@@ -277,7 +277,7 @@ fn file_name(path: &Path) -> String {
 }
 
 /// The pixels compared: every one, a mask file's non-zero ones, or the penumbra.
-fn region(args: &DiffArgs, a: &Image) -> Result<Region> {
+fn region(args: &DiffArgs, a: &Image, plan: &OutputPlan) -> Result<Region> {
     if let Some(path) = args.mask_file() {
         let mask = read_image(path)?;
         diff::check_same_size(
@@ -311,6 +311,7 @@ fn region(args: &DiffArgs, a: &Image) -> Result<Region> {
     for w in &scene.warnings {
         eprintln!("{w}");
     }
+    plan.check_scene_files("--scene", &scene)?;
     if scene.lights.is_empty() {
         bail!(
             "{}: --mask penumbra needs a scene with an area light, found none",

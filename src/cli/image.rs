@@ -160,6 +160,7 @@ pub fn scene_and_settings(
     path: Option<&Path>,
     image: &ImageArgs,
     seed: &SeedArgs,
+    plan: &OutputPlan,
 ) -> anyhow::Result<(Scene, Effective)> {
     let options = ImageOptions {
         seed: seed.seed,
@@ -170,6 +171,7 @@ pub fn scene_and_settings(
     for w in &scene.warnings {
         eprintln!("{w}");
     }
+    plan.check_scene_files("SCENE", &scene)?;
     let effective = options.resolve(scene.background.map(|c| c.to_array()));
     raywave::render::sampling::check(&effective.settings).map_err(|e| UsageError(e.to_string()))?;
     Ok((scene, effective))

@@ -117,6 +117,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         args.scene_path().map(PathBuf::as_path),
         &args.image,
         &args.seed,
+        &plan,
     )?;
     let settings = effective.settings.clone();
     phases.mark("outputs, scene, settings");
@@ -283,6 +284,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             None => record.write(path)?,
         }
     }
+    // Every output in place before the summary says it was written.
+    raywave::output::commit_outputs()?;
     if !args.quiet {
         let extra = args
             .hdr

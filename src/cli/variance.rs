@@ -239,6 +239,13 @@ fn with_progress<T>(
     out
 }
 
+/// No output of `plan` is a texture one of the cases' scenes read.
+fn check_textures(plan: &OutputPlan, cases: &[Case]) -> Result<()> {
+    cases
+        .iter()
+        .try_for_each(|case| plan.check_scene_files(&format!("case {}", case.name), &case.scene))
+}
+
 fn joined(paths: &[PathBuf]) -> String {
     paths
         .iter()
@@ -269,7 +276,9 @@ pub fn run(args: &VarianceArgs) -> Result<()> {
     let plan = args.study.inputs(&options, OutputPlan::new());
     if let Some(shard) = args.shard {
         let part = options.out.join(raywave::variance::part::file_name(shard));
-        plan.output_in_new_dir("--out", &part).check()?;
+        let plan = plan.output_in_new_dir("--out", &part);
+        plan.check()?;
+        check_textures(&plan, &cases)?;
         let identity = raywave::variance::plan::identity(&cases, options.engine.name());
         let jobs = identity.assignment(shard.count)[shard.index].len();
         let prefix = format!("variance shard {shard}, {jobs} jobs");
@@ -287,6 +296,7 @@ pub fn run(args: &VarianceArgs) -> Result<()> {
         plan = plan.output_in_new_dir("--out", &options.out.join(name));
     }
     plan.check()?;
+    check_textures(&plan, &cases)?;
     let jobs = raywave::variance::plan::identity(&cases, options.engine.name())
         .jobs()
         .len();

@@ -64,7 +64,13 @@ fn parse_token(value: &str) -> Result<Token, String> {
 /// Serves the page until Ctrl-C (exit 130) or SIGTERM (143); returns the exit code.
 pub fn run(args: &ViewArgs) -> Result<u8> {
     let access = access(args)?;
-    let (scene, effective) = scene_and_settings(args.scene.as_deref(), &args.image, &args.seed)?;
+    let (scene, effective) = scene_and_settings(
+        args.scene.as_deref(),
+        &args.image,
+        &args.seed,
+        // The viewer writes no file.
+        &raywave::output::OutputPlan::new(),
+    )?;
     let settings = effective.settings;
     if settings.width > MAX_SIDE || settings.height > MAX_SIDE {
         return Err(UsageError(format!(

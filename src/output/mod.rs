@@ -10,7 +10,8 @@
 //! ```
 //!
 //! `image_file.rs` turns a film into PNG, PPM, PFM or EXR bytes; `write.rs` writes the files
-//! (atomically for regular files, directly for devices, FIFOs and stdout) and removes temporary files on SIGINT/SIGTERM; `memory.rs` estimates a render's peak.
+//! (atomically for regular files, directly for devices, FIFOs and stdout; all of a run's at
+//! once, at its commit) and removes temporary files on SIGINT/SIGTERM; `memory.rs` estimates a render's peak.
 
 pub mod bench_record;
 pub mod build_info;
@@ -24,7 +25,10 @@ pub mod statistics;
 pub mod terminal;
 pub(crate) mod write;
 
-pub use write::{Target, install_signal_cleanup, target, write_output};
+pub use write::{
+    Target, commit_outputs, discard_outputs, hold_outputs, install_signal_cleanup, target,
+    write_output, write_output_now,
+};
 
 use crate::render::error::UsageError;
 use anyhow::{Result, bail};
@@ -192,10 +196,33 @@ impl OutputPlan {
         Ok(())
     }
 
+    /// Refuses an output that is one of the files `scene` read besides itself: its textures,
+    /// which are known only once it is parsed (the plan's other checks come before the parse).
+    /// `label` names the scene as the user gave it (`SCENE`, `--scene`).
+    pub fn check_scene_files(&self, label: &str, scene: &crate::render::scene::Scene) -> Result<()> {
+        let plan = scene.textures.iter().fold(
+            OutputPlan {
+                inputs: Vec::new(),
+                outputs: self.outputs.clone(),
+            },
+            |plan, t| plan.input(&format!("{label}'s texture_file"), &t.path),
+        );
+        plan.check_against_inputs()
+    }
+
     /// Refuses an output that is an input or another output (a [`UsageError`]), then an
     /// output whose directory is missing, not a directory or not writable, or an output that
     /// is a directory (a plain error: the flags are valid, the file system is not ready).
     pub fn check(&self) -> Result<()> {
+        self.check_against_inputs()?;
+        for out in &self.outputs {
+            check_writable(out)?;
+        }
+        Ok(())
+    }
+
+    /// The first half of [`OutputPlan::check`]: no output is an input or another output.
+    fn check_against_inputs(&self) -> Result<()> {
         let inputs: Vec<(&Named, Identity)> = self
             .inputs
             .iter()
@@ -228,9 +255,6 @@ impl OutputPlan {
                     .into());
                 }
             }
-        }
-        for out in &self.outputs {
-            check_writable(out)?;
         }
         Ok(())
     }

@@ -1,23 +1,155 @@
-//! Writing one output file, whole or not at all.
+//! Writing outputs, each whole or not at all, and all of a run's together or none.
 //!
 //! - A regular file (or a new one, or a symlink to either) is written to a temporary file
 //!   beside the real target, then renamed over it: the symlink stays a symlink.
 //! - Standard output (`-`), devices (`/dev/null`, `/dev/full`) and FIFOs are written directly:
 //!   renaming over them would replace a device node or a pipe with a plain file. Write errors
 //!   (ENOSPC on `/dev/full`, a closed pipe) are reported with the file's name.
+//! - After [`hold_outputs`] (the `raywave` binary calls it first thing), nothing reaches its
+//!   target until [`commit_outputs`]: each regular output waits in its temporary file, each
+//!   direct one in an unnamed temporary file, so a run that fails before the commit changes no
+//!   output ([`discard_outputs`] removes what was held). The commit first copies the direct
+//!   outputs (where ENOSPC and closed pipes show), then renames the regular ones, under the
+//!   lock the signal handler takes, so a signal during the renames waits for them.
 //! - Temporary files are registered while they exist; on SIGINT or SIGTERM the handler from
 //!   [`install_signal_cleanup`] removes them and exits 130 or 143, so no temporary file survives
 //!   an interruption and the old output stays as it was.
+//!
+//! ```text
+//! write_output(path)  regular -> temp beside it -> held ? queue (temp, real) : rename now
+//!                     direct  -> held ? unnamed temp file, queued : write now
+//! commit_outputs()    copy each queued direct output; any error -> remove every temp, fail
+//!                     rename each temp over its target; an error -> name what was and was
+//!                     not replaced, remove the rest, fail
+//! ```
 
-use anyhow::{Context, Result};
+use anyhow::{Context, Result, bail};
 use std::fs::File;
-use std::io::{BufWriter, Write};
+use std::io::{BufWriter, Seek, Write};
 use std::os::unix::fs::FileTypeExt;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
-/// Temporary files that exist now, removed by the signal handler.
-static TEMPORARIES: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+/// An output written in full and not yet at its target.
+enum Held {
+    /// A regular file's temporary file, renamed over `real` at the commit.
+    Rename {
+        tmp: tempfile::NamedTempFile,
+        real: PathBuf,
+        /// The path as the user gave it, for messages.
+        shown: PathBuf,
+    },
+    /// A device's, FIFO's or standard output's bytes, copied to it at the commit.
+    Direct { bytes: File, shown: PathBuf },
+}
+
+/// What the process's outputs are doing now.
+#[derive(Default)]
+struct Outputs {
+    /// Temporary files that exist now, removed by the signal handler.
+    temporaries: Vec<PathBuf>,
+    /// Outputs wait for [`commit_outputs`] (set by [`hold_outputs`]).
+    holding: bool,
+    /// The outputs waiting, in the order they were written.
+    held: Vec<Held>,
+}
+
+static OUTPUTS: Mutex<Outputs> = Mutex::new(Outputs {
+    temporaries: Vec::new(),
+    holding: false,
+    held: Vec::new(),
+});
+
+fn outputs() -> std::sync::MutexGuard<'static, Outputs> {
+    OUTPUTS.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// From now on, outputs are written in full but reach their targets only at
+/// [`commit_outputs`]: a run that fails first changes none of them.
+pub fn hold_outputs() {
+    outputs().holding = true;
+}
+
+/// Puts every held output in place: the direct ones first, then the renames. Outputs written
+/// after this are held again (the process stays in holding mode).
+pub fn commit_outputs() -> Result<()> {
+    let held = std::mem::take(&mut outputs().held);
+    let (direct, renames): (Vec<Held>, Vec<Held>) = held
+        .into_iter()
+        .partition(|h| matches!(h, Held::Direct { .. }));
+    // Without the lock: a FIFO may wait for its reader, and the signal handler must still be
+    // able to remove the held temporary files meanwhile.
+    let copied = direct.into_iter().try_for_each(|held| match held {
+        Held::Direct { mut bytes, shown } => copy_direct(&mut bytes, &shown),
+        Held::Rename { .. } => Ok(()),
+    });
+    let mut state = outputs();
+    let unregister = |state: &mut Outputs, tmp: &Path| state.temporaries.retain(|p| p != tmp);
+    if let Err(e) = copied {
+        for held in renames {
+            if let Held::Rename { tmp, .. } = held {
+                unregister(&mut state, tmp.path());
+            }
+        }
+        return Err(e.context("no file output was changed"));
+    }
+    let mut replaced = Vec::new();
+    let mut renames = renames.into_iter();
+    while let Some(Held::Rename { tmp, real, shown }) = renames.next() {
+        let tmp_path = tmp.path().to_path_buf();
+        match tmp.persist(&real) {
+            Ok(_) => {
+                unregister(&mut state, &tmp_path);
+                replaced.push(shown.display().to_string());
+            }
+            Err(e) => {
+                unregister(&mut state, &tmp_path);
+                let kept: Vec<String> = std::iter::once(shown.display().to_string())
+                    .chain(renames.filter_map(|h| match h {
+                        Held::Rename { tmp, shown, .. } => {
+                            unregister(&mut state, tmp.path());
+                            Some(shown.display().to_string())
+                        }
+                        Held::Direct { .. } => None,
+                    }))
+                    .collect();
+                let replaced = if replaced.is_empty() {
+                    "none".to_string()
+                } else {
+                    replaced.join(", ")
+                };
+                bail!(
+                    "cannot move the finished file to {}: {}; outputs replaced: {replaced}; left as they were: {}",
+                    shown.display(),
+                    e.error,
+                    kept.join(", ")
+                );
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Drops every held output: their temporary files are removed, their targets left as they
+/// were.
+pub fn discard_outputs() {
+    let mut state = outputs();
+    for held in std::mem::take(&mut state.held) {
+        if let Held::Rename { tmp, .. } = held {
+            let path = tmp.path().to_path_buf();
+            state.temporaries.retain(|p| p != &path);
+        }
+    }
+}
+
+/// Copies a held direct output to its target.
+fn copy_direct(bytes: &mut File, shown: &Path) -> Result<()> {
+    bytes.rewind()?;
+    write_output_now(shown, |w| {
+        std::io::copy(bytes, w)?;
+        Ok(())
+    })
+}
 
 /// What writing to a path means.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -89,8 +221,40 @@ pub(crate) fn may_write_in(dir: &Path) -> bool {
     unsafe { libc::access(c.as_ptr(), libc::W_OK | libc::X_OK) == 0 }
 }
 
-/// Writes through `fill`: atomically to a regular target, directly to anything else.
+/// Writes through `fill`: atomically to a regular target, directly to anything else; held
+/// until [`commit_outputs`] after [`hold_outputs`].
 pub fn write_output(
+    path: &Path,
+    fill: impl FnOnce(&mut BufWriter<&mut File>) -> Result<()>,
+) -> Result<()> {
+    if !outputs().holding {
+        return write_output_now(path, fill);
+    }
+    match target(path) {
+        Target::Regular(real) => {
+            let tmp = write_temporary(path, &real, fill)?;
+            outputs().held.push(Held::Rename {
+                tmp,
+                real,
+                shown: path.to_path_buf(),
+            });
+        }
+        Target::Stdout | Target::Special(_) => {
+            let mut bytes = tempfile::tempfile()
+                .context("cannot create a temporary file to hold an output")?;
+            write_direct(&mut bytes, &path.display().to_string(), fill)?;
+            outputs().held.push(Held::Direct {
+                bytes,
+                shown: path.to_path_buf(),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Writes through `fill` at once, held or not: for files the run reads back (the variance
+/// study's cache), which are not outputs to commit together.
+pub fn write_output_now(
     path: &Path,
     fill: impl FnOnce(&mut BufWriter<&mut File>) -> Result<()>,
 ) -> Result<()> {
@@ -164,19 +328,35 @@ fn write_atomically(
     real: &Path,
     fill: impl FnOnce(&mut BufWriter<&mut File>) -> Result<()>,
 ) -> Result<()> {
+    let tmp = write_temporary(path, real, fill)?;
+    let tmp_path = tmp.path().to_path_buf();
+    // Renamed under the lock: a signal now waits for the rename, and finds nothing to remove.
+    let mut state = outputs();
+    let persisted = tmp.persist(real);
+    state.temporaries.retain(|p| p != &tmp_path);
+    persisted.with_context(|| format!("cannot move the finished file to {}", path.display()))?;
+    Ok(())
+}
+
+/// The temporary file beside `real`, filled through `fill`, flushed, with the mode of the
+/// file it replaces; registered for the signal handler until it is renamed or dropped.
+fn write_temporary(
+    path: &Path,
+    real: &Path,
+    fill: impl FnOnce(&mut BufWriter<&mut File>) -> Result<()>,
+) -> Result<tempfile::NamedTempFile> {
     let dir = parent_dir(real);
     // Created and registered under the lock, so that the signal handler sees every
     // temporary file that exists.
     let mut tmp = {
-        let mut temps = TEMPORARIES.lock().unwrap_or_else(|e| e.into_inner());
+        let mut state = outputs();
         let tmp = tempfile::Builder::new()
             .prefix(".raywave-")
             .tempfile_in(dir)
             .with_context(|| format!("cannot create a temporary file in {}", dir.display()))?;
-        temps.push(tmp.path().to_path_buf());
+        state.temporaries.push(tmp.path().to_path_buf());
         tmp
     };
-    let tmp_path = tmp.path().to_path_buf();
     let result = (|| -> Result<()> {
         {
             let mut w = BufWriter::new(tmp.as_file_mut());
@@ -195,13 +375,14 @@ fn write_atomically(
             .with_context(|| format!("cannot set the permissions of {}", path.display()))?;
         Ok(())
     })();
-    let mut temps = TEMPORARIES.lock().unwrap_or_else(|e| e.into_inner());
-    temps.retain(|p| p != &tmp_path);
-    result?;
-    // Renamed under the lock: a signal now waits for the rename, and finds nothing to remove.
-    tmp.persist(real)
-        .with_context(|| format!("cannot move the finished file to {}", path.display()))?;
-    Ok(())
+    if let Err(e) = result {
+        let tmp_path = tmp.path().to_path_buf();
+        let mut state = outputs();
+        drop(tmp);
+        state.temporaries.retain(|p| p != &tmp_path);
+        return Err(e);
+    }
+    Ok(tmp)
 }
 
 /// Installs the SIGINT/SIGTERM handler: it removes every registered temporary file and exits
@@ -214,7 +395,8 @@ pub fn install_signal_cleanup() -> Result<()> {
         .name("signals".into())
         .spawn(move || {
             if let Some(signal) = signals.forever().next() {
-                let temps = TEMPORARIES.lock().unwrap_or_else(|e| e.into_inner());
+                let state = outputs();
+                let temps = &state.temporaries;
                 for p in temps.iter() {
                     let _ = std::fs::remove_file(p);
                 }

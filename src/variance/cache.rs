@@ -249,7 +249,9 @@ impl Cache {
                 .flat_map(|c| c.to_array())
         };
         let sum = floats().fold(FNV_START, |h, x| fnv(h, &x.to_le_bytes()));
-        crate::output::image_file::write_atomically(&path, |w| {
+        // At once, not held for the run's commit: the study reads its references back, and
+        // a reference rendered is worth keeping even if the study then fails.
+        crate::output::write_output_now(&path, |w| {
             w.write_all(MAGIC)?;
             for v in [CACHE_FORMAT, width, height] {
                 w.write_all(&v.to_le_bytes())?;

@@ -10,6 +10,7 @@
 use super::command::{Outcome, create_out, write_report};
 use super::jobs::{self, CaseFacts, JobResult};
 use super::part::{self, Part};
+use crate::render::error::UsageError;
 use anyhow::{Result, bail};
 use std::path::{Path, PathBuf};
 
@@ -93,20 +94,22 @@ pub fn merge(inputs: &[PathBuf], out: &Path, notice: &(dyn Fn(&str) + Sync)) -> 
     }
     for input in inputs {
         if same_place(out, input) {
-            bail!(
+            return Err(UsageError(format!(
                 "--out {} is one of the merge's inputs: expected a directory of its own for the report, so that no part is overwritten",
                 out.display()
-            );
+            ))
+            .into());
         }
     }
     let paths = part::expand(inputs)?;
     for path in &paths {
         if path.parent().is_some_and(|dir| same_place(out, dir)) {
-            bail!(
+            return Err(UsageError(format!(
                 "--out {} holds the part {}: expected a directory of its own for the report, so that no part is overwritten",
                 out.display(),
                 path.display()
-            );
+            ))
+            .into());
         }
     }
     let mut parts: Vec<(PathBuf, Part)> = Vec::new();

@@ -7,11 +7,13 @@
 mod common;
 
 mod hostile;
+mod hostile_all_or_none;
 mod hostile_cache;
 mod hostile_flags;
 mod hostile_inputs;
 mod hostile_outputs;
 mod hostile_outputs_commands;
+mod hostile_outputs_textures;
 mod hostile_records;
 mod hostile_shards;
 mod interrupt;
