@@ -231,15 +231,17 @@ fn sixteen_and_eight_lanes_give_the_same_bytes_on_every_scene() {
     }
 }
 
-/// Soft shadows on small scenes are spawned, tested and shaded in registers, block by block
-/// (`shadow::fused`), and hard shadows (and the unshadowed centroid rays of `--shadows off`)
-/// are spawned N hits at a time (`shadow::spawn_across`); the per-hit path sends every ray
-/// through the queue hit by hit. Both give the same bytes and counts on every bundled scene:
-/// every sampler, point counts with dead tail lanes at 8 and 16 lanes, both light models (the
-/// RPI model's fall-off is computed from each block's distances), bounces, antialiasing, two-
-/// sided faces and odd batch sizes (groups of hits that end mid-vector).
+/// Every shadow path a render admits (`shadow::ShadowPath`: soft shadows fused block by block
+/// in registers, hard shadows (and the unshadowed centroid rays of `--shadows off`) fused or
+/// queued N hits at a time) gives the bytes and counts of `QueuedPerHit`, which sends every ray
+/// through the queue hit by hit, on every bundled scene: every sampler, point counts with dead
+/// tail lanes at 8 and 16 lanes, both light models (the RPI model's fall-off is computed from
+/// each block's distances), bounces, antialiasing, two-sided faces and odd batch sizes (groups
+/// of hits that end mid-vector). Every path is taken somewhere, and the path a render chooses
+/// is among those held.
 #[test]
-fn shadow_paths_give_the_per_hit_path_s_bytes() {
+fn every_shadow_path_gives_the_per_hit_path_s_bytes() {
+    use raywave::render::wavefront::shadow::ShadowPath;
     use raywave::render::settings::LightModel;
     use raywave::render::wavefront::lanes::LaneWidth;
     let soft = |n, sampler, light_model| RenderSettings {
@@ -271,6 +273,7 @@ fn shadow_paths_give_the_per_hit_path_s_bytes() {
             });
         }
     }
+    let mut taken = std::collections::BTreeSet::new();
     for (name, scene) in bundled_scenes() {
         for (m, s) in settings.iter().enumerate() {
             // Odd batches for every mode without soft shadows too: groups of hits that end
@@ -282,25 +285,34 @@ fn shadow_paths_give_the_per_hit_path_s_bytes() {
             };
             for &batch in batches {
                 for width in [LaneWidth::Eight, LaneWidth::Sixteen] {
-                    let render = |per_hit| {
-                        let w = Wavefront::new(&scene, s, batch)
-                            .with_lane_width(width)
-                            .with_per_hit_shadows(per_hit);
-                        let (film, stats) = w.render(&|| {});
+                    let engine = || Wavefront::new(&scene, s, batch).with_lane_width(width);
+                    let render = |path| {
+                        let (film, stats) = engine().with_shadow_path(path).render(&|| {});
                         (film_bits(&film), stats.counts)
                     };
-                    let (per_hit, cp) = render(true);
-                    let (fast, cf) = render(false);
-                    assert!(
-                        per_hit == fast,
-                        "{name}: the shadow stage's fast paths changed the image at {width:?}, \
-                         batch {batch}, {s:?}"
-                    );
-                    assert_eq!(cp, cf, "{name}: ray counts differ with {s:?}");
+                    let (per_hit, cp) = render(ShadowPath::QueuedPerHit);
+                    let admitted: Vec<ShadowPath> = ShadowPath::ALL
+                        .into_iter()
+                        .filter(|p| p.admits(engine().context()))
+                        .collect();
+                    assert!(admitted.contains(&engine().shadow_path()), "{name}: {s:?}");
+                    for path in admitted {
+                        taken.insert(format!("{path:?}"));
+                        let (fast, cf) = render(path);
+                        assert!(
+                            per_hit == fast,
+                            "{name}: {path:?} changed the image at {width:?}, batch {batch}, \
+                             {s:?}"
+                        );
+                        assert_eq!(cp, cf, "{name}: {path:?}'s ray counts differ with {s:?}");
+                    }
                 }
             }
         }
     }
+    let every: std::collections::BTreeSet<String> =
+        ShadowPath::ALL.iter().map(|p| format!("{p:?}")).collect();
+    assert_eq!(taken, every, "some shadow path was never held to the per-hit one");
 }
 
 /// `LaneWidth::Auto` is the build's native width: 16 lanes when built for AVX-512, else 8.

@@ -32,6 +32,7 @@ use raywave::render::settings::{RenderSettings, ShadowMode};
 use raywave::render::spawn::{ShadowRay, SurfaceHit};
 use raywave::render::wavefront::batch::{HitBatch, RayBatch, ShadowQueue};
 use raywave::render::wavefront::context::Context;
+use raywave::render::wavefront::shadow::ShadowPath;
 use raywave::render::wavefront::{generate, intersect, reflect, shadow};
 use std::collections::BTreeMap;
 
@@ -233,8 +234,8 @@ fn reference_draws(scene: &Scene, s: &RenderSettings) -> Drawn {
 /// does, with a shadow queue large enough for a whole depth, read after `direct_light`.
 fn wavefront_draws(scene: &Scene, s: &RenderSettings) -> Drawn {
     // Hit by hit through the queue, where the drawn points can be read back: the fused
-    // soft-shadow path draws the same points (`shadow_paths_give_the_per_hit_path_s_bytes`).
-    let ctx = Context::new(scene, s).with_per_hit_shadows(true);
+    // soft-shadow path draws the same points (`every_shadow_path_gives_the_per_hit_path_s_bytes`).
+    let ctx = Context::new(scene, s).with_shadow_path(ShadowPath::QueuedPerHit);
     let n = s.points_per_light();
     let (mut rays, mut next) = (RayBatch::default(), RayBatch::default());
     let (mut hits, mut queue) = (HitBatch::default(), ShadowQueue::default());

@@ -4,6 +4,7 @@
 use super::bvh::MeshBvh;
 use super::lanes::LaneWidth;
 use super::shade::MaterialTerms;
+use super::shadow::ShadowPath;
 use super::simd::BlockSampler;
 use crate::render::camera::CameraRays;
 use crate::render::geometry::shadow_casters;
@@ -90,10 +91,9 @@ pub struct Context<'a> {
     /// The lane width of the brute-force, light and shading kernels, resolved (`Eight` or
     /// `Sixteen`): [`auto_width`]'s choice unless [`Context::with_lane_width`] says otherwise.
     pub lane_width: LaneWidth,
-    /// Every shadow ray spawned hit by hit and sent through the queue, where the shadow stage
-    /// would fuse soft-shadow blocks in registers or spawn hard-shadow rays across hits: false
-    /// unless [`Context::with_per_hit_shadows`] says otherwise. Speed only.
-    pub per_hit_shadows: bool,
+    /// How the shadow stage runs: [`ShadowPath::choose`]'s choice unless
+    /// [`Context::with_shadow_path`] says otherwise. Speed only.
+    pub shadow_path: ShadowPath,
     /// Where soft shadows' points fall on a light (the reference's, for the scalar paths and
     /// the samplers without a lane formula of their own).
     pub points: PointSet,
@@ -138,7 +138,7 @@ impl<'a> Context<'a> {
         let padded = (points_per_light as usize).div_ceil(16) * 16;
         let cell_x = (0..padded as u32).map(|j| (j % nx) as f32).collect();
         let cell_y = (0..padded as u32).map(|j| (j / nx) as f32).collect();
-        Context {
+        let mut ctx = Context {
             scene,
             settings,
             camera: CameraRays::new(&scene.camera, settings.width, settings.height),
@@ -164,12 +164,14 @@ impl<'a> Context<'a> {
             lights,
             points_per_light,
             lane_width: auto_width(settings, points_per_light),
-            per_hit_shadows: false,
+            shadow_path: ShadowPath::QueuedPerHit,
             points: PointSet::new(settings),
             cell_x,
             cell_y,
             grid: (nx as f32, ny as f32),
-        }
+        };
+        ctx.shadow_path = ShadowPath::choose(&ctx);
+        ctx
     }
 
     /// The same context with the kernels run `width` lanes wide (`Auto`: [`auto_width`]).
@@ -182,11 +184,15 @@ impl<'a> Context<'a> {
         self
     }
 
-    /// The same context with every shadow ray spawned hit by hit and sent through the queue
-    /// (`per_hit: true`): the path the fused soft-shadow blocks and the hard-shadow rays spawned
-    /// across hits are held to. Speed only: the image is the same.
-    pub fn with_per_hit_shadows(mut self, per_hit: bool) -> Self {
-        self.per_hit_shadows = per_hit;
+    /// The same context with its shadow stage run by `path`, which it must admit
+    /// ([`ShadowPath::admits`]): how tests hold every path to `QueuedPerHit`. Speed only: the
+    /// image is the same.
+    pub fn with_shadow_path(mut self, path: ShadowPath) -> Self {
+        assert!(
+            path.admits(&self),
+            "{path:?} does not give this scene and these settings their shadows"
+        );
+        self.shadow_path = path;
         self
     }
 

@@ -110,13 +110,17 @@ impl<'a> Wavefront<'a> {
         self
     }
 
-    /// The same engine with every shadow ray spawned hit by hit and sent through the queue,
-    /// where soft shadows on a small scene would otherwise be spawned, tested and shaded in
-    /// registers, and hard shadows spawned N hits at a time. Speed only: the image and the
-    /// counts are the same either way (tests hold them so).
-    pub fn with_per_hit_shadows(mut self, per_hit: bool) -> Self {
-        self.ctx = self.ctx.with_per_hit_shadows(per_hit);
+    /// The same engine with its shadow stage run by `path` (`Context::with_shadow_path`; the
+    /// context must admit it). Speed only: the image and the counts are the same on every
+    /// path (tests hold them so).
+    pub fn with_shadow_path(mut self, path: shadow::ShadowPath) -> Self {
+        self.ctx = self.ctx.with_shadow_path(path);
         self
+    }
+
+    /// The shadow path this engine's renders take.
+    pub fn shadow_path(&self) -> shadow::ShadowPath {
+        self.ctx.shadow_path
     }
 
     /// The lane width the kernels run at (resolved: `Eight` or `Sixteen`).

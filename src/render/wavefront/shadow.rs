@@ -12,13 +12,9 @@
 //!     shade:   in queue order, direct[hit] += Shade(l) / N for the rays not blocked
 //! ```
 //!
-//! On a scene without a BVH the queue is skipped. Soft shadows whose lights are all
-//! parallelograms: each block of N rays is spawned, tested and shaded while it is in registers
-//! (`fused`), in the same (hit, light, point) order with the same kernels. Hard shadows: one
-//! ray per hit, N hits at a time (`fused_hard`, `simd::hit_shadow_rays`), each hit's rays in
-//! light order. Either way the sums are the queue's, bit for bit. The queue is for the BVH's
-//! one-ray-at-a-time walk (its hard-shadow rays too are spawned N hits at a time:
-//! `spawn_across`).
+//! Which of four paths a render takes is [`ShadowPath`], chosen once when the context is
+//! built; its table below says when each is taken and what it costs. Every path gives the
+//! queue's sums bit for bit: the same (hit, light, point) order, the same kernels.
 //!
 //! Queue order is the reference's loop order, so each hit's sum is added in the same order and
 //! comes out bit-identical. Soft shadows on a parallelogram light (every lab light) go N points
@@ -43,6 +39,61 @@ use crate::render::scene::NO_HIT;
 use crate::render::settings::LightModel;
 use crate::render::spawn::{falloff, light_end, shadow_ray};
 use glam::Vec3;
+
+/// How the shadow stage runs, chosen once per render ([`ShadowPath::choose`], when the context
+/// is built); tests force each path the context admits and hold its image to `QueuedPerHit`'s.
+///
+/// | path | taken when | spawn | occlusion | shade | what it costs and saves |
+/// | --- | --- | --- | --- | --- | --- |
+/// | `FusedSoft` | soft shadows, every light a parallelogram, a sampler with a lane formula (all but the lab's at N = 1), no BVH | N points of one (hit, light) at a time (`simd::light_points`, `simd::shadow_rays`) | `simd::block_occluded` against the shadow casters | in registers, added in point order | no queue: each block is spawned, tested and shaded while it is in registers (the lab benchmark's path) |
+/// | `FusedHard` | hard shadows (or none), no BVH | N hits at a time, one ray per light (`simd::hit_shadow_rays`) | `simd::hit_rays_occluded` against the casters | each lit ray, in light order | no queue; spawning across hits is what a hard-shadow ray costs most (56 instructions a ray against 161 hit by hit) |
+/// | `QueuedAcross` | hard shadows (or none) with a BVH | N hits at a time into the queue | the queue through `MeshBvh::occluded`, one ray at a time | in queue order | the BVH's walk is one ray at a time, so the rays wait in the queue |
+/// | `QueuedPerHit` | everything else: soft shadows with a BVH, fan lights, the lab's sampler at N = 1 | hit by hit, in (light, point) order, N points at a time where a lane formula exists, else the scalar `PointSet::point` | the queue, N rays at a time against the casters, or through the BVH | in queue order, aligned blocks N lanes at a time | the general path, and the one every other is held to |
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ShadowPath {
+    /// Soft shadows spawned, tested and shaded block by block in registers.
+    FusedSoft,
+    /// One ray per (hit, light), N hits at a time, in registers.
+    FusedHard,
+    /// One ray per (hit, light), spawned N hits at a time into the queue for the BVH.
+    QueuedAcross,
+    /// Every ray spawned hit by hit into the queue.
+    QueuedPerHit,
+}
+
+impl ShadowPath {
+    /// Every path, fastest first: [`ShadowPath::choose`] takes the first the context admits.
+    pub const ALL: [ShadowPath; 4] = [
+        ShadowPath::FusedSoft,
+        ShadowPath::FusedHard,
+        ShadowPath::QueuedAcross,
+        ShadowPath::QueuedPerHit,
+    ];
+
+    /// True when this path gives `ctx`'s shadow stage its image (the table's "taken when",
+    /// or wider: `QueuedAcross` also runs without a BVH, `QueuedPerHit` everywhere).
+    pub fn admits(self, ctx: &Context) -> bool {
+        match self {
+            ShadowPath::FusedSoft => {
+                ctx.accel.is_none()
+                    && ctx.samples_lights()
+                    && ctx.simd_light_sampling()
+                    && ctx.lights.iter().all(|l| l.parallelogram.is_some())
+            }
+            ShadowPath::FusedHard => ctx.accel.is_none() && !ctx.samples_lights(),
+            ShadowPath::QueuedAcross => !ctx.samples_lights(),
+            ShadowPath::QueuedPerHit => true,
+        }
+    }
+
+    /// The fastest path `ctx` admits.
+    pub fn choose(ctx: &Context) -> ShadowPath {
+        ShadowPath::ALL
+            .into_iter()
+            .find(|p| p.admits(ctx))
+            .unwrap_or(ShadowPath::QueuedPerHit)
+    }
+}
 
 /// The hash state of a SampleKey before its dimension is mixed in: `sampling::hash(key, dim)`
 /// is `mix32(key_prefix(key) ^ dim)`, so a (hit, light) stream is hashed once, not once per
@@ -84,21 +135,20 @@ fn direct_light_lanes<V: Lanes>(
 ) -> u64 {
     let n = rays.len();
     hits.direct.fill(0..n, glam::Vec3::ZERO);
-    if fuses(ctx) {
-        return fused::<V>(ctx, rays, hits);
-    }
-    if fuses_hard(ctx) {
-        return fused_hard::<V>(ctx, rays, hits);
-    }
+    let across = match ctx.shadow_path {
+        ShadowPath::FusedSoft => return fused::<V>(ctx, rays, hits),
+        ShadowPath::FusedHard => return fused_hard::<V>(ctx, rays, hits),
+        ShadowPath::QueuedAcross => true,
+        ShadowPath::QueuedPerHit => false,
+    };
     // Room for one hit's rays at least, each light's points padded to whole N-lane blocks.
     let per_hit = ctx.lights.len() * (ctx.points_per_light as usize).div_ceil(V::N) * V::N;
     queue.reset(
         capacity.max(per_hit),
         ctx.settings.light_model != LightModel::Lab,
     );
-    // One ray per (hit, light) is spawned N hits at a time; a group of N hits needs at most
-    // lights × N entries, which is `per_hit` at one point per light.
-    let across = !ctx.per_hit_shadows && !ctx.samples_lights();
+    // Across hits, one ray per (hit, light) is spawned N hits at a time; a group of N hits
+    // needs at most lights × N entries, which is `per_hit` at one point per light.
     let mut cast = 0;
     let mut next = 0;
     while next < n {
@@ -151,17 +201,6 @@ fn first_block<'c>(
     }
 }
 
-/// True when every shadow ray goes through [`fused`]: soft shadows drawn by the SIMD samplers
-/// on parallelogram lights (every light; a queued light would change the order of a hit's
-/// sum), tested against the scene's few casters without a BVH.
-fn fuses(ctx: &Context) -> bool {
-    !ctx.per_hit_shadows
-        && ctx.accel.is_none()
-        && ctx.samples_lights()
-        && ctx.simd_light_sampling()
-        && ctx.lights.iter().all(|l| l.parallelogram.is_some())
-}
-
 /// [`direct_light`] without the queue: for hit, for light, for each block of N points, the
 /// block's rays (`simd::shadow_rays`), their blockers (`simd::block_occluded`) and their Shade
 /// (`shade_registers`) in registers, added to the hit lane by lane in point order, as
@@ -186,7 +225,7 @@ fn fused<V: Lanes>(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch) -> u64 {
         let mut sum = (hits.direct.x[i], hits.direct.y[i], hits.direct.z[i]);
         for (li, light) in ctx.lights.iter().enumerate() {
             let Some(parallelogram) = light.parallelogram else {
-                unreachable!("`fuses` admits parallelogram lights only")
+                unreachable!("`ShadowPath::FusedSoft` admits parallelogram lights only")
             };
             let key = sample_key(ctx, rays, i, li);
             let end = light_end(&scene.lights[li], light.end_offset, &hit);
@@ -224,13 +263,6 @@ fn fused<V: Lanes>(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch) -> u64 {
         (hits.direct.x[i], hits.direct.y[i], hits.direct.z[i]) = sum;
     }
     cast
-}
-
-/// True when every shadow ray goes through [`fused_hard`]: one ray per (hit, light) to the
-/// light's centroid (hard shadows, or none), tested against the scene's few casters without a
-/// BVH.
-fn fuses_hard(ctx: &Context) -> bool {
-    !ctx.per_hit_shadows && ctx.accel.is_none() && !ctx.samples_lights()
 }
 
 /// [`direct_light`] without the queue for one ray per (hit, light): for each group of N hits,
