@@ -207,7 +207,7 @@ pub fn run(args: &BenchOptions, hooks: &Hooks) -> Result<Outcome> {
         let setup = Setup {
             scene: SceneId {
                 source: scene.source.clone(),
-                text_hash: record::text_hash(&bytes),
+                text_hash: crate::render::digest::hex(&bytes),
                 triangles: scene.triangles.len(),
                 spheres: scene.spheres.len(),
                 lights: scene.lights.len(),

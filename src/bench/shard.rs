@@ -208,7 +208,7 @@ pub fn part_name(shard: Shard) -> String {
 
 /// The checksum of a payload's bytes, as part files spell it.
 fn checksum(payload: &str) -> String {
-    format!("fnv1a64:{}", record::text_hash(payload.as_bytes()))
+    format!("fnv1a64:{}", crate::render::digest::hex(payload.as_bytes()))
 }
 
 /// Writes `part` to `dir`/[`part_name`] atomically, creating `dir`; returns the path.

@@ -428,14 +428,6 @@ pub fn save(path: &Path, record: &BenchRecord) -> Result<()> {
     })
 }
 
-/// FNV-1a (64-bit, the `fnv` crate), hex: a stable hash of a scene's text.
-pub fn text_hash(bytes: &[u8]) -> String {
-    use std::hash::Hasher;
-    let mut h = fnv::FnvHasher::default();
-    h.write(bytes);
-    format!("{:016x}", h.finish())
-}
-
 /// Seconds since the Unix epoch as RFC 3339 UTC (`2026-11-22T20:13:01Z`), by `humantime`.
 pub fn rfc3339_utc(unix_seconds: u64) -> String {
     let t = std::time::UNIX_EPOCH + std::time::Duration::from_secs(unix_seconds);
@@ -450,15 +442,6 @@ pub fn now_utc() -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// FNV-1a's published 64-bit test vectors (the empty string, "a", "foobar"), so that the
-    /// hashes in saved records keep their meaning.
-    #[test]
-    fn text_hash_is_fnv1a_64() {
-        assert_eq!(text_hash(b""), "cbf29ce484222325");
-        assert_eq!(text_hash(b"a"), "af63dc4c8601ec8c");
-        assert_eq!(text_hash(b"foobar"), "85944171f73967e8");
-    }
 
     #[test]
     fn timestamps() {

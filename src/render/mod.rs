@@ -23,5 +23,7 @@ pub mod engine;
 pub mod film;
 pub mod per_kind;
 
+#[cfg(feature = "textures")]
+pub mod digest;
 pub mod error;
 pub mod quote;

@@ -24,6 +24,7 @@
 //! the reference is rendered again. The least recently used entries are removed once the
 //! entries together exceed the size limit.
 
+use crate::render::digest;
 use crate::render::film::Film;
 use crate::render::settings::RenderSettings;
 use anyhow::{Context, Result, bail};
@@ -97,17 +98,6 @@ pub enum Lookup {
     Invalid(String),
 }
 
-/// FNV-1a, 64-bit (the `fnv` crate), continued from the state `h`.
-fn fnv(h: u64, bytes: &[u8]) -> u64 {
-    use std::hash::Hasher;
-    let mut hasher = fnv::FnvHasher::with_key(h);
-    hasher.write(bytes);
-    hasher.finish()
-}
-
-/// FNV-1a's starting state (the offset basis): `fnv::FnvHasher::default()`'s.
-const FNV_START: u64 = 0xcbf2_9ce4_8422_2325;
-
 /// The key of a reference: the cache format, the scene bytes that were parsed, every setting
 /// of the two renders and the running executable's bytes (so new renderer code makes a new
 /// entry; where the executable cannot be read, the version stands in for it). Each part is
@@ -117,10 +107,10 @@ pub fn key(scene_bytes: &[u8], settings: &[RenderSettings]) -> u64 {
     let code = std::env::current_exe()
         .and_then(std::fs::read)
         .unwrap_or_else(|_| env!("CARGO_PKG_VERSION").as_bytes().to_vec());
-    let mut h = fnv(FNV_START, &CACHE_FORMAT.to_le_bytes());
+    let mut h = digest::of(&CACHE_FORMAT.to_le_bytes());
     for part in [scene_bytes, &json, &code] {
-        h = fnv(h, &(part.len() as u64).to_le_bytes());
-        h = fnv(h, part);
+        h = digest::continued(h, &(part.len() as u64).to_le_bytes());
+        h = digest::continued(h, part);
     }
     h
 }
@@ -248,7 +238,7 @@ impl Cache {
                 .flat_map(|f| &f.pixels)
                 .flat_map(|c| c.to_array())
         };
-        let sum = floats().fold(FNV_START, |h, x| fnv(h, &x.to_le_bytes()));
+        let sum = floats().fold(digest::START, |h, x| digest::continued(h, &x.to_le_bytes()));
         // At once, not held for the run's commit: the study reads its references back, and
         // a reference rendered is worth keeping even if the study then fails.
         crate::output::write_output_now(&path, |w| {
@@ -375,7 +365,7 @@ fn read_entry(
     if payload.len() as u64 != expected - HEADER_LEN {
         return Err("it shrank while being read".into());
     }
-    if fnv(FNV_START, &payload) != u64_at(28) {
+    if digest::of(&payload) != u64_at(28) {
         return Err("checksum mismatch: the pixels are not the ones written".into());
     }
     let values: Vec<f32> = payload

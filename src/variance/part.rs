@@ -136,13 +136,6 @@ impl JobRecord {
     }
 }
 
-fn fnv(bytes: &[u8]) -> u64 {
-    use std::hash::Hasher;
-    let mut h = fnv::FnvHasher::default();
-    h.write(bytes);
-    h.finish()
-}
-
 /// The file name of `shard`'s part.
 pub fn file_name(shard: Shard) -> String {
     format!("shard-{}-of-{}.part", shard.index, shard.count)
@@ -155,7 +148,7 @@ pub fn write(path: &Path, part: &Part) -> Result<()> {
     crate::output::image_file::write_atomically(path, |w| {
         w.write_all(MAGIC)?;
         w.write_all(&(payload.len() as u64).to_le_bytes())?;
-        w.write_all(&fnv(&payload).to_le_bytes())?;
+        w.write_all(&crate::render::digest::of(&payload).to_le_bytes())?;
         w.write_all(&payload)?;
         Ok(())
     })
@@ -200,7 +193,7 @@ pub fn read(path: &Path) -> Result<Part> {
     if payload.len() as u64 != length {
         anyhow::bail!("{shown}: it shrank while being read");
     }
-    if fnv(&payload) != sum {
+    if crate::render::digest::of(&payload) != sum {
         anyhow::bail!(
             "{shown}: corrupt: its checksum does not match its contents; run its shard again"
         );

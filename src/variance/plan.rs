@@ -57,14 +57,6 @@ pub struct CaseIdentity {
     pub config: StudyConfig,
 }
 
-/// FNV-1a 64 of `bytes`, in hex.
-pub fn content_hash(bytes: &[u8]) -> String {
-    use std::hash::Hasher;
-    let mut h = fnv::FnvHasher::default();
-    h.write(bytes);
-    format!("{:016x}", h.finish())
-}
-
 /// The build as an identity names it.
 fn build() -> (String, Option<String>) {
     let info = crate::output::build_info::current();
@@ -81,7 +73,7 @@ fn build() -> (String, Option<String>) {
             .get_or_init(|| {
                 std::env::current_exe()
                     .and_then(std::fs::read)
-                    .map_or_else(|_| "unreadable".to_string(), |b| content_hash(&b))
+                    .map_or_else(|_| "unreadable".to_string(), |b| crate::render::digest::hex(&b))
             })
             .clone()
     });
@@ -100,7 +92,7 @@ pub fn identity(cases: &[Case], engine: &str) -> StudyIdentity {
             .iter()
             .map(|c| CaseIdentity {
                 name: c.name.clone(),
-                scene_hash: content_hash(&c.bytes),
+                scene_hash: crate::render::digest::hex(&c.bytes),
                 lights: c.scene.lights.len(),
                 config: c.config.clone(),
             })

@@ -117,14 +117,9 @@ pub(crate) fn read_texture(name: &str, path: &Path) -> Result<Texture, String> {
     decoder.read_image(&mut bytes).map_err(|e| {
         format!("expected {width}×{height} RGB texels at {shown}, found a truncated or malformed body: {e}")
     })?;
-    let digest = {
-        use std::hash::Hasher;
-        let mut h = fnv::FnvHasher::default();
-        h.write(&width.to_le_bytes());
-        h.write(&height.to_le_bytes());
-        h.write(&bytes);
-        h.finish()
-    };
+    let digest = [&width.to_le_bytes()[..], &height.to_le_bytes(), &bytes]
+        .into_iter()
+        .fold(crate::render::digest::START, crate::render::digest::continued);
     let name = name.to_string();
     let path = path.to_path_buf();
     let texture = if wide {
