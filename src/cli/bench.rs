@@ -385,7 +385,8 @@ fn output_plan(args: &BenchArgs, points: &[raywave::bench::sweep::Point]) -> Out
 /// Runs the bench or one of its subcommands; the exit code is 3
 /// (`raywave::bench::EXIT_REGRESSION`) when `--compare`, `--against` or `bench compare` finds
 /// a regression, 4 (`EXIT_UNDECIDED`) when `--until-decided` ends undecided at its budget,
-/// else 0. `matches` are bench's own.
+/// else 0 (with `--against`: not slower, or with `--verdict three-way` faster or within, or a
+/// fixed-rounds run left undecided). `matches` are bench's own.
 pub fn run(args: &BenchArgs, matches: Option<&ArgMatches>) -> Result<u8> {
     match &args.action {
         Some(BenchAction::Compare(c)) => {
