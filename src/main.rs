@@ -1,9 +1,11 @@
-//! The `raywave` command. `main` owns the exit code: 0 on success, 2 for a usage error (clap),
-//! 3 when `raywave bench --compare` finds a regression or `raywave diff --fail-above` a figure
-//! past its threshold, 4 when `raywave bench --until-decided` ends undecided at its budget, 1
-//! for anything else, printed once with its cause chain; 130 after SIGINT and 143 after
-//! SIGTERM (`output::write`; `raywave view` after answering the requests in hand). The command
-//! line itself is in `cli/`, one file per command.
+//! The `raywave` command. `main` owns the exit code: 0 on success (for `raywave bench --against`
+//! also "not slower by more than the threshold", and a fixed-rounds run left undecided), 2 for a
+//! usage error (clap), 3 when `raywave bench --compare` or `--against` finds a regression or
+//! `raywave diff --fail-above` a figure past its threshold, 4 when `raywave bench --against
+//! --until-decided` ends undecided at its budget (neither a regression nor shown not to be one,
+//! in either `--verdict` form), 1 for anything else, printed once with its cause chain; 130
+//! after SIGINT and 143 after SIGTERM (`output::write`; `raywave view` after answering the
+//! requests in hand). The command line itself is in `cli/`, one file per command.
 
 mod cli;
 
@@ -59,8 +61,9 @@ fn main() -> ExitCode {
         // Exit 130 after SIGINT and 143 after SIGTERM, once the requests in hand are answered.
         Command::View(args) => cli::view::run(&args),
         Command::TracePixel(args) => cli::trace_pixel::run(&args).map(|()| 0),
-        // Exit 3 when --compare finds a regression (raywave::bench::EXIT_REGRESSION), 4 when
-        // --until-decided ends undecided (EXIT_UNDECIDED).
+        // Exit 3 when --compare or --against finds a regression
+        // (raywave::bench::EXIT_REGRESSION), 4 when --until-decided ends undecided
+        // (EXIT_UNDECIDED).
         Command::Bench(args) => cli::bench::run(&args, matches.subcommand_matches("bench")),
         // Exit 3 when the figure is past --fail-above (raywave::diff::EXIT_FAILED).
         Command::Diff(args) => cli::diff::run(&args),

@@ -13,16 +13,25 @@
 //!               its render seconds from the JSON (parsing and file writing excluded)
 //!     ratio_r = this_r / other_r
 //! per engine: median ratio, 95% interval of the median from order statistics (no resampling),
-//!             verdict against the threshold t:
-//!     slower  when the whole interval lies above 1 + t   → exit 3
-//!     faster  when it lies below 1 / (1 + t)
-//!     within  when it lies inside [1 / (1 + t), 1 + t]
+//!             verdict against the threshold t (`Rule::judge`):
+//!     slower      when the whole interval lies above 1 + t          → exit 3 (both forms)
+//!     --verdict regression (the default), one-sided:
+//!     not slower  when the whole interval lies at or below 1 + t
+//!     --verdict three-way:
+//!     faster      when it lies below 1 / (1 + t)
+//!     within      when it lies inside [1 / (1 + t), 1 + t]
 //!     undecided otherwise (the interval straddles a boundary: more rounds narrow it)
 //! ```
 //!
 //! The interval is distribution-free (`statistics::median_interval_rank`): for n paired ratios
 //! sorted, the median lies between the k-th and the (n − k + 1)-th with probability ≥ 95%, k the
 //! largest with P(Binomial(n, ½) < k) ≤ 2.5%. It needs n ≥ 6.
+//!
+//! The default form asks a pull request's one question, "is this build slower than the other by
+//! more than t?", so a build faster than the other by about t is decided as soon as its
+//! interval's high end is at or below 1 + t; the three-way form must also place it on one side
+//! of 1 / (1 + t), and a build about t faster straddles that line for as long as the rounds go
+//! on. Both forms judge the same interval, and the regression boundary is the same test in both.
 //!
 //! With `--until-decided` the rounds go on until the verdict is decided, judged at planned
 //! looks with narrower levels (`sequential`), within `--max-rounds` and `--max-time`.
@@ -62,8 +71,8 @@ pub struct AbOptions {
     pub until_decided: Option<Budget>,
     /// Untimed rounds first.
     pub warmup: u32,
-    /// Regression threshold in percent.
-    pub threshold_pct: f64,
+    /// The threshold and which verdicts it may reach.
+    pub rule: Rule,
     /// Print only the verdict table.
     pub quiet: bool,
 }
@@ -89,12 +98,70 @@ pub struct EngineAb {
 pub enum Verdict {
     /// The whole interval lies above 1 + t: a regression.
     Slower,
-    /// The whole interval lies below 1 / (1 + t).
+    /// The whole interval lies at or below 1 + t: not a regression (the one-sided form).
+    NotSlower,
+    /// The whole interval lies below 1 / (1 + t) (the three-way form).
     Faster,
-    /// The whole interval lies within [1 / (1 + t), 1 + t]: no change as large as t.
+    /// The whole interval lies within [1 / (1 + t), 1 + t]: no change as large as t (the
+    /// three-way form).
     Within,
     /// The interval straddles a boundary: more rounds are needed to decide.
     Undecided,
+}
+
+impl Verdict {
+    /// The verdict in one or two words, as each look of `--until-decided` is reported.
+    pub fn word(self) -> &'static str {
+        match self {
+            Verdict::Slower => "slower",
+            Verdict::NotSlower => "not slower",
+            Verdict::Faster => "faster",
+            Verdict::Within => "within",
+            Verdict::Undecided => "undecided",
+        }
+    }
+}
+
+/// Which verdicts `--against` can reach (`--verdict`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum VerdictForm {
+    /// One-sided, a pull request's gate: slower by more than the threshold (a regression), or
+    /// not.
+    #[default]
+    Regression,
+    /// Slower, faster, or no change beyond the threshold.
+    ThreeWay,
+}
+
+/// The verdict rule of `--against`: a threshold and the form of the verdict.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Rule {
+    /// Regression threshold in percent.
+    pub threshold_pct: f64,
+    /// Which verdicts the rule can reach.
+    pub form: VerdictForm,
+}
+
+impl Rule {
+    /// The verdict of an interval [`low`, `high`] of the ratio this / other.
+    ///
+    /// "Slower by more than t" needs the whole interval above 1 + t (strictly: a low end at
+    /// 1 + t is no evidence of more than t); "not slower by more than t" needs it at or below
+    /// 1 + t, since a median of exactly 1 + t is not more than t. So the two one-sided calls
+    /// split the line at 1 + t between them, and an interval that holds the median sits on
+    /// the true side of it. An unbounded interval (too few rounds) reaches neither.
+    pub fn judge(self, low: f64, high: f64) -> Verdict {
+        let slow = 1.0 + self.threshold_pct / 100.0;
+        if low > slow {
+            return Verdict::Slower;
+        }
+        match self.form {
+            VerdictForm::Regression if high <= slow => Verdict::NotSlower,
+            VerdictForm::ThreeWay if high < 1.0 / slow => Verdict::Faster,
+            VerdictForm::ThreeWay if low >= 1.0 / slow && high <= slow => Verdict::Within,
+            _ => Verdict::Undecided,
+        }
+    }
 }
 
 /// A ratio's summary: median, interval, verdict.
@@ -120,12 +187,12 @@ impl EngineAb {
             .collect()
     }
 
-    /// The ratios' median, 95% interval and verdict at `threshold_pct`; with `--until-decided`,
-    /// the last look's instead (at its level and the threshold it was judged at), or an
-    /// unbounded undecided interval when no look was taken.
-    pub fn summary(&self, threshold_pct: f64) -> RatioSummary {
+    /// The ratios' median, 95% interval and verdict by `rule`; with `--until-decided`, the
+    /// last look's instead (at its level, judged by the same rule), or an unbounded undecided
+    /// interval when no look was taken.
+    pub fn summary(&self, rule: Rule) -> RatioSummary {
         match &self.sequential {
-            None => summarize(&self.ratios(), threshold_pct),
+            None => summarize(&self.ratios(), rule),
             Some(outcome) => outcome.looks.last().map_or(
                 RatioSummary {
                     median: median(&self.ratios()),
@@ -140,28 +207,18 @@ impl EngineAb {
 }
 
 /// Median, 95% interval and verdict of per-round ratios.
-pub fn summarize(ratios: &[f64], threshold_pct: f64) -> RatioSummary {
-    summarize_at(ratios, threshold_pct, 0.05)
+pub fn summarize(ratios: &[f64], rule: Rule) -> RatioSummary {
+    summarize_at(ratios, rule, 0.05)
 }
 
 /// Median, (1 − `alpha`) interval and verdict of per-round ratios.
-pub fn summarize_at(ratios: &[f64], threshold_pct: f64, alpha: f64) -> RatioSummary {
+pub fn summarize_at(ratios: &[f64], rule: Rule, alpha: f64) -> RatioSummary {
     let (median, low, high) = median_with_interval_at(ratios, alpha);
-    let slow = 1.0 + threshold_pct / 100.0;
-    let verdict = if low > slow {
-        Verdict::Slower
-    } else if high < 1.0 / slow {
-        Verdict::Faster
-    } else if low >= 1.0 / slow && high <= slow {
-        Verdict::Within
-    } else {
-        Verdict::Undecided
-    };
     RatioSummary {
         median,
         low,
         high,
-        verdict,
+        verdict: rule.judge(low, high),
     }
 }
 
@@ -356,10 +413,8 @@ pub fn run(options: &AbOptions, progress: &dyn Fn(u64, u64)) -> Result<Vec<Engin
             engine_start + left / (engines - i) as u32
         });
         let mut round = options.warmup;
-        let outcome = sequential::decide(
-            &LookPlan::new(budget.max_rounds),
-            options.threshold_pct,
-            &mut |at| {
+        let outcome =
+            sequential::decide(&LookPlan::new(budget.max_rounds), options.rule, &mut |at| {
                 if let Some(end) = deadline
                     && !reachable(engine_start, round, at.next_look - at.rounds, end)
                 {
@@ -370,8 +425,7 @@ pub fn run(options: &AbOptions, progress: &dyn Fn(u64, u64)) -> Result<Vec<Engin
                 result.this.push(mine);
                 result.other.push(theirs);
                 Ok(Some(mine / theirs))
-            },
-        )?;
+            })?;
         result.sequential = Some(outcome);
         results.push(result);
     }
@@ -396,11 +450,12 @@ fn reachable(since: Instant, done: u32, rounds: u32, end: Instant) -> bool {
 }
 
 /// The process exit code: [`EXIT_REGRESSION`] when some engine's verdict is a regression, else
-/// [`EXIT_UNDECIDED`] when `--until-decided` left some engine undecided at its budget, else 0.
+/// [`EXIT_UNDECIDED`] when `--until-decided` left some engine undecided at its budget, else 0
+/// (a fixed-rounds run that ends undecided exits 0: a regression needs evidence).
 pub fn exit_code(options: &AbOptions, results: &[EngineAb]) -> u8 {
     let verdicts: Vec<Verdict> = results
         .iter()
-        .map(|r| r.summary(options.threshold_pct).verdict)
+        .map(|r| r.summary(options.rule).verdict)
         .collect();
     if verdicts.contains(&Verdict::Slower) {
         EXIT_REGRESSION
@@ -415,6 +470,22 @@ pub fn exit_code(options: &AbOptions, results: &[EngineAb]) -> u8 {
 mod tests {
     use super::*;
 
+    /// The default rule of `--against`, one-sided, at `threshold_pct`.
+    fn gate(threshold_pct: f64) -> Rule {
+        Rule {
+            threshold_pct,
+            form: VerdictForm::Regression,
+        }
+    }
+
+    /// `--verdict three-way` at `threshold_pct`.
+    fn three_way(threshold_pct: f64) -> Rule {
+        Rule {
+            threshold_pct,
+            form: VerdictForm::ThreeWay,
+        }
+    }
+
     #[test]
     fn verdicts_follow_the_whole_interval() {
         let around = |centre: f64, spread: f64| -> Vec<f64> {
@@ -422,38 +493,66 @@ mod tests {
                 .map(|i| centre + spread * (i as f64 / 19.0 - 0.5))
                 .collect()
         };
-        assert_eq!(summarize(&around(1.10, 0.02), 5.0).verdict, Verdict::Slower);
-        assert_eq!(summarize(&around(0.90, 0.02), 5.0).verdict, Verdict::Faster);
-        assert_eq!(summarize(&around(1.00, 0.02), 5.0).verdict, Verdict::Within);
-        // A 5% slowdown inside a wide spread is not called a regression.
-        assert_eq!(
-            summarize(&around(1.05, 0.30), 5.0).verdict,
-            Verdict::Undecided
-        );
+        let verdicts = |ratios: &[f64]| {
+            (
+                summarize(ratios, gate(5.0)).verdict,
+                summarize(ratios, three_way(5.0)).verdict,
+            )
+        };
+        use Verdict::*;
+        assert_eq!(verdicts(&around(1.10, 0.02)), (Slower, Slower));
+        assert_eq!(verdicts(&around(0.90, 0.02)), (NotSlower, Faster));
+        assert_eq!(verdicts(&around(1.00, 0.02)), (NotSlower, Within));
+        // About 5% faster, its interval across 1/1.05: undecided for the three-way form only.
+        assert_eq!(verdicts(&around(0.95, 0.04)), (NotSlower, Undecided));
+        // A 5% slowdown inside a wide spread is not called a regression, nor cleared.
+        assert_eq!(verdicts(&around(1.05, 0.30)), (Undecided, Undecided));
         // Too few rounds give an unbounded interval: never a verdict.
-        assert_eq!(summarize(&[2.0; 5], 5.0).verdict, Verdict::Undecided);
-        let s = summarize(&around(1.10, 0.02), 5.0);
+        assert_eq!(verdicts(&[2.0; 5]), (Undecided, Undecided));
+        assert_eq!(verdicts(&[0.5; 5]), (Undecided, Undecided));
+        let s = summarize(&around(1.10, 0.02), gate(5.0));
         assert!(s.low <= s.median && s.median <= s.high);
     }
 
     /// The interval's ends are the sign test's order statistics, known by hand: for the 20
     /// ratios 1 + i/64 (i = 0..20, given in reverse), rank 6, so the 6th and the 15th smallest,
-    /// 1 + 5/64 and 1 + 14/64, around the median 1 + 9.5/64 (all exact in binary). A threshold
-    /// whose bound equals the low end does not call a slowdown; one just below it does.
+    /// 1 + 5/64 and 1 + 14/64, around the median 1 + 9.5/64 (all exact in binary, and so are
+    /// the thresholds below: 1 + 7.8125/100 and 1 + 21.875/100 are those ends to the bit). A
+    /// threshold whose bound equals the low end does not call a slowdown; one just below it
+    /// does. A threshold whose bound equals the high end clears the build ("not more than
+    /// t"); one just below it leaves it undecided.
     #[test]
     fn the_interval_ends_are_the_sign_tests_order_statistics() {
         let ratios: Vec<f64> = (0..20).rev().map(|i| 1.0 + i as f64 / 64.0).collect();
-        let s = summarize(&ratios, 5.0);
+        let s = summarize(&ratios, gate(5.0));
         assert_eq!(
             (s.low, s.median, s.high),
             (1.0 + 5.0 / 64.0, 1.0 + 9.5 / 64.0, 1.0 + 14.0 / 64.0)
         );
         assert_eq!(s.verdict, Verdict::Slower);
         let at_low_end = 100.0 * 5.0 / 64.0;
-        assert_ne!(summarize(&ratios, at_low_end).verdict, Verdict::Slower);
+        assert_eq!(1.0 + at_low_end / 100.0, s.low);
+        for rule in [gate(at_low_end), three_way(at_low_end)] {
+            assert_eq!(summarize(&ratios, rule).verdict, Verdict::Undecided);
+            let below = Rule {
+                threshold_pct: at_low_end * 0.999,
+                ..rule
+            };
+            assert_eq!(summarize(&ratios, below).verdict, Verdict::Slower);
+        }
+        let at_high_end = 100.0 * 14.0 / 64.0;
+        assert_eq!(1.0 + at_high_end / 100.0, s.high);
         assert_eq!(
-            summarize(&ratios, at_low_end * 0.999).verdict,
-            Verdict::Slower
+            summarize(&ratios, gate(at_high_end)).verdict,
+            Verdict::NotSlower
+        );
+        assert_eq!(
+            summarize(&ratios, gate(at_high_end * 0.999)).verdict,
+            Verdict::Undecided
+        );
+        assert_eq!(
+            summarize(&ratios, three_way(at_high_end)).verdict,
+            Verdict::Within
         );
     }
 }

@@ -1,7 +1,7 @@
 //! The text of `raywave bench --against`: the verdict table, and with `--until-decided` the
 //! plan of looks and each engine's rounds and looks.
 
-use super::ab::{AbOptions, EngineAb, Verdict};
+use super::ab::{AbOptions, EngineAb, Verdict, VerdictForm};
 use super::sequential::{self, Budget, LookPlan, Stop};
 use crate::output::statistics::median;
 use std::time::Duration;
@@ -13,7 +13,11 @@ fn duration_text(d: Duration) -> String {
 
 /// The verdict table.
 pub fn report(options: &AbOptions, results: &[EngineAb]) -> String {
-    let t = options.threshold_pct;
+    let t = options.rule.threshold_pct;
+    let form = match options.rule.form {
+        VerdictForm::Regression => "one-sided: a regression or not",
+        VerdictForm::ThreeWay => "three-way: slower, faster or no change",
+    };
     let (rounds, plan, level) = match options.until_decided {
         None => (
             format!("{} rounds", options.rounds),
@@ -44,7 +48,8 @@ pub fn report(options: &AbOptions, results: &[EngineAb]) -> String {
         }
     };
     let mut out = format!(
-        "this build / {} · {rounds} after {} warm-up, alternating · threshold {t}%{plan}\n\
+        "this build / {} · {rounds} after {} warm-up, alternating · threshold {t}%, \
+         {form}{plan}\n\
          {:<10} {:>25} {:>25} {:>8} {:>18}  verdict\n",
         options.other.display(),
         options.warmup,
@@ -55,7 +60,7 @@ pub fn report(options: &AbOptions, results: &[EngineAb]) -> String {
         level,
     );
     for r in results {
-        let s = r.summary(t);
+        let s = r.summary(options.rule);
         let spread = |xs: &[f64]| {
             if xs.is_empty() {
                 return "no rounds".to_string();
@@ -69,6 +74,7 @@ pub fn report(options: &AbOptions, results: &[EngineAb]) -> String {
         };
         let verdict = match (s.verdict, &r.sequential) {
             (Verdict::Slower, _) => format!("slower by more than {t}%: a regression"),
+            (Verdict::NotSlower, _) => format!("not slower by more than {t}%: not a regression"),
             (Verdict::Faster, _) => format!("faster by more than {t}%"),
             (Verdict::Within, _) => format!("no change beyond {t}%"),
             (Verdict::Undecided, None) => {
@@ -110,15 +116,7 @@ fn looks_line(outcome: &sequential::Outcome, budget: Budget) -> String {
     let looks: Vec<String> = outcome
         .looks
         .iter()
-        .map(|l| {
-            let v = match l.summary.verdict {
-                Verdict::Slower => "slower",
-                Verdict::Faster => "faster",
-                Verdict::Within => "within",
-                Verdict::Undecided => "undecided",
-            };
-            format!("{} ({v})", l.rounds)
-        })
+        .map(|l| format!("{} ({})", l.rounds, l.summary.verdict.word()))
         .collect();
     let looks = if looks.is_empty() {
         "no look taken".to_string()

@@ -43,11 +43,13 @@ use std::path::PathBuf;
 
 pub use report::report;
 
-/// Exit code of `raywave bench --compare` when a headline figure regressed.
+/// Exit code of `raywave bench --compare` when a headline figure regressed, and of `--against`
+/// when an engine's verdict is a regression.
 pub const EXIT_REGRESSION: u8 = 3;
 
 /// Exit code of `raywave bench --against OTHER --until-decided` when no engine regressed but
-/// one was still undecided at the budget (`--max-rounds` or `--max-time`).
+/// one was still undecided at the budget (`--max-rounds` or `--max-time`), in either
+/// `--verdict` form.
 pub const EXIT_UNDECIDED: u8 = 4;
 
 /// Default `--threshold`, in percent: see docs/BENCHMARKING.md for the noise it is chosen from.

@@ -75,13 +75,14 @@ pub struct BenchArgs {
     pub dir: PathBuf,
     /// Regression threshold in percent: with --compare, a headline figure whose median fell
     /// by more and whose 95% interval lies wholly below the record's regressed; with
-    /// --against, a ratio whose whole 95% interval lies above 1 + PCT% [default: 40; 5 with
-    /// --against].
+    /// --against, a ratio whose whole 95% interval lies above 1 + PCT% (and, one-sided, not a
+    /// regression when it lies wholly at or below) [default: 40; 5 with --against].
     #[arg(long, value_name = "PCT", value_parser = float("a percentage between 0 and 1000", |x: f64| (0.0..1000.0).contains(&x)))]
     pub threshold: Option<f64>,
     /// Time this build against another raywave binary on the same flags: the two alternate,
     /// round after round, and each engine's time ratio (this / OTHER) gets a median and a 95%
-    /// interval from the paired rounds; exit 3 when the whole interval lies above the threshold.
+    /// interval from the paired rounds; exit 3 when the whole interval lies above the threshold
+    /// (a regression), "not slower" when it lies wholly at or below it.
     #[arg(long, value_name = "OTHER", conflicts_with_all = ["save", "compare", "json", "runs",
           "export_json", "export_csv", "export_markdown"])]
     pub against: Option<PathBuf>,
@@ -90,12 +91,17 @@ pub struct BenchArgs {
           value_parser = clap::value_parser!(u32).range(i64::from(MIN_ROUNDS)..=10_000))]
     pub rounds: u32,
     /// With --against: instead of --rounds, keep alternating until each engine's verdict is
-    /// decided, judged at planned looks (by default after 9, 14, 21, ..., 200 rounds) with
-    /// each look's interval widened so that the looks together keep the 5% error of one 95%
-    /// interval; exit 3 as above, 0 when decided otherwise, 4 (undecided at the budget) when
-    /// --max-rounds or --max-time runs out first.
+    /// decided (by default: a regression, or not), judged at planned looks (by default after
+    /// 9, 14, 21, ..., 200 rounds) with each look's interval widened so that the looks together
+    /// keep the 5% error of one 95% interval; exit 3 as above, 0 when decided otherwise, 4
+    /// (undecided at the budget) when --max-rounds or --max-time runs out first.
     #[arg(long, requires = "against", conflicts_with = "rounds")]
     pub until_decided: bool,
+    /// The verdicts of --against: `regression` asks only whether this build is slower than
+    /// OTHER by more than --threshold; `three-way` also tells faster from no change, and with
+    /// --until-decided goes on until it can (a build about --threshold faster may never).
+    #[arg(long, value_enum, default_value = "regression", requires = "against")]
+    pub verdict: super::values::VerdictArg,
     /// The last look's rounds with --until-decided, per engine.
     #[arg(long, value_name = "N", default_value_t = sequential::DEFAULT_MAX_ROUNDS,
           requires = "until_decided",
@@ -384,7 +390,8 @@ fn output_plan(args: &BenchArgs, points: &[raywave::bench::sweep::Point]) -> Out
 /// Runs the bench or one of its subcommands; the exit code is 3
 /// (`raywave::bench::EXIT_REGRESSION`) when `--compare`, `--against` or `bench compare` finds
 /// a regression, 4 (`EXIT_UNDECIDED`) when `--until-decided` ends undecided at its budget,
-/// else 0. `matches` are bench's own.
+/// else 0 (with `--against`: not slower, or with `--verdict three-way` faster or within, or a
+/// fixed-rounds run left undecided). `matches` are bench's own.
 pub fn run(args: &BenchArgs, matches: Option<&ArgMatches>) -> Result<u8> {
     match &args.action {
         Some(BenchAction::Compare(c)) => {
@@ -497,7 +504,10 @@ pub fn run(args: &BenchArgs, matches: Option<&ArgMatches>) -> Result<u8> {
             max_time: args.max_time,
         }),
         warmup: args.warmup,
-        threshold_pct: args.threshold.unwrap_or(AB_THRESHOLD_PCT),
+        rule: ab::Rule {
+            threshold_pct: args.threshold.unwrap_or(AB_THRESHOLD_PCT),
+            form: args.verdict.into(),
+        },
         quiet: args.quiet,
     };
     let bar = raywave::output::terminal::progress_bar(

@@ -43,7 +43,8 @@ pub enum Command {
     /// Compare light samplers: MSE, bias, variance and slopes against a converged reference.
     Variance(variance::VarianceArgs),
     /// Time both engines on a scene (rays/s per kind and stage); save and compare records
-    /// (exit 3 when a figure regresses past --threshold; 4 when --until-decided runs out).
+    /// (exit 3 when a figure regresses past --threshold; 4 when --until-decided runs out
+    /// undecided).
     Bench(bench::BenchArgs),
     /// The lab's debug window in the browser: the render, coarse to fine, the scene in 3D, a
     /// pixel's ray tree, two samplers side by side (a local server on 127.0.0.1).

@@ -7,6 +7,7 @@
 //! none for floats, so [`float`] is clap's string parser mapped through a check.
 
 use clap::builder::{StringValueParser, TypedValueParser};
+use raywave::bench::ab::VerdictForm;
 use raywave::render::engine::Engine;
 use raywave::render::film::ToneMap;
 use raywave::render::sampling::LightSampler;
@@ -71,6 +72,18 @@ mirror! {
         Wavefront,
         /// The scalar recursive renderer, one ray at a time: the whole-image twin.
         Reference,
+    }
+}
+
+mirror! {
+    /// Which verdicts `bench --against` can reach.
+    VerdictArg => VerdictForm {
+        /// One-sided, a pull request's gate: slower by more than --threshold (a regression,
+        /// exit 3), or not slower by more than it (exit 0).
+        Regression,
+        /// Slower by more than --threshold (exit 3), faster by more than it, or no change
+        /// beyond it (exit 0).
+        ThreeWay,
     }
 }
 

@@ -1,7 +1,8 @@
 //! `raywave bench --against OTHER`: the A/B mode's verdicts, end to end. The other build is a
 //! stand-in script that reports a fixed render time, so each verdict is certain: against a
 //! build that claims a microsecond per frame this build must be called a regression (exit 3),
-//! against one that claims a thousand seconds it must not.
+//! against one that claims a thousand seconds it must not (exit 0): "not slower" by default,
+//! "faster" with `--verdict three-way`.
 
 use crate::common;
 
@@ -43,26 +44,29 @@ fn real_rays(dir: &Path) -> String {
     json["rays"].to_string()
 }
 
+/// `bench --against OTHER` in 6 rounds at 8×8, wavefront only, no warm-up, plus `extra`.
+fn against_with(dir: &Path, other: &Path, extra: &[&str]) -> std::process::Output {
+    let mut args = vec![
+        "bench",
+        "--against",
+        other.to_str().unwrap(),
+        "--size",
+        "8",
+        "8",
+        "--rounds",
+        "6",
+        "--warmup",
+        "0",
+        "--engine",
+        "wavefront",
+        "-q",
+    ];
+    args.extend(extra);
+    raywave(dir, &args)
+}
+
 fn against(dir: &Path, other: &Path) -> std::process::Output {
-    let other = other.to_str().unwrap();
-    raywave(
-        dir,
-        &[
-            "bench",
-            "--against",
-            other,
-            "--size",
-            "8",
-            "8",
-            "--rounds",
-            "6",
-            "--warmup",
-            "0",
-            "--engine",
-            "wavefront",
-            "-q",
-        ],
-    )
+    against_with(dir, other, &[])
 }
 
 #[test]
@@ -72,20 +76,46 @@ fn a_build_claiming_a_microsecond_makes_this_one_a_regression() {
     let out = against(dir.path(), &fake_build(dir.path(), 1e-6, &rays));
     assert_eq!(out.status.code(), Some(3), "{}", stderr(&out));
     let table = stdout(&out);
-    assert!(table.contains("a regression"), "{table}");
+    assert!(
+        table.contains("slower by more than 5%: a regression"),
+        "{table}"
+    );
+    assert!(table.contains("one-sided: a regression or not"), "{table}");
     assert!(!table.contains("different work"), "{table}");
+    // The three-way form calls a regression by the same rule.
+    let out = against_with(
+        dir.path(),
+        &fake_build(dir.path(), 1e-6, &rays),
+        &["--verdict", "three-way"],
+    );
+    assert_eq!(out.status.code(), Some(3), "{}", stderr(&out));
+    assert!(
+        stdout(&out).contains("slower by more than 5%: a regression"),
+        "{}",
+        stdout(&out)
+    );
 }
 
 #[test]
-fn a_build_claiming_a_thousand_seconds_makes_this_one_faster() {
+fn a_build_claiming_a_thousand_seconds_makes_this_one_not_slower_or_faster() {
     let dir = tempfile::tempdir().unwrap();
     let rays = real_rays(dir.path());
-    let out = against(dir.path(), &fake_build(dir.path(), 1000.0, &rays));
+    let slow = fake_build(dir.path(), 1000.0, &rays);
+    let out = against(dir.path(), &slow);
     assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let table = stdout(&out);
     assert!(
-        stdout(&out).contains("faster by more than 5%"),
-        "{}",
-        stdout(&out)
+        table.contains("not slower by more than 5%: not a regression"),
+        "{table}"
+    );
+    assert!(!table.contains("faster"), "{table}");
+    let out = against_with(dir.path(), &slow, &["--verdict", "three-way"]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let table = stdout(&out);
+    assert!(table.contains("faster by more than 5%"), "{table}");
+    assert!(
+        table.contains("three-way: slower, faster or no change"),
+        "{table}"
     );
 }
 
@@ -174,17 +204,28 @@ fn until_decided_stops_at_the_first_look_that_decides() {
     let out = until_decided(dir.path(), &fake_build(dir.path(), 1e-6, &rays), &[]);
     assert_eq!(out.status.code(), Some(3), "{}", stderr(&out));
     let table = stdout(&out);
-    assert!(table.contains("a regression"), "{table}");
+    assert!(
+        table.contains("slower by more than 5%: a regression"),
+        "{table}"
+    );
     assert!(table.contains("looks at 9 (slower); decided"), "{table}");
     assert_eq!(rounds_used(&table), 9, "{table}");
-    // Faster is decided too: exit 0.
-    let out = until_decided(dir.path(), &fake_build(dir.path(), 1000.0, &rays), &[]);
+    // Not slower is decided at the first look too: exit 0.
+    let slow = fake_build(dir.path(), 1000.0, &rays);
+    let out = until_decided(dir.path(), &slow, &[]);
     assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let table = stdout(&out);
+    assert!(table.contains("not a regression"), "{table}");
     assert!(
-        stdout(&out).contains("faster by more than 5%"),
-        "{}",
-        stdout(&out)
+        table.contains("looks at 9 (not slower); decided"),
+        "{table}"
     );
+    // The three-way form: faster, at the first look.
+    let out = until_decided(dir.path(), &slow, &["--verdict", "three-way"]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let table = stdout(&out);
+    assert!(table.contains("faster by more than 5%"), "{table}");
+    assert!(table.contains("looks at 9 (faster); decided"), "{table}");
 }
 
 #[test]
@@ -192,12 +233,18 @@ fn until_decided_ends_undecided_at_the_budget_with_exit_4() {
     let dir = tempfile::tempdir().unwrap();
     let rays = real_rays(dir.path());
     let seesaw = seesaw_build(dir.path(), &rays);
-    let out = until_decided(dir.path(), &seesaw, &["--max-rounds", "14"]);
-    assert_eq!(out.status.code(), Some(4), "{}", stderr(&out));
-    let table = stdout(&out);
-    assert!(table.contains("undecided at the budget"), "{table}");
-    assert!(table.contains("--max-rounds 14 reached"), "{table}");
-    assert_eq!(rounds_used(&table), 14, "{table}");
+    for form in ["regression", "three-way"] {
+        let out = until_decided(
+            dir.path(),
+            &seesaw,
+            &["--max-rounds", "14", "--verdict", form],
+        );
+        assert_eq!(out.status.code(), Some(4), "{form}: {}", stderr(&out));
+        let table = stdout(&out);
+        assert!(table.contains("undecided at the budget"), "{table}");
+        assert!(table.contains("--max-rounds 14 reached"), "{table}");
+        assert_eq!(rounds_used(&table), 14, "{table}");
+    }
     // Out of time long before 10 000 rounds: stopped by --max-time, still exit 4.
     let started = std::time::Instant::now();
     let out = until_decided(
@@ -225,7 +272,7 @@ fn until_decided_against_itself_reports_its_rounds_and_a_documented_code() {
     let this = Path::new(env!("CARGO_BIN_EXE_raywave"));
     let out = until_decided(dir.path(), this, &["--max-rounds", "9"]);
     let table = stdout(&out);
-    let expected = if table.contains("a regression") {
+    let expected = if table.contains("slower by more than 5%: a regression") {
         3
     } else if table.contains("undecided at the budget") {
         4
@@ -252,6 +299,11 @@ fn until_decided_flags_are_checked() {
         (&["--until-decided"], "--against"),
         (&["--max-rounds", "50"], "--until-decided"),
         (&["--max-time", "10m"], "--until-decided"),
+        (&["--verdict", "three-way"], "--against"),
+        (
+            &["--against", this, "--verdict", "sideways"],
+            "possible values: regression, three-way",
+        ),
         (
             &["--against", this, "--until-decided", "--rounds", "30"],
             "--rounds",

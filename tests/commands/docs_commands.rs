@@ -373,7 +373,8 @@ fn the_checker_refuses_what_ci_does_not_run() {
 
 /// docs/examples/bench-regression.yml, the pull-request gate BENCHMARKING.md shows: valid
 /// YAML (when python3 has PyYAML), run on pull requests, building the base and the head and
-/// timing one against the other, failing on exit 3 and only warning on 4; its export step
+/// timing one against the other until decided, one-sided (a regression or not), failing on
+/// exit 3 and only warning on 4; its export step
 /// runs here with this build (shortened), so its flags cannot rot.
 #[test]
 fn the_ci_workflow_example_gates_on_a_regression_and_its_exports_run() {
@@ -412,6 +413,10 @@ fn the_ci_workflow_example_gates_on_a_regression_and_its_exports_run() {
             let gate = runs.iter().find(|r| r.contains("--against")).unwrap();
             assert!(gate.contains("3) ") && gate.contains("exit 3"), "{gate}");
             assert!(gate.contains("4) ") && gate.contains("::warning"), "{gate}");
+            assert!(
+                gate.contains("--until-decided") && gate.contains("--verdict regression"),
+                "{gate}"
+            );
         }
         _ => println!("SKIPPED the YAML check: no python3 with PyYAML"),
     }
