@@ -1,9 +1,12 @@
 //! Gates: checks on the code itself rather than on what it renders. The instruction-count gate
 //! (`icount`: callgrind's counts of the hot kernels against committed baselines; its child
 //! workloads are the `raywave-icount-child` example, `icount_child.rs`), the layering rule
-//! (`layering`: only the lane layer names `wide`) and the module map (`module_map`:
-//! docs/ARCHITECTURE.md's tree is `src/`).
+//! (`layering`: only the lane layer names `wide`), the module map (`module_map`:
+//! docs/ARCHITECTURE.md's tree is `src/`) and the docs' budgets (`doc_budgets`: README.md,
+//! docs/PERFORMANCE.md and docs/BENCHMARKING.md within their line counts, docs/TESTING.md
+//! without a diary of CI timings).
 
+mod doc_budgets;
 mod icount;
 mod layering;
 mod module_map;
