@@ -485,8 +485,13 @@ pub fn run(args: &BenchArgs, matches: Option<&ArgMatches>) -> Result<u8> {
         .into());
     }
     // The other build reads the scene itself; its textures are held against the outputs here.
-    if let Some(scene) = options.scene.as_ref().filter(|s| !raywave::output::is_stdio(s)) {
-        let scene = raywave::render::scene::load_scene(Some(scene), &options.image.parse_options())?;
+    if let Some(scene) = options
+        .scene
+        .as_ref()
+        .filter(|s| !raywave::output::is_stdio(s))
+    {
+        let scene =
+            raywave::render::scene::load_scene(Some(scene), &options.image.parse_options())?;
         options.plan.check_scene_files("SCENE", &scene.scene)?;
     }
     let options = AbOptions {

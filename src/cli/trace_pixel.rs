@@ -85,7 +85,8 @@ pub fn run(args: &TracePixelArgs) -> Result<()> {
     plan.check()?;
     plan.refuse_binary_on_terminal(&["--png"])?;
 
-    let (scene, effective) = scene_and_settings(args.scene.as_deref(), &args.image, &args.seed, &plan)?;
+    let (scene, effective) =
+        scene_and_settings(args.scene.as_deref(), &args.image, &args.seed, &plan)?;
     let settings = effective.settings;
     let mut tree =
         trace_pixel(&scene, &settings, args.x, args.y).map_err(|e| UsageError(e.to_string()))?;

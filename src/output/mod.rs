@@ -199,7 +199,11 @@ impl OutputPlan {
     /// Refuses an output that is one of the files `scene` read besides itself: its textures,
     /// which are known only once it is parsed (the plan's other checks come before the parse).
     /// `label` names the scene as the user gave it (`SCENE`, `--scene`).
-    pub fn check_scene_files(&self, label: &str, scene: &crate::render::scene::Scene) -> Result<()> {
+    pub fn check_scene_files(
+        &self,
+        label: &str,
+        scene: &crate::render::scene::Scene,
+    ) -> Result<()> {
         let plan = scene.textures.iter().fold(
             OutputPlan {
                 inputs: Vec::new(),

@@ -240,8 +240,8 @@ pub fn write_output(
             });
         }
         Target::Stdout | Target::Special(_) => {
-            let mut bytes = tempfile::tempfile()
-                .context("cannot create a temporary file to hold an output")?;
+            let mut bytes =
+                tempfile::tempfile().context("cannot create a temporary file to hold an output")?;
             write_direct(&mut bytes, &path.display().to_string(), fill)?;
             outputs().held.push(Held::Direct {
                 bytes,

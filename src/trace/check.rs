@@ -6,6 +6,7 @@
 //! in: every lane is bit-equal to the scalar twins and each pixel is summed in sample order).
 
 use super::tree::{PixelCheck, RayCountCheck, RayTree, Segment, SegmentKind};
+use crate::render::engine::Engine;
 use crate::render::per_kind::RayCounts;
 use crate::render::reference::Reference;
 use crate::render::scene::Scene;
@@ -20,39 +21,21 @@ use glam::Vec3;
 /// about 80 ulps at 1.
 pub(crate) const TOLERANCE: f64 = 1e-5;
 
-/// Which renderer computes a pixel.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum PixelEngine {
-    /// `Reference::pixel`.
-    Reference,
-    /// `Wavefront::render_tile` on a one-pixel tile.
-    Wavefront,
-}
-
-/// Pixel `index` (row-major) as `engine` renders it, in linear RGB.
-pub fn render_pixel(
-    engine: PixelEngine,
-    scene: &Scene,
-    settings: &RenderSettings,
-    index: u32,
-) -> Vec3 {
-    render_pixel_counted(engine, scene, settings, index).0
-}
-
-/// Pixel `index` as `engine` renders it, and the rays the engine counts for it.
+/// Pixel `index` (row-major) as `engine` renders it, in linear RGB (`Reference::pixel`, or
+/// `Wavefront::render_tile` on a one-pixel tile), and the rays the engine counts for it.
 pub fn render_pixel_counted(
-    engine: PixelEngine,
+    engine: Engine,
     scene: &Scene,
     settings: &RenderSettings,
     index: u32,
 ) -> (Vec3, RayCounts) {
     match engine {
-        PixelEngine::Reference => {
+        Engine::Reference => {
             let mut counts = RayCounts::default();
             let colour = Reference::new(scene, settings).pixel(index, &mut counts, &mut ());
             (colour, counts)
         }
-        PixelEngine::Wavefront => {
+        Engine::Wavefront => {
             let batch = settings.aa_samples.max(1) as usize;
             let wavefront = Wavefront::new(scene, settings, batch);
             let mut out = [Vec3::ZERO];
@@ -96,9 +79,9 @@ pub fn check_pixel(scene: &Scene, settings: &RenderSettings, tree: &RayTree) -> 
     let index = tree.pixel.index;
     let sum = contribution_sum(&tree.segments);
     let (reference, reference_rays) =
-        render_pixel_counted(PixelEngine::Reference, scene, settings, index);
+        render_pixel_counted(Engine::Reference, scene, settings, index);
     let (wavefront, wavefront_rays) =
-        render_pixel_counted(PixelEngine::Wavefront, scene, settings, index);
+        render_pixel_counted(Engine::Wavefront, scene, settings, index);
     let rays = RayCountCheck {
         tree: tree_counts(tree),
         reference: reference_rays,

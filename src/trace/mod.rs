@@ -25,9 +25,7 @@ pub(crate) mod tracer;
 pub(crate) mod tree;
 pub mod view;
 
-pub use check::{
-    PixelEngine, check_pixel, contribution_sum, render_pixel, render_pixel_counted, tree_counts,
-};
+pub use check::{check_pixel, contribution_sum, render_pixel_counted, tree_counts};
 pub use scene_view::{
     LightView, MaterialView, SceneGeometry, SphereView, TriangleView, scene_bounds, scene_geometry,
 };

@@ -71,9 +71,10 @@ fn build() -> (String, Option<String>) {
     let executable = (info.dirty != Some(false)).then(|| {
         EXECUTABLE
             .get_or_init(|| {
-                std::env::current_exe()
-                    .and_then(std::fs::read)
-                    .map_or_else(|_| "unreadable".to_string(), |b| crate::render::digest::hex(&b))
+                std::env::current_exe().and_then(std::fs::read).map_or_else(
+                    |_| "unreadable".to_string(),
+                    |b| crate::render::digest::hex(&b),
+                )
             })
             .clone()
     });

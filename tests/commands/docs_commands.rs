@@ -243,9 +243,7 @@ fn readme_setup(readme: &str) -> Vec<String> {
     let section = &readme[readme
         .find("\n## Set up")
         .expect("README.md has a \"## Set up\" heading")..];
-    let mut lines = section
-        .lines()
-        .skip_while(|l| !l.starts_with("```sh"));
+    let mut lines = section.lines().skip_while(|l| !l.starts_with("```sh"));
     assert!(
         lines.next().is_some(),
         "README.md's \"## Set up\" has a ```sh block"

@@ -327,7 +327,11 @@ fn merge_refuses_parts_that_are_missing_repeated_cut_short_corrupt_or_foreign() 
     );
     // The output directory is the parts' own.
     let out = raywave(d, &["variance", "merge", "parts", "--out", "parts"]);
-    assert_eq!(out.status.code(), Some(2), "an output that is an input is a usage error");
+    assert_eq!(
+        out.status.code(),
+        Some(2),
+        "an output that is an input is a usage error"
+    );
     assert!(
         stderr(&out).contains("--out parts is one of the merge's inputs"),
         "{}",
@@ -338,7 +342,11 @@ fn merge_refuses_parts_that_are_missing_repeated_cut_short_corrupt_or_foreign() 
         d,
         &["variance", "merge", &p(0), &p(1), &p(2), "--out", "parts"],
     );
-    assert_eq!(out.status.code(), Some(2), "an output that is an input is a usage error");
+    assert_eq!(
+        out.status.code(),
+        Some(2),
+        "an output that is an input is a usage error"
+    );
     assert!(
         stderr(&out).contains("--out parts holds the part parts/shard-0-of-3.part"),
         "{}",

@@ -241,9 +241,9 @@ fn sixteen_and_eight_lanes_give_the_same_bytes_on_every_scene() {
 /// is among those held.
 #[test]
 fn every_shadow_path_gives_the_per_hit_path_s_bytes() {
-    use raywave::render::wavefront::shadow::ShadowPath;
     use raywave::render::settings::LightModel;
     use raywave::render::wavefront::lanes::LaneWidth;
+    use raywave::render::wavefront::shadow::ShadowPath;
     let soft = |n, sampler, light_model| RenderSettings {
         shadows: ShadowMode::Soft,
         shadow_samples: n,
@@ -312,7 +312,10 @@ fn every_shadow_path_gives_the_per_hit_path_s_bytes() {
     }
     let every: std::collections::BTreeSet<String> =
         ShadowPath::ALL.iter().map(|p| format!("{p:?}")).collect();
-    assert_eq!(taken, every, "some shadow path was never held to the per-hit one");
+    assert_eq!(
+        taken, every,
+        "some shadow path was never held to the per-hit one"
+    );
 }
 
 /// `LaneWidth::Auto` is the build's native width: 16 lanes when built for AVX-512, else 8.

@@ -14,8 +14,8 @@ use std::path::Path;
 fn outputs_there(d: &Path) {
     setup::cornell_box(d);
     for name in [
-        "x.png", "x.pfm", "x.json", "t.json", "t.obj", "t.ply", "t.png", "b.json", "b.csv",
-        "b.md", "d.png",
+        "x.png", "x.pfm", "x.json", "t.json", "t.obj", "t.ply", "t.png", "b.json", "b.csv", "b.md",
+        "d.png",
     ] {
         setup::file(d, name, b"the old contents\n");
     }
@@ -45,40 +45,154 @@ macro_rules! full {
 #[test]
 fn a_run_that_fails_on_one_output_changes_none() {
     check_all(&[
-        full!("render: --hdr on a full device after -o", [
-            "render", "cornell_box.obj", "--size", "8", "8", "-q", "-o", "x.png", "--hdr",
-            "/dev/full"
-        ]),
-        full!("render: --stats-json on a full device after -o and --hdr", [
-            "render", "cornell_box.obj", "--size", "8", "8", "-q", "-o", "x.png", "--hdr",
-            "x.pfm", "--stats-json", "/dev/full"
-        ]),
-        full!("render: --stats-json on a symlink to a full device", [
-            "render", "cornell_box.obj", "--size", "8", "8", "-q", "-o", "x.png",
-            "--stats-json", "full.json"
-        ]),
-        full!("trace-pixel: --obj on a full device after --json", [
-            "trace-pixel", "1", "1", "cornell_box.obj", "--size", "8", "8", "--json", "t.json",
-            "--obj", "/dev/full"
-        ]),
-        full!("trace-pixel: --ply on a full device after --json and --obj", [
-            "trace-pixel", "1", "1", "cornell_box.obj", "--size", "8", "8", "--json", "t.json",
-            "--obj", "t.obj", "--ply", "/dev/full"
-        ]),
-        full!("trace-pixel: --png on a full device after the three others", [
-            "trace-pixel", "1", "1", "cornell_box.obj", "--size", "8", "8", "--json", "t.json",
-            "--obj", "t.obj", "--ply", "t.ply", "--png", "/dev/full"
-        ]),
-        full!("bench: --export-csv on a full device after --json", [
-            "bench", "cornell_box.obj", "--size", "8", "8", "--runs", "1", "-q", "--json",
-            "b.json", "--export-csv", "/dev/full"
-        ]),
-        full!("bench: --export-markdown on a full device after --json and --export-csv", [
-            "bench", "cornell_box.obj", "--size", "8", "8", "--runs", "1", "-q", "--json",
-            "b.json", "--export-csv", "b.csv", "--export-markdown", "/dev/full"
-        ]),
-        full!("diff: --json on a full device after --out", [
-            "diff", "a.pfm", "b.pfm", "--out", "d.png", "--json", "/dev/full"
-        ]),
+        full!(
+            "render: --hdr on a full device after -o",
+            [
+                "render",
+                "cornell_box.obj",
+                "--size",
+                "8",
+                "8",
+                "-q",
+                "-o",
+                "x.png",
+                "--hdr",
+                "/dev/full"
+            ]
+        ),
+        full!(
+            "render: --stats-json on a full device after -o and --hdr",
+            [
+                "render",
+                "cornell_box.obj",
+                "--size",
+                "8",
+                "8",
+                "-q",
+                "-o",
+                "x.png",
+                "--hdr",
+                "x.pfm",
+                "--stats-json",
+                "/dev/full"
+            ]
+        ),
+        full!(
+            "render: --stats-json on a symlink to a full device",
+            [
+                "render",
+                "cornell_box.obj",
+                "--size",
+                "8",
+                "8",
+                "-q",
+                "-o",
+                "x.png",
+                "--stats-json",
+                "full.json"
+            ]
+        ),
+        full!(
+            "trace-pixel: --obj on a full device after --json",
+            [
+                "trace-pixel",
+                "1",
+                "1",
+                "cornell_box.obj",
+                "--size",
+                "8",
+                "8",
+                "--json",
+                "t.json",
+                "--obj",
+                "/dev/full"
+            ]
+        ),
+        full!(
+            "trace-pixel: --ply on a full device after --json and --obj",
+            [
+                "trace-pixel",
+                "1",
+                "1",
+                "cornell_box.obj",
+                "--size",
+                "8",
+                "8",
+                "--json",
+                "t.json",
+                "--obj",
+                "t.obj",
+                "--ply",
+                "/dev/full"
+            ]
+        ),
+        full!(
+            "trace-pixel: --png on a full device after the three others",
+            [
+                "trace-pixel",
+                "1",
+                "1",
+                "cornell_box.obj",
+                "--size",
+                "8",
+                "8",
+                "--json",
+                "t.json",
+                "--obj",
+                "t.obj",
+                "--ply",
+                "t.ply",
+                "--png",
+                "/dev/full"
+            ]
+        ),
+        full!(
+            "bench: --export-csv on a full device after --json",
+            [
+                "bench",
+                "cornell_box.obj",
+                "--size",
+                "8",
+                "8",
+                "--runs",
+                "1",
+                "-q",
+                "--json",
+                "b.json",
+                "--export-csv",
+                "/dev/full"
+            ]
+        ),
+        full!(
+            "bench: --export-markdown on a full device after --json and --export-csv",
+            [
+                "bench",
+                "cornell_box.obj",
+                "--size",
+                "8",
+                "8",
+                "--runs",
+                "1",
+                "-q",
+                "--json",
+                "b.json",
+                "--export-csv",
+                "b.csv",
+                "--export-markdown",
+                "/dev/full"
+            ]
+        ),
+        full!(
+            "diff: --json on a full device after --out",
+            [
+                "diff",
+                "a.pfm",
+                "b.pfm",
+                "--out",
+                "d.png",
+                "--json",
+                "/dev/full"
+            ]
+        ),
     ]);
 }

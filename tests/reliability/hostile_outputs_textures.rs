@@ -17,15 +17,14 @@ fn textured(d: &Path) {
     let scenes = common::bin::scenes();
     let text = std::fs::read_to_string(scenes.join("textured_box.obj"))
         .unwrap()
-        .replace("texture_file textures/asymmetric.ppm", "texture_file ok.ppm");
+        .replace(
+            "texture_file textures/asymmetric.ppm",
+            "texture_file ok.ppm",
+        );
     assert!(text.contains("texture_file ok.ppm"));
     std::fs::create_dir_all(d.join("tx/sub")).unwrap();
     std::fs::write(d.join("tx/ok.obj"), text).unwrap();
-    std::fs::copy(
-        scenes.join("textures/asymmetric.ppm"),
-        d.join("tx/ok.ppm"),
-    )
-    .unwrap();
+    std::fs::copy(scenes.join("textures/asymmetric.ppm"), d.join("tx/ok.ppm")).unwrap();
     for link in ["link.png", "link.pfm", "link.json", "link.csv"] {
         setup::symlink(d, link, "tx/ok.ppm");
     }
@@ -67,62 +66,195 @@ const RENDER: [&str; 6] = ["render", "tx/ok.obj", "--size", "8", "8", "-q"];
 #[test]
 fn no_output_is_a_texture_the_scene_reads() {
     check_all(&[
-        case!("render -o is the texture", [
-            RENDER[0], RENDER[1], RENDER[2], RENDER[3], RENDER[4], RENDER[5], "-o", "tx/ok.ppm"
-        ]),
-        case!("render -o is the texture through ..", [
-            RENDER[0], RENDER[1], RENDER[2], RENDER[3], RENDER[4], RENDER[5], "-o",
-            "tx/sub/../ok.ppm"
-        ]),
-        case!("render -o is a symlink to the texture", [
-            RENDER[0], RENDER[1], RENDER[2], RENDER[3], RENDER[4], RENDER[5], "-o", "link.png"
-        ]),
-        case!("render -input, -o is the texture", [
-            "-input", "tx/ok.obj", "-size", "8", "8", "-o", "tx/ok.ppm"
-        ]),
-        case!("render --hdr is a symlink to the texture", [
-            RENDER[0], RENDER[1], RENDER[2], RENDER[3], RENDER[4], RENDER[5], "-o", "x.png",
-            "--hdr", "link.pfm"
-        ]),
-        case!("render --stats-json is the texture", [
-            RENDER[0], RENDER[1], RENDER[2], RENDER[3], RENDER[4], RENDER[5], "-o", "x.png",
-            "--stats-json", "tx/ok.ppm"
-        ]),
-        case!("render --stats-json is the texture through ..", [
-            RENDER[0], RENDER[1], RENDER[2], RENDER[3], RENDER[4], RENDER[5], "-o", "x.png",
-            "--stats-json", "tx/sub/../ok.ppm"
-        ]),
-        case!("trace-pixel --json is the texture", [
-            "trace-pixel", "1", "1", "tx/ok.obj", "--size", "8", "8", "--json", "tx/ok.ppm"
-        ]),
-        case!("trace-pixel --obj is the texture through ..", [
-            "trace-pixel", "1", "1", "tx/ok.obj", "--size", "8", "8", "--obj",
-            "tx/sub/../ok.ppm"
-        ]),
-        case!("trace-pixel --ply is the texture", [
-            "trace-pixel", "1", "1", "tx/ok.obj", "--size", "8", "8", "--ply", "tx/ok.ppm"
-        ]),
-        case!("trace-pixel --png is a symlink to the texture", [
-            "trace-pixel", "1", "1", "tx/ok.obj", "--size", "8", "8", "--png", "link.png"
-        ]),
-        case!("bench --json is the texture", [
-            "bench", "tx/ok.obj", "--size", "8", "8", "--runs", "1", "-q", "--json",
-            "tx/ok.ppm"
-        ]),
-        case!("bench --export-csv is a symlink to the texture", [
-            "bench", "tx/ok.obj", "--size", "8", "8", "--runs", "1", "-q", "--export-csv",
-            "link.csv"
-        ]),
-        case!("bench --export-markdown is the texture through ..", [
-            "bench", "tx/ok.obj", "--size", "8", "8", "--runs", "1", "-q",
-            "--export-markdown", "tx/sub/../ok.ppm"
-        ]),
+        case!(
+            "render -o is the texture",
+            [
+                RENDER[0],
+                RENDER[1],
+                RENDER[2],
+                RENDER[3],
+                RENDER[4],
+                RENDER[5],
+                "-o",
+                "tx/ok.ppm"
+            ]
+        ),
+        case!(
+            "render -o is the texture through ..",
+            [
+                RENDER[0],
+                RENDER[1],
+                RENDER[2],
+                RENDER[3],
+                RENDER[4],
+                RENDER[5],
+                "-o",
+                "tx/sub/../ok.ppm"
+            ]
+        ),
+        case!(
+            "render -o is a symlink to the texture",
+            [
+                RENDER[0], RENDER[1], RENDER[2], RENDER[3], RENDER[4], RENDER[5], "-o", "link.png"
+            ]
+        ),
+        case!(
+            "render -input, -o is the texture",
+            ["-input", "tx/ok.obj", "-size", "8", "8", "-o", "tx/ok.ppm"]
+        ),
+        case!(
+            "render --hdr is a symlink to the texture",
+            [
+                RENDER[0], RENDER[1], RENDER[2], RENDER[3], RENDER[4], RENDER[5], "-o", "x.png",
+                "--hdr", "link.pfm"
+            ]
+        ),
+        case!(
+            "render --stats-json is the texture",
+            [
+                RENDER[0],
+                RENDER[1],
+                RENDER[2],
+                RENDER[3],
+                RENDER[4],
+                RENDER[5],
+                "-o",
+                "x.png",
+                "--stats-json",
+                "tx/ok.ppm"
+            ]
+        ),
+        case!(
+            "render --stats-json is the texture through ..",
+            [
+                RENDER[0],
+                RENDER[1],
+                RENDER[2],
+                RENDER[3],
+                RENDER[4],
+                RENDER[5],
+                "-o",
+                "x.png",
+                "--stats-json",
+                "tx/sub/../ok.ppm"
+            ]
+        ),
+        case!(
+            "trace-pixel --json is the texture",
+            [
+                "trace-pixel",
+                "1",
+                "1",
+                "tx/ok.obj",
+                "--size",
+                "8",
+                "8",
+                "--json",
+                "tx/ok.ppm"
+            ]
+        ),
+        case!(
+            "trace-pixel --obj is the texture through ..",
+            [
+                "trace-pixel",
+                "1",
+                "1",
+                "tx/ok.obj",
+                "--size",
+                "8",
+                "8",
+                "--obj",
+                "tx/sub/../ok.ppm"
+            ]
+        ),
+        case!(
+            "trace-pixel --ply is the texture",
+            [
+                "trace-pixel",
+                "1",
+                "1",
+                "tx/ok.obj",
+                "--size",
+                "8",
+                "8",
+                "--ply",
+                "tx/ok.ppm"
+            ]
+        ),
+        case!(
+            "trace-pixel --png is a symlink to the texture",
+            [
+                "trace-pixel",
+                "1",
+                "1",
+                "tx/ok.obj",
+                "--size",
+                "8",
+                "8",
+                "--png",
+                "link.png"
+            ]
+        ),
+        case!(
+            "bench --json is the texture",
+            [
+                "bench",
+                "tx/ok.obj",
+                "--size",
+                "8",
+                "8",
+                "--runs",
+                "1",
+                "-q",
+                "--json",
+                "tx/ok.ppm"
+            ]
+        ),
+        case!(
+            "bench --export-csv is a symlink to the texture",
+            [
+                "bench",
+                "tx/ok.obj",
+                "--size",
+                "8",
+                "8",
+                "--runs",
+                "1",
+                "-q",
+                "--export-csv",
+                "link.csv"
+            ]
+        ),
+        case!(
+            "bench --export-markdown is the texture through ..",
+            [
+                "bench",
+                "tx/ok.obj",
+                "--size",
+                "8",
+                "8",
+                "--runs",
+                "1",
+                "-q",
+                "--export-markdown",
+                "tx/sub/../ok.ppm"
+            ]
+        ),
         case!(
             "diff --out is the texture of the penumbra scene",
             textured_and_images,
             [
-                "diff", "a.pfm", "b.pfm", "--mask", "penumbra", "--scene", "tx/ok.obj",
-                "--mask-samples", "4", "--out", "tx/ok.ppm"
+                "diff",
+                "a.pfm",
+                "b.pfm",
+                "--mask",
+                "penumbra",
+                "--scene",
+                "tx/ok.obj",
+                "--mask-samples",
+                "4",
+                "--out",
+                "tx/ok.ppm"
             ],
             ["is the same file as the input --scene's texture_file"]
         ),
@@ -130,8 +262,17 @@ fn no_output_is_a_texture_the_scene_reads() {
             "diff --json is a symlink to the texture of the penumbra scene",
             textured_and_images,
             [
-                "diff", "a.pfm", "b.pfm", "--mask", "penumbra", "--scene", "tx/ok.obj",
-                "--mask-samples", "4", "--json", "link.json"
+                "diff",
+                "a.pfm",
+                "b.pfm",
+                "--mask",
+                "penumbra",
+                "--scene",
+                "tx/ok.obj",
+                "--mask-samples",
+                "4",
+                "--json",
+                "link.json"
             ],
             ["is the same file as the input --scene's texture_file"]
         ),
@@ -154,9 +295,26 @@ fn no_variance_report_file_is_a_texture() {
             std::fs::copy(d.join("tx/ok.ppm"), d.join("tx/report/table.txt")).unwrap();
         },
         [
-            "variance", "tx/ok.obj", "--size", "8", "8", "--budgets", "1", "--samplers",
-            "random", "--seeds", "2", "--reference-samples", "4", "--mask-samples", "4",
-            "--cache", "cache", "--out", "tx/report", "-q"
+            "variance",
+            "tx/ok.obj",
+            "--size",
+            "8",
+            "8",
+            "--budgets",
+            "1",
+            "--samplers",
+            "random",
+            "--seeds",
+            "2",
+            "--reference-samples",
+            "4",
+            "--mask-samples",
+            "4",
+            "--cache",
+            "cache",
+            "--out",
+            "tx/report",
+            "-q"
         ],
         ["is the same file as the input case", "texture_file"]
     )]);

@@ -119,7 +119,10 @@ pub(crate) fn read_texture(name: &str, path: &Path) -> Result<Texture, String> {
     })?;
     let digest = [&width.to_le_bytes()[..], &height.to_le_bytes(), &bytes]
         .into_iter()
-        .fold(crate::render::digest::START, crate::render::digest::continued);
+        .fold(
+            crate::render::digest::START,
+            crate::render::digest::continued,
+        );
     let name = name.to_string();
     let path = path.to_path_buf();
     let texture = if wide {
