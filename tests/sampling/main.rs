@@ -14,5 +14,6 @@ mod sampling;
 mod sampling_edges;
 mod sampling_study;
 mod soft_shadows;
+mod study_split;
 mod variance_report;
 mod variance_stats;
