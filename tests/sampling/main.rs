@@ -8,6 +8,7 @@ mod common;
 #[path = "../oracle/mod.rs"]
 mod oracle;
 
+mod low_band_share;
 mod point_sets;
 mod sample_streams;
 mod sampling;
