@@ -387,6 +387,9 @@ fn status_of(raw: &[u8]) -> u16 {
         .unwrap_or_else(|| panic!("no status line in {line:?}"))
 }
 
+/// A request to refuse: target, headers, a part of the message.
+type Try<'a> = (String, Vec<(&'a str, &'a str)>, &'a str);
+
 #[test]
 fn every_route_refuses_a_missing_or_wrong_token() {
     let server = ViewServer::start(&["--size", "16", "8", "--bounces", "0"]);
@@ -467,7 +470,7 @@ fn every_route_refuses_a_missing_or_wrong_token() {
     let wrong_cookie = format!("raywave_token_{port}={wrong}");
     let mut refused = 0;
     for (method, url) in &requests {
-        let mut tries: Vec<(String, Vec<(&str, &str)>, &str)> = vec![
+        let mut tries: Vec<Try> = vec![
             (url.to_string(), vec![], "needs its access token"),
             (
                 url.to_string(),
