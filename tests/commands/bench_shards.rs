@@ -311,6 +311,33 @@ fn merge_refuses_missing_duplicated_and_damaged_parts() {
 }
 
 #[test]
+fn a_copy_of_a_shard_under_another_name_is_refused_naming_both() {
+    // Shard 0, its copy under another name, shard 1 of 2: no shard is missing, no part is
+    // damaged or foreign, so only the check that each shard comes once can refuse it. Only
+    // the refusal is asserted, not its exit code.
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let parts = shards(d, 2);
+    std::fs::copy(d.join(&parts[0]), d.join("copy-of-0.json")).unwrap();
+    for order in [
+        [parts[0].as_str(), "copy-of-0.json", parts[1].as_str()],
+        ["copy-of-0.json", parts[1].as_str(), parts[0].as_str()],
+    ] {
+        let out = run(
+            d,
+            &format!("bench merge {} -q --export-csv rows.csv", order.join(" ")),
+        );
+        let err = stderr(&out);
+        assert!(!out.status.success(), "{order:?} merged:\n{}", stdout(&out));
+        for n in [parts[0].as_str(), "copy-of-0.json", "shard 0/2"] {
+            assert!(err.contains(n), "{order:?}: missing `{n}` in:\n{err}");
+        }
+        assert!(!d.join("rows.csv").exists(), "{order:?} wrote its export");
+    }
+    ok(&run(d, &format!("bench merge {} -q", parts.join(" "))));
+}
+
+#[test]
 fn merge_refuses_parts_of_other_sweeps_builds_and_splits() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();

@@ -360,6 +360,53 @@ fn merge_refuses_parts_that_are_missing_repeated_cut_short_corrupt_or_foreign() 
     ));
 }
 
+/// Refused, without a report: a non-zero exit and every needle in the error. (The exit code
+/// itself is left to the merge's other tests.)
+fn refused_naming(d: &Path, args: &[&str], needles: &[&str]) {
+    let out = raywave(d, args);
+    let err = stderr(&out);
+    assert!(
+        !out.status.success(),
+        "{args:?} merged:\n{}\n{err}",
+        stdout(&out)
+    );
+    for n in needles {
+        assert!(err.contains(n), "{args:?}: expected {n:?} in:\n{err}");
+    }
+    assert!(!d.join("report").exists(), "{args:?} wrote a report");
+}
+
+#[test]
+fn a_copy_of_a_shard_under_another_name_is_refused_naming_both() {
+    // Shard 0, the same file copied under another name, and shard 1 of 2: every shard is
+    // there, every part is whole and of this study, and the copy is another file, so only
+    // the check that each shard comes once can refuse it.
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    for i in 0..2 {
+        let shard = format!("{i}/2");
+        let mut args = vec!["variance", "--size", "8", "8", "--seeds", "2"];
+        args.extend(["--budgets", "1,4", "--samplers", "random"]);
+        args.extend(["--reference-samples", "4", "--mask-samples", "4"]);
+        args.extend(["--heatmap-n", "1", "--no-cache", "--shard", &shard]);
+        args.extend(["--out", "parts", "-q"]);
+        ok(&raywave(d, &args));
+    }
+    let (zero, one) = ("parts/shard-0-of-2.part", "parts/shard-1-of-2.part");
+    std::fs::copy(d.join(zero), d.join("copy-of-0.part")).unwrap();
+    for order in [[zero, "copy-of-0.part", one], ["copy-of-0.part", one, zero]] {
+        let mut args = vec!["variance", "merge"];
+        args.extend(order);
+        args.extend(["--out", "report"]);
+        refused_naming(d, &args, &[zero, "copy-of-0.part", "shard 0/2"]);
+    }
+    // The two shards alone merge.
+    ok(&raywave(
+        d,
+        &["variance", "merge", zero, one, "--out", "report"],
+    ));
+}
+
 #[test]
 fn a_shard_out_of_range_is_a_usage_error() {
     let dir = tempfile::tempdir().unwrap();

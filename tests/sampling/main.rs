@@ -8,11 +8,13 @@ mod common;
 #[path = "../oracle/mod.rs"]
 mod oracle;
 
+mod low_band_share;
 mod point_sets;
 mod sample_streams;
 mod sampling;
 mod sampling_edges;
 mod sampling_study;
 mod soft_shadows;
+mod study_split;
 mod variance_report;
 mod variance_stats;
