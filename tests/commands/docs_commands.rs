@@ -37,8 +37,8 @@ const README: Page = Page {
     after: nothing,
 };
 
-/// docs/BENCHMARKING.md, shortened so that the whole page runs in seconds; the page repeats
-/// this table.
+/// docs/BENCHMARKING.md, shortened so that the whole page runs in seconds; the page points
+/// here for this table.
 const BENCHMARKING: Page = Page {
     path: "docs/BENCHMARKING.md",
     text: include_str!("../../docs/BENCHMARKING.md"),

@@ -28,7 +28,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 /// A region whose count rises by more than this fraction fails. Counts repeat exactly from run
-/// to run on one machine (docs/BENCHMARKING.md); the threshold absorbs what the key does not
+/// to run on one machine (docs/TRIED.md); the threshold absorbs what the key does not
 /// capture, chiefly glibc's `memset`/`memcpy`/`malloc`, which are picked per CPU at run time.
 const THRESHOLD: f64 = 0.01;
 /// The committed baselines.

@@ -16,7 +16,7 @@
 //! stratified soft-shadow points), their scalar twins (`Accel::closest` on the same rays, the
 //! reference renderer on 128 of the tile's pixels), and intersect and shadow on
 //! `scenes/mesh_spheres_small.obj` (684 triangles), which go through the mesh BVH (`MeshBvh`).
-//! Built only with the `icount-child` feature; the gate builds it (docs/BENCHMARKING.md, "The
+//! Built only with the `icount-child` feature; the gate builds it (docs/TESTING.md, "The
 //! instruction-count gate").
 
 use raywave::render::geometry::{Accel, Ray};
