@@ -1,9 +1,10 @@
-//! The `raywave` command. `main` owns the exit code: 0 on success, 2 for a usage error (clap),
-//! 3 when `raywave bench --compare` finds a regression or `raywave diff --fail-above` a figure
-//! past its threshold, 4 when `raywave bench --until-decided` ends undecided at its budget, 1
-//! for anything else, printed once with its cause chain; 130 after SIGINT and 143 after
-//! SIGTERM (`output::write`; `raywave view` after answering the requests in hand). The command
-//! line itself is in `cli/`, one file per command.
+//! The `raywave` command. `main` owns the exit code: 0 on success, 2 for a usage error (clap)
+//! and for a CPU without an x86 feature the build uses (`raywave::output::cpu`), 3 when
+//! `raywave bench --compare` finds a regression or `raywave diff --fail-above` a figure past its
+//! threshold, 4 when `raywave bench --until-decided` ends undecided at its budget, 1 for
+//! anything else, printed once with its cause chain; 130 after SIGINT and 143 after SIGTERM
+//! (`output::write`; `raywave view` after answering the requests in hand). The command line
+//! itself is in `cli/`, one file per command.
 
 mod cli;
 
@@ -12,6 +13,9 @@ use raywave::render::error::UsageError;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
+    // Exit 2, naming them, when this CPU lacks instructions the build uses: before any code
+    // that might use them.
+    raywave::output::cpu::exit_unless_supported();
     cli::phases::start();
     let normalized = match cli::foreign::normalize_args(std::env::args_os()) {
         Ok(n) => n,
