@@ -18,8 +18,8 @@
 //! CPUID, XGETBV and integer tests against constant masks (no variable shifts: with BMI2
 //! compiled in those become `shrx`), and the refusal to formatting and one write. Whether the
 //! compiled code keeps to that is tested, not assumed: `tests/commands/cpu_check.rs` runs the
-//! real binary under QEMU emulating an AVX2 CPU without AVX-512, where any AVX-512 instruction
-//! before the refusal would end it with SIGILL instead.
+//! real binary on emulated AVX2 CPUs without AVX-512 (valgrind's, and QEMU's Haswell), where any
+//! AVX-512 instruction before the refusal would end it with SIGILL instead.
 
 /// Where CPUID reports a feature: (leaf, sub-leaf, register).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

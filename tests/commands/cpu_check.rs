@@ -1,11 +1,13 @@
 //! The start-up check that the CPU has every x86 feature the binary was compiled with
-//! (`raywave::output::cpu`), end to end: the real binary run under QEMU's user-mode emulator as
-//! an AVX2 CPU without AVX-512 (`-cpu Haswell`), which is what a binary built on an AVX-512
-//! node meets on an older one. Before the check it died there of SIGILL, with no message.
+//! (`raywave::output::cpu`), end to end: the real binary run on an emulated CPU with AVX2 and
+//! without AVX-512, which is what a binary built on an AVX-512 node meets on an older one.
+//! Before the check it died there of SIGILL, with no message. Two emulators, each a CPU of its
+//! own: valgrind (the host's CPUID less what valgrind cannot run, AVX-512 first) and QEMU's
+//! user mode as a Haswell, whose CPUID is another CPU's altogether.
 //!
-//! QEMU is the honest test: it runs the very instructions the build contains, so had the check
-//! itself (compiled with AVX-512 like the rest) used one, it would die of SIGILL too. A hidden
-//! environment variable that made the binary pretend a feature was absent would test the
+//! An emulator is the honest test: it runs the very instructions the build contains, so had the
+//! check itself (compiled with AVX-512 like the rest) used one, it would die of SIGILL too. A
+//! hidden environment variable that made the binary pretend a feature was absent would test the
 //! message but not that; the message's wording is the unit tests' in `src/output/cpu.rs`.
 
 use crate::common;
@@ -14,7 +16,7 @@ use common::bin::{raywave, stderr, stdout};
 use common::skip::skip_or_fail;
 use raywave::output::cpu::FEATURES;
 use std::path::PathBuf;
-use std::process::Command;
+use std::process::{Command, Output};
 
 /// `name` on PATH.
 fn on_path(name: &str) -> Option<PathBuf> {
@@ -24,8 +26,83 @@ fn on_path(name: &str) -> Option<PathBuf> {
         .find(|p| p.is_file())
 }
 
+/// Checks a run of `raywave info` on an emulated CPU without AVX-512 whose own lines in
+/// standard error start with `noise`; returns the features the refusal names (empty when the
+/// build needs nothing beyond that CPU's).
+fn refused_or_ran(out: &Output, noise: &str) -> Vec<String> {
+    let err: String = stderr(out)
+        .lines()
+        .filter(|l| !l.starts_with(noise))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    assert!(
+        !err.contains("signal") && out.status.code().is_some_and(|c| c < 128),
+        "the binary died on a CPU without AVX-512 instead of refusing it ({:?}):\n{err}",
+        out.status
+    );
+    if out.status.code() == Some(0) {
+        // Built for the emulated CPU or an older one: it runs there.
+        assert!(!cfg!(target_feature = "avx512f"), "{err}");
+        assert!(
+            stdout(out).contains("this CPU has every one"),
+            "{}",
+            stdout(out)
+        );
+        return Vec::new();
+    }
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(stdout(out).is_empty(), "{}", stdout(out));
+    assert!(
+        err.starts_with("error: this raywave was compiled for CPU features that this CPU"),
+        "{err}"
+    );
+    // Both emulators show the host's /proc/cpuinfo, so the model named is the host's.
+    let model = raywave::output::machine::cpu_model();
+    assert!(
+        err.contains(&format!("this CPU ({model}) lacks: ")),
+        "{err}"
+    );
+    assert!(err.contains("or build it on this machine"), "{err}");
+    let lacks: Vec<String> = err
+        .lines()
+        .next()
+        .and_then(|l| l.split_once("lacks: "))
+        .map(|(_, list)| list.split(", ").map(str::to_string).collect())
+        .unwrap_or_default();
+    // Every AVX-512 feature the build has is missing, and is named.
+    for f in FEATURES.iter().filter(|f| f.compiled) {
+        if f.name.starts_with("avx512") {
+            assert!(lacks.iter().any(|l| l == f.name), "{}: {err}", f.name);
+        }
+    }
+    if cfg!(target_feature = "avx512f") {
+        assert!(err.contains("lacks: avx512f, "), "{err}");
+        assert!(
+            err.contains("RUSTFLAGS=\"-C target-cpu=x86-64-v3\" cargo build --release"),
+            "{err}"
+        );
+    }
+    lacks
+}
+
 #[test]
-fn a_build_the_cpu_cannot_run_exits_2_naming_the_features_the_cpu_and_the_fix() {
+fn a_build_the_cpu_cannot_run_exits_2_under_valgrind_naming_the_features_the_cpu_and_the_fix() {
+    let Some(valgrind) = on_path("valgrind") else {
+        return skip_or_fail("valgrind is missing (.ci/run installs it)");
+    };
+    let out = Command::new(valgrind)
+        .args(["--tool=none", "-q", env!("CARGO_BIN_EXE_raywave"), "info"])
+        .output()
+        .expect("run valgrind");
+    let lacks = refused_or_ran(&out, "==");
+    // Valgrind runs AVX2, FMA and BMI: an x86-64-v3 feature is never what it lacks.
+    for f in FEATURES.iter().filter(|f| (1..=3).contains(&f.level)) {
+        assert!(!lacks.iter().any(|l| l == f.name), "{}: {lacks:?}", f.name);
+    }
+}
+
+#[test]
+fn a_build_the_cpu_cannot_run_exits_2_under_qemu_as_haswell() {
     let Some(qemu) = on_path("qemu-x86_64") else {
         return skip_or_fail("qemu-x86_64 is missing (.ci/run installs qemu-user)");
     };
@@ -33,50 +110,9 @@ fn a_build_the_cpu_cannot_run_exits_2_naming_the_features_the_cpu_and_the_fix() 
         .args(["-cpu", "Haswell", env!("CARGO_BIN_EXE_raywave"), "info"])
         .output()
         .expect("run qemu-x86_64");
-    // QEMU warns about the Haswell features its emulator leaves out; the rest is raywave's.
-    let err: String = stderr(&out)
-        .lines()
-        .filter(|l| !l.starts_with("qemu-x86_64: warning:"))
-        .map(|l| format!("{l}\n"))
-        .collect();
-    assert!(
-        !err.contains("uncaught target signal"),
-        "the binary died under an AVX2 CPU instead of refusing it:\n{err}"
-    );
-    // Features beyond x86-64-v3 that QEMU emulates for Haswell: none of AVX-512 and none of
-    // the few others a newer CPU adds.
-    let beyond_v3: Vec<&str> = FEATURES
-        .iter()
-        .filter(|f| f.compiled && !(1..=3).contains(&f.level))
-        .map(|f| f.name)
-        .collect();
-    if beyond_v3.is_empty() {
-        // Built for x86-64-v3 or older: it runs there.
-        assert_eq!(out.status.code(), Some(0), "{err}");
-        assert!(
-            stdout(&out).contains("this CPU has every one"),
-            "{}",
-            stdout(&out)
-        );
-        return;
-    }
-    assert_eq!(out.status.code(), Some(2), "{err}");
-    assert!(stdout(&out).is_empty(), "{}", stdout(&out));
-    assert!(err.starts_with("error: this raywave was compiled for CPU features that this CPU"));
-    // QEMU's user mode shows the host's /proc/cpuinfo, so the model named is the host's.
-    let model = raywave::output::machine::cpu_model();
-    assert!(
-        err.contains(&format!("this CPU ({model}) lacks: ")),
-        "{err}"
-    );
-    // A second CPUID to read besides the host's: what Haswell has is not missing, and every
-    // AVX-512 feature the build has is.
-    let lacks: Vec<&str> = err
-        .lines()
-        .next()
-        .and_then(|l| l.split_once("lacks: "))
-        .map(|(_, list)| list.split(", ").collect())
-        .unwrap_or_default();
+    // QEMU warns about the Haswell features its emulator leaves out.
+    let lacks = refused_or_ran(&out, "qemu-x86_64: warning:");
+    // Another CPU's CPUID read through the same table: what Haswell has is not missing.
     let haswell = [
         "sse3",
         "ssse3",
@@ -98,26 +134,12 @@ fn a_build_the_cpu_cannot_run_exits_2_naming_the_features_the_cpu_and_the_fix() 
         "pclmulqdq",
         "rdrand",
     ];
-    for f in FEATURES.iter().filter(|f| f.compiled) {
-        if haswell.contains(&f.name) {
-            assert!(!lacks.contains(&f.name), "{} is on Haswell: {err}", f.name);
-        }
-        if f.name.starts_with("avx512") {
-            assert!(
-                lacks.contains(&f.name),
-                "{} is not on Haswell: {err}",
-                f.name
-            );
-        }
-    }
-    if cfg!(target_feature = "avx512f") {
-        assert!(err.contains("lacks: avx512f, "), "{err}");
+    for name in haswell {
         assert!(
-            err.contains("RUSTFLAGS=\"-C target-cpu=x86-64-v3\" cargo build --release"),
-            "{err}"
+            !lacks.iter().any(|l| l == name),
+            "{name} is on Haswell: {lacks:?}"
         );
     }
-    assert!(err.contains("or build it on this machine"), "{err}");
 }
 
 #[test]
