@@ -372,6 +372,53 @@ mod tests {
     }
 
     #[test]
+    fn a_bit_counts_only_with_the_os_state_and_the_vendor_it_needs() {
+        let named = |name: &str| *FEATURES.iter().find(|f| f.name == name).unwrap();
+        // Every bit set: what decides is the rest.
+        let all = Cpuid {
+            words: [u32::MAX; 10],
+            amd: false,
+            intel: true,
+            avx_state: true,
+            avx512_state: true,
+        };
+        for f in FEATURES {
+            assert!(all.has(f) || f.needs == Needs::Amd, "{}", f.name);
+        }
+        // The OS saves the AVX registers but not the AVX-512 ones (XCR0 bits 5 to 7 clear).
+        let no_zmm = Cpuid {
+            avx512_state: false,
+            ..all
+        };
+        assert!(!no_zmm.has(&named("avx512f")) && !no_zmm.has(&named("avx512bf16")));
+        assert!(no_zmm.has(&named("avx2")) && no_zmm.has(&named("sse4.2")));
+        // Nor the AVX ones: no VEX feature, and an Intel CPU's BMI bits are its erratum.
+        let no_ymm = Cpuid {
+            avx_state: false,
+            avx512_state: false,
+            ..all
+        };
+        for name in [
+            "avx", "avx2", "fma", "f16c", "xsave", "vaes", "bmi1", "bmi2",
+        ] {
+            assert!(!no_ymm.has(&named(name)), "{name}");
+        }
+        assert!(no_ymm.has(&named("popcnt")) && no_ymm.has(&named("lzcnt")));
+        let amd_no_ymm = Cpuid {
+            amd: true,
+            intel: false,
+            ..no_ymm
+        };
+        assert!(amd_no_ymm.has(&named("bmi1")) && amd_no_ymm.has(&named("sse4a")));
+        // SSE4a and TBM's bits mean them on AMD only.
+        assert!(!all.has(&named("sse4a")) && !all.has(&named("tbm")));
+        // A bit clear is absent, whatever else holds.
+        let mut no_avx512f = all;
+        no_avx512f.words[Word::Leaf7Ebx as usize] &= !(1 << 16);
+        assert!(!no_avx512f.has(&named("avx512f")) && no_avx512f.has(&named("avx512dq")));
+    }
+
+    #[test]
     fn the_suggestion_is_the_highest_level_the_cpu_has_whole() {
         let levels: Vec<Feature> = FEATURES.iter().copied().filter(|f| f.level > 0).collect();
         let up_to = |l: u8| move |f: &Feature| f.level <= l;
