@@ -1,6 +1,7 @@
 //! The `raywave` command. `main` owns the exit code: 0 on success (for `raywave bench --against`
 //! also "not slower by more than the threshold", and a fixed-rounds run left undecided), 2 for a
-//! usage error (clap), 3 when `raywave bench --compare` or `--against` finds a regression or
+//! usage error (clap) and for a CPU without an x86 feature the build uses
+//! (`raywave::output::cpu`), 3 when `raywave bench --compare` or `--against` finds a regression or
 //! `raywave diff --fail-above` a figure past its threshold, 4 when `raywave bench --against
 //! --until-decided` ends undecided at its budget (neither a regression nor shown not to be one,
 //! in either `--verdict` form), 1 for anything else, printed once with its cause chain; 130
@@ -14,6 +15,9 @@ use raywave::render::error::UsageError;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
+    // Exit 2, naming them, when this CPU lacks instructions the build uses: before any code
+    // that might use them.
+    raywave::output::cpu::exit_unless_supported();
     cli::phases::start();
     let normalized = match cli::foreign::normalize_args(std::env::args_os()) {
         Ok(n) => n,

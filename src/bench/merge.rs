@@ -3,8 +3,8 @@
 //!
 //! ```text
 //! read every part (whole, checksum, consistent with itself; errors name the file)
-//! refuse: shard counts that disagree; another build; another sweep; a shard missing or twice;
-//!         more than one machine without --across-machines
+//! refuse: shard counts that disagree; another SIMD path; another build; another sweep; a shard
+//!         missing or twice; more than one machine without --across-machines
 //! records in sweep order (grouped by host with --across-machines); --save; the exports
 //! ```
 //!
@@ -111,6 +111,18 @@ pub fn merge(args: &MergeOptions) -> Result<Merged> {
             first
                 .sweep
                 .build_differences(&part.sweep, &format!("in {a}"), &format!("in {b}"));
+        // The SIMD path first: binaries built for two CPUs (`target-cpu=native` on two kinds of
+        // node) can share a commit and differ only there, and their kernels are not the same.
+        if first.sweep.simd != part.sweep.simd {
+            bail!(
+                "{a} and {b} were run by binaries with different SIMD paths, {} and {}, so \
+                 their figures do not time the same kernels:\n  {}\nrun every shard with one \
+                 build (for nodes of several CPUs, one built for the oldest: docs/SCALING.md)",
+                first.sweep.simd,
+                part.sweep.simd,
+                build.join("\n  ")
+            );
+        }
         if !build.is_empty() {
             bail!(
                 "{a} and {b} come from different raywave builds, so their figures do not \

@@ -223,8 +223,16 @@ fn take_values<'a>(
             (Some(_), Value::Text) => true,
         };
         if !ok {
+            // `1e39` is a number, just not an f32: say so, as the scene parser does.
+            let past_f32 = matches!((&found, kind), (Some(v), Value::Number)
+                if v.parse::<f32>().is_ok_and(|x| !x.is_finite())
+                    && raywave::render::scene::beyond_range(v));
             let found = found.map_or("the end of the command line".to_string(), |v| {
-                format!("`{v}`")
+                if past_f32 {
+                    format!("`{v}`, of magnitude past the largest f32, 3.4e38")
+                } else {
+                    format!("`{v}`")
+                }
             });
             return Err(UsageError(format!(
                 "{spelling}: expected {what}, found {found}"

@@ -15,14 +15,38 @@ use raywave::render::settings::options::Defaults;
 use raywave::render::settings::{LightModel, ShadowMode};
 use raywave::render::wavefront::lanes::LaneWidth;
 
+/// The float types of flags.
+pub trait Float: std::str::FromStr + Copy + Send + Sync + 'static {
+    /// The type's name and its largest finite value, for messages.
+    const RANGE: &'static str;
+    /// Not an infinity nor NaN.
+    fn finite(self) -> bool;
+}
+
+impl Float for f32 {
+    const RANGE: &'static str = "the largest f32, 3.4e38";
+    fn finite(self) -> bool {
+        self.is_finite()
+    }
+}
+
+impl Float for f64 {
+    const RANGE: &'static str = "the largest f64, 1.8e308";
+    fn finite(self) -> bool {
+        self.is_finite()
+    }
+}
+
 /// A float that `ok` accepts, refused otherwise with "expected {what}, found `text`" (clap
-/// names the flag).
-pub fn float<T>(what: &'static str, ok: fn(T) -> bool) -> impl TypedValueParser<Value = T>
-where
-    T: std::str::FromStr + Copy + Send + Sync + 'static,
-{
+/// names the flag), and for a finite number too large for the type (`1e39` as an f32, which
+/// Rust's parser rounds to an infinity) with the magnitude it is past.
+pub fn float<T: Float>(what: &'static str, ok: fn(T) -> bool) -> impl TypedValueParser<Value = T> {
     StringValueParser::new().try_map(move |text| match text.parse::<T>() {
         Ok(x) if ok(x) => Ok(x),
+        Ok(x) if !x.finite() && raywave::render::scene::beyond_range(&text) => Err(format!(
+            "expected {what}, found `{text}`, of magnitude past {}",
+            T::RANGE
+        )),
         _ => Err(format!("expected {what}, found `{text}`")),
     })
 }

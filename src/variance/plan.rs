@@ -138,6 +138,20 @@ impl StudyIdentity {
                 self.format, other.format
             ));
         }
+        // The SIMD path first: binaries built for two CPUs (`target-cpu=native` on two kinds of
+        // node) can share a commit and differ only there.
+        let simd = |build: &str| build.split_once(" simd ").map(|(_, path)| path.to_string());
+        if simd(&self.build) != simd(&other.build) {
+            return Some(format!(
+                "different SIMD paths: {} against {} (run by {} against {}); run every shard \
+                 with one build (for nodes of several CPUs, one built for the oldest: \
+                 docs/SCALING.md)",
+                simd(&self.build).unwrap_or_default(),
+                simd(&other.build).unwrap_or_default(),
+                self.build,
+                other.build
+            ));
+        }
         if self.build != other.build || self.executable != other.executable {
             return Some(format!(
                 "different raywave builds: {}{} against {}{}",
@@ -258,6 +272,16 @@ mod tests {
             a.difference(&b)
                 .unwrap()
                 .contains("different raywave builds")
+        );
+        // Built for another CPU: the same commit, another SIMD path.
+        let mut v3 = a.clone();
+        v3.build = "raywave 0.1.0 commit abc simd avx2+fma (f32x8 in one 256-bit register)".into();
+        let d = a.difference(&v3).unwrap();
+        assert!(
+            d.contains(
+                "different SIMD paths: avx2 against avx2+fma (f32x8 in one 256-bit register)"
+            ),
+            "{d}"
         );
         let mut c = a.clone();
         c.cases[0].config.seeds = 9;

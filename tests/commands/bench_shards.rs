@@ -2,8 +2,8 @@
 //! shards (and as 2) and merged equals the sweep run whole in everything that does not depend
 //! on timing (points, settings, ray counts, figure names); the split is by cost; a shard
 //! without points still writes its file; merge refuses missing, duplicated, truncated,
-//! damaged and mismatched parts (other sweep, other build, other shard count, other machine
-//! unless --across-machines), and outputs that are inputs; bad --shard values are usage errors.
+//! damaged and mismatched parts (other sweep, other SIMD path, other build, other shard count,
+//! other machine unless --across-machines), and outputs that are inputs; bad --shard values are usage errors.
 //! Tiny images: no timing is asserted.
 
 use crate::common;
@@ -408,6 +408,63 @@ fn merge_refuses_parts_of_other_sweeps_builds_and_splits() {
     refused(
         &run(d, &format!("bench merge {} points.json", parts[0])),
         &["points.json: inconsistent bench shard file"],
+    );
+}
+
+#[test]
+fn merge_refuses_a_part_run_with_another_simd_path_naming_both() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let parts = shards(d, 2);
+    // Shard 1 as a binary of the same commit built for the other kind of node would have left
+    // it: another SIMD path, target features and RUSTFLAGS, in the sweep and in every record.
+    let ours = read(d, &parts[1])["payload"]["sweep"]["simd"]
+        .as_str()
+        .unwrap()
+        .to_string();
+    let theirs = if ours.contains("avx512") {
+        "avx2+fma (f32x8 in one 256-bit register)"
+    } else {
+        "avx512 (f32x16 in one 512-bit register)"
+    };
+    std::fs::copy(d.join(&parts[1]), d.join("other-cpu.json")).unwrap();
+    doctor(d, "other-cpu.json", |p| {
+        let mut build = p["sweep"]["build"].clone();
+        build["rustflags"] = json!("-C target-cpu=x86-64-v3");
+        build["target_features"] = json!("avx,avx2,bmi1,bmi2,f16c,fma,lzcnt,movbe,xsave");
+        p["sweep"]["build"] = build.clone();
+        p["sweep"]["simd"] = json!(theirs);
+        for r in p["records"].as_array_mut().unwrap() {
+            r["build"] = build.clone();
+            r["simd"] = json!(theirs);
+        }
+    });
+    let err = refused(
+        &run(d, &format!("bench merge {} other-cpu.json", parts[0])),
+        &[
+            "were run by binaries with different SIMD paths",
+            &format!("{ours} and {theirs}"),
+            &parts[0],
+            "other-cpu.json",
+            "RUSTFLAGS: ",
+        ],
+    );
+    assert!(!err.contains("are shards of different sweeps"), "{err}");
+    assert!(!d.join("merged").exists());
+    // The SIMD path alone, every other field the same: still refused.
+    std::fs::copy(d.join(&parts[1]), d.join("simd-only.json")).unwrap();
+    doctor(d, "simd-only.json", |p| {
+        p["sweep"]["simd"] = json!(theirs);
+        for r in p["records"].as_array_mut().unwrap() {
+            r["simd"] = json!(theirs);
+        }
+    });
+    refused(
+        &run(d, &format!("bench merge {} simd-only.json", parts[0])),
+        &[
+            "were run by binaries with different SIMD paths",
+            &format!("simd: {ours} in {}, {theirs} in simd-only.json", parts[0]),
+        ],
     );
 }
 

@@ -69,6 +69,77 @@ fn bad_flags_are_usage_errors_with_exit_code_2() {
     }
 }
 
+#[test]
+fn float_flags_past_their_type_get_the_magnitude_message_and_infinities_do_not() {
+    let dir = dir_with(&["cornell_box.obj"]);
+    const F32: &str = "of magnitude past the largest f32, 3.4e38";
+    // (arguments, the flag as the message names it, the value, whether it is past the range)
+    let cases: &[(&str, &str, &str, bool)] = &[
+        ("--background 1 1e39 0", "--background", "1e39", true),
+        ("--ambient 0 0 1e39", "--ambient", "1e39", true),
+        (
+            "-background_color 1 1e39 0",
+            "-background_color",
+            "1e39",
+            true,
+        ),
+        ("-ambient_light -1e39 0 0", "-ambient_light", "-1e39", true),
+        (
+            "trace-pixel 1 1 cornell_box.obj --orbit 1e39",
+            "--orbit",
+            "1e39",
+            true,
+        ),
+        (
+            "trace-pixel 1 1 cornell_box.obj --orbit -1e39",
+            "--orbit",
+            "-1e39",
+            true,
+        ),
+        (
+            "trace-pixel 1 1 cornell_box.obj --view-distance 1e39",
+            "--view-distance",
+            "1e39",
+            true,
+        ),
+        (
+            "trace-pixel 1 1 cornell_box.obj --view-from 0 -1e39 0",
+            "--view-from",
+            "-1e39",
+            true,
+        ),
+        ("--background 1 inf 0", "--background", "inf", false),
+        (
+            "-background_color 1 -inf 0",
+            "-background_color",
+            "-inf",
+            false,
+        ),
+        (
+            "trace-pixel 1 1 cornell_box.obj --orbit NaN",
+            "--orbit",
+            "NaN",
+            false,
+        ),
+    ];
+    for &(args, flag, value, past) in cases {
+        let out = raywave(dir.path(), &words(args));
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(2), "{args}: {err}");
+        assert!(err.contains(flag), "{args}: no {flag} in {err}");
+        assert!(err.contains(&format!("found `{value}`")), "{args}: {err}");
+        assert_eq!(err.contains(F32), past, "{args}: {err}");
+    }
+    // f64 flags: past f64's range.
+    let out = raywave(dir.path(), &words("diff a.png b.png --fail-above -1e309"));
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("found `-1e309`, of magnitude past the largest f64, 1.8e308"),
+        "{err}"
+    );
+}
+
 /// A scene whose line 6 has a word where a number belongs.
 const BAD_SCENE: &str = "material\ndiffuse 1 1 1\nm 0\nv 0 0 0\nv 1 0 0\nv 0 1 zero\nf 1 2 3\n";
 /// A ring whose inner radius is not below its outer one, on line 4.

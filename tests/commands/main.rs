@@ -1,5 +1,5 @@
-//! Command tests: the built binary run as a user runs it: the command line and its errors,
-//! `bench` (records, verdicts, A/B), `diff`, `trace-pixel` and its exports (on
+//! Command tests: the built binary run as a user runs it: the command line and its errors, the
+//! start-up CPU check (under QEMU), `bench` (records, verdicts, A/B), `diff`, `trace-pixel` and its exports (on
 //! scenes/trace_demo.obj, `trace_demo/`), `view` over HTTP, in a browser and its page's modules
 //! under node, the JSON Schemas of its output, every command the documentation shows, and the
 //! batch systems that run a sharded study (`batch_*`: a real Slurm cluster, GNU parallel, the
@@ -19,6 +19,7 @@ mod bench_trackers;
 mod bench_verdict;
 mod cli;
 mod cli_errors;
+mod cpu_check;
 mod diff;
 mod docs_commands;
 mod schema;

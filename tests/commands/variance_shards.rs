@@ -1,8 +1,8 @@
 //! `raywave variance --shard I/N`, `variance merge` and `variance prepare`: a study of two
 //! scenes run in four shards and merged gives the single process's report, figure for figure
 //! (every figure that does not come from a clock); merges of parts that are missing, repeated,
-//! cut short, corrupt or of another study are refused naming the files; concurrent shards
-//! render a shared reference once.
+//! cut short, corrupt, of another study or of a binary with another SIMD path are refused naming
+//! the files; concurrent shards render a shared reference once.
 
 use crate::common;
 
@@ -405,6 +405,40 @@ fn a_copy_of_a_shard_under_another_name_is_refused_naming_both() {
         d,
         &["variance", "merge", zero, one, "--out", "report"],
     ));
+}
+
+#[test]
+fn merge_refuses_a_part_run_with_another_simd_path_naming_both() {
+    use raywave::variance::part;
+    let dir = flag_shards(&["--no-cache"]);
+    let d = dir.path();
+    // Shard 1 as a binary of the same commit built for the other kind of node would have
+    // written it: the identity's build differs in its SIMD path alone.
+    let mut other = part::read(&d.join("parts/shard-1-of-3.part")).unwrap();
+    let ours = raywave::simd_path();
+    let theirs = if ours.contains("avx512") {
+        "avx2+fma (f32x8 in one 256-bit register)"
+    } else {
+        "avx512 (f32x16 in one 512-bit register)"
+    };
+    assert!(other.identity.build.ends_with(&format!(" simd {ours}")));
+    other.identity.build = other.identity.build.replace(ours, theirs);
+    part::write(&d.join("other-cpu.part"), &other).unwrap();
+    let out = raywave(
+        d,
+        &words(
+            "variance merge parts/shard-0-of-3.part other-cpu.part parts/shard-2-of-3.part --out report",
+        ),
+    );
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    for needle in [
+        "parts/shard-0-of-3.part and other-cpu.part are not parts of the same study",
+        &format!("different SIMD paths: {ours} against {theirs}"),
+    ] {
+        assert!(err.contains(needle), "expected {needle:?} in:\n{err}");
+    }
+    assert!(!d.join("report").exists());
 }
 
 #[test]

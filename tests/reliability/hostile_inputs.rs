@@ -378,7 +378,7 @@ fn bytes_that_are_not_text_and_tokens_that_are_not_polite() {
             |d| setup::file(d, "ovf.obj", b"v 1e39 0 0\n"),
             &["ovf.obj", "-q"],
             1,
-            &["ovf.obj:1:", "finite number"],
+            &["ovf.obj:1:", "of magnitude at most 1e9", "`1e39`"],
             &[],
         ),
         case(

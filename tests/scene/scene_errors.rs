@@ -174,6 +174,75 @@ fn numbers_too_large_to_square_are_errors() {
 }
 
 #[test]
+fn numbers_past_f32_get_the_magnitude_message_and_infinities_do_not() {
+    // 1e39 is finite, only too large for an f32, which Rust's parser rounds it to infinity:
+    // it is past the parser's 1e9 like 1e10, and called that, not "not a finite number".
+    let body = format!("{MAT}m 0\ns 0 0 0 1\n");
+    let camera = |position: &str| {
+        format!(
+            "{body}PerspectiveCamera {{\n camera_position 0 {position} 5\n point_of_interest 0 0 0\n angle 30\n}}\n"
+        )
+    };
+    let box_ = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nm 0\nf 1 2 3 4\n";
+    for big in ["1e39", "-1e39", "1e400", "+3.5e38"] {
+        let found = format!("found `{big}`");
+        let magnitude = |what: &str| {
+            [
+                what.to_string(),
+                "of magnitude at most 1e9".into(),
+                found.clone(),
+            ]
+        };
+        let cases: [(String, usize, [String; 3]); 6] = [
+            (
+                format!("{MAT}v 0 {big} 0\n{box_}"),
+                6,
+                magnitude("2nd number of `v`"),
+            ),
+            (
+                format!("material\ndiffuse {big} 1 1\n"),
+                2,
+                magnitude("1st number of `diffuse`"),
+            ),
+            (
+                format!("material\nemitted 1 1 {big}\n"),
+                2,
+                magnitude("3rd number of `emitted`"),
+            ),
+            (camera(big), 9, magnitude("2nd number of `camera_position`")),
+            (
+                format!("{MAT}m 0\ns 0 0 0 {big}\n"),
+                7,
+                magnitude("the radius of `s`"),
+            ),
+            (
+                format!("{body}background_color {big} 0 0\n"),
+                8,
+                magnitude("`background_color`"),
+            ),
+        ];
+        for (text, line, needles) in &cases {
+            let needles: Vec<&str> = needles.iter().map(String::as_str).collect();
+            let msg = error_at(text, *line, &needles);
+            assert!(!msg.contains("finite"), "{msg}");
+        }
+    }
+    // What is spelled infinite or not a number is still called that.
+    for bad in ["inf", "-inf", "+Infinity", "NaN", "-nan"] {
+        let found = format!("found `{bad}`");
+        for (text, line) in [
+            (format!("{MAT}v 0 {bad} 0\n"), 6),
+            (format!("material\ndiffuse {bad} 1 1\n"), 2),
+            (camera(bad), 9),
+            (format!("{MAT}m 0\ns 0 0 0 {bad}\n"), 7),
+        ] {
+            let msg = error_at(&text, line, &["(a finite number)", &found]);
+            assert!(!msg.contains("magnitude"), "{msg}");
+        }
+    }
+}
+
+#[test]
 fn errors_after_a_continuation_name_a_line_of_the_logical_line() {
     // Lines 7-8 form one logical line; the bad number is on line 8 physically. Accept either
     // line of the logical line, but never a later one.

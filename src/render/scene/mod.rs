@@ -12,7 +12,7 @@ pub mod texture;
 mod texture_file;
 
 pub use parse::{
-    ParseError, ParseOptions, RPI_RING_SEGMENTS, SceneError, Warning, parse_scene_in,
+    ParseError, ParseOptions, RPI_RING_SEGMENTS, SceneError, Warning, beyond_range, parse_scene_in,
     parse_scene_str, parse_scene_str_with,
 };
 pub use read::{MAX_SCENE_BYTES, STDIN_NAME, read_capped, read_scene_bytes};

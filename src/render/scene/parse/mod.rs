@@ -225,6 +225,17 @@ pub fn parse_scene_in(
 /// infinite lights.
 pub(super) const MAX_NUMBER: f32 = 1e9;
 
+/// Whether `token`, which Rust's float parser read as an infinity or NaN, is a finite number
+/// past the type's range (`1e39` as an f32, `-1e309` as an f64: the parser rounds those to an
+/// infinity) rather than one spelled infinite or not a number (`inf`, `-Infinity`, `NaN`).
+pub fn beyond_range(token: &str) -> bool {
+    let unsigned = token.strip_prefix(['+', '-']).unwrap_or(token);
+    !["inf", "infinity", "nan"]
+        .iter()
+        .any(|s| unsigned.eq_ignore_ascii_case(s))
+}
+
+/// The one reading of a number in a scene file: an f32 of magnitude at most [`MAX_NUMBER`].
 fn number(file: &str, line: usize, what: &str, token: Option<&str>) -> Result<f32, ParseError> {
     let error = |message: String| ParseError {
         file: file.to_string(),
@@ -234,10 +245,12 @@ fn number(file: &str, line: usize, what: &str, token: Option<&str>) -> Result<f3
     let token =
         token.ok_or_else(|| error(format!("expected {what}, found the end of the line")))?;
     let parsed = token.parse::<f32>();
+    let finite_beyond_f32 = beyond_range(token);
     let token = quote(token);
     match parsed {
         Ok(x) if x.is_finite() && x.abs() <= MAX_NUMBER => Ok(x),
-        Ok(x) if x.is_finite() => Err(error(format!(
+        // Past 1e9, up to past f32's range: the same limit, the same message.
+        Ok(x) if x.is_finite() || finite_beyond_f32 => Err(error(format!(
             "expected {what} of magnitude at most 1e9, found `{token}`"
         ))),
         Ok(_) => Err(error(format!(
