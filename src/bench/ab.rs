@@ -143,6 +143,22 @@ pub struct Rule {
 }
 
 impl Rule {
+    /// The pull-request gate's rule at `threshold_pct`: one-sided, a regression or not.
+    pub fn regression(threshold_pct: f64) -> Rule {
+        Rule {
+            threshold_pct,
+            form: VerdictForm::Regression,
+        }
+    }
+
+    /// `--verdict three-way` at `threshold_pct`: slower, faster or no change beyond it.
+    pub fn three_way(threshold_pct: f64) -> Rule {
+        Rule {
+            threshold_pct,
+            form: VerdictForm::ThreeWay,
+        }
+    }
+
     /// The verdict of an interval [`low`, `high`] of the ratio this / other.
     ///
     /// "Slower by more than t" needs the whole interval above 1 + t (strictly: a low end at
@@ -470,22 +486,6 @@ pub fn exit_code(options: &AbOptions, results: &[EngineAb]) -> u8 {
 mod tests {
     use super::*;
 
-    /// The default rule of `--against`, one-sided, at `threshold_pct`.
-    fn gate(threshold_pct: f64) -> Rule {
-        Rule {
-            threshold_pct,
-            form: VerdictForm::Regression,
-        }
-    }
-
-    /// `--verdict three-way` at `threshold_pct`.
-    fn three_way(threshold_pct: f64) -> Rule {
-        Rule {
-            threshold_pct,
-            form: VerdictForm::ThreeWay,
-        }
-    }
-
     #[test]
     fn verdicts_follow_the_whole_interval() {
         let around = |centre: f64, spread: f64| -> Vec<f64> {
@@ -495,8 +495,8 @@ mod tests {
         };
         let verdicts = |ratios: &[f64]| {
             (
-                summarize(ratios, gate(5.0)).verdict,
-                summarize(ratios, three_way(5.0)).verdict,
+                summarize(ratios, Rule::regression(5.0)).verdict,
+                summarize(ratios, Rule::three_way(5.0)).verdict,
             )
         };
         use Verdict::*;
@@ -510,7 +510,7 @@ mod tests {
         // Too few rounds give an unbounded interval: never a verdict.
         assert_eq!(verdicts(&[2.0; 5]), (Undecided, Undecided));
         assert_eq!(verdicts(&[0.5; 5]), (Undecided, Undecided));
-        let s = summarize(&around(1.10, 0.02), gate(5.0));
+        let s = summarize(&around(1.10, 0.02), Rule::regression(5.0));
         assert!(s.low <= s.median && s.median <= s.high);
     }
 
@@ -524,7 +524,7 @@ mod tests {
     #[test]
     fn the_interval_ends_are_the_sign_tests_order_statistics() {
         let ratios: Vec<f64> = (0..20).rev().map(|i| 1.0 + i as f64 / 64.0).collect();
-        let s = summarize(&ratios, gate(5.0));
+        let s = summarize(&ratios, Rule::regression(5.0));
         assert_eq!(
             (s.low, s.median, s.high),
             (1.0 + 5.0 / 64.0, 1.0 + 9.5 / 64.0, 1.0 + 14.0 / 64.0)
@@ -532,7 +532,7 @@ mod tests {
         assert_eq!(s.verdict, Verdict::Slower);
         let at_low_end = 100.0 * 5.0 / 64.0;
         assert_eq!(1.0 + at_low_end / 100.0, s.low);
-        for rule in [gate(at_low_end), three_way(at_low_end)] {
+        for rule in [Rule::regression(at_low_end), Rule::three_way(at_low_end)] {
             assert_eq!(summarize(&ratios, rule).verdict, Verdict::Undecided);
             let below = Rule {
                 threshold_pct: at_low_end * 0.999,
@@ -543,15 +543,15 @@ mod tests {
         let at_high_end = 100.0 * 14.0 / 64.0;
         assert_eq!(1.0 + at_high_end / 100.0, s.high);
         assert_eq!(
-            summarize(&ratios, gate(at_high_end)).verdict,
+            summarize(&ratios, Rule::regression(at_high_end)).verdict,
             Verdict::NotSlower
         );
         assert_eq!(
-            summarize(&ratios, gate(at_high_end * 0.999)).verdict,
+            summarize(&ratios, Rule::regression(at_high_end * 0.999)).verdict,
             Verdict::Undecided
         );
         assert_eq!(
-            summarize(&ratios, three_way(at_high_end)).verdict,
+            summarize(&ratios, Rule::three_way(at_high_end)).verdict,
             Verdict::Within
         );
     }

@@ -471,22 +471,6 @@ mod tests {
     /// above 0.08, so σ of a ratio's logarithm about 0.15).
     const JITTER: f64 = 0.1;
 
-    /// The default rule of `--against`, one-sided, at `threshold_pct`.
-    fn gate(threshold_pct: f64) -> Rule {
-        Rule {
-            threshold_pct,
-            form: VerdictForm::Regression,
-        }
-    }
-
-    /// `--verdict three-way` at `threshold_pct`.
-    fn three_way(threshold_pct: f64) -> Rule {
-        Rule {
-            threshold_pct,
-            form: VerdictForm::ThreeWay,
-        }
-    }
-
     /// The limit on a one-sided false alarm over [`RUNS`] runs: 2.5% plus the margin.
     fn one_sided_limit() -> f64 {
         ALPHA / 2.0 + margin(ALPHA / 2.0, RUNS)
@@ -500,7 +484,7 @@ mod tests {
     fn peeking_at_95_percent_inflates_false_alarms_and_the_plan_does_not() {
         let plan = LookPlan::new(DEFAULT_MAX_ROUNDS);
         let any_limit = ALPHA + margin(ALPHA, RUNS);
-        for rule in [gate(0.0), three_way(0.0)] {
+        for rule in [Rule::regression(0.0), Rule::three_way(0.0)] {
             let corrected = simulate(&plan, rule, 1.0, RUNS);
             let peeking = simulate(&naive(&plan), rule, 1.0, RUNS);
             println!("A/A at threshold 0, {:?}:", rule.form);
@@ -516,7 +500,7 @@ mod tests {
                 "{peeking:?}"
             );
         }
-        let peeking = simulate(&naive(&plan), three_way(0.0), 1.0, RUNS);
+        let peeking = simulate(&naive(&plan), Rule::three_way(0.0), 1.0, RUNS);
         assert!(
             Tally::rate(peeking.slower + peeking.faster) > any_limit,
             "{peeking:?}"
@@ -528,7 +512,7 @@ mod tests {
     #[test]
     fn a_head_exactly_at_the_threshold_is_rarely_called_a_regression() {
         let plan = LookPlan::new(DEFAULT_MAX_ROUNDS);
-        let tally = simulate(&plan, gate(5.0), 1.05, RUNS);
+        let tally = simulate(&plan, Rule::regression(5.0), 1.05, RUNS);
         println!("exactly 5% slower at threshold 5%: {tally:?}");
         assert!(Tally::rate(tally.slower) <= one_sided_limit(), "{tally:?}");
     }
@@ -551,8 +535,8 @@ mod tests {
     fn a_faster_head_is_cleared_well_before_the_budget() {
         let plan = LookPlan::new(DEFAULT_MAX_ROUNDS);
         for speed in [0.97, 0.95, 0.93] {
-            let one_sided = simulate(&plan, gate(5.0), speed, RUNS);
-            let three = simulate(&plan, three_way(5.0), speed, RUNS);
+            let one_sided = simulate(&plan, Rule::regression(5.0), speed, RUNS);
+            let three = simulate(&plan, Rule::three_way(5.0), speed, RUNS);
             println!(
                 "head {speed} × base at threshold 5%:\n  gate {one_sided:?}\n  three-way {three:?}"
             );
@@ -570,9 +554,9 @@ mod tests {
     #[test]
     fn a_slowdown_past_the_threshold_is_still_caught() {
         let plan = LookPlan::new(DEFAULT_MAX_ROUNDS);
-        let ten = simulate(&plan, gate(5.0), 1.10, RUNS);
-        let fifteen = simulate(&plan, gate(5.0), 1.15, RUNS);
-        let fixed = simulate(&fixed_20(), gate(5.0), 1.15, RUNS);
+        let ten = simulate(&plan, Rule::regression(5.0), 1.10, RUNS);
+        let fifteen = simulate(&plan, Rule::regression(5.0), 1.15, RUNS);
+        let fixed = simulate(&fixed_20(), Rule::regression(5.0), 1.15, RUNS);
         println!("10% slower at threshold 5%: {ten:?}");
         println!("15% slower at threshold 5%: {fifteen:?}\n  20 fixed rounds: {fixed:?}");
         assert!(Tally::rate(ten.slower) >= 0.7, "{ten:?}");
@@ -590,9 +574,9 @@ mod tests {
     #[test]
     fn an_unchanged_build_is_cleared_early_by_the_gate() {
         let plan = LookPlan::new(DEFAULT_MAX_ROUNDS);
-        let one_sided = simulate(&plan, gate(5.0), 1.0, RUNS);
-        let three = simulate(&plan, three_way(5.0), 1.0, RUNS);
-        let fixed = simulate(&fixed_20(), three_way(5.0), 1.0, RUNS);
+        let one_sided = simulate(&plan, Rule::regression(5.0), 1.0, RUNS);
+        let three = simulate(&plan, Rule::three_way(5.0), 1.0, RUNS);
+        let fixed = simulate(&fixed_20(), Rule::three_way(5.0), 1.0, RUNS);
         println!(
             "A/A at threshold 5%:\n  gate {one_sided:?}\n  three-way {three:?}\n  three-way, \
              20 fixed rounds: {fixed:?}"
@@ -616,7 +600,7 @@ mod tests {
     fn decide_stops_at_a_decided_look_or_the_budget() {
         let plan = LookPlan::new(DEFAULT_MAX_ROUNDS);
         // Ratios of 2: slower at the first look, after exactly its rounds, in both forms.
-        for rule in [gate(5.0), three_way(5.0)] {
+        for rule in [Rule::regression(5.0), Rule::three_way(5.0)] {
             let mut asked = Vec::new();
             let outcome = decide(&plan, rule, &mut |at| {
                 asked.push(at);
@@ -631,12 +615,12 @@ mod tests {
         }
         // Ratios of 0.95, 5% faster: not slower at the first look; the three-way form, whose
         // boundary 1/1.05 = 0.952 they lie just below, faster at the first look too.
-        let outcome = decide(&plan, gate(5.0), &mut |_| Ok(Some(0.95))).unwrap();
+        let outcome = decide(&plan, Rule::regression(5.0), &mut |_| Ok(Some(0.95))).unwrap();
         assert_eq!((outcome.verdict(), outcome.rounds), (Verdict::NotSlower, 9));
-        let outcome = decide(&plan, three_way(5.0), &mut |_| Ok(Some(0.95))).unwrap();
+        let outcome = decide(&plan, Rule::three_way(5.0), &mut |_| Ok(Some(0.95))).unwrap();
         assert_eq!((outcome.verdict(), outcome.rounds), (Verdict::Faster, 9));
         // Ratios alternating far above and below the threshold: never decided.
-        for rule in [gate(5.0), three_way(5.0)] {
+        for rule in [Rule::regression(5.0), Rule::three_way(5.0)] {
             let outcome = decide(&plan, rule, &mut |at| {
                 Ok(Some(if at.rounds % 2 == 0 { 10.0 } else { 0.1 }))
             })
@@ -647,7 +631,7 @@ mod tests {
             assert_eq!(outcome.verdict(), Verdict::Undecided);
         }
         // A budget that ends after 30 rounds: the looks before it, then undecided.
-        let outcome = decide(&plan, gate(5.0), &mut |at| {
+        let outcome = decide(&plan, Rule::regression(5.0), &mut |at| {
             Ok((at.rounds < 30).then_some(if at.rounds % 2 == 0 { 10.0 } else { 0.1 }))
         })
         .unwrap();
@@ -656,7 +640,10 @@ mod tests {
         let taken: Vec<u32> = outcome.looks.iter().map(|l| l.rounds).collect();
         assert_eq!(taken, [9, 14, 21]);
         // An error in a round ends the rounds with it.
-        let err = decide(&plan, gate(5.0), &mut |_| anyhow::bail!("build failed")).unwrap_err();
+        let err = decide(&plan, Rule::regression(5.0), &mut |_| {
+            anyhow::bail!("build failed")
+        })
+        .unwrap_err();
         assert!(err.to_string().contains("build failed"));
     }
 }

@@ -28,7 +28,18 @@ fn outputs_there(d: &Path) {
     std::fs::write(d.join("b.pfm"), &pfm).unwrap();
 }
 
+/// A case whose last output is on a full device: exit 1, nothing changed. `render`, `trace`
+/// and `bench` put that command, the scene and a tiny size before the case's own arguments.
 macro_rules! full {
+    ($name:expr, render [$($a:expr),*]) => {
+        full!($name, ["render", "cornell_box.obj", "--size", "8", "8", "-q", $($a),*])
+    };
+    ($name:expr, trace [$($a:expr),*]) => {
+        full!($name, ["trace-pixel", "1", "1", "cornell_box.obj", "--size", "8", "8", $($a),*])
+    };
+    ($name:expr, bench [$($a:expr),*]) => {
+        full!($name, ["bench", "cornell_box.obj", "--size", "8", "8", "--runs", "1", "-q", $($a),*])
+    };
     ($name:expr, [$($a:expr),*]) => {
         Case {
             name: $name,
@@ -43,156 +54,25 @@ macro_rules! full {
 }
 
 #[test]
+#[rustfmt::skip]
 fn a_run_that_fails_on_one_output_changes_none() {
     check_all(&[
-        full!(
-            "render: --hdr on a full device after -o",
-            [
-                "render",
-                "cornell_box.obj",
-                "--size",
-                "8",
-                "8",
-                "-q",
-                "-o",
-                "x.png",
-                "--hdr",
-                "/dev/full"
-            ]
-        ),
-        full!(
-            "render: --stats-json on a full device after -o and --hdr",
-            [
-                "render",
-                "cornell_box.obj",
-                "--size",
-                "8",
-                "8",
-                "-q",
-                "-o",
-                "x.png",
-                "--hdr",
-                "x.pfm",
-                "--stats-json",
-                "/dev/full"
-            ]
-        ),
-        full!(
-            "render: --stats-json on a symlink to a full device",
-            [
-                "render",
-                "cornell_box.obj",
-                "--size",
-                "8",
-                "8",
-                "-q",
-                "-o",
-                "x.png",
-                "--stats-json",
-                "full.json"
-            ]
-        ),
-        full!(
-            "trace-pixel: --obj on a full device after --json",
-            [
-                "trace-pixel",
-                "1",
-                "1",
-                "cornell_box.obj",
-                "--size",
-                "8",
-                "8",
-                "--json",
-                "t.json",
-                "--obj",
-                "/dev/full"
-            ]
-        ),
-        full!(
-            "trace-pixel: --ply on a full device after --json and --obj",
-            [
-                "trace-pixel",
-                "1",
-                "1",
-                "cornell_box.obj",
-                "--size",
-                "8",
-                "8",
-                "--json",
-                "t.json",
-                "--obj",
-                "t.obj",
-                "--ply",
-                "/dev/full"
-            ]
-        ),
-        full!(
-            "trace-pixel: --png on a full device after the three others",
-            [
-                "trace-pixel",
-                "1",
-                "1",
-                "cornell_box.obj",
-                "--size",
-                "8",
-                "8",
-                "--json",
-                "t.json",
-                "--obj",
-                "t.obj",
-                "--ply",
-                "t.ply",
-                "--png",
-                "/dev/full"
-            ]
-        ),
-        full!(
-            "bench: --export-csv on a full device after --json",
-            [
-                "bench",
-                "cornell_box.obj",
-                "--size",
-                "8",
-                "8",
-                "--runs",
-                "1",
-                "-q",
-                "--json",
-                "b.json",
-                "--export-csv",
-                "/dev/full"
-            ]
-        ),
-        full!(
-            "bench: --export-markdown on a full device after --json and --export-csv",
-            [
-                "bench",
-                "cornell_box.obj",
-                "--size",
-                "8",
-                "8",
-                "--runs",
-                "1",
-                "-q",
-                "--json",
-                "b.json",
-                "--export-csv",
-                "b.csv",
-                "--export-markdown",
-                "/dev/full"
-            ]
-        ),
-        full!(
-            "diff: --json on a full device after --out",
-            [
-                "diff",
-                "a.pfm",
-                "b.pfm",
-                "--out",
-                "d.png",
-                "--json",
-                "/dev/full"
-            ]
-        ),
+        full!("render: --hdr on a full device after -o", render ["-o", "x.png", "--hdr", "/dev/full"]),
+        full!("render: --stats-json on a full device after -o and --hdr",
+            render ["-o", "x.png", "--hdr", "x.pfm", "--stats-json", "/dev/full"]),
+        full!("render: --stats-json on a symlink to a full device",
+            render ["-o", "x.png", "--stats-json", "full.json"]),
+        full!("trace-pixel: --obj on a full device after --json",
+            trace ["--json", "t.json", "--obj", "/dev/full"]),
+        full!("trace-pixel: --ply on a full device after --json and --obj",
+            trace ["--json", "t.json", "--obj", "t.obj", "--ply", "/dev/full"]),
+        full!("trace-pixel: --png on a full device after the three others",
+            trace ["--json", "t.json", "--obj", "t.obj", "--ply", "t.ply", "--png", "/dev/full"]),
+        full!("bench: --export-csv on a full device after --json",
+            bench ["--json", "b.json", "--export-csv", "/dev/full"]),
+        full!("bench: --export-markdown on a full device after --json and --export-csv",
+            bench ["--json", "b.json", "--export-csv", "b.csv", "--export-markdown", "/dev/full"]),
+        full!("diff: --json on a full device after --out",
+            ["diff", "a.pfm", "b.pfm", "--out", "d.png", "--json", "/dev/full"]),
     ]);
 }

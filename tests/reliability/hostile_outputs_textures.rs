@@ -44,7 +44,18 @@ fn textured_and_images(d: &Path) {
 /// What every case's stderr says.
 const TEXTURE: &str = "is the same file as the input SCENE's texture_file";
 
+/// A case that must be refused (exit 2) with every file left as it was. `render`, `trace` and
+/// `bench` put that command, the scene and a tiny size before the case's own arguments.
 macro_rules! case {
+    ($name:expr, render [$($a:expr),*]) => {
+        case!($name, ["render", "tx/ok.obj", "--size", "8", "8", "-q", $($a),*])
+    };
+    ($name:expr, trace [$($a:expr),*]) => {
+        case!($name, ["trace-pixel", "1", "1", "tx/ok.obj", "--size", "8", "8", $($a),*])
+    };
+    ($name:expr, bench [$($a:expr),*]) => {
+        case!($name, ["bench", "tx/ok.obj", "--size", "8", "8", "--runs", "1", "-q", $($a),*])
+    };
     ($name:expr, [$($a:expr),*]) => {
         case!($name, textured, [$($a),*], [TEXTURE])
     };
@@ -61,227 +72,45 @@ macro_rules! case {
     };
 }
 
-const RENDER: [&str; 6] = ["render", "tx/ok.obj", "--size", "8", "8", "-q"];
-
 #[test]
+#[rustfmt::skip]
 fn no_output_is_a_texture_the_scene_reads() {
+    const PENUMBRA: &str = "is the same file as the input --scene's texture_file";
     check_all(&[
-        case!(
-            "render -o is the texture",
-            [
-                RENDER[0],
-                RENDER[1],
-                RENDER[2],
-                RENDER[3],
-                RENDER[4],
-                RENDER[5],
-                "-o",
-                "tx/ok.ppm"
-            ]
-        ),
-        case!(
-            "render -o is the texture through ..",
-            [
-                RENDER[0],
-                RENDER[1],
-                RENDER[2],
-                RENDER[3],
-                RENDER[4],
-                RENDER[5],
-                "-o",
-                "tx/sub/../ok.ppm"
-            ]
-        ),
-        case!(
-            "render -o is a symlink to the texture",
-            [
-                RENDER[0], RENDER[1], RENDER[2], RENDER[3], RENDER[4], RENDER[5], "-o", "link.png"
-            ]
-        ),
-        case!(
-            "render -input, -o is the texture",
-            ["-input", "tx/ok.obj", "-size", "8", "8", "-o", "tx/ok.ppm"]
-        ),
-        case!(
-            "render --hdr is a symlink to the texture",
-            [
-                RENDER[0], RENDER[1], RENDER[2], RENDER[3], RENDER[4], RENDER[5], "-o", "x.png",
-                "--hdr", "link.pfm"
-            ]
-        ),
-        case!(
-            "render --stats-json is the texture",
-            [
-                RENDER[0],
-                RENDER[1],
-                RENDER[2],
-                RENDER[3],
-                RENDER[4],
-                RENDER[5],
-                "-o",
-                "x.png",
-                "--stats-json",
-                "tx/ok.ppm"
-            ]
-        ),
-        case!(
-            "render --stats-json is the texture through ..",
-            [
-                RENDER[0],
-                RENDER[1],
-                RENDER[2],
-                RENDER[3],
-                RENDER[4],
-                RENDER[5],
-                "-o",
-                "x.png",
-                "--stats-json",
-                "tx/sub/../ok.ppm"
-            ]
-        ),
-        case!(
-            "trace-pixel --json is the texture",
-            [
-                "trace-pixel",
-                "1",
-                "1",
-                "tx/ok.obj",
-                "--size",
-                "8",
-                "8",
-                "--json",
-                "tx/ok.ppm"
-            ]
-        ),
-        case!(
-            "trace-pixel --obj is the texture through ..",
-            [
-                "trace-pixel",
-                "1",
-                "1",
-                "tx/ok.obj",
-                "--size",
-                "8",
-                "8",
-                "--obj",
-                "tx/sub/../ok.ppm"
-            ]
-        ),
-        case!(
-            "trace-pixel --ply is the texture",
-            [
-                "trace-pixel",
-                "1",
-                "1",
-                "tx/ok.obj",
-                "--size",
-                "8",
-                "8",
-                "--ply",
-                "tx/ok.ppm"
-            ]
-        ),
-        case!(
-            "trace-pixel --png is a symlink to the texture",
-            [
-                "trace-pixel",
-                "1",
-                "1",
-                "tx/ok.obj",
-                "--size",
-                "8",
-                "8",
-                "--png",
-                "link.png"
-            ]
-        ),
-        case!(
-            "bench --json is the texture",
-            [
-                "bench",
-                "tx/ok.obj",
-                "--size",
-                "8",
-                "8",
-                "--runs",
-                "1",
-                "-q",
-                "--json",
-                "tx/ok.ppm"
-            ]
-        ),
-        case!(
-            "bench --export-csv is a symlink to the texture",
-            [
-                "bench",
-                "tx/ok.obj",
-                "--size",
-                "8",
-                "8",
-                "--runs",
-                "1",
-                "-q",
-                "--export-csv",
-                "link.csv"
-            ]
-        ),
-        case!(
-            "bench --export-markdown is the texture through ..",
-            [
-                "bench",
-                "tx/ok.obj",
-                "--size",
-                "8",
-                "8",
-                "--runs",
-                "1",
-                "-q",
-                "--export-markdown",
-                "tx/sub/../ok.ppm"
-            ]
-        ),
-        case!(
-            "diff --out is the texture of the penumbra scene",
-            textured_and_images,
-            [
-                "diff",
-                "a.pfm",
-                "b.pfm",
-                "--mask",
-                "penumbra",
-                "--scene",
-                "tx/ok.obj",
-                "--mask-samples",
-                "4",
-                "--out",
-                "tx/ok.ppm"
-            ],
-            ["is the same file as the input --scene's texture_file"]
-        ),
-        case!(
-            "diff --json is a symlink to the texture of the penumbra scene",
-            textured_and_images,
-            [
-                "diff",
-                "a.pfm",
-                "b.pfm",
-                "--mask",
-                "penumbra",
-                "--scene",
-                "tx/ok.obj",
-                "--mask-samples",
-                "4",
-                "--json",
-                "link.json"
-            ],
-            ["is the same file as the input --scene's texture_file"]
-        ),
+        case!("render -o is the texture", render ["-o", "tx/ok.ppm"]),
+        case!("render -o is the texture through ..", render ["-o", "tx/sub/../ok.ppm"]),
+        case!("render -o is a symlink to the texture", render ["-o", "link.png"]),
+        case!("render -input, -o is the texture",
+            ["-input", "tx/ok.obj", "-size", "8", "8", "-o", "tx/ok.ppm"]),
+        case!("render --hdr is a symlink to the texture",
+            render ["-o", "x.png", "--hdr", "link.pfm"]),
+        case!("render --stats-json is the texture",
+            render ["-o", "x.png", "--stats-json", "tx/ok.ppm"]),
+        case!("render --stats-json is the texture through ..",
+            render ["-o", "x.png", "--stats-json", "tx/sub/../ok.ppm"]),
+        case!("trace-pixel --json is the texture", trace ["--json", "tx/ok.ppm"]),
+        case!("trace-pixel --obj is the texture through ..", trace ["--obj", "tx/sub/../ok.ppm"]),
+        case!("trace-pixel --ply is the texture", trace ["--ply", "tx/ok.ppm"]),
+        case!("trace-pixel --png is a symlink to the texture", trace ["--png", "link.png"]),
+        case!("bench --json is the texture", bench ["--json", "tx/ok.ppm"]),
+        case!("bench --export-csv is a symlink to the texture", bench ["--export-csv", "link.csv"]),
+        case!("bench --export-markdown is the texture through ..",
+            bench ["--export-markdown", "tx/sub/../ok.ppm"]),
+        case!("diff --out is the texture of the penumbra scene", textured_and_images,
+            ["diff", "a.pfm", "b.pfm", "--mask", "penumbra", "--scene", "tx/ok.obj",
+             "--mask-samples", "4", "--out", "tx/ok.ppm"],
+            [PENUMBRA]),
+        case!("diff --json is a symlink to the texture of the penumbra scene", textured_and_images,
+            ["diff", "a.pfm", "b.pfm", "--mask", "penumbra", "--scene", "tx/ok.obj",
+             "--mask-samples", "4", "--json", "link.json"],
+            [PENUMBRA]),
     ]);
 }
 
 /// A variance report file that is the texture: the report's `--out` directory holds the
 /// scene's texture under the name of one of the report's files.
 #[test]
+#[rustfmt::skip]
 fn no_variance_report_file_is_a_texture() {
     check_all(&[case!(
         "variance --out holds the texture under a report file's name",
@@ -294,28 +123,9 @@ fn no_variance_report_file_is_a_texture() {
             std::fs::create_dir_all(d.join("tx/report")).unwrap();
             std::fs::copy(d.join("tx/ok.ppm"), d.join("tx/report/table.txt")).unwrap();
         },
-        [
-            "variance",
-            "tx/ok.obj",
-            "--size",
-            "8",
-            "8",
-            "--budgets",
-            "1",
-            "--samplers",
-            "random",
-            "--seeds",
-            "2",
-            "--reference-samples",
-            "4",
-            "--mask-samples",
-            "4",
-            "--cache",
-            "cache",
-            "--out",
-            "tx/report",
-            "-q"
-        ],
+        ["variance", "tx/ok.obj", "--size", "8", "8", "--budgets", "1", "--samplers", "random",
+         "--seeds", "2", "--reference-samples", "4", "--mask-samples", "4", "--cache", "cache",
+         "--out", "tx/report", "-q"],
         ["is the same file as the input case", "texture_file"]
     )]);
 }
