@@ -29,15 +29,6 @@ pub struct ViewPlacement {
 }
 
 impl ViewPlacement {
-    /// The default: the render's eye orbited by [`DEFAULT_ORBIT_DEGREES`].
-    pub fn default_orbit() -> ViewPlacement {
-        ViewPlacement {
-            from: None,
-            orbit_degrees: DEFAULT_ORBIT_DEGREES,
-            distance: 1.0,
-        }
-    }
-
     /// The debug camera for a render camera: same point of interest, up axis and field of view.
     /// Errors when the eye lands on the point of interest or on its up axis through it (no
     /// view direction, or none the up axis can orient).
