@@ -77,7 +77,7 @@ pub const DEFAULT_MAX_ROUNDS: u32 = 200;
 pub const ALPHA: f64 = 0.05;
 
 /// Each planned look after the first comes at ⌈GROWTH × the previous look's rounds⌉.
-pub const GROWTH: f64 = 1.5;
+pub(crate) const GROWTH: f64 = 1.5;
 
 /// How long `--until-decided` may go on, per run of the command.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -246,7 +246,6 @@ pub fn decide(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bench::ab::VerdictForm;
     use crate::output::statistics::median_interval_rank_at;
     use rand::rngs::Xoshiro256PlusPlus;
     use rand::{RngExt, SeedableRng};

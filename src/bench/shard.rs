@@ -32,10 +32,10 @@ use std::path::{Path, PathBuf};
 pub const PART_FORMAT: &str = "raywave-bench-shard";
 
 /// The layout version of part files, bumped when the payload's layout changes.
-pub const PART_VERSION: u32 = 1;
+pub(crate) const PART_VERSION: u32 = 1;
 
 /// The largest part file `read_part` reads (a record of 1000 runs is about 1 MiB).
-pub const MAX_PART_BYTES: u64 = 512 << 20;
+pub(crate) const MAX_PART_BYTES: u64 = 512 << 20;
 
 /// The estimated cost of timing one point: the rays its renders cast (camera rays, and a
 /// shadow ray per light and shadow point, at every pixel; bounces and anti-aliasing are the
@@ -177,7 +177,7 @@ pub struct Part {
 /// of those bytes as written. (The type gives the JSON Schema; the payload itself is written
 /// and read as raw bytes, so that the checksum covers exactly them.)
 #[derive(Serialize, Deserialize, JsonSchema)]
-pub struct PartFile {
+pub(crate) struct PartFile {
     /// Always `raywave-bench-shard`.
     #[schemars(extend("const" = PART_FORMAT))]
     pub format: String,

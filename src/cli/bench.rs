@@ -147,7 +147,7 @@ pub struct BenchArgs {
 
 /// Which engines `raywave bench` times.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum BenchEngine {
+pub(crate) enum BenchEngine {
     /// The SIMD wavefront engine only.
     Wavefront,
     /// The scalar reference only.
@@ -169,7 +169,7 @@ impl BenchEngine {
 
 /// `raywave bench compare` and `raywave bench list`.
 #[derive(Subcommand, Debug, Clone)]
-pub enum BenchAction {
+pub(crate) enum BenchAction {
     /// Compare two saved records (B against A) by the verdict rule; exit 3 if B regressed.
     Compare(CompareArgs),
     /// List the saved records: name, date, commit, scene, settings, threads, total medians.
@@ -238,7 +238,7 @@ impl MergeArgs {
 
 /// Flags of `raywave bench compare`.
 #[derive(Args, Debug, Clone)]
-pub struct CompareArgs {
+pub(crate) struct CompareArgs {
     /// The earlier record: a name in --dir, or a path ending in .json.
     pub a: String,
     /// The later record, judged against A.
@@ -253,7 +253,7 @@ pub struct CompareArgs {
 
 /// Flags of `raywave bench list`.
 #[derive(Args, Debug, Clone)]
-pub struct ListArgs {
+pub(crate) struct ListArgs {
     /// Directory of saved records.
     #[arg(long, default_value = ".raywave-bench")]
     pub dir: PathBuf,

@@ -19,7 +19,7 @@ use std::path::{Path, PathBuf};
 
 /// `--metric` on the command line.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum MetricArg {
+pub(crate) enum MetricArg {
     /// Mean squared error.
     Mse,
     /// Relative MSE: mean (a−b)²/(b+0.01)² (pbrt-v4's MRSE).

@@ -146,7 +146,7 @@ const SUBCOMMANDS: &[&str] = &[
 
 /// argv rewritten for clap, and the notes to print on stderr.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Normalized {
+pub(crate) struct Normalized {
     /// The arguments clap reads.
     pub args: Vec<OsString>,
     /// One line each for flags accepted without effect (printed with a `note:` prefix).

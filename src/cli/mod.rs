@@ -22,7 +22,7 @@ use clap::{ArgMatches, CommandFactory, FromArgMatches, Parser, Subcommand};
 /// raywave: a SIMD wavefront ray tracer for the lab's Cornell-box scenes.
 #[derive(Parser, Debug)]
 #[command(name = "raywave", version, about, long_about = None)]
-pub struct Cli {
+pub(crate) struct Cli {
     /// What to do (default: render).
     #[command(subcommand)]
     pub command: Command,

@@ -52,7 +52,7 @@ pub struct VarianceArgs {
 
 /// The subcommands of `raywave variance`.
 #[derive(Subcommand, Debug, Clone)]
-pub enum VarianceAction {
+pub(crate) enum VarianceAction {
     /// Render every case's converged reference into --cache, so that the shards of a study
     /// find it there instead of racing to render it.
     Prepare(PrepareArgs),
@@ -64,7 +64,7 @@ pub enum VarianceAction {
 
 /// Flags of `raywave variance prepare`.
 #[derive(Args, Debug, Clone)]
-pub struct PrepareArgs {
+pub(crate) struct PrepareArgs {
     /// What to study.
     #[command(flatten)]
     pub study: StudyArgs,
@@ -88,7 +88,7 @@ pub struct MergeArgs {
 
 /// What a study measures and where: the scenes or a study file, and the measuring flags.
 #[derive(Args, Debug, Clone)]
-pub struct StudyArgs {
+pub(crate) struct StudyArgs {
     /// Scene files; without one, the built-in lab Cornell box with mirror spheres.
     pub scenes: Vec<PathBuf>,
     /// A study file (TOML: scenes, samplers, budgets, seeds, sizes, ...; docs/SAMPLING.md and

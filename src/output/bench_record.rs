@@ -293,7 +293,7 @@ impl KindRates {
 }
 
 /// `rays` per thread-second of `time`: `None` without rays or time.
-pub fn per_thread_second(rays: u64, time: std::time::Duration) -> Option<f64> {
+pub(crate) fn per_thread_second(rays: u64, time: std::time::Duration) -> Option<f64> {
     let seconds = time.as_secs_f64();
     (rays > 0 && seconds > 0.0).then(|| rays as f64 / seconds)
 }
@@ -370,7 +370,7 @@ pub fn record_path(dir: &Path, name: &str) -> Result<std::path::PathBuf> {
 }
 
 /// The largest record file `load` reads (a record of 1000 runs is about 1 MiB).
-pub const MAX_RECORD_BYTES: u64 = 64 << 20;
+pub(crate) const MAX_RECORD_BYTES: u64 = 64 << 20;
 
 /// Reads a saved record; a missing file says how to make one.
 pub fn load(path: &Path, name: &str) -> Result<BenchRecord> {
@@ -429,7 +429,8 @@ pub fn save(path: &Path, record: &BenchRecord) -> Result<()> {
 }
 
 /// Seconds since the Unix epoch as RFC 3339 UTC (`2026-11-22T20:13:01Z`), by `humantime`.
-pub fn rfc3339_utc(unix_seconds: u64) -> String {
+#[cfg(test)]
+pub(crate) fn rfc3339_utc(unix_seconds: u64) -> String {
     let t = std::time::UNIX_EPOCH + std::time::Duration::from_secs(unix_seconds);
     humantime::format_rfc3339_seconds(t).to_string()
 }

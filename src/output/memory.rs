@@ -10,19 +10,19 @@
 use anyhow::{Result, bail};
 
 /// Bytes per pixel of the linear film (three `f32`).
-pub const FILM_BYTES_PER_PIXEL: u64 = 12;
+pub(crate) const FILM_BYTES_PER_PIXEL: u64 = 12;
 /// Bytes per pixel of the tone-mapped 8-bit copy.
-pub const RGB8_BYTES_PER_PIXEL: u64 = 3;
+pub(crate) const RGB8_BYTES_PER_PIXEL: u64 = 3;
 /// The process before any image: code, the thread pool, stacks, the scene's small arrays
 /// (a 512² PFM render peaks at 10.9 MiB, of which 3 MiB is the film).
-pub const BASE_BYTES: u64 = 8 << 20;
+pub(crate) const BASE_BYTES: u64 = 8 << 20;
 /// Per pixel, for encoder buffers and the allocator's rounding: keeps the estimate above the
 /// measured peaks (PNG at 4096² was within 1 % of film + 8-bit copy + base).
-pub const SLACK_BYTES_PER_PIXEL: u64 = 1;
+pub(crate) const SLACK_BYTES_PER_PIXEL: u64 = 1;
 /// Per triangle or sphere, the scene arrays and both engines' BVH copies.
-pub const BYTES_PER_PRIMITIVE: u64 = 400;
+pub(crate) const BYTES_PER_PRIMITIVE: u64 = 400;
 /// Per camera sample of a wavefront tile (rays, hits, shadow queue, radiance, next rays).
-pub const WORKSPACE_BYTES_PER_SAMPLE: u64 = 512;
+pub(crate) const WORKSPACE_BYTES_PER_SAMPLE: u64 = 512;
 
 /// What a render holds at its peak.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -43,7 +43,7 @@ pub struct RenderFootprint {
 
 impl RenderFootprint {
     /// The estimated peak in bytes: an upper bound of the measured peak.
-    pub fn peak_bytes(&self) -> u64 {
+    pub(crate) fn peak_bytes(&self) -> u64 {
         let per_pixel = FILM_BYTES_PER_PIXEL
             + SLACK_BYTES_PER_PIXEL
             + if self.rgb8 { RGB8_BYTES_PER_PIXEL } else { 0 }
@@ -143,7 +143,7 @@ pub fn parse_size(s: &str) -> Result<u64, String> {
 }
 
 /// Bytes for people: `1.5 GiB`, `300 MiB`.
-pub fn format_bytes(bytes: u64) -> String {
+pub(crate) fn format_bytes(bytes: u64) -> String {
     let mib = bytes as f64 / (1u64 << 20) as f64;
     if mib >= 1024.0 {
         format!("{:.1} GiB", mib / 1024.0)

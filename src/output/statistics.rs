@@ -87,7 +87,7 @@ pub const OUTLIER_Z: f64 = 14.0;
 /// median absolute deviation: robust, since neither the median nor the MAD moves much with one
 /// wild value. When the MAD is 0 (most values equal), a value equal to the median scores 0 and
 /// any other ±∞. NaN values score NaN.
-pub fn modified_z_scores(xs: &[f64]) -> Vec<f64> {
+pub(crate) fn modified_z_scores(xs: &[f64]) -> Vec<f64> {
     let m = median(xs);
     let deviations: Vec<f64> = xs.iter().map(|x| (x - m).abs()).collect();
     let mad = median(&deviations);

@@ -23,7 +23,7 @@ pub fn progress_bar(len: u64, template: &str, quiet: bool) -> ProgressBar {
 /// Writes `text` to standard output and flushes it. A closed pipe (`raywave ... | head`) or a
 /// full disk is an error, so that `main` exits 1 with a message instead of panicking as
 /// `println!` does.
-pub fn write_stdout(text: &str) -> std::io::Result<()> {
+pub(crate) fn write_stdout(text: &str) -> std::io::Result<()> {
     let mut out = std::io::stdout().lock();
     out.write_all(text.as_bytes())?;
     out.flush()

@@ -575,7 +575,7 @@ impl Agreement {
 
 /// Relative distance tolerance under which two hits on different triangles count as one hit
 /// on their shared edge.
-pub const EDGE_T_TOLERANCE: f32 = 1e-4;
+pub(crate) const EDGE_T_TOLERANCE: f32 = 1e-4;
 
 /// Under this distance a hit that one engine reports counts as agreeing with whatever the other
 /// reports (a miss, or a hit farther on): a ray that starts on the edge where two faces meet (a

@@ -22,9 +22,9 @@ use glam::Vec3;
 use std::f32::consts::PI;
 
 /// Latitude bands of a tessellated sphere.
-pub const SPHERE_RINGS: u32 = 12;
+pub(crate) const SPHERE_RINGS: u32 = 12;
 /// Longitude steps of a tessellated sphere.
-pub const SPHERE_SEGMENTS: u32 = 24;
+pub(crate) const SPHERE_SEGMENTS: u32 = 24;
 
 /// One named group.
 #[derive(Clone, Debug, PartialEq)]

@@ -291,7 +291,7 @@ pub struct Row {
 
 /// A sampler's name (an alias, so that serde's derive does not take the field for a borrow of
 /// the input and tie rows to a `'static` input).
-pub type SamplerName = &'static str;
+pub(crate) type SamplerName = &'static str;
 
 /// A sampler's name as the `&'static str` a [`Row`] holds.
 fn sampler_name<'de, D: serde::Deserializer<'de>>(d: D) -> Result<&'static str, D::Error> {
@@ -364,7 +364,7 @@ pub fn run_study(
 
 impl StudyResult {
     /// The smallest MSE measured in a region, to compare with the reference's own error.
-    pub fn smallest_mse(&self, region: Region) -> f64 {
+    pub(crate) fn smallest_mse(&self, region: Region) -> f64 {
         self.rows
             .iter()
             .filter(|r| r.region == region && r.stats.mse > 0.0)

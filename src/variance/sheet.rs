@@ -22,13 +22,13 @@ use std::path::Path;
 /// Tiles are enlarged by a whole factor until their shorter side reaches this many pixels.
 pub const MIN_TILE: u32 = 128;
 /// Width of the row labels on the left.
-pub const LABEL_WIDTH: u32 = 110;
+pub(crate) const LABEL_WIDTH: u32 = 110;
 /// Height of the title.
 pub const TITLE_HEIGHT: u32 = 34;
 /// Height of the column headers.
-pub const HEADER_HEIGHT: u32 = 24;
+pub(crate) const HEADER_HEIGHT: u32 = 24;
 /// Space between and around tiles.
-pub const GAP: u32 = 8;
+pub(crate) const GAP: u32 = 8;
 
 /// The sheet of `images[row][col]` (all of one size), `rows` and `cols` labelling them.
 pub fn contact_sheet(

@@ -20,10 +20,10 @@ use subtle::ConstantTimeEq;
 const RANDOM_BYTES: usize = 24;
 
 /// The shortest token `--token` accepts.
-pub const MIN_LEN: usize = 16;
+pub(crate) const MIN_LEN: usize = 16;
 
 /// The longest token `--token` accepts.
-pub const MAX_LEN: usize = 256;
+pub(crate) const MAX_LEN: usize = 256;
 
 /// The secret every request must carry.
 #[derive(Clone, PartialEq, Eq)]

@@ -92,7 +92,7 @@ pub struct Rays<V = f32x8> {
 }
 
 /// Eight rays in registers.
-pub type Rays8 = Rays<f32x8>;
+pub(crate) type Rays8 = Rays<f32x8>;
 
 impl<V: Lanes> Rays<V> {
     /// Loads rays `i..i + N` (padding past the end with NaN directions).
