@@ -22,7 +22,6 @@ pub mod ab;
 mod ab_report;
 pub(crate) mod adopt;
 pub mod compare;
-pub(crate) mod continuous;
 pub mod export;
 pub mod list;
 pub(crate) mod measure;

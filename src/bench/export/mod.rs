@@ -1,0 +1,91 @@
+//! `raywave bench`'s exports, one file per format behind [`Format`]: `--export-json` (the
+//! whole records), `--export-csv` and `--export-markdown` (every point's headline figures:
+//! median, its 95% interval, min, max), and for continuous-benchmarking services `--export-bmf`
+//! and `--export-github-action-benchmark` (their naming in continuous.rs). [`Exports`] writes
+//! the ones asked for, for `raywave bench` and `raywave bench merge` alike. A new format is a new
+//! file, a field of [`Exports`] and a line of [`FORMATS`].
+
+mod bmf;
+mod continuous;
+mod csv;
+mod github_action_benchmark;
+mod json;
+mod markdown;
+
+use crate::output::bench_record::BenchRecord;
+use anyhow::Result;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// One export format: the flag that asks for it and the file it writes.
+trait Format: Sync {
+    /// The flag, e.g. `--export-csv`.
+    fn flag(&self) -> &'static str;
+    /// The file's text for every point's record; `labels[i]` names point i, `by_host` adds the
+    /// host to every row and name.
+    fn text(&self, records: &[BenchRecord], labels: &[String], by_host: bool) -> Result<String>;
+}
+
+/// Every format, in the order of [`Exports`]' fields.
+const FORMATS: [&dyn Format; 5] = [
+    &json::Json,
+    &csv::Csv,
+    &markdown::Markdown,
+    &bmf::Bmf,
+    &github_action_benchmark::GithubActionBenchmark,
+];
+
+/// Where each export goes (`--export-*`; `-` is standard output), `None` when not asked for.
+#[derive(Clone, Debug, Default)]
+pub struct Exports {
+    /// `--export-json`: the records as a JSON array.
+    pub json: Option<PathBuf>,
+    /// `--export-csv`: one row per point, engine and figure.
+    pub csv: Option<PathBuf>,
+    /// `--export-markdown`: a table for a pull request.
+    pub markdown: Option<PathBuf>,
+    /// `--export-bmf`: Bencher Metric Format.
+    pub bmf: Option<PathBuf>,
+    /// `--export-github-action-benchmark`: github-action-benchmark's `customBiggerIsBetter`.
+    pub github_action_benchmark: Option<PathBuf>,
+}
+
+impl Exports {
+    /// Each export asked for, with its flag.
+    pub fn flags(&self) -> Vec<(&'static str, &Path)> {
+        self.asked()
+            .into_iter()
+            .map(|(format, path)| (format.flag(), path))
+            .collect()
+    }
+
+    /// Writes every export asked for, each atomically. `labels[i]` names point i; `by_host`
+    /// adds the host to every row and name (points measured on several machines).
+    pub fn write(&self, records: &[BenchRecord], labels: &[String], by_host: bool) -> Result<()> {
+        for (format, path) in self.asked() {
+            write(path, &format.text(records, labels, by_host)?)?;
+        }
+        Ok(())
+    }
+
+    /// Each export asked for: its format and its path, in flag order.
+    fn asked(&self) -> Vec<(&'static dyn Format, &Path)> {
+        let paths = [
+            &self.json,
+            &self.csv,
+            &self.markdown,
+            &self.bmf,
+            &self.github_action_benchmark,
+        ];
+        FORMATS
+            .into_iter()
+            .zip(paths)
+            .filter_map(|(format, path)| Some((format, path.as_deref()?)))
+            .collect()
+    }
+}
+
+/// Writes `text` to `path` through `crate::output` (atomically; `-` is standard output).
+pub(crate) fn write(path: &Path, text: &str) -> Result<()> {
+    crate::output::write_output(path, |w| Ok(w.write_all(text.as_bytes())?))
+}
