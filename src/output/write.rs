@@ -30,17 +30,18 @@ use std::os::unix::fs::FileTypeExt;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
-/// An output written in full and not yet at its target.
-enum Held {
-    /// A regular file's temporary file, renamed over `real` at the commit.
-    Rename {
-        tmp: tempfile::NamedTempFile,
-        real: PathBuf,
-        /// The path as the user gave it, for messages.
-        shown: PathBuf,
-    },
-    /// A device's, FIFO's or standard output's bytes, copied to it at the commit.
-    Direct { bytes: File, shown: PathBuf },
+/// A regular output written in full to its temporary file, renamed over `real` at the commit.
+struct HeldRename {
+    tmp: tempfile::NamedTempFile,
+    real: PathBuf,
+    /// The path as the user gave it, for messages.
+    shown: PathBuf,
+}
+
+/// A device's, FIFO's or standard output's bytes, copied to it at the commit.
+struct HeldDirect {
+    bytes: File,
+    shown: PathBuf,
 }
 
 /// What the process's outputs are doing now.
@@ -50,18 +51,40 @@ struct Outputs {
     temporaries: Vec<PathBuf>,
     /// Outputs wait for [`commit_outputs`] (set by [`hold_outputs`]).
     holding: bool,
-    /// The outputs waiting, in the order they were written.
-    held: Vec<Held>,
+    /// The regular outputs waiting, in the order they were written.
+    renames: Vec<HeldRename>,
+    /// The direct outputs waiting, in the order they were written.
+    direct: Vec<HeldDirect>,
 }
 
 static OUTPUTS: Mutex<Outputs> = Mutex::new(Outputs {
     temporaries: Vec::new(),
     holding: false,
-    held: Vec::new(),
+    renames: Vec::new(),
+    direct: Vec::new(),
 });
 
 fn outputs() -> std::sync::MutexGuard<'static, Outputs> {
     OUTPUTS.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+impl Outputs {
+    /// Forgets a temporary file that is renamed or dropped.
+    fn unregister(&mut self, tmp: &Path) {
+        self.temporaries.retain(|p| p != tmp);
+    }
+
+    /// Drops the regular outputs in `renames` (their temporary files are removed) and returns
+    /// the paths they would have replaced.
+    fn drop_renames(&mut self, renames: impl IntoIterator<Item = HeldRename>) -> Vec<String> {
+        renames
+            .into_iter()
+            .map(|held| {
+                self.unregister(held.tmp.path());
+                held.shown.display().to_string()
+            })
+            .collect()
+    }
 }
 
 /// From now on, outputs are written in full but reach their targets only at
@@ -73,59 +96,46 @@ pub fn hold_outputs() {
 /// Puts every held output in place: the direct ones first, then the renames. Outputs written
 /// after this are held again (the process stays in holding mode).
 pub fn commit_outputs() -> Result<()> {
-    let held = std::mem::take(&mut outputs().held);
-    let (direct, renames): (Vec<Held>, Vec<Held>) = held
-        .into_iter()
-        .partition(|h| matches!(h, Held::Direct { .. }));
+    let (direct, renames) = {
+        let mut state = outputs();
+        (
+            std::mem::take(&mut state.direct),
+            std::mem::take(&mut state.renames),
+        )
+    };
     // Without the lock: a FIFO may wait for its reader, and the signal handler must still be
     // able to remove the held temporary files meanwhile.
-    let copied = direct.into_iter().try_for_each(|held| match held {
-        Held::Direct { mut bytes, shown } => copy_direct(&mut bytes, &shown),
-        Held::Rename { .. } => Ok(()),
-    });
+    let copied = direct
+        .into_iter()
+        .try_for_each(|mut held| copy_direct(&mut held.bytes, &held.shown));
     let mut state = outputs();
-    let unregister = |state: &mut Outputs, tmp: &Path| state.temporaries.retain(|p| p != tmp);
     if let Err(e) = copied {
-        for held in renames {
-            if let Held::Rename { tmp, .. } = held {
-                unregister(&mut state, tmp.path());
-            }
-        }
+        state.drop_renames(renames);
         return Err(e.context("no file output was changed"));
     }
     let mut replaced = Vec::new();
     let mut renames = renames.into_iter();
-    while let Some(Held::Rename { tmp, real, shown }) = renames.next() {
+    while let Some(HeldRename { tmp, real, shown }) = renames.next() {
         let tmp_path = tmp.path().to_path_buf();
-        match tmp.persist(&real) {
-            Ok(_) => {
-                unregister(&mut state, &tmp_path);
-                replaced.push(shown.display().to_string());
-            }
-            Err(e) => {
-                unregister(&mut state, &tmp_path);
-                let kept: Vec<String> = std::iter::once(shown.display().to_string())
-                    .chain(renames.filter_map(|h| match h {
-                        Held::Rename { tmp, shown, .. } => {
-                            unregister(&mut state, tmp.path());
-                            Some(shown.display().to_string())
-                        }
-                        Held::Direct { .. } => None,
-                    }))
-                    .collect();
-                let replaced = if replaced.is_empty() {
-                    "none".to_string()
-                } else {
-                    replaced.join(", ")
-                };
-                bail!(
-                    "cannot move the finished file to {}: {}; outputs replaced: {replaced}; left as they were: {}",
-                    shown.display(),
-                    e.error,
-                    kept.join(", ")
-                );
-            }
+        let persisted = tmp.persist(&real);
+        state.unregister(&tmp_path);
+        if let Err(e) = persisted {
+            let kept = std::iter::once(shown.display().to_string())
+                .chain(state.drop_renames(renames))
+                .collect::<Vec<_>>()
+                .join(", ");
+            let replaced = if replaced.is_empty() {
+                "none".to_string()
+            } else {
+                replaced.join(", ")
+            };
+            bail!(
+                "cannot move the finished file to {}: {}; outputs replaced: {replaced}; left as they were: {kept}",
+                shown.display(),
+                e.error,
+            );
         }
+        replaced.push(shown.display().to_string());
     }
     Ok(())
 }
@@ -134,12 +144,9 @@ pub fn commit_outputs() -> Result<()> {
 /// were.
 pub fn discard_outputs() {
     let mut state = outputs();
-    for held in std::mem::take(&mut state.held) {
-        if let Held::Rename { tmp, .. } = held {
-            let path = tmp.path().to_path_buf();
-            state.temporaries.retain(|p| p != &path);
-        }
-    }
+    state.direct.clear();
+    let renames = std::mem::take(&mut state.renames);
+    state.drop_renames(renames);
 }
 
 /// Copies a held direct output to its target.
@@ -233,7 +240,7 @@ pub fn write_output(
     match target(path) {
         Target::Regular(real) => {
             let tmp = write_temporary(path, &real, fill)?;
-            outputs().held.push(Held::Rename {
+            outputs().renames.push(HeldRename {
                 tmp,
                 real,
                 shown: path.to_path_buf(),
@@ -243,7 +250,7 @@ pub fn write_output(
             let mut bytes =
                 tempfile::tempfile().context("cannot create a temporary file to hold an output")?;
             write_direct(&mut bytes, &path.display().to_string(), fill)?;
-            outputs().held.push(Held::Direct {
+            outputs().direct.push(HeldDirect {
                 bytes,
                 shown: path.to_path_buf(),
             });
@@ -333,7 +340,7 @@ fn write_atomically(
     // Renamed under the lock: a signal now waits for the rename, and finds nothing to remove.
     let mut state = outputs();
     let persisted = tmp.persist(real);
-    state.temporaries.retain(|p| p != &tmp_path);
+    state.unregister(&tmp_path);
     persisted.with_context(|| format!("cannot move the finished file to {}", path.display()))?;
     Ok(())
 }
@@ -379,7 +386,7 @@ fn write_temporary(
         let tmp_path = tmp.path().to_path_buf();
         let mut state = outputs();
         drop(tmp);
-        state.temporaries.retain(|p| p != &tmp_path);
+        state.unregister(&tmp_path);
         return Err(e);
     }
     Ok(tmp)
