@@ -346,9 +346,6 @@ fn output_plan(args: &BenchArgs, points: &[raywave::bench::sweep::Point]) -> Out
     if let Some(scene) = args.scene.as_ref().or(args.input.as_ref()) {
         plan = plan.input("SCENE", scene);
     }
-    if let Some(other) = &args.against {
-        plan = plan.input("--against", other);
-    }
     // `--compare X --save X` is the rolling baseline, by design: X is read whole before any
     // timing, and replaced only when this run did not regress against it.
     if let Some(Ok(path)) = args
@@ -483,16 +480,6 @@ pub fn run(args: &BenchArgs, matches: Option<&ArgMatches>) -> Result<u8> {
              --shadow-samples and one --threads"
         ))
         .into());
-    }
-    // The other build reads the scene itself; its textures are held against the outputs here.
-    if let Some(scene) = options
-        .scene
-        .as_ref()
-        .filter(|s| !raywave::output::is_stdio(s))
-    {
-        let scene =
-            raywave::render::scene::load_scene(Some(scene), &options.image.parse_options())?;
-        options.plan.check_scene_files("SCENE", &scene.scene)?;
     }
     let options = AbOptions {
         other: other.clone(),
