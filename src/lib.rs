@@ -61,6 +61,10 @@ pub mod render;
 #[cfg(feature = "tools")]
 pub mod output;
 
+// What the tools share that is not an output: sharding a command's work and merging its parts.
+#[cfg(feature = "tools")]
+pub mod shard;
+
 // The tools built on both, one folder per command.
 #[cfg(feature = "tools")]
 pub mod bench;

@@ -2,9 +2,8 @@
 //! together, with the reports, exports and saved records of the sweep run whole.
 //!
 //! ```text
-//! read every part (whole, checksum, consistent with itself; errors name the file)
-//! refuse: shard counts that disagree; another SIMD path; another build; another sweep; a shard
-//!         missing or twice; more than one machine without --across-machines
+//! crate::shard::merge: every part read and checked, alone and against the others; more
+//!                      than one machine refused without --across-machines
 //! records in sweep order (grouped by host with --across-machines); --save; the exports
 //! ```
 //!
@@ -13,14 +12,14 @@
 //! and then every report, row and exported name carries its host, the points grouped by host.
 
 use super::export::Exports;
-use super::shard::{Part, read_part};
+use super::shard::SweepPoints;
 use super::sweep::record_name;
 use crate::output::OutputPlan;
 use crate::output::bench_record::{self as record, BenchRecord};
-use crate::output::machine::Machine;
-use anyhow::{Result, bail};
+use crate::shard::{HostSummary, Machines};
+use anyhow::Result;
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// What `raywave bench merge` is asked to do (its flags, as plain values).
 #[derive(Clone, Debug)]
@@ -37,24 +36,6 @@ pub struct MergeOptions {
     pub across_machines: bool,
 }
 
-/// A machine that ran shards: its host name and CPU.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Host {
-    /// Host name.
-    pub hostname: String,
-    /// CPU model.
-    pub cpu: String,
-}
-
-impl Host {
-    fn of(m: &Machine) -> Host {
-        Host {
-            hostname: m.hostname.clone(),
-            cpu: m.cpu.clone(),
-        }
-    }
-}
-
 /// What a merge put together.
 #[derive(Debug)]
 pub struct Merged {
@@ -62,17 +43,10 @@ pub struct Merged {
     pub records: Vec<BenchRecord>,
     /// Each record's point label.
     pub labels: Vec<String>,
-    /// Each record's host, an index into `hosts`.
+    /// Each record's host, an index into `shards.hosts`.
     pub host_of: Vec<usize>,
-    /// The machines, in the order of the first point each ran.
-    pub hosts: Vec<Host>,
-    /// The part files, by shard index.
-    pub parts: Vec<(PathBuf, Part)>,
-    /// Seconds of benching, summed over the shards.
-    pub wall_seconds: f64,
-    /// Seconds from the first shard's start to the last one's end (clocks of different
-    /// machines may disagree).
-    pub elapsed_seconds: f64,
+    /// The parts and the machines that ran them (their records are in `records`).
+    pub shards: crate::shard::Merged<SweepPoints>,
     /// The records saved.
     pub saved: Vec<PathBuf>,
     /// Whether the outputs are grouped by host.
@@ -81,191 +55,34 @@ pub struct Merged {
 
 /// Reads and checks the parts, then saves and exports the merged sweep as asked.
 pub fn merge(args: &MergeOptions) -> Result<Merged> {
-    let mut parts = Vec::new();
-    let paths = crate::output::shard::expand_parts(
-        &args.parts,
-        |n| n.starts_with("bench-shard-") && n.ends_with(".json"),
-        "bench shard parts (bench-shard-I-of-N.json)",
-    )?;
-    for path in &paths {
-        parts.push((path.clone(), read_part(path)?));
-    }
-    let Some((first_path, first)) = parts.first() else {
-        bail!("nothing to merge: expected the part files of `raywave bench --shard I/N`");
+    let machines = if args.across_machines {
+        Machines::Any
+    } else {
+        Machines::One {
+            unless: "--across-machines",
+        }
     };
-    let shown = |p: &Path| p.display().to_string();
-    let count = first.shard.count;
-    if let Some((p, part)) = parts.iter().find(|(_, q)| q.shard.count != count) {
-        bail!(
-            "the parts disagree on the number of shards: {} is shard {}, {} is shard {}; \
-             expected the N shards of one `--shard I/N` split",
-            shown(first_path),
-            first.shard,
-            shown(p),
-            part.shard
-        );
-    }
-    for (p, part) in &parts[1..] {
-        let (a, b) = (shown(first_path), shown(p));
-        let build =
-            first
-                .sweep
-                .build_differences(&part.sweep, &format!("in {a}"), &format!("in {b}"));
-        // The SIMD path first: binaries built for two CPUs (`target-cpu=native` on two kinds of
-        // node) can share a commit and differ only there, and their kernels are not the same.
-        if first.sweep.simd != part.sweep.simd {
-            bail!(
-                "{a} and {b} were run by binaries with different SIMD paths, {} and {}, so \
-                 their figures do not time the same kernels:\n  {}\nrun every shard with one \
-                 build (for nodes of several CPUs, one built for the oldest: docs/SCALING.md)",
-                first.sweep.simd,
-                part.sweep.simd,
-                build.join("\n  ")
-            );
-        }
-        if !build.is_empty() {
-            bail!(
-                "{a} and {b} come from different raywave builds, so their figures do not \
-                 describe the same code:\n  {}\nrun every shard with one build",
-                build.join("\n  ")
-            );
-        }
-        let sweep =
-            first
-                .sweep
-                .sweep_differences(&part.sweep, &format!("in {a}"), &format!("in {b}"));
-        if !sweep.is_empty() {
-            bail!(
-                "{a} and {b} are shards of different sweeps:\n  {}\nrun every shard with the \
-                 same scene and flags (give --threads when the machines' core counts differ)",
-                sweep.join("\n  ")
-            );
-        }
-    }
-    let mut by_index: Vec<Option<usize>> = vec![None; count];
-    for (k, (p, part)) in parts.iter().enumerate() {
-        if let Some(j) = by_index[part.shard.index] {
-            bail!(
-                "shard {} is given twice: {} and {}; expected each shard once",
-                part.shard,
-                shown(&parts[j].0),
-                shown(p)
-            );
-        }
-        by_index[part.shard.index] = Some(k);
-    }
-    let missing: Vec<String> = (0..count)
-        .filter(|&i| by_index[i].is_none())
-        .map(|i| format!("{i}/{count}"))
-        .collect();
-    if !missing.is_empty() {
-        let given: Vec<String> = parts
-            .iter()
-            .map(|(p, part)| format!("{} ({})", shown(p), part.shard))
-            .collect();
-        bail!(
-            "shard(s) {} missing: got {}; run `raywave bench` with the same flags and \
-             --shard {} to make it",
-            missing.join(", "),
-            given.join(", "),
-            missing[0]
-        );
-    }
-    let mut parts: Vec<(PathBuf, Part)> = {
-        let mut v: Vec<Option<(PathBuf, Part)>> = parts.into_iter().map(Some).collect();
-        by_index
-            .iter()
-            .filter_map(|k| k.and_then(|k| v[k].take()))
-            .collect()
-    };
-
-    let mut hosts: Vec<Host> = Vec::new();
-    let mut point_host = vec![0usize; parts[0].1.sweep.points.len()];
-    let mut order: Vec<usize> = (0..point_host.len()).collect();
-    for (_, part) in &parts {
-        let h = Host::of(&part.host);
-        let at = hosts.iter().position(|x| *x == h).unwrap_or_else(|| {
-            hosts.push(h);
-            hosts.len() - 1
-        });
-        for &i in &part.points {
-            point_host[i] = at;
-        }
-    }
-    if hosts.len() > 1 && !args.across_machines {
-        let ran: Vec<String> = parts
-            .iter()
-            .map(|(p, part)| format!("{} on {} ({})", shown(p), part.host.hostname, part.host.cpu))
-            .collect();
-        bail!(
-            "the parts were measured on {} machines:\n  {}\nrates of different machines are \
-             not one machine's figures: run every shard on one machine, or give \
-             --across-machines to merge them with every point labelled and grouped by host",
-            hosts.len(),
-            ran.join("\n  ")
-        );
-    }
+    let mut shards = crate::shard::merge::<SweepPoints>(&args.parts, machines)?;
     let by_host = args.across_machines;
+    let sweep = shards.identity().work.clone();
+    // In sweep order, or grouped by host (hosts in the order of their first point, each
+    // host's points in sweep order).
+    let mut order: Vec<usize> = (0..sweep.points.len()).collect();
     if by_host {
-        // Hosts in the order of their first point, each host's points in sweep order.
-        hosts = {
-            let mut first_point: Vec<(usize, usize)> = (0..hosts.len())
-                .map(|h| {
-                    (
-                        point_host
-                            .iter()
-                            .position(|&x| x == h)
-                            .unwrap_or(usize::MAX),
-                        h,
-                    )
-                })
-                .collect();
-            first_point.sort();
-            let renumber: Vec<usize> = {
-                let mut r = vec![0; hosts.len()];
-                for (new, &(_, old)) in first_point.iter().enumerate() {
-                    r[old] = new;
-                }
-                r
-            };
-            for h in &mut point_host {
-                *h = renumber[*h];
-            }
-            first_point
-                .iter()
-                .map(|&(_, old)| hosts[old].clone())
-                .collect()
-        };
-        order.sort_by_key(|&i| (point_host[i], i));
+        order.sort_by_key(|&i| (shards.item_host[i], i));
     }
-
-    let mut slots: Vec<Option<BenchRecord>> = vec![None; point_host.len()];
-    for (_, part) in &mut parts {
-        for (&i, r) in part.points.iter().zip(std::mem::take(&mut part.records)) {
-            slots[i] = Some(r);
-        }
-    }
-    let sweep = &parts[0].1.sweep;
+    let mut slots: Vec<Option<BenchRecord>> = std::mem::take(&mut shards.results)
+        .into_iter()
+        .map(Some)
+        .collect();
     let mut records = Vec::new();
     let mut labels = Vec::new();
     let mut host_of = Vec::new();
     for &i in &order {
-        let Some(r) = slots[i].take() else {
-            bail!("no shard ran point {i} of the sweep: the parts are inconsistent");
-        };
-        records.push(r);
+        records.extend(slots[i].take());
         labels.push(sweep.points[i].label.clone());
-        host_of.push(point_host[i]);
+        host_of.push(shards.item_host[i]);
     }
-
-    let time = |s: &str| humantime::parse_rfc3339(s).ok();
-    let wall_seconds = parts.iter().map(|(_, p)| p.seconds).sum();
-    let start = parts.iter().filter_map(|(_, p)| time(&p.started)).min();
-    let end = parts.iter().filter_map(|(_, p)| time(&p.finished)).max();
-    let elapsed_seconds = match (start, end) {
-        (Some(s), Some(e)) => e.duration_since(s).map_or(0.0, |d| d.as_secs_f64()),
-        _ => 0.0,
-    };
 
     // Every output is checked against the parts and each other before anything is written.
     let mut to_save = Vec::new();
@@ -281,7 +98,7 @@ pub fn merge(args: &MergeOptions) -> Result<Merged> {
         }
     }
     let mut plan = OutputPlan::new();
-    for (p, _) in &parts {
+    for (p, _) in &shards.parts {
         plan = plan.input("PARTS", p);
     }
     for p in &to_save {
@@ -295,16 +112,12 @@ pub fn merge(args: &MergeOptions) -> Result<Merged> {
         record::save(path, r)?;
     }
     args.exports.write(&records, &labels, by_host)?;
-    let saved = to_save;
     Ok(Merged {
         records,
         labels,
         host_of,
-        hosts,
-        parts,
-        wall_seconds,
-        elapsed_seconds,
-        saved,
+        shards,
+        saved: to_save,
         by_host,
     })
 }
@@ -322,7 +135,8 @@ impl Merged {
                     let _ = writeln!(
                         out,
                         "\nhost    {} · {}",
-                        self.hosts[h].hostname, self.hosts[h].cpu
+                        self.hosts()[h].hostname,
+                        self.hosts()[h].cpu
                     );
                     host = Some(h);
                 }
@@ -339,17 +153,23 @@ impl Merged {
         let _ = writeln!(
             out,
             "merged  {} shard(s), {} point(s) of one sweep, measured on {} host(s)",
-            self.parts.len(),
+            self.shards.parts.len(),
             self.records.len(),
-            self.hosts.len()
+            self.hosts().len()
         );
-        for (path, part) in &self.parts {
-            let points = if part.labels.is_empty() {
+        let sweep = &self.shards.identity().work;
+        for (path, part) in &self.shards.parts {
+            let labels: Vec<&str> = part
+                .items
+                .iter()
+                .map(|&i| sweep.points[i].label.as_str())
+                .collect();
+            let points = if labels.is_empty() {
                 "no points".to_string()
-            } else if part.labels.iter().all(|l| l.is_empty()) {
-                format!("{} point(s)", part.labels.len())
+            } else if labels.iter().all(|l| l.is_empty()) {
+                format!("{} point(s)", labels.len())
             } else {
-                part.labels.join(", ")
+                labels.join(", ")
             };
             let _ = writeln!(
                 out,
@@ -358,18 +178,24 @@ impl Merged {
                 path.display(),
                 points,
                 part.host.hostname,
-                part.seconds
+                part.host.seconds()
             );
         }
-        for h in &self.hosts {
+        for h in self.hosts() {
             let _ = writeln!(out, "  host {}: {}", h.hostname, h.cpu);
         }
         let _ = writeln!(
             out,
             "time    {:.2} s of benching summed over the shards, {:.2} s elapsed from the \
              first start to the last end",
-            self.wall_seconds, self.elapsed_seconds
+            self.shards.summed_seconds(),
+            self.shards.elapsed_seconds()
         );
         out
+    }
+
+    /// The machines that ran the shards, in the order of the first point each ran.
+    pub fn hosts(&self) -> &[HostSummary] {
+        &self.shards.hosts
     }
 }

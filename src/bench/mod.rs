@@ -98,7 +98,7 @@ pub struct BenchOptions {
     /// Write every point's headline figures as github-action-benchmark's JSON to this file.
     pub export_github_action_benchmark: Option<PathBuf>,
     /// Time only this shard's points and write them to a part file in this directory.
-    pub shard: Option<(crate::output::shard::Shard, PathBuf)>,
+    pub shard: Option<(crate::shard::Shard, PathBuf)>,
     /// The flags given on the command line (clap ids: `size`, `threads`, `engine`, ...):
     /// with `--compare`, every other setting comes from the record.
     pub explicit: Vec<String>,
@@ -119,7 +119,7 @@ pub struct Outcome {
     /// The comparison and the record compared with, if asked for.
     pub comparison: Option<(compare::Comparison, BenchRecord)>,
     /// With `--shard`: the part file written, and the shard and point count of the sweep.
-    pub part: Option<(PathBuf, crate::output::shard::Shard, usize)>,
+    pub part: Option<(PathBuf, crate::shard::Shard, usize)>,
 }
 
 impl Outcome {
@@ -267,10 +267,7 @@ pub fn run(args: &BenchOptions, hooks: &Hooks) -> Result<Outcome> {
     let sweep_points = plans.len();
     let shard_run = match &args.shard {
         Some((which, dir)) => {
-            let identity = shard::SweepIdentity {
-                raywave: env!("CARGO_PKG_VERSION").to_string(),
-                build: build.clone(),
-                simd: simd.clone(),
+            let sweep = shard::SweepPoints {
                 engines: args.engines.iter().map(|e| e.name().to_string()).collect(),
                 runs: args.runs,
                 warmup: args.warmup,
@@ -283,7 +280,8 @@ pub fn run(args: &BenchOptions, hooks: &Hooks) -> Result<Outcome> {
                     })
                     .collect(),
             };
-            let mine = which.items(&identity.costs());
+            let identity = crate::shard::Identity::current(&simd, sweep);
+            let mine = which.items(&crate::shard::Work::costs(&identity.work));
             plans = plans
                 .into_iter()
                 .enumerate()
@@ -294,7 +292,7 @@ pub fn run(args: &BenchOptions, hooks: &Hooks) -> Result<Outcome> {
         }
         None => None,
     };
-    let started = (shard::now_millis(), std::time::Instant::now());
+    let host = crate::shard::Host::start(rayon::current_num_threads());
 
     if let Some(w) = report::load_warning() {
         (hooks.notice)(&format!("warning: {w}"));
@@ -391,19 +389,17 @@ pub fn run(args: &BenchOptions, hooks: &Hooks) -> Result<Outcome> {
     }
     .write(&records, &labels, false)?;
     let part = match shard_run {
-        Some((which, dir, sweep, points)) => {
-            let part = shard::Part {
-                sweep,
+        Some((which, dir, identity, points)) => {
+            let mut part = crate::shard::Part {
+                identity,
                 shard: which,
-                points,
-                labels: labels.clone(),
-                host: Machine::current(),
-                started: started.0,
-                finished: shard::now_millis(),
-                seconds: started.1.elapsed().as_secs_f64(),
-                records: records.clone(),
+                items: points,
+                host,
+                extra: (),
+                results: records.clone(),
             };
-            Some((shard::write_part(dir, &part)?, which, sweep_points))
+            part.host.finish();
+            Some((crate::shard::write_part(dir, &part)?, which, sweep_points))
         }
         None => None,
     };

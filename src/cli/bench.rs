@@ -11,15 +11,16 @@ use raywave::bench::ab::{self, AbOptions, MIN_ROUNDS};
 use raywave::bench::export::Exports;
 use raywave::bench::merge::{self, MergeOptions};
 use raywave::bench::sequential;
-use raywave::bench::shard::part_name;
+use raywave::bench::shard::SweepPoints;
 use raywave::bench::sweep::{Sweep, record_name};
 use raywave::bench::{BenchOptions, DEFAULT_RUNS, DEFAULT_THRESHOLD_PCT, EXIT_REGRESSION, list};
 use raywave::output::OutputPlan;
 use raywave::output::bench_record::record_path;
 use raywave::output::memory::{self, RenderFootprint};
-use raywave::output::shard::Shard;
 use raywave::render::engine::{Engine, Hooks};
 use raywave::render::error::UsageError;
+use raywave::shard::Shard;
+use raywave::shard::part_name;
 use std::path::PathBuf;
 
 /// Flags of `raywave bench`. A scene file literally named `compare` or `list` is given as
@@ -132,7 +133,7 @@ pub struct BenchArgs {
     #[arg(long, value_name = "FILE", conflicts_with = "against")]
     pub export_github_action_benchmark: Option<PathBuf>,
     /// Time only shard I of N of the sweep's points (0-based; split by estimated cost) and
-    /// write them to DIR/bench-shard-I-of-N.json for `raywave bench merge`.
+    /// write them to DIR/bench-shard-I-of-N.part for `raywave bench merge`.
     #[arg(long, value_name = "I/N", requires = "out",
           conflicts_with_all = ["against", "save", "compare", "json", "export_json", "export_csv",
           "export_markdown", "export_bmf", "export_github_action_benchmark"])]
@@ -182,7 +183,7 @@ pub(crate) enum BenchAction {
 /// Flags of `raywave bench merge`.
 #[derive(Args, Debug, Clone)]
 pub struct MergeArgs {
-    /// The part files (DIR/bench-shard-I-of-N.json), or directories holding them: every shard
+    /// The part files (DIR/bench-shard-I-of-N.part), or directories holding them: every shard
     /// of one sweep once.
     #[arg(required = true, value_name = "PARTS")]
     pub parts: Vec<PathBuf>,
@@ -379,7 +380,7 @@ fn output_plan(args: &BenchArgs, points: &[raywave::bench::sweep::Point]) -> Out
         }
     }
     if let (Some(shard), Some(dir)) = (args.shard, &args.out) {
-        plan = plan.output_in_new_dir("--out", &dir.join(part_name(shard)));
+        plan = plan.output_in_new_dir("--out", &dir.join(part_name::<SweepPoints>(shard)));
     }
     plan
 }

@@ -6,12 +6,12 @@ use super::values::{EngineArg, LightModelArg, SamplerArg};
 use anyhow::Result;
 use clap::{Args, Subcommand};
 use raywave::output::OutputPlan;
-use raywave::output::shard::Shard;
 use raywave::output::terminal::{print, progress_bar};
 use raywave::render::engine::{Hooks, clamped_warning};
 use raywave::render::scene::Scene;
 use raywave::render::settings::RenderSettings;
 use raywave::render::wavefront::DEFAULT_BATCH_SIZE;
+use raywave::shard::Shard;
 use raywave::variance::command::{VarianceOptions, load_cases, prepare, run_shard, study};
 use raywave::variance::plan::Case;
 use std::path::{Path, PathBuf};
@@ -30,7 +30,7 @@ pub struct VarianceArgs {
     /// Directory for the report: table.txt, results.csv, seeds.csv, perceived.csv,
     /// spectra.csv, results.json, mse.png, contact_sheet.png, the heat maps and the spectra
     /// (with several cases, one directory per case and summary.txt/.csv/.json); with --shard,
-    /// the directory of the shard's part, shard-I-of-N.part.
+    /// the directory of the shard's part, variance-shard-I-of-N.part.
     #[arg(long, default_value = "variance-report")]
     pub out: PathBuf,
     /// Run only shard I of N (0-based: 0/4 to 3/4) and write its part into --out, for a batch
@@ -78,7 +78,7 @@ pub(crate) struct PrepareArgs {
 /// Flags of `raywave variance merge`.
 #[derive(Args, Debug, Clone)]
 pub struct MergeArgs {
-    /// The shards' part files, or directories holding them (their *.part files).
+    /// The shards' part files, or directories holding them (their variance-shard-*.part files).
     #[arg(required = true, value_name = "PARTS")]
     pub parts: Vec<PathBuf>,
     /// Directory for the report (not one of the inputs).
@@ -275,12 +275,16 @@ pub fn run(args: &VarianceArgs) -> Result<()> {
     let pool = args.workers.pool()?;
     let plan = args.study.inputs(&options, OutputPlan::new());
     if let Some(shard) = args.shard {
-        let part = options.out.join(raywave::variance::part::file_name(shard));
+        let part = options
+            .out
+            .join(raywave::shard::part_name::<raywave::variance::plan::Study>(
+                shard,
+            ));
         let plan = plan.output_in_new_dir("--out", &part);
         plan.check()?;
         check_textures(&plan, &cases)?;
         let identity = raywave::variance::plan::identity(&cases, options.engine.name());
-        let jobs = identity.assignment(shard.count)[shard.index].len();
+        let jobs = identity.work.assignment(shard.count)[shard.index].len();
         let prefix = format!("variance shard {shard}, {jobs} jobs");
         let (path, jobs) = with_progress(&options, prefix, |render, hooks| {
             pool.install(|| run_shard(&options, &cases, shard, render, hooks))
@@ -298,6 +302,7 @@ pub fn run(args: &VarianceArgs) -> Result<()> {
     plan.check()?;
     check_textures(&plan, &cases)?;
     let jobs = raywave::variance::plan::identity(&cases, options.engine.name())
+        .work
         .jobs()
         .len();
     let prefix = format!("variance, {jobs} jobs");

@@ -1,17 +1,17 @@
 //! `raywave variance`: the study as a command (options, checks, outputs); the flags, the
 //! progress bar and the printed table are the binary's (`cli/variance.rs`).
 
+use super::job_record::JobRecord;
 use super::jobs::{self, CaseFacts, Job, JobResult, Setup};
-use super::part::{Host, JobRecord, Part};
-use super::plan::{Case, StudyIdentity, case_names, identity};
+use super::plan::{Case, Study, case_names, identity};
 use super::summary::Summary;
 use super::{Cache, Region, RenderFn, StudyConfig};
-use crate::output::shard::Shard;
 use crate::render::engine::{Engine, Hooks};
 use crate::render::error::UsageError;
 use crate::render::sampling::LightSampler;
 use crate::render::scene::{ParseOptions, SceneFile, load_scene};
 use crate::render::settings::{LightModel, RenderSettings, ShadowMode};
+use crate::shard::{Host, Identity, Part, Shard, Work};
 use anyhow::{Context, Result, bail};
 use std::path::{Path, PathBuf};
 
@@ -277,14 +277,14 @@ impl Progress<'_> {
 /// returns per case touched its number, facts and results.
 fn run_selected(
     cases: &[Case],
-    identity: &StudyIdentity,
+    identity: &Identity<Study>,
     selected: &[usize],
     cache: Option<&Cache>,
     render: &RenderFn,
     hooks: &Hooks,
 ) -> Result<Vec<(usize, CaseFacts, Vec<JobResult>)>> {
-    let all = identity.jobs();
-    let costs = identity.costs();
+    let all = identity.work.jobs();
+    let costs = identity.work.costs();
     let progress = Progress {
         done: std::cell::Cell::new(0.0),
         total: selected.iter().map(|&j| costs[j]).sum(),
@@ -362,7 +362,7 @@ pub fn study(
     create_out(&options.out)?;
     let cache = open_cache(options, hooks.notice);
     let identity = identity(cases, options.engine.name());
-    let selected: Vec<usize> = (0..identity.jobs().len()).collect();
+    let selected: Vec<usize> = (0..identity.work.jobs().len()).collect();
     let ran = run_selected(cases, &identity, &selected, cache.as_ref(), render, hooks)?;
     let threads = rayon::current_num_threads();
     let results = ran
@@ -447,40 +447,26 @@ pub fn run_shard(
     create_out(&options.out)?;
     let cache = open_cache(options, hooks.notice);
     let identity = identity(cases, options.engine.name());
-    let assignment = identity.assignment(shard.count);
+    let assignment = identity.work.assignment(shard.count);
     let selected = &assignment[shard.index];
-    let started = unix_now();
+    let host = Host::start(rayon::current_num_threads());
     let ran = run_selected(cases, &identity, selected, cache.as_ref(), render, hooks)?;
     let mut part = Part {
         identity,
         shard,
-        jobs: selected.clone(),
-        host: Host {
-            hostname: crate::output::machine::hostname(),
-            cpu: crate::output::machine::cpu_model(),
-            threads: rayon::current_num_threads(),
-            started,
-            finished: 0.0,
-        },
-        cases: Vec::new(),
+        items: selected.clone(),
+        host,
+        extra: Vec::new(),
         results: Vec::new(),
     };
     for (c, facts, results) in ran {
-        part.cases.push((c, cases[c].scene.source.clone(), facts));
+        part.extra.push((c, cases[c].scene.source.clone(), facts));
         part.results
             .extend(results.into_iter().map(JobRecord::from));
     }
-    part.host.finished = unix_now();
-    let path = options.out.join(super::part::file_name(shard));
-    super::part::write(&path, &part)?;
+    part.host.finish();
+    let path = crate::shard::write_part(&options.out, &part)?;
     Ok((path, selected.len()))
-}
-
-/// Seconds since the Unix epoch.
-pub(crate) fn unix_now() -> f64 {
-    std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map_or(0.0, |d| d.as_secs_f64())
 }
 
 /// Fills the cache with the converged reference of every case (`raywave variance prepare`);

@@ -1,21 +1,21 @@
 //! A study over several cases (scene × image size), its identity and its job list: what every
-//! shard of a study computes alike, and what a merge checks its parts against.
+//! shard of a study computes alike, and what a merge checks its parts against. The study is
+//! the variance command's sharded work (`crate::shard::Work`).
 //!
 //! ```text
 //! cases    = scenes × sizes, named by the scene's file stem (and the size, given several)
-//! identity = format, raywave build (version, commit, SIMD path; the executable's hash when the
-//!            tree was dirty), engine, per case: name, scene bytes' hash, lights, settings
+//! identity = crate::shard::Identity: the raywave build, and the Study: the engine and per
+//!            case its name, scene bytes' hash, lights and settings
 //! jobs     = per case in order: budgets × samplers (jobs::case_jobs), numbered across cases
-//! shard i  = output::shard::partition(costs of the jobs, count)[i]
+//! shard i  = crate::shard::partition(costs of the jobs, count)[i]
 //! ```
 
 use super::StudyConfig;
-use super::jobs::{self, Job};
+use super::job_record::JobRecord;
+use super::jobs::{self, CaseFacts, Job};
 use crate::render::scene::Scene;
+use crate::shard::{Identity, Work};
 use serde::{Deserialize, Serialize};
-
-/// Bumped when the parts' layout or the meaning of a study's identity changes.
-pub const PART_FORMAT: u32 = 1;
 
 /// One case of a study: a scene at one size.
 pub struct Case {
@@ -29,15 +29,9 @@ pub struct Case {
     pub config: StudyConfig,
 }
 
-/// What makes two runs parts of the same study.
+/// What makes two runs parts of the same study, besides the build.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct StudyIdentity {
-    /// [`PART_FORMAT`].
-    pub format: u32,
-    /// raywave's version, commit and SIMD path.
-    pub build: String,
-    /// FNV-1a of the running executable, when its commit does not identify it (a dirty tree).
-    pub executable: Option<String>,
+pub struct Study {
     /// The engine rendering the images.
     pub engine: String,
     /// The cases, in order.
@@ -57,37 +51,9 @@ pub struct CaseIdentity {
     pub config: StudyConfig,
 }
 
-/// The build as an identity names it.
-fn build() -> (String, Option<String>) {
-    let info = crate::output::build_info::current();
-    let build = format!(
-        "raywave {} commit {} simd {}",
-        env!("CARGO_PKG_VERSION"),
-        info.commit,
-        crate::simd_path()
-    );
-    // Read and hashed once per process: the command line and the study both ask.
-    static EXECUTABLE: std::sync::OnceLock<String> = std::sync::OnceLock::new();
-    let executable = (info.dirty != Some(false)).then(|| {
-        EXECUTABLE
-            .get_or_init(|| {
-                std::env::current_exe().and_then(std::fs::read).map_or_else(
-                    |_| "unreadable".to_string(),
-                    |b| crate::render::digest::hex(&b),
-                )
-            })
-            .clone()
-    });
-    (build, executable)
-}
-
 /// The identity of a study of `cases` rendered by `engine`.
-pub fn identity(cases: &[Case], engine: &str) -> StudyIdentity {
-    let (build, executable) = build();
-    StudyIdentity {
-        format: PART_FORMAT,
-        build,
-        executable,
+pub fn identity(cases: &[Case], engine: &str) -> Identity<Study> {
+    let study = Study {
         engine: engine.to_string(),
         cases: cases
             .iter()
@@ -98,10 +64,11 @@ pub fn identity(cases: &[Case], engine: &str) -> StudyIdentity {
                 config: c.config.clone(),
             })
             .collect(),
-    }
+    };
+    Identity::current(crate::simd_path(), study)
 }
 
-impl StudyIdentity {
+impl Study {
     /// Every job of the study, cases in order.
     pub fn jobs(&self) -> Vec<Job> {
         self.cases
@@ -111,8 +78,22 @@ impl StudyIdentity {
             .collect()
     }
 
-    /// The estimated cost of each of [`StudyIdentity::jobs`].
-    pub fn costs(&self) -> Vec<f64> {
+    /// The job numbers of each of `count` shards.
+    pub fn assignment(&self, count: usize) -> Vec<Vec<usize>> {
+        crate::shard::partition(&self.costs(), count)
+    }
+}
+
+impl Work for Study {
+    const KIND: &'static str = "variance";
+    const NOUN: &'static str = "study";
+    const COMMAND: &'static str = "raywave variance --shard I/N";
+    const SAME_RUN: &'static str = "run every shard with the same scenes and flags";
+    type Result = JobRecord;
+    /// Per case the part touched: the case's number, where its scene came from, its facts.
+    type Extra = Vec<(usize, String, CaseFacts)>;
+
+    fn costs(&self) -> Vec<f64> {
         self.jobs()
             .iter()
             .map(|j| {
@@ -122,94 +103,56 @@ impl StudyIdentity {
             .collect()
     }
 
-    /// The job numbers of each of `count` shards.
-    pub fn assignment(&self, count: usize) -> Vec<Vec<usize>> {
-        crate::output::shard::partition(&self.costs(), count)
-    }
-
-    /// How `other` differs from this identity, in words; None when they are the same study.
-    pub fn difference(&self, other: &StudyIdentity) -> Option<String> {
-        if self == other {
-            return None;
-        }
-        if self.format != other.format {
-            return Some(format!(
-                "part format {} against {}",
-                self.format, other.format
-            ));
-        }
-        // The SIMD path first: binaries built for two CPUs (`target-cpu=native` on two kinds of
-        // node) can share a commit and differ only there.
-        let simd = |build: &str| build.split_once(" simd ").map(|(_, path)| path.to_string());
-        if simd(&self.build) != simd(&other.build) {
-            return Some(format!(
-                "different SIMD paths: {} against {} (run by {} against {}); run every shard \
-                 with one build (for nodes of several CPUs, one built for the oldest: \
-                 docs/SCALING.md)",
-                simd(&self.build).unwrap_or_default(),
-                simd(&other.build).unwrap_or_default(),
-                self.build,
-                other.build
-            ));
-        }
-        if self.build != other.build || self.executable != other.executable {
-            return Some(format!(
-                "different raywave builds: {}{} against {}{}",
-                self.build,
-                self.executable
-                    .as_ref()
-                    .map_or(String::new(), |e| format!(" (executable {e})")),
-                other.build,
-                other
-                    .executable
-                    .as_ref()
-                    .map_or(String::new(), |e| format!(" (executable {e})")),
-            ));
-        }
+    fn differences(&self, other: &Study, a: &str, b: &str) -> Vec<String> {
+        let mut out = Vec::new();
         if self.engine != other.engine {
-            return Some(format!("engine {} against {}", self.engine, other.engine));
+            out.push(format!("engine: {} {a}, {} {b}", self.engine, other.engine));
         }
-        let names = |i: &StudyIdentity| {
-            i.cases
-                .iter()
-                .map(|c| c.name.as_str())
-                .collect::<Vec<_>>()
-                .join(", ")
+        let names = |s: &Study| {
+            let v: Vec<&str> = s.cases.iter().map(|c| c.name.as_str()).collect();
+            format!("[{}]", v.join(", "))
         };
         if self.cases.len() != other.cases.len() {
-            return Some(format!(
-                "different studies: cases [{}] against [{}]",
-                names(self),
-                names(other)
-            ));
+            out.push(format!("cases: {} {a}, {} {b}", names(self), names(other)));
+            return out;
         }
-        for (a, b) in self.cases.iter().zip(&other.cases) {
-            if a.name != b.name || a.scene_hash != b.scene_hash || a.lights != b.lights {
-                return Some(format!(
-                    "different studies: case {} (scene {}) against {} (scene {})",
-                    a.name, a.scene_hash, b.name, b.scene_hash
+        for (x, y) in self.cases.iter().zip(&other.cases) {
+            if x.name != y.name || x.scene_hash != y.scene_hash || x.lights != y.lights {
+                out.push(format!(
+                    "case: {} (scene {}) {a}, {} (scene {}) {b}",
+                    x.name, x.scene_hash, y.name, y.scene_hash
                 ));
+                continue;
             }
-            if a.config != b.config {
-                let json = |c: &StudyConfig| serde_json::to_value(c).unwrap_or_default();
-                let (x, y) = (json(&a.config), json(&b.config));
-                let differing: Vec<String> = x
-                    .as_object()
-                    .into_iter()
-                    .flatten()
-                    .filter(|(k, v)| y.get(k.as_str()) != Some(v))
-                    .map(|(k, v)| {
-                        format!("{k} {v} against {}", y.get(k.as_str()).unwrap_or_default())
-                    })
-                    .collect();
-                return Some(format!(
-                    "different studies: case {} has {}",
-                    a.name,
-                    differing.join("; ")
-                ));
+            let json = |c: &StudyConfig| serde_json::to_value(c).unwrap_or_default();
+            let (p, q) = (json(&x.config), json(&y.config));
+            for (k, v) in p.as_object().into_iter().flatten() {
+                let w = q.get(k.as_str()).cloned().unwrap_or_default();
+                if *v != w {
+                    out.push(format!("case {}: {k}: {v} {a}, {w} {b}", x.name));
+                }
             }
         }
-        Some("different studies".into())
+        out
+    }
+
+    fn check_results(
+        identity: &Identity<Study>,
+        items: &[usize],
+        results: &[JobRecord],
+    ) -> Option<String> {
+        let all = identity.work.jobs();
+        let differs = items
+            .iter()
+            .zip(results)
+            .any(|(&j, r)| all.get(j) != Some(&r.job()));
+        differs.then(|| {
+            format!(
+                "its results are not those of its {} jobs: was it edited, or written by another \
+                 raywave?",
+                items.len()
+            )
+        })
     }
 }
 
@@ -253,10 +196,7 @@ mod tests {
     #[test]
     fn a_difference_names_what_differs() {
         let config = StudyConfig::standard(crate::render::settings::RenderSettings::default());
-        let a = StudyIdentity {
-            format: PART_FORMAT,
-            build: "raywave 0.1.0 commit abc simd avx2".into(),
-            executable: None,
+        let a = Study {
             engine: "wavefront".into(),
             cases: vec![CaseIdentity {
                 name: "box".into(),
@@ -265,30 +205,27 @@ mod tests {
                 config: config.clone(),
             }],
         };
-        assert_eq!(a.difference(&a.clone()), None);
-        let mut b = a.clone();
-        b.build = "raywave 0.1.0 commit def simd avx2".into();
-        assert!(
-            a.difference(&b)
-                .unwrap()
-                .contains("different raywave builds")
-        );
-        // Built for another CPU: the same commit, another SIMD path.
-        let mut v3 = a.clone();
-        v3.build = "raywave 0.1.0 commit abc simd avx2+fma (f32x8 in one 256-bit register)".into();
-        let d = a.difference(&v3).unwrap();
-        assert!(
-            d.contains(
-                "different SIMD paths: avx2 against avx2+fma (f32x8 in one 256-bit register)"
-            ),
-            "{d}"
-        );
+        assert!(a.differences(&a.clone(), "in A", "in B").is_empty());
         let mut c = a.clone();
         c.cases[0].config.seeds = 9;
-        let d = a.difference(&c).unwrap();
-        assert!(d.contains("seeds 8 against 9"), "{d}");
+        assert_eq!(
+            a.differences(&c, "in A", "in B"),
+            ["case box: seeds: 8 in A, 9 in B"]
+        );
         let mut e = a.clone();
         e.cases[0].scene_hash = "02".into();
-        assert!(a.difference(&e).unwrap().contains("scene 01"));
+        let d = a.differences(&e, "in A", "in B");
+        assert_eq!(d, ["case: box (scene 01) in A, box (scene 02) in B"]);
+        let mut f = a.clone();
+        f.engine = "reference".into();
+        f.cases.push(f.cases[0].clone());
+        let d = a.differences(&f, "in A", "in B");
+        assert_eq!(
+            d,
+            [
+                "engine: wavefront in A, reference in B",
+                "cases: [box] in A, [box, box] in B"
+            ]
+        );
     }
 }

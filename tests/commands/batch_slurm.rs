@@ -112,9 +112,9 @@ fn a_task_that_fails_or_is_killed_fails_sbatch_wait() {
     assert_eq!(
         files_in(&work.join("parts")),
         [
-            "shard-0-of-4.part",
-            "shard-1-of-4.part",
-            "shard-3-of-4.part"
+            "variance-shard-0-of-4.part",
+            "variance-shard-1-of-4.part",
+            "variance-shard-3-of-4.part"
         ]
     );
     let merged = raywave(&work, &["variance", "merge", "parts", "--out", "merged"]);

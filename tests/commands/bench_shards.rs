@@ -9,6 +9,8 @@
 use crate::common;
 
 use common::bin::{files_in, raywave, stderr, stdout, words};
+use raywave::bench::shard::SweepPoints;
+use raywave::shard::{Part, read_part, write_part};
 use serde_json::{Value, json};
 use std::path::Path;
 use std::process::Output;
@@ -46,7 +48,7 @@ fn shards(dir: &Path, n: usize) -> Vec<String> {
     (0..n)
         .map(|i| {
             ok(&run(dir, &format!("{SWEEP} --shard {i}/{n} --out parts")));
-            format!("parts/bench-shard-{i}-of-{n}.json")
+            format!("parts/bench-shard-{i}-of-{n}.part")
         })
         .collect()
 }
@@ -119,7 +121,7 @@ fn three_shards_merged_equal_the_sweep_run_whole() {
         "point   16x16+t1",
         "wavefront  total",
         "merged  3 shard(s), 4 point(s) of one sweep, measured on 1 host(s)",
-        "0/3 parts/bench-shard-0-of-3.json: 24x16+t1",
+        "0/3 parts/bench-shard-0-of-3.part: 24x16+t1",
         "summed over the shards",
         "elapsed from the first start to the last end",
     ] {
@@ -167,20 +169,20 @@ fn two_shards_split_by_cost_and_merge_in_sweep_order() {
     // 16x16+t2 2688, 24x16+t1 8064, 24x16+t2 4032. Longest first to the least loaded:
     // 24x16+t1 → 0; 16x16+t1 → 1; 24x16+t2 → 1 (5376 < 8064); 16x16+t2 → 0 (8064 < 9408).
     // By count it would be two and two in sweep order; by cost shard 0 gets the dearest.
-    let labels = |i: usize| read(d, &parts[i])["payload"]["labels"].clone();
-    assert_eq!(labels(0), json!(["16x16+t2", "24x16+t1"]));
-    assert_eq!(labels(1), json!(["16x16+t1", "24x16+t2"]));
-    let part = read(d, &parts[0]);
-    assert_eq!(part["format"], "raywave-bench-shard");
-    assert_eq!(part["payload"]["shard"], json!({"index": 0, "count": 2}));
-    assert_eq!(part["payload"]["points"], json!([1, 2]));
-    assert_eq!(
-        part["payload"]["sweep"]["points"].as_array().unwrap().len(),
-        4
-    );
-    assert!(part["payload"]["host"]["cpu"].is_string());
-    assert!(part["payload"]["host"]["hostname"].is_string());
-    assert_eq!(part["payload"]["records"].as_array().unwrap().len(), 2);
+    assert_eq!(labels(d, &parts[0]), ["16x16+t2", "24x16+t1"]);
+    assert_eq!(labels(d, &parts[1]), ["16x16+t1", "24x16+t2"]);
+    let zero = part(d, &parts[0]);
+    assert_eq!((zero.shard.index, zero.shard.count), (0, 2));
+    assert_eq!(zero.items, [1, 2]);
+    assert_eq!(zero.identity.work.points.len(), 4);
+    assert!(!zero.host.cpu.is_empty() && !zero.host.hostname.is_empty());
+    assert_eq!(zero.results.len(), 2);
+    let setups: Vec<_> = zero.results.iter().map(|r| r.setup.clone()).collect();
+    let theirs: Vec<_> = [1, 2]
+        .iter()
+        .map(|&i| zero.identity.work.points[i].setup.clone())
+        .collect();
+    assert_eq!(setups, theirs);
     // Given in any order, merged in sweep order.
     let out = run(
         d,
@@ -203,7 +205,7 @@ fn two_shards_split_by_cost_and_merge_in_sweep_order() {
     // No temporary file left beside the parts.
     assert_eq!(
         files_in(&d.join("parts")),
-        ["bench-shard-0-of-2.json", "bench-shard-1-of-2.json"]
+        ["bench-shard-0-of-2.part", "bench-shard-1-of-2.part"]
     );
 }
 
@@ -212,51 +214,51 @@ fn a_shard_without_points_still_writes_its_file() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let parts = shards(d, 5);
-    let empty = read(d, &parts[4]);
-    assert_eq!(empty["payload"]["points"], json!([]));
-    assert_eq!(empty["payload"]["records"], json!([]));
+    let empty = part(d, &parts[4]);
+    assert!(empty.items.is_empty() && empty.results.is_empty());
     let out = run(
         d,
         &format!("bench merge {} --export-csv rows.csv -q", parts.join(" ")),
     );
     ok(&out);
-    assert!(stdout(&out).contains("4/5 parts/bench-shard-4-of-5.json: no points"));
+    assert!(stdout(&out).contains("4/5 parts/bench-shard-4-of-5.part: no points"));
     let mut points = csv_points(d, "rows.csv");
     points.dedup();
     assert_eq!(points.len(), 4);
 }
 
-/// FNV-1a, 64-bit: the part files' checksum, written here from its definition.
-fn fnv1a(bytes: &[u8]) -> String {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for &b in bytes {
-        h ^= u64::from(b);
-        h = h.wrapping_mul(0x0000_0100_0000_01b3);
-    }
-    format!("{h:016x}")
+/// The part `name` in `dir`, as the library reads it.
+fn part(dir: &Path, name: &str) -> Part<SweepPoints> {
+    read_part(&dir.join(name)).unwrap_or_else(|e| panic!("{name}: {e:#}"))
 }
 
-/// Rewrites the part `name` with `doctor` applied to its payload and a checksum that matches
-/// (a part made by another build, sweep or machine, not a damaged one).
-fn doctor(dir: &Path, name: &str, doctor: impl FnOnce(&mut Value)) {
-    let mut part = read(dir, name);
-    doctor(&mut part["payload"]);
-    let payload = serde_json::to_string(&part["payload"]).unwrap();
-    let text = format!(
-        "{{\"format\":\"raywave-bench-shard\",\"version\":1,\"checksum\":\"fnv1a64:{}\",\"payload\":{payload}}}",
-        fnv1a(payload.as_bytes())
-    );
-    std::fs::write(dir.join(name), text).unwrap();
+/// Writes the part `from` with `doctor` applied as `to`, whole and with its checksum right (a
+/// part made by another build, sweep or machine, not a damaged one).
+fn doctor(dir: &Path, from: &str, to: &str, doctor: impl FnOnce(&mut Part<SweepPoints>)) {
+    let mut p = part(dir, from);
+    doctor(&mut p);
+    let scratch = tempfile::tempdir().unwrap();
+    let written = write_part(scratch.path(), &p).unwrap();
+    std::fs::copy(written, dir.join(to)).unwrap();
+}
+
+/// The labels of the points the part `name` ran.
+fn labels(dir: &Path, name: &str) -> Vec<String> {
+    let p = part(dir, name);
+    p.items
+        .iter()
+        .map(|&i| p.identity.work.points[i].label.clone())
+        .collect()
 }
 
 #[test]
 fn a_doctored_part_with_its_checksum_redone_is_read() {
-    // The reader hashes the payload's bytes as they are, whatever their layout: the
-    // refusals below are for what was changed, not for the layout.
+    // A part rewritten unchanged merges: the refusals below are for what was changed, not for
+    // how it was rewritten.
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let parts = shards(d, 2);
-    doctor(d, &parts[1], |_| {});
+    doctor(d, &parts[1], &parts[1], |_| {});
     ok(&run(d, &format!("bench merge {} -q", parts.join(" "))));
 }
 
@@ -268,40 +270,50 @@ fn merge_refuses_missing_duplicated_and_damaged_parts() {
     let merge = |args: &str| run(d, &format!("bench merge {args} -q --export-csv rows.csv"));
     refused(
         &merge(&format!("{} {}", parts[0], parts[2])),
-        &["shard(s) 1/3 missing", &parts[0], &parts[2], "--shard 1/3"],
+        &["shard 1/3 is missing", &parts[0], &parts[2], "--shard 1/3"],
     );
     refused(
         &merge(&format!(
             "{} {} {} {}",
             parts[0], parts[1], parts[1], parts[2]
         )),
-        &["shard 1/3 is given twice", &parts[1]],
+        &[&parts[1], "is given twice"],
     );
-    std::fs::copy(d.join(&parts[1]), d.join("copy.json")).unwrap();
+    std::fs::copy(d.join(&parts[1]), d.join("copy.part")).unwrap();
     refused(
-        &merge(&format!("{} {} copy.json {}", parts[0], parts[1], parts[2])),
-        &["shard 1/3 is given twice", &parts[1], "copy.json"],
+        &merge(&format!("{} {} copy.part {}", parts[0], parts[1], parts[2])),
+        &["shard 1/3 is given twice", &parts[1], "copy.part"],
     );
-    // Truncated: not whole JSON.
-    let text = std::fs::read_to_string(d.join(&parts[1])).unwrap();
-    std::fs::write(d.join("cut.json"), &text[..text.len() / 2]).unwrap();
+    // Truncated, as a copy interrupted mid-way leaves it.
+    let whole = std::fs::read(d.join(&parts[1])).unwrap();
+    std::fs::write(d.join("cut.part"), &whole[..whole.len() / 2]).unwrap();
     refused(
-        &merge(&format!("{} cut.json {}", parts[0], parts[2])),
-        &["cut.json: not a whole bench shard file", "truncated"],
+        &merge(&format!("{} cut.part {}", parts[0], parts[2])),
+        &["cut.part: truncated"],
     );
-    // Damaged: still JSON, but not the bytes that were hashed.
-    let damaged = text.replacen("\"runs\": 6,", "\"runs\": 7,", 1);
-    assert_ne!(damaged, text);
-    std::fs::write(d.join("damaged.json"), damaged).unwrap();
+    // Damaged: one bit flipped in the payload, so not the bytes that were hashed.
+    let mut damaged = whole.clone();
+    let mid = damaged.len() / 2;
+    damaged[mid] ^= 0x10;
+    std::fs::write(d.join("damaged.part"), damaged).unwrap();
     refused(
-        &merge(&format!("{} damaged.json {}", parts[0], parts[2])),
-        &["damaged.json: checksum mismatch"],
+        &merge(&format!("{} damaged.part {}", parts[0], parts[2])),
+        &["damaged.part: corrupt"],
     );
-    // Not a part at all.
+    // Not a part at all, and a part of the JSON format of an earlier raywave.
     std::fs::write(d.join("other.json"), r#"{"format": 2, "engines": []}"#).unwrap();
+    refused(&merge("other.json"), &["other.json: not a raywave part"]);
+    std::fs::write(
+        d.join("old.json"),
+        "{\n  \"format\": \"raywave-bench-shard\",\n  \"version\": 1,\n  \"payload\": {}\n}\n",
+    )
+    .unwrap();
     refused(
-        &merge("other.json"),
-        &["other.json: not a whole bench shard file"],
+        &merge("old.json"),
+        &[
+            "old.json: written by an earlier raywave",
+            "run its shard again",
+        ],
     );
     refused(&merge("nothing.json"), &["nothing.json"]);
     assert!(
@@ -318,10 +330,10 @@ fn a_copy_of_a_shard_under_another_name_is_refused_naming_both() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let parts = shards(d, 2);
-    std::fs::copy(d.join(&parts[0]), d.join("copy-of-0.json")).unwrap();
+    std::fs::copy(d.join(&parts[0]), d.join("copy-of-0.part")).unwrap();
     for order in [
-        [parts[0].as_str(), "copy-of-0.json", parts[1].as_str()],
-        ["copy-of-0.json", parts[1].as_str(), parts[0].as_str()],
+        [parts[0].as_str(), "copy-of-0.part", parts[1].as_str()],
+        ["copy-of-0.part", parts[1].as_str(), parts[0].as_str()],
     ] {
         let out = run(
             d,
@@ -329,7 +341,7 @@ fn a_copy_of_a_shard_under_another_name_is_refused_naming_both() {
         );
         let err = stderr(&out);
         assert!(!out.status.success(), "{order:?} merged:\n{}", stdout(&out));
-        for n in [parts[0].as_str(), "copy-of-0.json", "shard 0/2"] {
+        for n in [parts[0].as_str(), "copy-of-0.part", "shard 0/2"] {
             assert!(err.contains(n), "{order:?}: missing `{n}` in:\n{err}");
         }
         assert!(!d.join("rows.csv").exists(), "{order:?} wrote its export");
@@ -353,12 +365,12 @@ fn merge_refuses_parts_of_other_sweeps_builds_and_splits() {
     refused(
         &run(
             d,
-            &format!("bench merge {} other/bench-shard-1-of-2.json", parts[0]),
+            &format!("bench merge {} other/bench-shard-1-of-2.part", parts[0]),
         ),
         &[
-            "are shards of different sweeps",
+            "are not shards of the same sweep",
             &parts[0],
-            "other/bench-shard-1-of-2.json",
+            "other/bench-shard-1-of-2.part",
             "runs: 6 in",
         ],
     );
@@ -373,23 +385,23 @@ fn merge_refuses_parts_of_other_sweeps_builds_and_splits() {
     refused(
         &run(
             d,
-            &format!("bench merge {} scene/bench-shard-1-of-2.json", parts[0]),
+            &format!("bench merge {} scene/bench-shard-1-of-2.part", parts[0]),
         ),
-        &["are shards of different sweeps", "scene.text_hash"],
+        &["are not shards of the same sweep", "scene.text_hash"],
     );
     // Another build.
-    std::fs::copy(d.join(&parts[1]), d.join("build.json")).unwrap();
-    doctor(d, "build.json", |p| {
-        p["sweep"]["build"]["commit"] = json!("0123456789abcdef0123456789abcdef01234567");
-        for r in p["records"].as_array_mut().unwrap() {
-            r["build"]["commit"] = json!("0123456789abcdef0123456789abcdef01234567");
+    doctor(d, &parts[1], "build.part", |p| {
+        let commit = "0123456789abcdef0123456789abcdef01234567";
+        p.identity.build.commit = commit.into();
+        for r in &mut p.results {
+            r.build.commit = commit.into();
         }
     });
     refused(
-        &run(d, &format!("bench merge {} build.json", parts[0])),
+        &run(d, &format!("bench merge {} build.part", parts[0])),
         &[
             "come from different raywave builds",
-            "build.json",
+            "build.part",
             "commit: ",
         ],
     );
@@ -398,16 +410,15 @@ fn merge_refuses_parts_of_other_sweeps_builds_and_splits() {
     refused(
         &run(
             d,
-            &format!("bench merge {} three/bench-shard-1-of-3.json", parts[0]),
+            &format!("bench merge {} three/bench-shard-1-of-3.part", parts[0]),
         ),
         &["disagree on the number of shards", "0/2", "1/3"],
     );
     // A part whose points are not its shard's share contradicts itself.
-    std::fs::copy(d.join(&parts[1]), d.join("points.json")).unwrap();
-    doctor(d, "points.json", |p| p["points"] = json!([0, 1]));
+    doctor(d, &parts[1], "points.part", |p| p.items = vec![0, 1]);
     refused(
-        &run(d, &format!("bench merge {} points.json", parts[0])),
-        &["points.json: inconsistent bench shard file"],
+        &run(d, &format!("bench merge {} points.part", parts[0])),
+        &["points.part: inconsistent part", "it ran items [0, 1]"],
     );
 }
 
@@ -418,52 +429,47 @@ fn merge_refuses_a_part_run_with_another_simd_path_naming_both() {
     let parts = shards(d, 2);
     // Shard 1 as a binary of the same commit built for the other kind of node would have left
     // it: another SIMD path, target features and RUSTFLAGS, in the sweep and in every record.
-    let ours = read(d, &parts[1])["payload"]["sweep"]["simd"]
-        .as_str()
-        .unwrap()
-        .to_string();
+    let ours = part(d, &parts[1]).identity.simd;
     let theirs = if ours.contains("avx512") {
         "avx2+fma (f32x8 in one 256-bit register)"
     } else {
         "avx512 (f32x16 in one 512-bit register)"
     };
-    std::fs::copy(d.join(&parts[1]), d.join("other-cpu.json")).unwrap();
-    doctor(d, "other-cpu.json", |p| {
-        let mut build = p["sweep"]["build"].clone();
-        build["rustflags"] = json!("-C target-cpu=x86-64-v3");
-        build["target_features"] = json!("avx,avx2,bmi1,bmi2,f16c,fma,lzcnt,movbe,xsave");
-        p["sweep"]["build"] = build.clone();
-        p["sweep"]["simd"] = json!(theirs);
-        for r in p["records"].as_array_mut().unwrap() {
-            r["build"] = build.clone();
-            r["simd"] = json!(theirs);
+    doctor(d, &parts[1], "other-cpu.part", |p| {
+        let build = &mut p.identity.build;
+        build.rustflags = "-C target-cpu=x86-64-v3".into();
+        build.target_features = "avx,avx2,bmi1,bmi2,f16c,fma,lzcnt,movbe,xsave".into();
+        let build = build.clone();
+        p.identity.simd = theirs.into();
+        for r in &mut p.results {
+            r.build = build.clone();
+            r.simd = theirs.into();
         }
     });
     let err = refused(
-        &run(d, &format!("bench merge {} other-cpu.json", parts[0])),
+        &run(d, &format!("bench merge {} other-cpu.part", parts[0])),
         &[
             "were run by binaries with different SIMD paths",
             &format!("{ours} and {theirs}"),
             &parts[0],
-            "other-cpu.json",
+            "other-cpu.part",
             "RUSTFLAGS: ",
         ],
     );
-    assert!(!err.contains("are shards of different sweeps"), "{err}");
+    assert!(!err.contains("are not shards of the same sweep"), "{err}");
     assert!(!d.join("merged").exists());
     // The SIMD path alone, every other field the same: still refused.
-    std::fs::copy(d.join(&parts[1]), d.join("simd-only.json")).unwrap();
-    doctor(d, "simd-only.json", |p| {
-        p["sweep"]["simd"] = json!(theirs);
-        for r in p["records"].as_array_mut().unwrap() {
-            r["simd"] = json!(theirs);
+    doctor(d, &parts[1], "simd-only.part", |p| {
+        p.identity.simd = theirs.into();
+        for r in &mut p.results {
+            r.simd = theirs.into();
         }
     });
     refused(
-        &run(d, &format!("bench merge {} simd-only.json", parts[0])),
+        &run(d, &format!("bench merge {} simd-only.part", parts[0])),
         &[
             "were run by binaries with different SIMD paths",
-            &format!("simd: {ours} in {}, {theirs} in simd-only.json", parts[0]),
+            &format!("simd: {ours} in {}, {theirs} in simd-only.part", parts[0]),
         ],
     );
 }
@@ -473,12 +479,12 @@ fn parts_of_two_machines_merge_only_across_machines_grouped_by_host() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let parts = shards(d, 2);
-    doctor(d, &parts[1], |p| {
-        p["host"]["hostname"] = json!("elsewhere");
-        p["host"]["cpu"] = json!("Other CPU");
-        for r in p["records"].as_array_mut().unwrap() {
-            r["machine"]["hostname"] = json!("elsewhere");
-            r["machine"]["cpu"] = json!("Other CPU");
+    doctor(d, &parts[1], &parts[1], |p| {
+        p.host.hostname = "elsewhere".into();
+        p.host.cpu = "Other CPU".into();
+        for r in &mut p.results {
+            r.machine.hostname = "elsewhere".into();
+            r.machine.cpu = "Other CPU".into();
         }
     });
     let both = parts.join(" ");
@@ -547,13 +553,12 @@ fn merge_refuses_an_output_that_is_an_input() {
     let one = "bench --size 16 16 --runs 6 --shadow-samples 2 --engine wavefront -q";
     ok(&run(d, &format!("{one} --shard 0/2 --out parts")));
     ok(&run(d, &format!("{one} --shard 1/2 --out parts")));
-    let before = std::fs::read(d.join("parts/bench-shard-0-of-2.json")).unwrap();
-    let parts = "parts/bench-shard-0-of-2.json parts/bench-shard-1-of-2.json";
+    let before = std::fs::read(d.join("parts/bench-shard-0-of-2.part")).unwrap();
+    let parts = "parts/bench-shard-0-of-2.part parts/bench-shard-1-of-2.part";
     for outputs in [
-        "--export-json parts/bench-shard-0-of-2.json",
-        "--export-bmf parts/bench-shard-1-of-2.json",
-        // A sweep of one point saves NAME.json: here the part itself.
-        "--dir parts --save bench-shard-0-of-2",
+        "--export-json parts/bench-shard-0-of-2.part",
+        "--export-bmf parts/bench-shard-1-of-2.part",
+        "--export-csv parts/../parts/bench-shard-1-of-2.part",
     ] {
         let out = run(d, &format!("bench merge {parts} {outputs}"));
         assert_eq!(out.status.code(), Some(2), "{outputs}: {}", stderr(&out));
@@ -564,7 +569,7 @@ fn merge_refuses_an_output_that_is_an_input() {
         );
     }
     assert_eq!(
-        std::fs::read(d.join("parts/bench-shard-0-of-2.json")).unwrap(),
+        std::fs::read(d.join("parts/bench-shard-0-of-2.part")).unwrap(),
         before
     );
     // Saved elsewhere, the single point keeps its plain name.

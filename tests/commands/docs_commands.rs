@@ -216,7 +216,7 @@ fn the_shortening_replaces_adds_and_keeps_sweep_points_apart() {
         &[
             "bench",
             "merge",
-            "parts/bench-shard-0-of-2.json",
+            "parts/bench-shard-0-of-2.part",
             "--export-bmf",
             "b.json",
         ],

@@ -96,11 +96,7 @@ fn assert_valid(python: &str, name: &str, instance: &Value) {
 #[test]
 fn the_checked_in_schemas_are_the_generated_ones() {
     let update = std::env::var_os("RAYWAVE_UPDATE_SCHEMA").is_some_and(|v| v == "1");
-    let shard = ("bench-shard.schema.json", raywave::bench::shard::schema());
-    for (name, generated) in raywave::output::render_record::schemas()
-        .into_iter()
-        .chain([shard])
-    {
+    for (name, generated) in raywave::output::render_record::schemas() {
         let path = schema_dir().join(name);
         if update {
             std::fs::create_dir_all(schema_dir()).unwrap();
@@ -320,8 +316,8 @@ fn first_metric(bmf: &mut Value) -> &mut Value {
     metric
 }
 
-/// A tiny sweep's part file (shard 0 of 2), its exports for the trackers, parsed.
-fn part_and_exports() -> (Value, Value, Value) {
+/// A tiny sweep's exports for the trackers, parsed.
+fn exports() -> (Value, Value) {
     let dir = tempfile::tempdir().unwrap();
     let flags = "bench --size 16 12 --threads 1,2 --runs 6 --engine wavefront -q";
     let read = |name: &str| -> Value {
@@ -329,31 +325,20 @@ fn part_and_exports() -> (Value, Value, Value) {
     };
     let out = raywave(
         dir.path(),
-        &words(&format!("{flags} --shard 0/2 --out parts")),
-    );
-    assert!(out.status.success(), "{}", stderr(&out));
-    let out = raywave(
-        dir.path(),
         &words(&format!(
             "{flags} --export-bmf bmf.json --export-github-action-benchmark gab.json"
         )),
     );
     assert!(out.status.success(), "{}", stderr(&out));
-    (
-        read("parts/bench-shard-0-of-2.json"),
-        read("bmf.json"),
-        read("gab.json"),
-    )
+    (read("bmf.json"), read("gab.json"))
 }
 
-/// Real output validates against the checked-in schemas: the part file against its generated
-/// one, the exports against the schemas written from Bencher's reference and
+/// Real output validates against the checked-in schemas written from Bencher's reference and
 /// github-action-benchmark's README; doctored output does not.
 #[test]
-fn part_files_and_tracker_exports_validate() {
+fn tracker_exports_validate() {
     let Some(python) = python() else { return };
-    let (part, bmf, gab) = part_and_exports();
-    assert_valid(python, "bench-shard.schema.json", &part);
+    let (bmf, gab) = exports();
     assert_valid(python, "bencher-metric-format.schema.json", &bmf);
     assert_valid(python, "github-action-benchmark.schema.json", &gab);
     type Doctor = fn(&mut Value);
@@ -394,23 +379,6 @@ fn part_files_and_tracker_exports_validate() {
         assert!(
             !violations(python, "github-action-benchmark.schema.json", &g).is_empty(),
             "github-action-benchmark JSON with {what} validated"
-        );
-    }
-    let part_doctored: [(&str, Doctor); 3] = [
-        ("another format", |p| p["format"] = json!("raywave-bench")),
-        ("a checksum that is not FNV-1a", |p| {
-            p["checksum"] = json!("md5:0123")
-        }),
-        ("no records", |p| {
-            p["payload"].as_object_mut().unwrap().remove("records");
-        }),
-    ];
-    for (what, doctor) in part_doctored {
-        let mut p = part.clone();
-        doctor(&mut p);
-        assert!(
-            !violations(python, "bench-shard.schema.json", &p).is_empty(),
-            "a part file with {what} validated"
         );
     }
 }

@@ -224,7 +224,7 @@ fn merge_refuses_parts_that_are_missing_repeated_cut_short_corrupt_or_foreign() 
         }
         assert!(!d.join("report").exists(), "{args:?} wrote a report");
     };
-    let p = |i: usize| format!("parts/shard-{i}-of-3.part");
+    let p = |i: usize| format!("parts/variance-shard-{i}-of-3.part");
     refused(
         &["variance", "merge", &p(0), &p(2), "--out", "report"],
         &["shard 1/3 is missing", &p(0)],
@@ -269,15 +269,15 @@ fn merge_refuses_parts_that_are_missing_repeated_cut_short_corrupt_or_foreign() 
             "variance",
             "merge",
             &p(0),
-            "other/shard-1-of-3.part",
+            "other/variance-shard-1-of-3.part",
             &p(2),
             "--out",
             "report",
         ],
         &[
-            "not parts of the same study",
-            "seeds 2 against 3",
-            "other/shard-1-of-3.part",
+            "are not shards of the same study",
+            "seeds: 2 in",
+            "3 in other/variance-shard-1-of-3.part",
         ],
     );
     // Cut short, as a copy interrupted mid-way leaves it.
@@ -323,7 +323,7 @@ fn merge_refuses_parts_that_are_missing_repeated_cut_short_corrupt_or_foreign() 
             "--out",
             "report",
         ],
-        &["text.part", "not a raywave study part"],
+        &["text.part", "not a raywave part"],
     );
     // The output directory is the parts' own.
     let out = raywave(d, &["variance", "merge", "parts", "--out", "parts"]);
@@ -348,7 +348,7 @@ fn merge_refuses_parts_that_are_missing_repeated_cut_short_corrupt_or_foreign() 
         "an output that is an input is a usage error"
     );
     assert!(
-        stderr(&out).contains("--out parts holds the part parts/shard-0-of-3.part"),
+        stderr(&out).contains("--out parts holds the part parts/variance-shard-0-of-3.part"),
         "{}",
         stderr(&out)
     );
@@ -392,7 +392,10 @@ fn a_copy_of_a_shard_under_another_name_is_refused_naming_both() {
         args.extend(["--out", "parts", "-q"]);
         ok(&raywave(d, &args));
     }
-    let (zero, one) = ("parts/shard-0-of-2.part", "parts/shard-1-of-2.part");
+    let (zero, one) = (
+        "parts/variance-shard-0-of-2.part",
+        "parts/variance-shard-1-of-2.part",
+    );
     std::fs::copy(d.join(zero), d.join("copy-of-0.part")).unwrap();
     for order in [[zero, "copy-of-0.part", one], ["copy-of-0.part", one, zero]] {
         let mut args = vec!["variance", "merge"];
@@ -409,32 +412,34 @@ fn a_copy_of_a_shard_under_another_name_is_refused_naming_both() {
 
 #[test]
 fn merge_refuses_a_part_run_with_another_simd_path_naming_both() {
-    use raywave::variance::part;
+    use raywave::shard::{Part, read_part, write_part};
+    use raywave::variance::plan::Study;
     let dir = flag_shards(&["--no-cache"]);
     let d = dir.path();
     // Shard 1 as a binary of the same commit built for the other kind of node would have
-    // written it: the identity's build differs in its SIMD path alone.
-    let mut other = part::read(&d.join("parts/shard-1-of-3.part")).unwrap();
+    // written it: the identity differs in its SIMD path alone.
+    let mut other: Part<Study> = read_part(&d.join("parts/variance-shard-1-of-3.part")).unwrap();
     let ours = raywave::simd_path();
     let theirs = if ours.contains("avx512") {
         "avx2+fma (f32x8 in one 256-bit register)"
     } else {
         "avx512 (f32x16 in one 512-bit register)"
     };
-    assert!(other.identity.build.ends_with(&format!(" simd {ours}")));
-    other.identity.build = other.identity.build.replace(ours, theirs);
-    part::write(&d.join("other-cpu.part"), &other).unwrap();
+    assert_eq!(other.identity.simd, ours);
+    other.identity.simd = theirs.into();
+    let written = write_part(&d.join("other-cpu"), &other).unwrap();
+    std::fs::rename(written, d.join("other-cpu.part")).unwrap();
     let out = raywave(
         d,
         &words(
-            "variance merge parts/shard-0-of-3.part other-cpu.part parts/shard-2-of-3.part --out report",
+            "variance merge parts/variance-shard-0-of-3.part other-cpu.part parts/variance-shard-2-of-3.part --out report",
         ),
     );
     let err = stderr(&out);
     assert_eq!(out.status.code(), Some(1), "{err}");
     for needle in [
-        "parts/shard-0-of-3.part and other-cpu.part are not parts of the same study",
-        &format!("different SIMD paths: {ours} against {theirs}"),
+        "parts/variance-shard-0-of-3.part and other-cpu.part were run by binaries with different SIMD paths",
+        &format!("simd: {ours} in parts/variance-shard-0-of-3.part, {theirs} in other-cpu.part"),
     ] {
         assert!(err.contains(needle), "expected {needle:?} in:\n{err}");
     }

@@ -73,15 +73,24 @@ const TOOLS: [&str; 6] = ["bench", "diff", "peer", "trace", "variance", "view"];
 
 /// The layers of docs/ARCHITECTURE.md, each depending only on those above it: the renderer
 /// names neither the outputs nor a tool (its `--no-default-features` build would fail
-/// anyway), and the outputs and records name no tool.
+/// anyway), the outputs and records name neither the sharding layer nor a tool, and the
+/// sharding layer names no tool.
 #[test]
 fn each_layer_names_only_the_layers_above_it() {
     let src = Path::new("src");
-    let mut offenders = uses_of(&src.join("render"), &[&["output"][..], &TOOLS].concat());
-    offenders.extend(uses_of(&src.join("output"), &TOOLS));
+    let mut offenders = uses_of(
+        &src.join("render"),
+        &[&["output", "shard"][..], &TOOLS].concat(),
+    );
+    offenders.extend(uses_of(
+        &src.join("output"),
+        &[&["shard"][..], &TOOLS].concat(),
+    ));
+    offenders.extend(uses_of(&src.join("shard"), &TOOLS));
     assert!(
         offenders.is_empty(),
-        "a layer names one below it (render/ < output/ < the tools, docs/ARCHITECTURE.md):\n{}",
+        "a layer names one below it (render/ < output/ < shard/ < the tools, \
+         docs/ARCHITECTURE.md):\n{}",
         offenders.join("\n")
     );
 }

@@ -9,7 +9,7 @@ use crate::common;
 use common::hostile::{case, check_all, setup, setup_streams};
 use std::path::Path;
 
-/// The smallest study as one shard, `parts/shard-0-of-1.part`.
+/// The smallest study as one shard, `parts/variance-shard-0-of-1.part`.
 fn one_part(dir: &Path) {
     let r = common::hostile::run(
         dir,
@@ -62,7 +62,9 @@ fn special_files_and_odd_outputs_in_a_sharded_study_are_refused() {
             },
             &["variance", "merge", "d.part", "--out", "rep"],
             1,
-            &["d.part: expected shard parts (*.part) in this directory, found none"],
+            &[
+                "d.part: expected variance shard parts (variance-shard-I-of-N.part) in this directory, found none",
+            ],
             &[],
         ),
         case(
@@ -70,7 +72,7 @@ fn special_files_and_odd_outputs_in_a_sharded_study_are_refused() {
             |d| setup_streams::sparse(d, "big.part", 64 << 20),
             &["variance", "merge", "big.part", "--out", "rep"],
             1,
-            &["big.part: not a raywave study part"],
+            &["big.part: not a raywave part"],
             &[],
         ),
         case(
@@ -82,7 +84,7 @@ fn special_files_and_odd_outputs_in_a_sharded_study_are_refused() {
             &["variance", "merge", "parts", "--out", "report"],
             1,
             &["cannot create the output directory report"],
-            &["parts", "parts/shard-0-of-1.part"],
+            &["parts", "parts/variance-shard-0-of-1.part"],
         ),
         case(
             "a FIFO as the study file",

@@ -27,7 +27,7 @@ use raywave::render::settings::RenderSettings;
 use raywave::render::wavefront::{DEFAULT_BATCH_SIZE, Wavefront};
 use raywave::variance::StudyConfig;
 use raywave::variance::jobs::{self, Job, Setup};
-use raywave::variance::plan::{CaseIdentity, PART_FORMAT, StudyIdentity};
+use raywave::variance::plan::{CaseIdentity, Study};
 use std::sync::Mutex;
 
 /// A job's estimate is within this factor of the rays it traces (both ways).
@@ -137,10 +137,7 @@ fn shards_trace_rays_within_a_bound_of_the_best_split() {
     let mut worst: f64 = 0.0;
     let mut failed = Vec::new();
     for study in &studies {
-        let identity = StudyIdentity {
-            format: PART_FORMAT,
-            build: "test".into(),
-            executable: None,
+        let identity = Study {
             engine: "wavefront".into(),
             cases: study
                 .iter()
@@ -172,7 +169,7 @@ fn shards_trace_rays_within_a_bound_of_the_best_split() {
             .map(|&(s, samplers)| format!("{} × {} samplers", scenes[s].0, samplers.len()))
             .collect();
         for m in 2..=8 {
-            let shards = identity.assignment(m);
+            let shards = raywave::shard::partition(&raywave::shard::Work::costs(&identity), m);
             let loads: Vec<f64> = shards
                 .iter()
                 .map(|jobs| jobs.iter().map(|&j| rays[j]).sum())

@@ -1,7 +1,6 @@
-//! Splitting a command's work into shards that separate jobs or machines run: [`Shard`] is one
-//! job's `I/N` (shard I of N, 0-based), and [`partition`] deals items out by estimated cost,
-//! not by count, so that every shard takes about as long. Nothing here knows what an item is:
-//! `raywave bench --shard` deals out the points of a sweep.
+//! The split: [`Shard`] is one job's `I/N` (shard I of N, 0-based), and [`partition`] deals
+//! items out by estimated cost, not by count, so that every shard takes about as long. Nothing
+//! here knows what an item is (a point of a bench sweep, a job of a variance study).
 //!
 //! ```text
 //! partition(costs, n): longest processing time first (Graham's LPT rule)
@@ -110,38 +109,6 @@ pub fn partition(costs: &[f64], n: usize) -> Vec<Vec<usize>> {
         shard.sort_unstable();
     }
     shards
-}
-
-/// The part files named by `inputs`: each file as given, and in each directory the files whose
-/// name `is_part` accepts, in name order (`what` names them in the error for a directory with
-/// none). The merges of `raywave variance` and `raywave bench` take parts this way.
-pub fn expand_parts(
-    inputs: &[std::path::PathBuf],
-    is_part: impl Fn(&str) -> bool,
-    what: &str,
-) -> anyhow::Result<Vec<std::path::PathBuf>> {
-    use anyhow::Context;
-    let mut out = Vec::new();
-    for input in inputs {
-        if !input.is_dir() {
-            out.push(input.clone());
-            continue;
-        }
-        let mut found: Vec<std::path::PathBuf> = std::fs::read_dir(input)
-            .with_context(|| format!("cannot list {}", input.display()))?
-            .filter_map(|e| e.ok().map(|e| e.path()))
-            .filter(|p| p.is_file() && p.file_name().is_some_and(|n| is_part(&n.to_string_lossy())))
-            .collect();
-        if found.is_empty() {
-            anyhow::bail!(
-                "{}: expected {what} in this directory, found none",
-                input.display()
-            );
-        }
-        found.sort();
-        out.extend(found);
-    }
-    Ok(out)
 }
 
 #[cfg(test)]
