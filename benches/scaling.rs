@@ -19,10 +19,10 @@
 
 mod common;
 
-use raywave::output::statistics::median;
 use raywave::render::scene::Scene;
 use raywave::render::settings::RenderSettings;
 use raywave::render::wavefront::{DEFAULT_BATCH_SIZE, Wavefront};
+use raywave::stats::median;
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 use wide::f32x8;

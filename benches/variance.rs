@@ -26,13 +26,13 @@
 mod common;
 
 use criterion::{BenchmarkId, Throughput};
-use raywave::output::statistics::{BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, bootstrap_interval};
 use raywave::render::engine::Engine;
 use raywave::render::film::Film;
 use raywave::render::per_kind::RayCounts;
 use raywave::render::sampling::LightSampler;
 use raywave::render::scene::Scene;
 use raywave::render::settings::RenderSettings;
+use raywave::stats::{BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, bootstrap_interval};
 use raywave::variance::{
     StudyConfig, converged_reference, error_stats, penumbra_mask, per_image_errors,
 };

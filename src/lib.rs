@@ -61,9 +61,12 @@ pub mod render;
 #[cfg(feature = "tools")]
 pub mod output;
 
-// What the tools share that is not an output: sharding a command's work and merging its parts.
+// What the tools share that is not an output: sharding a command's work and merging its
+// parts, and the statistics.
 #[cfg(feature = "tools")]
 pub mod shard;
+#[cfg(feature = "tools")]
+pub mod stats;
 
 // The tools built on both, one folder per command.
 #[cfg(feature = "tools")]

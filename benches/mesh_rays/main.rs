@@ -49,7 +49,6 @@ mod peer_table;
 
 use criterion::{BenchmarkId, Criterion, Throughput};
 use peer_table::{Tables, peer_rows, print_peer_table};
-use raywave::output::statistics::median;
 use raywave::peer::stage::ShadowStage;
 use raywave::peer::{
     Hits, ObvhsMesh, RaySet, RaySetKind, RaySets, hit_agreement, occlusion_agreement,
@@ -61,6 +60,7 @@ use raywave::render::scene::{NO_HIT, Scene, parse_scene_str};
 use raywave::render::settings::RenderSettings;
 use raywave::render::wavefront::batch::HitBatch;
 use raywave::render::wavefront::context::Context;
+use raywave::stats::median;
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 

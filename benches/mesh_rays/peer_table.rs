@@ -5,9 +5,9 @@
 use super::{
     Outputs, Setup, agreement, answer, builds, peers, ratio, stage_engine, time_rounds, trace,
 };
-use raywave::output::statistics::median;
 use raywave::peer::stage::ShadowStage;
 use raywave::render::wavefront::context::Context;
+use raywave::stats::median;
 /// Agreement of a peer with raywave below which the peer table flags a cell.
 const TABLE_MIN_AGREEMENT: f64 = 0.9999;
 

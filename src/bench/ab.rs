@@ -36,11 +36,12 @@
 //! With `--until-decided` the rounds go on until the verdict is decided, judged at planned
 //! looks with narrower levels (`sequential`), within `--max-rounds` and `--max-time`.
 
-use super::sequential::{self, Budget, LookPlan};
+use super::sequential::{self, Budget};
 use super::{EXIT_REGRESSION, EXIT_UNDECIDED};
-use crate::output::statistics::{MIN_FOR_INTERVAL, median, median_with_interval_at};
 use crate::render::engine::Engine;
 use crate::render::error::UsageError;
+use crate::stats::looks::LookPlan;
+use crate::stats::{MIN_FOR_INTERVAL, median, median_with_interval_at};
 use anyhow::{Context, Result, bail};
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};

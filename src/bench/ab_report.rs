@@ -2,8 +2,9 @@
 //! plan of looks and each engine's rounds and looks.
 
 use super::ab::{AbOptions, EngineAb, Verdict, VerdictForm};
-use super::sequential::{self, Budget, LookPlan, Stop};
-use crate::output::statistics::median;
+use super::sequential::{self, Budget, Stop};
+use crate::stats::looks::{self, LookPlan};
+use crate::stats::median;
 use std::time::Duration;
 
 /// `--max-time`'s value as typed back (`10m`, `1h 30m`).
@@ -40,7 +41,7 @@ pub fn report(options: &AbOptions, results: &[EngineAb]) -> String {
                     " · looks at {} rounds, each a {}% interval ({}% split over {} looks)",
                     looks.join(", "),
                     round_pct(plan.confidence_pct()),
-                    sequential::ALPHA * 100.0,
+                    looks::ALPHA * 100.0,
                     plan.split,
                 ),
                 "interval".to_string(),

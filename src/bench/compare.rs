@@ -331,7 +331,7 @@ pub fn record_problems(record: &BenchRecord, engines: &[&str]) -> Vec<String> {
                     e.engine,
                     f.figure,
                     f.runs,
-                    crate::output::statistics::MIN_FOR_INTERVAL
+                    crate::stats::MIN_FOR_INTERVAL
                 )),
             }
         }
@@ -376,7 +376,7 @@ pub fn compare(
                     a.engine,
                     fa.figure,
                     fa.runs,
-                    crate::output::statistics::MIN_FOR_INTERVAL
+                    crate::stats::MIN_FOR_INTERVAL
                 ));
                 continue;
             }

@@ -234,11 +234,11 @@ pub fn run(args: &BenchOptions, hooks: &Hooks) -> Result<Outcome> {
             if !problems.is_empty() {
                 bail!(incomparable(path, &problems));
             }
-            if args.runs < crate::output::statistics::MIN_FOR_INTERVAL as u32 {
+            if args.runs < crate::stats::MIN_FOR_INTERVAL as u32 {
                 return Err(crate::render::error::UsageError(format!(
                     "--compare needs --runs {} or more: with {} run(s) the median has no 95% \
                      interval, and the verdict needs one",
-                    crate::output::statistics::MIN_FOR_INTERVAL,
+                    crate::stats::MIN_FOR_INTERVAL,
                     args.runs
                 ))
                 .into());

@@ -176,7 +176,7 @@ pub(crate) fn warnings(r: &BenchRecord, point: &str) -> Vec<String> {
                     f.figure,
                     values.join(", "),
                     f.median / 1e6,
-                    crate::output::statistics::OUTLIER_Z
+                    crate::stats::OUTLIER_Z
                 ));
             }
             if let Some(w) = f.relative_width_pct().filter(|w| *w > NOISY_WIDTH_PCT) {

@@ -119,7 +119,7 @@ pub struct FigureSummary {
 impl FigureSummary {
     /// The summary of `values`, one per run.
     pub fn of(figure: &str, unit: &str, values: &[f64]) -> FigureSummary {
-        let (median, low, high) = crate::output::statistics::median_with_interval(values);
+        let (median, low, high) = crate::stats::median_with_interval(values);
         let finite = |x: f64| x.is_finite().then_some(x);
         FigureSummary {
             figure: figure.to_string(),
@@ -130,7 +130,7 @@ impl FigureSummary {
             low: finite(low),
             high: finite(high),
             max: values.iter().copied().fold(f64::NEG_INFINITY, f64::max),
-            outliers: crate::output::statistics::outliers(values),
+            outliers: crate::stats::outliers(values),
         }
     }
 
@@ -149,7 +149,7 @@ impl FigureSummary {
             _ => format!(
                 "[none: {} run(s) < {}]",
                 self.runs,
-                crate::output::statistics::MIN_FOR_INTERVAL
+                crate::stats::MIN_FOR_INTERVAL
             ),
         }
     }
@@ -298,7 +298,7 @@ pub(crate) fn per_thread_second(rays: u64, time: std::time::Duration) -> Option<
     (rays > 0 && seconds > 0.0).then(|| rays as f64 / seconds)
 }
 
-use crate::output::statistics::median;
+use crate::stats::median;
 
 impl Measurement {
     /// Each figure's median over `runs` (ray counts from the first run: they do not vary).

@@ -21,7 +21,6 @@ pub mod image_file;
 pub mod machine;
 pub mod memory;
 pub mod render_record;
-pub mod statistics;
 pub mod terminal;
 pub(crate) mod write;
 

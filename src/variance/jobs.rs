@@ -161,7 +161,7 @@ struct Measured<'a> {
 
 fn rows_of(m: &Measured, reference: &Converged, masks: &[Vec<bool>; 3], host: &str) -> Vec<Row> {
     let k = m.images.len();
-    let (seconds, lo, hi) = crate::output::statistics::median_with_interval(&m.times);
+    let (seconds, lo, hi) = crate::stats::median_with_interval(&m.times);
     let seconds_interval = (lo.is_finite() && hi.is_finite()).then_some([lo, hi]);
     let excluded_sampler = deterministic(m.sampler, m.n);
     Region::ALL
@@ -182,8 +182,7 @@ fn rows_of(m: &Measured, reference: &Converged, masks: &[Vec<bool>; 3], host: &s
             let times = &m.times;
             let efficiency_interval = fits::interval(k, |idx| {
                 let t: Vec<f64> = idx.iter().map(|&i| times[i]).collect();
-                1.0 / (fits::mean_at(&seed_mse, Some(idx))
-                    * crate::output::statistics::median(&t).max(1e-12))
+                1.0 / (fits::mean_at(&seed_mse, Some(idx)) * crate::stats::median(&t).max(1e-12))
             });
             Row {
                 sampler: m.sampler.name(),

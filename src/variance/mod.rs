@@ -48,8 +48,8 @@ use serde::{Deserialize, Serialize};
 
 pub use cache::Cache;
 pub use figures::{
-    BIAS_FALSE_ALARM, ErrorStats, LogLogFit, bias_bound, deterministic, error_stats, loglog_fit,
-    per_image_errors, pixel_mse,
+    BIAS_FALSE_ALARM, ErrorStats, bias_bound, deterministic, error_stats, per_image_errors,
+    pixel_mse,
 };
 pub use fits::{Matching, Slope, match_budget};
 pub use mask::{Regions, penumbra_mask};

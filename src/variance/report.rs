@@ -496,8 +496,8 @@ impl StudyResult {
                 threads: self.threads,
                 study: &self.config,
                 bootstrap: Bootstrap {
-                    resamples: crate::output::statistics::BOOTSTRAP_RESAMPLES,
-                    seed: crate::output::statistics::BOOTSTRAP_SEED,
+                    resamples: crate::stats::BOOTSTRAP_RESAMPLES,
+                    seed: crate::stats::BOOTSTRAP_SEED,
                     level: 0.95,
                     unit: "seed: one resample draws K seeds with replacement, the same for every sampler, budget and region",
                 },

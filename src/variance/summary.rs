@@ -14,8 +14,8 @@
 
 use super::fits::{fit_rows, fitted, mean_at};
 use super::{Region, Row, StudyResult};
-use crate::output::statistics::{BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, grouped_bootstrap_interval};
 use crate::render::sampling::LightSampler;
+use crate::stats::{BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, grouped_bootstrap_interval};
 use anyhow::{Context, Result};
 use serde::Serialize;
 use std::fmt::Write as _;

@@ -15,11 +15,11 @@
 use super::http::ApiError;
 use super::request::{Resolved, ViewSettings};
 use crate::output::image_file::png_bytes;
-use crate::output::statistics::median;
 use crate::render::engine::Engine;
 use crate::render::film::{Film, ToneMap};
 use crate::render::sampling::LightSampler;
 use crate::render::scene::Scene;
+use crate::stats::median;
 use crate::variance::perceived::{self, Perceived};
 use crate::variance::{
     StudyConfig, converged_reference, error_stats, penumbra_mask, pixel_mse, plot::heat_images,

@@ -74,7 +74,7 @@ const TOOLS: [&str; 6] = ["bench", "diff", "peer", "trace", "variance", "view"];
 /// The layers of docs/ARCHITECTURE.md, each depending only on those above it: the renderer
 /// names neither the outputs nor a tool (its `--no-default-features` build would fail
 /// anyway), the outputs and records name neither the sharding layer nor a tool, and the
-/// sharding layer names no tool.
+/// sharding layer names no tool; the statistics name no other module.
 #[test]
 fn each_layer_names_only_the_layers_above_it() {
     let src = Path::new("src");
@@ -87,6 +87,11 @@ fn each_layer_names_only_the_layers_above_it() {
         &[&["shard"][..], &TOOLS].concat(),
     ));
     offenders.extend(uses_of(&src.join("shard"), &TOOLS));
+    // The statistics are a leaf: numbers in, numbers out.
+    offenders.extend(uses_of(
+        &src.join("stats"),
+        &[&["render", "output", "shard"][..], &TOOLS].concat(),
+    ));
     assert!(
         offenders.is_empty(),
         "a layer names one below it (render/ < output/ < shard/ < the tools, \

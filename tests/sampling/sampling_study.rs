@@ -246,7 +246,8 @@ fn light_points_stay_on_the_light() {
 
 #[test]
 fn matching_budget_inverts_the_fits() {
-    use raywave::variance::{LogLogFit, match_budget};
+    use raywave::stats::LogLogFit;
+    use raywave::variance::match_budget;
     // random: MSE = 1/N; stratified: MSE = N^-1.5. Random at 150 gives 1/150; stratified
     // matches it at N = 150^(1/1.5) = 28.2.
     let random = LogLogFit {

@@ -324,7 +324,7 @@ fn the_reference_noise_is_half_the_squared_half_difference() {
 
 #[test]
 fn the_fit_skips_zero_errors() {
-    use raywave::variance::loglog_fit;
+    use raywave::stats::loglog_fit;
     // A region with no noise at some N (an umbra, say) has MSE 0: log 0 is −∞, so such a point
     // must be left out of the fit, not turn the slope into NaN.
     assert!(loglog_fit(&[(1.0, 0.0), (4.0, 0.0), (16.0, 1e-3)]).is_none());
@@ -343,7 +343,7 @@ fn normal(rng: &mut common::TestRng) -> f64 {
 /// How often the study's bootstrap interval of a mean of `k` normal units holds the true mean,
 /// over `trials` seeded experiments.
 fn mean_coverage(k: usize, trials: usize) -> f64 {
-    use raywave::output::statistics::{BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, bootstrap_interval};
+    use raywave::stats::{BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, bootstrap_interval};
     let mut rng = seeded(0xc0fe);
     let (mu, sigma) = (3.0, 0.7);
     let mut hits = 0;
@@ -376,8 +376,8 @@ fn bootstrap_intervals_cover_the_truth_at_about_the_nominal_rate() {
 /// (0.95 for a well-behaved statistic; the bound allows the small-sample shortfall above).
 #[test]
 fn bootstrap_slope_intervals_cover_the_true_slope() {
-    use raywave::output::statistics::{BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, bootstrap_interval};
-    use raywave::variance::loglog_fit;
+    use raywave::stats::loglog_fit;
+    use raywave::stats::{BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, bootstrap_interval};
     let mut rng = seeded(0x51_09e);
     let (s, c, k) = (-1.5, 0.04, 16);
     let budgets = [1.0, 4.0, 16.0, 64.0, 256.0];

@@ -52,7 +52,7 @@ fn github_action_benchmark(records: &[BenchRecord], by_host: bool) -> Result<Str
                 format!(
                     "no 95% interval of the median: {} run(s) < {}",
                     f.runs,
-                    crate::output::statistics::MIN_FOR_INTERVAL
+                    crate::stats::MIN_FOR_INTERVAL
                 ),
             ),
         };
