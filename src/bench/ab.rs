@@ -37,6 +37,7 @@
 //! looks with narrower levels (`sequential`), within `--max-rounds` and `--max-time`.
 
 use super::sequential::{self, Budget};
+pub use super::verdict::{Rule, Verdict, VerdictForm};
 use super::{EXIT_REGRESSION, EXIT_UNDECIDED};
 use crate::render::engine::Engine;
 use crate::render::error::UsageError;
@@ -92,93 +93,6 @@ pub struct EngineAb {
     pub different_work: Option<(String, String)>,
     /// With `--until-decided`: the looks taken, the rounds used and why they stopped.
     pub sequential: Option<sequential::Outcome>,
-}
-
-/// How a ratio's interval sits against the threshold.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Verdict {
-    /// The whole interval lies above 1 + t: a regression.
-    Slower,
-    /// The whole interval lies at or below 1 + t: not a regression (the one-sided form).
-    NotSlower,
-    /// The whole interval lies below 1 / (1 + t) (the three-way form).
-    Faster,
-    /// The whole interval lies within [1 / (1 + t), 1 + t]: no change as large as t (the
-    /// three-way form).
-    Within,
-    /// The interval straddles a boundary: more rounds are needed to decide.
-    Undecided,
-}
-
-impl Verdict {
-    /// The verdict in one or two words, as each look of `--until-decided` is reported.
-    pub fn word(self) -> &'static str {
-        match self {
-            Verdict::Slower => "slower",
-            Verdict::NotSlower => "not slower",
-            Verdict::Faster => "faster",
-            Verdict::Within => "within",
-            Verdict::Undecided => "undecided",
-        }
-    }
-}
-
-/// Which verdicts `--against` can reach (`--verdict`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum VerdictForm {
-    /// One-sided, a pull request's gate: slower by more than the threshold (a regression), or
-    /// not.
-    #[default]
-    Regression,
-    /// Slower, faster, or no change beyond the threshold.
-    ThreeWay,
-}
-
-/// The verdict rule of `--against`: a threshold and the form of the verdict.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Rule {
-    /// Regression threshold in percent.
-    pub threshold_pct: f64,
-    /// Which verdicts the rule can reach.
-    pub form: VerdictForm,
-}
-
-impl Rule {
-    /// The pull-request gate's rule at `threshold_pct`: one-sided, a regression or not.
-    pub fn regression(threshold_pct: f64) -> Rule {
-        Rule {
-            threshold_pct,
-            form: VerdictForm::Regression,
-        }
-    }
-
-    /// `--verdict three-way` at `threshold_pct`: slower, faster or no change beyond it.
-    pub fn three_way(threshold_pct: f64) -> Rule {
-        Rule {
-            threshold_pct,
-            form: VerdictForm::ThreeWay,
-        }
-    }
-
-    /// The verdict of an interval [`low`, `high`] of the ratio this / other.
-    ///
-    /// "Slower by more than t" needs the whole interval above 1 + t (strictly: a low end at
-    /// 1 + t is no evidence of more than t); "not slower by more than t" needs it at or below
-    /// 1 + t, since a median of exactly 1 + t is not more than t. So the two one-sided calls
-    /// split the line at 1 + t between them, and an interval that holds the median sits on
-    /// the true side of it. An unbounded interval (too few rounds) reaches neither.
-    pub fn judge(self, low: f64, high: f64) -> Verdict {
-        let slow = 1.0 + self.threshold_pct / 100.0;
-        if low > slow {
-            return Verdict::Slower;
-        }
-        match self.form {
-            VerdictForm::Regression if high <= slow => Verdict::NotSlower,
-            VerdictForm::ThreeWay if high < 1.0 / slow => Verdict::Faster,
-            VerdictForm::ThreeWay if low >= 1.0 / slow && high <= slow => Verdict::Within,
-            _ => Verdict::Undecided,
-        }
-    }
 }
 
 /// A ratio's summary: median, interval, verdict.

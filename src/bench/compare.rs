@@ -1,19 +1,9 @@
 //! Comparing two bench records: refuse different setups, then a before/after table of the
 //! headline figures and the verdict. Pure functions of the two records and the threshold.
 //!
-//! The rule (docs/BENCHMARKING.md, "The verdict"): a headline figure **regressed** when both
-//!
-//! ```text
-//! (after.median − before.median) / before.median < −threshold      the effect is large enough
-//! after.high < before.low                                          and beyond the noise: the
-//!                                                                  95% intervals of the two
-//!                                                                  medians do not overlap
-//! ```
-//!
-//! and is **faster** in the mirror case (+threshold, after.low > before.high). Either alone is
-//! not enough: a large change with overlapping intervals is noise a few runs could produce, a
-//! small change with separate intervals is real but below what the threshold says matters.
+//! The rule is in `verdict.rs` (docs/BENCHMARKING.md, "The verdict").
 
+use super::verdict::{Verdict, of_records};
 use crate::output::bench_record::{BenchRecord, FigureSummary, Setup};
 use std::fmt::Write;
 
@@ -70,64 +60,6 @@ fn diff(
     }
 }
 
-/// What the rule says of one headline figure.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Verdict {
-    /// Fell by more than the threshold, and the intervals do not overlap.
-    Regressed,
-    /// Rose by more than the threshold, and the intervals do not overlap.
-    Faster,
-    /// Changed by more than the threshold, but the intervals overlap: noise could explain it.
-    WithinNoise,
-    /// The intervals do not overlap, but the change is within the threshold.
-    WithinThreshold,
-    /// Within the threshold, intervals overlapping.
-    NoChange,
-}
-
-impl Verdict {
-    /// The word printed in the table.
-    pub fn label(self) -> &'static str {
-        match self {
-            Verdict::Regressed => "REGRESSED",
-            Verdict::Faster => "faster",
-            Verdict::WithinNoise => "noise (intervals overlap)",
-            Verdict::WithinThreshold => "within threshold",
-            Verdict::NoChange => "no change",
-        }
-    }
-}
-
-/// The rule, on the summaries of one figure before and after (rates: higher is better).
-/// A figure without an interval on either side, or whose `after` median is not a positive
-/// finite rate, is decided by [`compare`] before this is called.
-pub fn verdict(before: &FigureSummary, after: &FigureSummary, threshold_pct: f64) -> Verdict {
-    let change = change_pct(before.median, after.median);
-    let (Some(bl), Some(bh), Some(al), Some(ah)) = (before.low, before.high, after.low, after.high)
-    else {
-        return Verdict::WithinNoise;
-    };
-    let apart_below = ah < bl;
-    let apart_above = al > bh;
-    if change < -threshold_pct {
-        if apart_below {
-            Verdict::Regressed
-        } else {
-            Verdict::WithinNoise
-        }
-    } else if change > threshold_pct {
-        if apart_above {
-            Verdict::Faster
-        } else {
-            Verdict::WithinNoise
-        }
-    } else if apart_below || apart_above {
-        Verdict::WithinThreshold
-    } else {
-        Verdict::NoChange
-    }
-}
-
 /// One headline figure of one engine, before and after.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Row {
@@ -162,7 +94,7 @@ fn mega(x: f64) -> f64 {
 impl Comparison {
     /// Whether any headline figure regressed.
     pub fn regressed(&self) -> bool {
-        self.rows.iter().any(|r| r.verdict == Verdict::Regressed)
+        self.rows.iter().any(|r| r.verdict == Verdict::Slower)
     }
 
     /// The before/after table, the rule, the notes and the verdict, as `raywave bench
@@ -205,8 +137,9 @@ impl Comparison {
         );
         let _ = writeln!(
             s,
-            "rule: REGRESSED when the median fell by more than {t:.1}% and the 95% intervals do \
-             not overlap ({b}'s high < {a}'s low); faster in the mirror case",
+            "rule: SLOWER when the median fell by more than {t:.1}% and the 95% intervals do \
+             not overlap ({b}'s high < {a}'s low); faster in the mirror case; undecided when \
+             the change passes {t:.1}% but the intervals overlap",
             t = self.threshold_pct
         );
         for n in &self.notes {
@@ -215,7 +148,7 @@ impl Comparison {
         let regressed: Vec<String> = self
             .rows
             .iter()
-            .filter(|r| r.verdict == Verdict::Regressed)
+            .filter(|r| r.verdict == Verdict::Slower)
             .map(|r| {
                 format!(
                     "{} {} {:+.1}% ({} < {})",
@@ -384,9 +317,9 @@ pub fn compare(
             // A figure of the newer run that is not a positive finite rate (with a positive one
             // before) fails: it is no evidence of speed.
             let verdict = if usable(fa.median) {
-                verdict(fb, fa, threshold_pct)
+                of_records(fb, fa, threshold_pct)
             } else {
-                Verdict::Regressed
+                Verdict::Slower
             };
             rows.push(Row {
                 engine: a.engine.clone(),
@@ -451,36 +384,36 @@ mod tests {
         let before = fig(100.0, 95.0, 105.0);
         // -50%, apart: regressed.
         assert_eq!(
-            verdict(&before, &fig(50.0, 45.0, 55.0), 10.0),
-            Verdict::Regressed
+            of_records(&before, &fig(50.0, 45.0, 55.0), 10.0),
+            Verdict::Slower
         );
         // -50% but a wide interval reaching the old one: noise.
         assert_eq!(
-            verdict(&before, &fig(50.0, 40.0, 96.0), 10.0),
-            Verdict::WithinNoise
+            of_records(&before, &fig(50.0, 40.0, 96.0), 10.0),
+            Verdict::Undecided
         );
         // -8%, apart: real but within the threshold.
         assert_eq!(
-            verdict(&before, &fig(92.0, 91.0, 94.0), 10.0),
-            Verdict::WithinThreshold
+            of_records(&before, &fig(92.0, 91.0, 94.0), 10.0),
+            Verdict::Within
         );
         // Touching ends overlap.
         assert_eq!(
-            verdict(&before, &fig(50.0, 45.0, 95.0), 10.0),
-            Verdict::WithinNoise
+            of_records(&before, &fig(50.0, 45.0, 95.0), 10.0),
+            Verdict::Undecided
         );
         assert_eq!(
-            verdict(&before, &fig(101.0, 97.0, 104.0), 10.0),
-            Verdict::NoChange
+            of_records(&before, &fig(101.0, 97.0, 104.0), 10.0),
+            Verdict::Within
         );
         assert_eq!(
-            verdict(&before, &fig(200.0, 190.0, 210.0), 10.0),
+            of_records(&before, &fig(200.0, 190.0, 210.0), 10.0),
             Verdict::Faster
         );
         // Exactly the threshold is not past it.
         assert_eq!(
-            verdict(&before, &fig(90.0, 85.0, 91.0), 10.0),
-            Verdict::WithinThreshold
+            of_records(&before, &fig(90.0, 85.0, 91.0), 10.0),
+            Verdict::Within
         );
     }
 }

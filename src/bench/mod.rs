@@ -30,6 +30,7 @@ pub(crate) mod report;
 pub mod sequential;
 pub mod shard;
 pub mod sweep;
+pub mod verdict;
 
 use crate::output::bench_record::{self as record, BenchRecord, SceneId, Setup};
 use crate::output::machine::Machine;

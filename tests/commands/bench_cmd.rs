@@ -136,7 +136,7 @@ fn an_inflated_record_makes_compare_exit_3_with_the_table() {
         stdout.contains("before") && stdout.contains("after"),
         "{stdout}"
     );
-    assert!(stdout.contains("REGRESSED"), "{stdout}");
+    assert!(stdout.contains("SLOWER"), "{stdout}");
     assert!(
         stdout.contains("verdict: REGRESSION past 50.0%"),
         "{stdout}"

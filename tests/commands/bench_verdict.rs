@@ -7,7 +7,8 @@
 use crate::common;
 
 use common::bin::{raywave, stderr, stdout};
-use raywave::bench::compare::{Refusal, Verdict, compare};
+use raywave::bench::compare::{Refusal, compare};
+use raywave::bench::verdict::Verdict;
 use raywave::output::bench_record::BenchRecord;
 use serde_json::{Value, json};
 use std::path::Path;
@@ -84,21 +85,21 @@ fn a_clear_slowdown_is_a_regression_and_the_table_shows_the_rule_inputs() {
     let c = compare(&before, &after, 40.0).unwrap();
     assert!(c.regressed());
     let total = c.rows.iter().find(|r| r.after.figure == "total").unwrap();
-    assert_eq!(total.verdict, Verdict::Regressed);
+    assert_eq!(total.verdict, Verdict::Slower);
     assert_eq!(total.change_pct, -50.0);
     let shadow = c
         .rows
         .iter()
         .find(|r| r.after.figure == "stage shadow")
         .unwrap();
-    assert_eq!(shadow.verdict, Verdict::NoChange);
+    assert_eq!(shadow.verdict, Verdict::Within);
     let table = c.table();
     for needle in [
         "100.00 [97.00, 103.00]",
         "50.00 [48.00, 52.00]",
-        "-50.0%  REGRESSED",
+        "-50.0%  SLOWER",
         "verdict: REGRESSION past 40.0%: wavefront total -50.0% ([48.00, 52.00] < [97.00, 103.00])",
-        "rule: REGRESSED when the median fell by more than 40.0% and the 95% intervals do not overlap",
+        "rule: SLOWER when the median fell by more than 40.0% and the 95% intervals do not overlap",
     ] {
         assert!(table.contains(needle), "missing `{needle}` in:\n{table}");
     }
@@ -111,12 +112,12 @@ fn a_change_inside_the_noise_or_inside_the_threshold_is_not_a_regression() {
     let after = parse(&record((55.0, 40.0, 90.0), STEADY));
     let c = compare(&before, &after, 40.0).unwrap();
     assert!(!c.regressed(), "{}", c.table());
-    assert_eq!(c.rows[0].verdict, Verdict::WithinNoise);
+    assert_eq!(c.rows[0].verdict, Verdict::Undecided);
     // -10%, intervals apart: real, but inside the 40% threshold.
     let after = parse(&record((90.0, 89.0, 91.0), STEADY));
     let c = compare(&parse(&record(STEADY, STEADY)), &after, 40.0).unwrap();
     assert!(!c.regressed());
-    assert_eq!(c.rows[0].verdict, Verdict::WithinThreshold);
+    assert_eq!(c.rows[0].verdict, Verdict::Within);
     // The same -10% with a 5% threshold is a regression.
     assert!(
         compare(&parse(&record(STEADY, STEADY)), &after, 5.0)
@@ -138,7 +139,7 @@ fn a_stage_alone_regresses() {
     let bad: Vec<&str> = c
         .rows
         .iter()
-        .filter(|r| r.verdict == Verdict::Regressed)
+        .filter(|r| r.verdict == Verdict::Slower)
         .map(|r| r.after.figure.as_str())
         .collect();
     assert_eq!(bad, ["stage shadow"]);
@@ -205,10 +206,10 @@ fn bench_compare_a_b_gives_the_table_and_exit_3_on_a_regression() {
         text.contains("A [95% interval]") && text.contains("B [95% interval]"),
         "{text}"
     );
-    assert!(text.contains("-50.0%  REGRESSED"), "{text}");
+    assert!(text.contains("-50.0%  SLOWER"), "{text}");
     let out = raywave(dir.path(), &["bench", "compare", "old", "noisy"]);
     assert_eq!(out.status.code(), Some(0), "{}", stdout(&out));
-    assert!(stdout(&out).contains("noise (intervals overlap)"));
+    assert!(stdout(&out).contains("undecided"));
     // A threshold of its own, and a path instead of a name.
     let path = dir.path().join(".raywave-bench/slow.json");
     let out = raywave(
