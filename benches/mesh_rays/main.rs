@@ -1,7 +1,8 @@
 //! Mesh rays: raywave's wavefront intersect stage and occlusion pass (its own 8-wide BVH,
 //! `wavefront::bvh::MeshBvh`, or its brute-force kernels below 64 triangles) against obvhs's
-//! one-ray CWBVH traversal, (with `--features embree`) Embree's single rays and 8-ray packets
-//! and (with `--features tinybvh`) tinybvh's plain BVH and BVH8_CPU, on the same camera,
+//! one-ray CWBVH traversal, (with `--features embree4`, `--features embree`) Embree 4's and
+//! Embree 3's single rays and 8-ray packets and (with `--features tinybvh`) tinybvh's plain BVH
+//! and BVH8_CPU, on the same camera,
 //! shadow, soft-shadow and incoherent rays of the lab's box (triangles only) and the
 //! generated ~12k and ~1M triangle Cornell boxes.
 //!
@@ -11,8 +12,8 @@
 //!     for set in [primary, shadow, shadow_fan16, shadow_fan64, incoherent]:
 //!         group "<set>_<scene>", throughput in rays:
 //!         obvhs_one_ray, wavefront, wavefront_bvh (closest-hit sets, meshes),
-//!         wavefront_one_ray (primary, meshes), embree_single, embree_packet8,
-//!         tinybvh_bvh, tinybvh_bvh8_cpu
+//!         wavefront_one_ray (primary, meshes), embree4_single, embree4_packet8,
+//!         embree3_single, embree3_packet8, tinybvh_bvh, tinybvh_bvh8_cpu
 //! ```
 //!
 //! `wavefront` is the engine's intersect stage (hit search, then point, normal and material for
@@ -34,14 +35,15 @@
 //! per-round ratios: on a machine whose speed drifts from second to second, a ratio taken
 //! within a round is steadier than one between criterion groups timed seconds apart.
 //!
-//! `RAYWAVE_PEER_TABLE=ROUNDS cargo bench --bench mesh_rays --features embree,tinybvh` does the
+//! `RAYWAVE_PEER_TABLE=ROUNDS cargo bench --bench mesh_rays --features embree4,tinybvh` does the
 //! same for raywave and the peers only and prints one Markdown table (docs/BENCHMARKING.md,
 //! "The peer table"): a row per scene and ray kind, Mrays/s of raywave (the path the renderer
 //! takes for that scene), Embree single and packet8, each tinybvh layout, and raywave's ratio
 //! to each, checked for agreement with raywave before any timing.
 //!
-//! `RAYWAVE_MESH=lab` (or `12k`, `1M`) limits any mode but the test mode to one scene. The
-//! test mode ignores all three switches.
+//! `RAYWAVE_MESH=lab` (or `12k`, `1M`) limits any mode but the test mode to one scene;
+//! `RAYWAVE_EMBREE_QUALITY=low|medium|high` (default high) sets both Embrees' build quality.
+//! The test mode ignores all four switches.
 
 #[path = "../common/mod.rs"]
 mod common;
@@ -52,9 +54,9 @@ use peer_table::{Tables, peer_rows, print_peer_table};
 use raywave::output::statistics::median;
 use raywave::peer::stage::ShadowStage;
 use raywave::peer::{
-    Hits, ObvhsMesh, RaySet, RaySetKind, RaySets, hit_agreement, occlusion_agreement,
-    raywave_closest, wavefront_bvh_closest, wavefront_bvh_closest_one_ray, wavefront_closest,
-    wavefront_occluded, without_emitters, without_spheres,
+    Hits, ObvhsMesh, RaySet, RaySetKind, RaySets, hit_agreement, mesh_bvh_bytes,
+    occlusion_agreement, raywave_closest, wavefront_bvh_closest, wavefront_bvh_closest_one_ray,
+    wavefront_closest, wavefront_occluded, without_emitters, without_spheres,
 };
 use raywave::render::scene::meshgen::{bands_for, cornell_box_mesh_spheres, triangle_count};
 use raywave::render::scene::{NO_HIT, Scene, parse_scene_str};
@@ -71,10 +73,38 @@ const TEST_SIZE: u32 = 32;
 /// Seed of the shadow and incoherent rays.
 const SEED: u64 = 2026;
 
+#[cfg(any(feature = "embree", feature = "embree4"))]
+use raywave::peer::embree_shared::{BuildQuality, EmbreeCalls};
 #[cfg(feature = "embree")]
-use raywave::peer::embree::EmbreeMesh;
+use raywave::peer::embree3::Embree3Mesh;
+#[cfg(feature = "embree4")]
+use raywave::peer::embree4::Embree4Mesh;
 #[cfg(feature = "tinybvh")]
 use raywave::peer::tinybvh::{TinybvhLayout, TinybvhMesh};
+
+/// Embree's build quality (`RAYWAVE_EMBREE_QUALITY`); nothing without an Embree feature.
+#[cfg(any(feature = "embree", feature = "embree4"))]
+type Quality = BuildQuality;
+/// Embree's build quality (`RAYWAVE_EMBREE_QUALITY`); nothing without an Embree feature.
+#[cfg(not(any(feature = "embree", feature = "embree4")))]
+#[derive(Clone, Copy)]
+struct Quality;
+
+/// The quality `RAYWAVE_EMBREE_QUALITY` names (exits on a bad value), the default in the
+/// test mode.
+#[cfg(any(feature = "embree", feature = "embree4"))]
+fn embree_quality(test_mode: bool) -> Quality {
+    if test_mode {
+        return BuildQuality::High;
+    }
+    BuildQuality::from_env().unwrap_or_else(|e| exit_with(&format!("{e:#}")))
+}
+
+/// Nothing to choose without an Embree feature.
+#[cfg(not(any(feature = "embree", feature = "embree4")))]
+fn embree_quality(_test_mode: bool) -> Quality {
+    Quality
+}
 
 /// Where a scene comes from.
 #[derive(Clone, Copy)]
@@ -99,8 +129,10 @@ struct Setup {
     settings: RenderSettings,
     obvhs: ObvhsMesh,
     sets: RaySets,
+    #[cfg(feature = "embree4")]
+    embree4: Embree4Mesh,
     #[cfg(feature = "embree")]
-    embree: EmbreeMesh,
+    embree3: Embree3Mesh,
     #[cfg(feature = "tinybvh")]
     tinybvh: TinybvhMesh,
 }
@@ -131,7 +163,11 @@ fn load(label: &'static str, source: Source) -> Scene {
     scene
 }
 
-fn setup(label: &'static str, source: Source, size: u32) -> Setup {
+#[cfg_attr(
+    not(any(feature = "embree", feature = "embree4")),
+    allow(unused_variables)
+)]
+fn setup(label: &'static str, source: Source, size: u32, quality: Quality) -> Setup {
     let scene = load(label, source);
     let obvhs = ObvhsMesh::new(&scene);
     let sets = RaySets::new(&scene, &obvhs, size, size, SEED);
@@ -144,8 +180,10 @@ fn setup(label: &'static str, source: Source, size: u32) -> Setup {
     Setup {
         label,
         settings,
+        #[cfg(feature = "embree4")]
+        embree4: Embree4Mesh::new(&scene, quality).unwrap_or_else(|e| exit_with(&format!("{e:#}"))),
         #[cfg(feature = "embree")]
-        embree: EmbreeMesh::new(&scene).expect("Embree builds the scene"),
+        embree3: Embree3Mesh::new(&scene, quality).expect("Embree 3 builds the scene"),
         #[cfg(feature = "tinybvh")]
         tinybvh: TinybvhMesh::new(&scene).expect("tinybvh builds the scene"),
         scene,
@@ -164,9 +202,11 @@ fn builds(s: &Setup, ctx: &Context) -> Vec<String> {
         Some(bvh) => {
             let (nodes, blocks) = bvh.size();
             lines.push(format!(
-                "raywave MeshBvh {:.3} s ({nodes} 8-wide nodes, {blocks} triangle blocks, depth {})",
+                "raywave MeshBvh {:.3} s ({nodes} 8-wide nodes, {blocks} triangle blocks, depth {}, \
+                 {:.1} MB)",
                 bvh.build_time.as_secs_f64(),
-                bvh.depth
+                bvh.depth,
+                mesh_bvh_bytes(bvh) as f64 / 1e6
             ));
         }
         None => lines.push(format!(
@@ -174,11 +214,19 @@ fn builds(s: &Setup, ctx: &Context) -> Vec<String> {
             s.scene.triangles.len()
         )),
     }
+    #[cfg(feature = "embree4")]
+    lines.push(format!(
+        "{}: {:.3} s, {}",
+        s.embree4.describe(),
+        s.embree4.build_time.as_secs_f64(),
+        s.embree4.memory.describe()
+    ));
     #[cfg(feature = "embree")]
     lines.push(format!(
-        "Embree {:.3} s ({})",
-        s.embree.build_time.as_secs_f64(),
-        s.embree.describe()
+        "{}: {:.3} s, {}",
+        s.embree3.describe(),
+        s.embree3.build_time.as_secs_f64(),
+        s.embree3.memory.describe()
     ));
     #[cfg(feature = "tinybvh")]
     lines.push(format!(
@@ -314,8 +362,6 @@ fn trace<'s>(
         black_box(&*out);
         return set.len();
     }
-    #[cfg(feature = "embree")]
-    let coherent = set.kind.is_coherent();
     match (engine, shadow) {
         ("obvhs_one_ray", true) => s.obvhs.occluded(&s.scene, set, &mut out.blocked),
         ("obvhs_one_ray", false) => s.obvhs.closest(&s.scene, set, &mut out.hits),
@@ -324,14 +370,22 @@ fn trace<'s>(
         ("raywave", false) => raywave_closest(ctx, set, &mut out.hits),
         ("wavefront_bvh", false) => wavefront_bvh_closest(ctx, set, &mut out.hits),
         ("wavefront_one_ray", false) => wavefront_bvh_closest_one_ray(ctx, set, &mut out.hits),
+        #[cfg(feature = "embree4")]
+        ("embree4_single", true) => s.embree4.occluded_single(set, &mut out.blocked),
+        #[cfg(feature = "embree4")]
+        ("embree4_single", false) => s.embree4.closest_single(set, &mut out.hits),
+        #[cfg(feature = "embree4")]
+        ("embree4_packet8", true) => s.embree4.occluded_packet8(set, &mut out.blocked),
+        #[cfg(feature = "embree4")]
+        ("embree4_packet8", false) => s.embree4.closest_packet8(set, &mut out.hits),
         #[cfg(feature = "embree")]
-        ("embree_single", true) => s.embree.occluded1(set, &mut out.blocked),
+        ("embree3_single", true) => s.embree3.occluded_single(set, &mut out.blocked),
         #[cfg(feature = "embree")]
-        ("embree_single", false) => s.embree.closest1(set, coherent, &mut out.hits),
+        ("embree3_single", false) => s.embree3.closest_single(set, &mut out.hits),
         #[cfg(feature = "embree")]
-        ("embree_packet8", true) => s.embree.occluded8(set, &mut out.blocked),
+        ("embree3_packet8", true) => s.embree3.occluded_packet8(set, &mut out.blocked),
         #[cfg(feature = "embree")]
-        ("embree_packet8", false) => s.embree.closest8(set, coherent, &mut out.hits),
+        ("embree3_packet8", false) => s.embree3.closest_packet8(set, &mut out.hits),
         _ => unreachable!("engine {engine}"),
     }
     black_box(&*out);
@@ -360,14 +414,20 @@ struct Outputs<'s> {
     stage: Option<ShadowStage<'s>>,
 }
 
-/// The peers, in the order they are timed and tabled: (engine, column title).
+/// The peers, in the order they are timed and tabled: (engine, column title). Embree 4 first,
+/// the headline peer.
 fn peers() -> Vec<(&'static str, &'static str)> {
     #[allow(unused_mut)]
     let mut peers = Vec::new();
+    #[cfg(feature = "embree4")]
+    peers.extend([
+        ("embree4_single", "Embree 4 single"),
+        ("embree4_packet8", "Embree 4 packet8"),
+    ]);
     #[cfg(feature = "embree")]
     peers.extend([
-        ("embree_single", "Embree single"),
-        ("embree_packet8", "Embree packet8"),
+        ("embree3_single", "Embree 3 single"),
+        ("embree3_packet8", "Embree 3 packet8"),
     ]);
     #[cfg(feature = "tinybvh")]
     peers.extend(TinybvhLayout::ALL.iter().map(|l| (l.name(), l.title())));
@@ -447,10 +507,13 @@ fn interleaved(s: &Setup, ctx: &Context, rounds: usize) {
         for (ours, theirs) in [
             ("wavefront", "obvhs_one_ray"),
             ("wavefront_bvh", "obvhs_one_ray"),
-            ("wavefront", "embree_single"),
-            ("wavefront_bvh", "embree_single"),
+            ("wavefront", "embree4_single"),
+            ("wavefront_bvh", "embree4_single"),
+            ("wavefront", "embree4_packet8"),
+            ("wavefront", "embree3_single"),
+            ("wavefront_bvh", "embree3_single"),
+            ("wavefront", "embree3_packet8"),
             ("wavefront_bvh", "wavefront_one_ray"),
-            ("wavefront", "embree_packet8"),
         ] {
             let at = |name| engines.iter().position(|&e| e == name);
             if let (Some(a), Some(b)) = (at(ours), at(theirs)) {
@@ -493,6 +556,7 @@ fn main() {
         exit_with("RAYWAVE_INTERLEAVE and RAYWAVE_PEER_TABLE: one mode at a time");
     }
     let size = if test_mode { TEST_SIZE } else { SIZE };
+    let quality = embree_quality(test_mode);
     let mut c = common::criterion_for_frames(Duration::from_millis(300));
     eprintln!(
         "machine: {}, simd {}",
@@ -506,7 +570,7 @@ fn main() {
         if (!only.is_empty() && only != label) || (test_mode && label == "1M") {
             continue;
         }
-        let s = setup(label, source, size);
+        let s = setup(label, source, size, quality);
         let ctx = Context::new(&s.scene, &s.settings);
         if let Some(rounds) = table {
             peer_rows(&s, &ctx, rounds, &mut tables);
