@@ -1,6 +1,6 @@
 //! Peer comparison on mesh scenes: the same rays traced by obvhs's CWBVH one ray at a time, by
-//! raywave's wavefront stages, and by Embree (feature `embree`) and tinybvh (feature
-//! `tinybvh`), with the hits compared.
+//! raywave's wavefront stages, and by Embree 4 (feature `embree4`), Embree 3 (feature
+//! `embree`) and tinybvh (feature `tinybvh`), with the hits compared.
 //!
 //! ```text
 //! RaySets::new(scene, seed):                      built once, from a fixed seed
@@ -15,7 +15,7 @@
 //! agreement: same prim, or both hit with |Δt| ≤ 1e-4·max(1, t) (shared edges), or both miss.
 //! ```
 //!
-//! Every comparison is **two-sided**: Embree (as Debian builds it, without
+//! Every comparison is **two-sided**: Embree (as Debian and Intel's release build it, without
 //! `EMBREE_BACKFACE_CULLING`) and tinybvh report hits on both sides of a triangle, so raywave's
 //! kernels are called with `two_sided = true` here, whatever the lab's one-sided convention
 //! says; and the scene is `without_emitters`, since a two-sided light wall would hide the lab's
@@ -26,7 +26,11 @@
 //! inside the timed loop.
 
 #[cfg(feature = "embree")]
-pub mod embree;
+pub mod embree3;
+#[cfg(feature = "embree4")]
+pub mod embree4;
+#[cfg(any(feature = "embree", feature = "embree4"))]
+pub mod embree_shared;
 pub mod stage;
 #[cfg(feature = "tinybvh")]
 pub mod tinybvh;
@@ -415,6 +419,17 @@ pub fn wavefront_closest(ctx: &Context, set: &RaySet, scratch: &mut HitBatch, ou
         out.t.extend_from_slice(&scratch.t[..batch.len()]);
         out.prim.extend_from_slice(&scratch.prim[..batch.len()]);
     }
+}
+
+/// Bytes of raywave's mesh BVH: its 8-wide nodes at 224 bytes and triangle blocks at 320, the
+/// sizes `wavefront::bvh` documents. The blocks hold copies of the triangles, so these are all
+/// the bytes its traversal reads, as Embree's BVH holds its Triangle4 leaves.
+pub fn mesh_bvh_bytes(bvh: &MeshBvh) -> usize {
+    /// `size_of::<Node>()` and `size_of::<Block>()` of `wavefront::bvh` (private there).
+    const NODE_BYTES: usize = 224;
+    const BLOCK_BYTES: usize = 320;
+    let (nodes, blocks) = bvh.size();
+    nodes * NODE_BYTES + blocks * BLOCK_BYTES
 }
 
 /// The context's mesh BVH. Scenes below `BVH_MIN_TRIANGLES` have none and are not mesh

@@ -55,20 +55,28 @@ const BENCHMARKING: Page = Page {
     ],
     manual: &[
         (
+            "python3 -m venv /tmp/embree4-venv && /tmp/embree4-venv/bin/pip install embreex==4.4.0",
+            "installs a package from PyPI",
+        ),
+        (
+            "export RAYWAVE_EMBREE4_DIR=$(echo /tmp/embree4-venv/lib/python3*/site-packages/embreex.libs)",
+            "points the embree4 feature at the wheel installed above",
+        ),
+        (
+            "cargo bench --features embree4 --bench mesh_rays",
+            "needs libembree4 (the embreex wheel); .ci/run builds without the embree4 feature",
+        ),
+        (
+            "RAYWAVE_INTERLEAVE=20 cargo bench --features embree4 --bench mesh_rays",
+            "needs libembree4 (the embreex wheel); .ci/run builds without the embree4 feature",
+        ),
+        (
+            "RAYWAVE_PEER_TABLE=9 cargo bench --bench mesh_rays --features embree4,tinybvh",
+            "needs libembree4 and builds tinybvh's C++; .ci/run builds without either feature",
+        ),
+        (
             "sudo apt-get install libembree-dev",
             "installs a system package",
-        ),
-        (
-            "cargo bench --features embree --bench mesh_rays",
-            "needs libembree3; .ci/run builds without the embree feature",
-        ),
-        (
-            "RAYWAVE_INTERLEAVE=20 cargo bench --features embree --bench mesh_rays",
-            "needs libembree3; .ci/run builds without the embree feature",
-        ),
-        (
-            "RAYWAVE_PEER_TABLE=9 cargo bench --bench mesh_rays --features embree,tinybvh",
-            "needs libembree3 and builds tinybvh's C++; .ci/run builds without either feature",
         ),
     ],
     after: nothing,

@@ -1,10 +1,14 @@
 //! The peer comparison's engines find the same hits on the same rays: obvhs's one-ray CWBVH
 //! traversal equals an all-triangles brute force, raywave's wavefront stage equals obvhs, and
-//! the peers equal raywave: (with `--features embree`) Embree's single rays and 8-ray packets,
-//! (with `--features tinybvh`) tinybvh's plain BVH and BVH8_CPU, each on more than 99.99% of
-//! the rays of every set, on a small generated mesh and on the lab's box without its spheres
-//! (raywave's brute-force path), all two-sided like the peers.
+//! the peers equal raywave: (with `--features embree4`, `--features embree`) Embree 4's and
+//! Embree 3's single rays and 8-ray packets, (with `--features tinybvh`) tinybvh's plain BVH
+//! and BVH8_CPU, each on more than 99.99% of the rays of every set, on a small generated mesh
+//! and on the lab's box without its spheres (raywave's brute-force path), all two-sided like
+//! the peers. With an Embree feature, the hit records of `peer::embree_shared` are checked
+//! against what each library writes.
 
+#[cfg(any(feature = "embree", feature = "embree4"))]
+use raywave::peer::embree_shared::{BuildQuality, EmbreeCalls};
 use raywave::peer::stage::ShadowStage;
 use raywave::peer::{
     Agreement, FAN_SIZES, Hits, ObvhsMesh, RaySet, RaySets, blocker_agreement, brute_force_closest,
@@ -288,7 +292,7 @@ fn agreement_counts_edges_and_real_differences() {
 /// Every set's raywave answer (`raywave_closest`, `wavefront_occluded`) against a peer's, on
 /// `scene`. On meshes the shadow sets must hold both blocked and free rays, so that their
 /// agreement says something (in the lab's box without spheres nothing blocks a light).
-#[cfg(any(feature = "embree", feature = "tinybvh"))]
+#[cfg(any(feature = "embree", feature = "embree4", feature = "tinybvh"))]
 fn check_peer_against_raywave(
     what: &str,
     scene: &Scene,
@@ -336,38 +340,305 @@ fn check_peer_against_raywave(
     }
 }
 
-#[cfg(feature = "embree")]
-#[test]
-fn embree_single_and_packet8_equal_raywave() {
-    use raywave::peer::embree::EmbreeMesh;
-    // The mesh at the benchmark's image size. (Before the kernels' edge slack, the two crack
-    // rays of the test below were 2 of 9216 at 96×96, under the 99.99% bar.)
+/// An Embree version's single rays and 8-ray packets against raywave, on the mesh at the
+/// benchmark's image size and on the lab's box. (Before the kernels' edge slack, the two crack
+/// rays of `camera_rays_entering_the_closed_box_hit_it` were 2 of 9216 at 96×96, under the
+/// 99.99% bar.)
+#[cfg(any(feature = "embree", feature = "embree4"))]
+fn check_embree<E: EmbreeCalls>(version: &str, build: &dyn Fn(&Scene) -> E) {
     for (scene, size) in [(mesh_scene(), 256), (lab_scene(), SIZE)] {
-        let embree = EmbreeMesh::new(&scene).expect("Embree builds the scene");
+        let embree = build(&scene);
         let n = scene.triangles.len();
         check_peer_against_raywave(
-            &format!("Embree single, {n} triangles"),
+            &format!("{version} single, {n} triangles"),
             &scene,
             size,
-            &|set, out| embree.closest1(set, set.kind.is_coherent(), out),
+            &|set, out| embree.closest_single(set, out),
             &|set, ours| {
                 let mut theirs = Vec::new();
-                embree.occluded1(set, &mut theirs);
+                embree.occluded_single(set, &mut theirs);
                 occlusion_agreement(ours, &theirs)
             },
         );
         check_peer_against_raywave(
-            &format!("Embree packet8, {n} triangles"),
+            &format!("{version} packet8, {n} triangles"),
             &scene,
             size,
-            &|set, out| embree.closest8(set, set.kind.is_coherent(), out),
+            &|set, out| embree.closest_packet8(set, out),
             &|set, ours| {
                 let mut theirs = Vec::new();
-                embree.occluded8(set, &mut theirs);
+                embree.occluded_packet8(set, &mut theirs);
                 occlusion_agreement(ours, &theirs)
             },
         );
     }
+}
+
+/// Embree 3.13 (Debian's), at the peer table's default quality.
+#[cfg(feature = "embree")]
+#[test]
+fn embree3_single_and_packet8_equal_raywave() {
+    use raywave::peer::embree3::Embree3Mesh;
+    check_embree("Embree 3", &|scene| {
+        Embree3Mesh::new(scene, BuildQuality::High).expect("Embree 3 builds the scene")
+    });
+}
+
+/// Embree 4 (`RAYWAVE_EMBREE4_DIR`'s), at every build quality the peer table can be set to.
+#[cfg(feature = "embree4")]
+#[test]
+fn embree4_single_and_packet8_equal_raywave() {
+    use raywave::peer::embree4::Embree4Mesh;
+    for quality in BuildQuality::ALL {
+        check_embree(&format!("Embree 4 ({})", quality.name()), &|scene| {
+            Embree4Mesh::new(scene, quality).unwrap_or_else(|e| panic!("{e:#}"))
+        });
+    }
+}
+
+/// One Embree call's hit record and what lies after it: a guard that the library must leave
+/// as it was.
+#[cfg(any(feature = "embree", feature = "embree4"))]
+#[repr(C)]
+struct Guarded<T> {
+    record: T,
+    guard: [u32; 16],
+}
+
+/// What Embree wrote into `embree_shared`'s hit records of camera rays that hit the lab box:
+/// the fields the bindings declare, each where the library writes it, and nothing past them.
+/// Returns whether the library wrote the instance-array field `inst_prim_id` (Embree 4's
+/// `RTC_GEOMETRY_INSTANCE_ARRAY`, which Embree 3 lacks).
+#[cfg(any(feature = "embree", feature = "embree4"))]
+fn hit_records_written(embree: &impl EmbreeCalls, scene: &Scene) -> bool {
+    use raywave::peer::embree_shared::{Hit1, Hit8, Ray1, RayHit1, RayHit8, Valid8};
+    /// Neither a valid id nor `RTC_INVALID_GEOMETRY_ID`: a field still holding it was not written.
+    const UNWRITTEN: u32 = 0x5eed_0000;
+    const GUARD: u32 = 0xdead_beef;
+    let bvh = ObvhsMesh::new(scene);
+    let sets = RaySets::new(scene, &bvh, SIZE, SIZE, SEED);
+    let mut hits = Hits::default();
+    bvh.closest(scene, &sets.primary, &mut hits);
+    let batch = &sets.primary.batches[0];
+    let hit_rays: Vec<usize> = (0..batch.len())
+        .filter(|&i| hits.prim[i] != NO_HIT)
+        .collect();
+    assert!(
+        hit_rays.len() >= 8,
+        "{} camera rays of the first batch hit",
+        hit_rays.len()
+    );
+    let ray = |i: usize| Ray1 {
+        org_x: batch.origin.x[i],
+        org_y: batch.origin.y[i],
+        org_z: batch.origin.z[i],
+        tnear: 0.0,
+        dir_x: batch.direction.x[i],
+        dir_y: batch.direction.y[i],
+        dir_z: batch.direction.z[i],
+        time: 0.0,
+        tfar: f32::INFINITY,
+        mask: u32::MAX,
+        id: i as u32,
+        flags: 0,
+    };
+    let unwritten1 = Hit1 {
+        ng: [f32::NAN; 3],
+        u: f32::NAN,
+        v: f32::NAN,
+        prim_id: UNWRITTEN,
+        geom_id: UNWRITTEN,
+        inst_id: UNWRITTEN,
+        inst_prim_id: UNWRITTEN,
+    };
+    // Checks one hit's fields against the triangle the reference found.
+    let check_hit =
+        |i: usize, t: f32, ng: [f32; 3], u: f32, v: f32, prim: u32, geom: u32, inst: u32| {
+            assert_eq!((geom, inst), (0, u32::MAX), "ray {i}: geomID, instID");
+            let tri = &scene.triangles[prim as usize];
+            assert!(
+                (t - hits.t[i]).abs() <= 1e-4 * t.max(1.0),
+                "ray {i}: t {t} against {}",
+                hits.t[i]
+            );
+            assert!(
+                u >= -1e-4 && v >= -1e-4 && u + v <= 1.0 + 1e-4,
+                "ray {i}: u {u}, v {v}"
+            );
+            let normal = tri.e1.cross(tri.e2);
+            let ng = glam::Vec3::from(ng);
+            assert!(
+                ng.cross(normal).length() <= 1e-3 * ng.length() * normal.length(),
+                "ray {i}: Ng {ng}"
+            );
+        };
+    let mut args = embree.args(true);
+    let mut inst_prim_written = Vec::new();
+    for &i in &hit_rays[..8] {
+        let mut rh = Guarded {
+            record: RayHit1 {
+                ray: ray(i),
+                hit: unwritten1,
+            },
+            guard: [GUARD; 16],
+        };
+        embree.intersect1(&mut args, &mut rh.record);
+        let h = rh.record.hit;
+        check_hit(
+            i,
+            rh.record.ray.tfar,
+            h.ng,
+            h.u,
+            h.v,
+            h.prim_id,
+            h.geom_id,
+            h.inst_id,
+        );
+        assert_eq!(
+            rh.guard, [GUARD; 16],
+            "ray {i}: rtcIntersect1 wrote past RTCRayHit"
+        );
+        assert!(
+            matches!(h.inst_prim_id, UNWRITTEN | u32::MAX),
+            "ray {i}: instPrimID {:#x}",
+            h.inst_prim_id
+        );
+        inst_prim_written.push(h.inst_prim_id == u32::MAX);
+    }
+    // Eight hitting rays in one packet.
+    let lanes: [usize; 8] = std::array::from_fn(|k| hit_rays[k]);
+    let column = |f: &dyn Fn(&Ray1) -> f32| lanes.map(|i| f(&ray(i)));
+    let mut rh8 = Guarded {
+        record: RayHit8 {
+            ray: raywave::peer::embree_shared::Ray8 {
+                org: [
+                    column(&|r| r.org_x),
+                    column(&|r| r.org_y),
+                    column(&|r| r.org_z),
+                ],
+                tnear: [0.0; 8],
+                dir: [
+                    column(&|r| r.dir_x),
+                    column(&|r| r.dir_y),
+                    column(&|r| r.dir_z),
+                ],
+                time: [0.0; 8],
+                tfar: [f32::INFINITY; 8],
+                mask: [u32::MAX; 8],
+                id: std::array::from_fn(|k| k as u32),
+                flags: [0; 8],
+            },
+            hit: Hit8 {
+                ng: [[f32::NAN; 8]; 3],
+                u: [f32::NAN; 8],
+                v: [f32::NAN; 8],
+                prim_id: [UNWRITTEN; 8],
+                geom_id: [UNWRITTEN; 8],
+                inst_id: [UNWRITTEN; 8],
+                inst_prim_id: [UNWRITTEN; 8],
+            },
+        },
+        guard: [GUARD; 16],
+    };
+    embree.intersect8(&mut args, &Valid8([-1; 8]), &mut rh8.record);
+    let h = &rh8.record.hit;
+    for (k, &i) in lanes.iter().enumerate() {
+        let ng = [h.ng[0][k], h.ng[1][k], h.ng[2][k]];
+        check_hit(
+            i,
+            rh8.record.ray.tfar[k],
+            ng,
+            h.u[k],
+            h.v[k],
+            h.prim_id[k],
+            h.geom_id[k],
+            h.inst_id[k],
+        );
+        assert_eq!(
+            h.inst_prim_id[k] == u32::MAX,
+            inst_prim_written[k],
+            "lane {k}: instPrimID"
+        );
+    }
+    assert_eq!(
+        rh8.guard, [GUARD; 16],
+        "rtcIntersect8 wrote past RTCRayHit8"
+    );
+    assert!(
+        inst_prim_written.iter().all(|&w| w == inst_prim_written[0]),
+        "instPrimID written on some rays only: {inst_prim_written:?}"
+    );
+    inst_prim_written[0]
+}
+
+/// Embree 4.4's hit records are the bindings' (`embree_shared`'s sizes and offsets were read
+/// off its headers with gcc; this checks them against the library itself): every field lands
+/// where declared, nothing is written past the record, and the release's instance-array field
+/// is there and written.
+#[cfg(feature = "embree4")]
+#[test]
+fn embree4_writes_the_hit_records_the_bindings_declare() {
+    use raywave::peer::embree4::Embree4Mesh;
+    let scene = lab_scene();
+    let embree = Embree4Mesh::new(&scene, BuildQuality::High).unwrap_or_else(|e| panic!("{e:#}"));
+    assert!(
+        hit_records_written(&embree, &scene),
+        "Embree 4 left instPrimID unwritten"
+    );
+}
+
+/// Embree 3.13's records are a prefix of the shared (Embree 4) ones: it writes every field but
+/// `inst_prim_id`, and nothing past its own record.
+#[cfg(feature = "embree")]
+#[test]
+fn embree3_writes_a_prefix_of_the_hit_records() {
+    use raywave::peer::embree3::Embree3Mesh;
+    let scene = lab_scene();
+    let embree = Embree3Mesh::new(&scene, BuildQuality::High).expect("Embree 3 builds the scene");
+    assert!(
+        !hit_records_written(&embree, &scene),
+        "Embree 3 wrote instPrimID"
+    );
+}
+
+/// Both libraries in one process answer as themselves: Embree 4 is loaded with its own symbols
+/// (dlopen, deep binding), so Embree 3's same-named C functions do not capture its calls.
+#[cfg(all(feature = "embree", feature = "embree4"))]
+#[test]
+fn embree3_and_embree4_coexist() {
+    use raywave::peer::embree3::Embree3Mesh;
+    use raywave::peer::embree4::Embree4Mesh;
+    let scene = lab_scene();
+    let three = Embree3Mesh::new(&scene, BuildQuality::High).expect("Embree 3 builds the scene");
+    let four = Embree4Mesh::new(&scene, BuildQuality::High).unwrap_or_else(|e| panic!("{e:#}"));
+    assert!(
+        three.describe().starts_with("Embree 3."),
+        "{}",
+        three.describe()
+    );
+    assert!(
+        four.describe().starts_with("Embree 4."),
+        "{}",
+        four.describe()
+    );
+}
+
+/// The memory monitor counts the buffers before the commit and the BVH after it: the BVH of
+/// the test mesh (684 triangles in Triangle4 leaves of 176 bytes, at least) is more than its
+/// leaves' share of the triangles, and the build's peak holds both.
+#[cfg(feature = "embree4")]
+#[test]
+fn embree4_memory_counts_buffers_and_bvh() {
+    use raywave::peer::embree4::Embree4Mesh;
+    let scene = mesh_scene();
+    let n = scene.triangles.len() as i64;
+    let m = Embree4Mesh::new(&scene, BuildQuality::High)
+        .unwrap_or_else(|e| panic!("{e:#}"))
+        .memory;
+    // 3 vertices of 12 bytes and one index triple of 12 per triangle, plus Embree's padding.
+    assert!(m.buffers >= 48 * n && m.buffers < 64 * n + 4096, "{m:?}");
+    assert!(m.bvh >= 176 * n / 4, "{m:?}");
+    assert!(m.peak >= m.buffers + m.bvh, "{m:?}");
 }
 
 /// tinybvh's layouts through tinybvh-rs; shadow rays by its closest hit limited to tmax (the
