@@ -182,7 +182,12 @@ fn measure(scene: &Scene, config: &StudyConfig) -> (usize, Vec<Measured>) {
         config,
         &render,
         cache_dir()
-            .map(|d| raywave::variance::Cache::new(&d, raywave::variance::cache::DEFAULT_LIMIT_MIB))
+            .map(|d| {
+                raywave::variance::Cache::new(
+                    &d,
+                    raywave::variance::study::cache::DEFAULT_LIMIT_MIB,
+                )
+            })
             .as_ref(),
         &|line| eprintln!("{line}"),
     )

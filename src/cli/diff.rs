@@ -321,7 +321,8 @@ fn region(args: &DiffArgs, a: &Image, plan: &OutputPlan) -> Result<Region> {
     let settings = options
         .resolve(scene.background.map(|c| c.to_array()))
         .settings;
-    let regions = raywave::variance::mask::penumbra_mask(&scene, &settings, args.mask_samples);
+    let regions =
+        raywave::variance::figures::mask::penumbra_mask(&scene, &settings, args.mask_samples);
     Ok(Region {
         name: format!("penumbra of {}, {} bounces", scene.source, settings.bounces),
         inside: regions.penumbra,

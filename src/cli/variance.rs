@@ -13,7 +13,7 @@ use raywave::render::settings::RenderSettings;
 use raywave::render::wavefront::DEFAULT_BATCH_SIZE;
 use raywave::shard::Shard;
 use raywave::variance::command::{VarianceOptions, load_cases, prepare, run_shard, study};
-use raywave::variance::plan::Case;
+use raywave::variance::study::plan::Case;
 use std::path::{Path, PathBuf};
 
 /// Flags of `raywave variance`. A scene file literally named `prepare` or `merge` is given as
@@ -136,7 +136,7 @@ pub(crate) struct StudyArgs {
     /// Bound on the cache's total size in MiB; the least recently used entries are removed
     /// above it.
     #[arg(long, value_name = "MIB",
-          default_value_t = raywave::variance::cache::DEFAULT_LIMIT_MIB,
+          default_value_t = raywave::variance::study::cache::DEFAULT_LIMIT_MIB,
           value_parser = clap::value_parser!(u64).range(1..=1 << 30))]
     pub cache_limit: u64,
     /// How a light's colour reaches a point: lab (no fall-off) or rpi (divided by π·d², as
@@ -171,7 +171,7 @@ impl StudyArgs {
             quiet,
         };
         if let Some(file) = &self.study {
-            raywave::variance::study_file::read(file, &mut options)?;
+            raywave::variance::study::study_file::read(file, &mut options)?;
         }
         Ok(options)
     }
@@ -263,7 +263,7 @@ pub fn run(args: &VarianceArgs) -> Result<()> {
     }
     let options = args.study.options(&args.out, args.quiet)?;
     if args.clean_cache {
-        let (files, bytes) = raywave::variance::cache::clean(&options.cache)?;
+        let (files, bytes) = raywave::variance::study::cache::clean(&options.cache)?;
         return print(&format!(
             "removed {files} cache entr{} ({:.1} MiB) from {}\n",
             if files == 1 { "y" } else { "ies" },
@@ -275,15 +275,13 @@ pub fn run(args: &VarianceArgs) -> Result<()> {
     let pool = args.workers.pool()?;
     let plan = args.study.inputs(&options, OutputPlan::new());
     if let Some(shard) = args.shard {
-        let part = options
-            .out
-            .join(raywave::shard::part_name::<raywave::variance::plan::Study>(
-                shard,
-            ));
+        let part = options.out.join(raywave::shard::part_name::<
+            raywave::variance::study::plan::Study,
+        >(shard));
         let plan = plan.output_in_new_dir("--out", &part);
         plan.check()?;
         check_textures(&plan, &cases)?;
-        let identity = raywave::variance::plan::identity(&cases, options.engine.name());
+        let identity = raywave::variance::study::plan::identity(&cases, options.engine.name());
         let jobs = identity.work.assignment(shard.count)[shard.index].len();
         let prefix = format!("variance shard {shard}, {jobs} jobs");
         let (path, jobs) = with_progress(&options, prefix, |render, hooks| {
@@ -301,7 +299,7 @@ pub fn run(args: &VarianceArgs) -> Result<()> {
     }
     plan.check()?;
     check_textures(&plan, &cases)?;
-    let jobs = raywave::variance::plan::identity(&cases, options.engine.name())
+    let jobs = raywave::variance::study::plan::identity(&cases, options.engine.name())
         .work
         .jobs()
         .len();
@@ -329,7 +327,7 @@ pub fn run(args: &VarianceArgs) -> Result<()> {
 
 /// The files the study's report writes into --out.
 fn report_files(options: &VarianceOptions, cases: &[Case]) -> Vec<String> {
-    let per_case = raywave::variance::report::file_names(
+    let per_case = raywave::variance::report::tables::file_names(
         &options.samplers,
         &options.budgets,
         options.heatmap_budget(),
@@ -338,7 +336,7 @@ fn report_files(options: &VarianceOptions, cases: &[Case]) -> Vec<String> {
         per_case
     } else {
         let names: Vec<String> = cases.iter().map(|c| c.name.clone()).collect();
-        raywave::variance::summary::file_names(&names, &per_case)
+        raywave::variance::report::summary::file_names(&names, &per_case)
     }
 }
 

@@ -1,10 +1,10 @@
 //! `raywave variance`: the study as a command (options, checks, outputs); the flags, the
 //! progress bar and the printed table are the binary's (`cli/variance.rs`).
 
-use super::job_record::JobRecord;
-use super::jobs::{self, CaseFacts, Job, JobResult, Setup};
-use super::plan::{Case, Study, case_names, identity};
-use super::summary::Summary;
+use super::report::summary::Summary;
+use super::study::job_record::JobRecord;
+use super::study::jobs::{self, CaseFacts, Job, JobResult, Setup};
+use super::study::plan::{Case, Study, case_names, identity};
 use super::{Cache, Region, RenderFn, StudyConfig};
 use crate::render::engine::{Engine, Hooks};
 use crate::render::error::UsageError;
@@ -73,7 +73,7 @@ impl Default for VarianceOptions {
             out: PathBuf::from("variance-report"),
             cache: PathBuf::from(".raywave-cache"),
             no_cache: false,
-            cache_limit_mib: super::cache::DEFAULT_LIMIT_MIB,
+            cache_limit_mib: super::study::cache::DEFAULT_LIMIT_MIB,
             clean_cache: false,
             light_model: LightModel::Lab,
             engine: Engine::Wavefront,
@@ -406,7 +406,7 @@ pub(crate) fn write_report(
         for (name, result) in names.iter().zip(&results) {
             written.extend(result.write(&out.join(name))?);
         }
-        let summary = super::summary::summarize(names, &results);
+        let summary = super::report::summary::summarize(names, &results);
         written.extend(summary.write(&results, out)?);
         Some(summary)
     };

@@ -8,8 +8,8 @@
 //! not its shard's, and an output directory that is one of its inputs.
 
 use super::command::{Outcome, create_out, write_report};
-use super::jobs::{self, CaseFacts, JobResult};
-use super::plan::Study;
+use super::study::jobs::{self, CaseFacts, JobResult};
+use super::study::plan::Study;
 use crate::render::error::UsageError;
 use crate::shard::{HostSummary, Machines, same_file};
 use anyhow::{Result, bail};

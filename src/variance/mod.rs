@@ -18,24 +18,11 @@
 //!                (statistics::bootstrap_interval); time by the median's sign-test interval
 //! ```
 
-pub mod cache;
 pub mod command;
-pub(crate) mod figures;
-pub(crate) mod fits;
-pub mod job_record;
-pub mod jobs;
-pub mod mask;
+pub mod figures;
 pub mod merge;
-pub mod perceived;
-mod perceived_report;
-pub mod plan;
-pub(crate) mod plot;
 pub mod report;
-pub mod sheet;
-pub mod spectrum;
-pub mod spectrum_plot;
-pub mod study_file;
-pub mod summary;
+pub mod study;
 
 use crate::render::engine::Hooks;
 use crate::render::film::Film;
@@ -46,13 +33,16 @@ use crate::render::settings::{RenderSettings, ShadowMode};
 use anyhow::{Result, bail};
 use serde::{Deserialize, Serialize};
 
-pub use cache::Cache;
-pub use figures::{
+pub use figures::errors::{
     BIAS_FALSE_ALARM, ErrorStats, bias_bound, deterministic, error_stats, per_image_errors,
     pixel_mse,
 };
-pub use fits::{Matching, Slope, match_budget};
-pub use mask::{Regions, penumbra_mask};
+pub use figures::fits::{Matching, Slope, match_budget};
+pub use figures::mask::{Regions, penumbra_mask};
+pub use study::cache::Cache;
+
+use figures::perceived;
+use study::{cache, jobs};
 
 /// Renders one image: the engine is the caller's choice (the fastest one, normally).
 pub type RenderFn<'a> = dyn Fn(&Scene, &RenderSettings) -> (Film, RayCounts) + Sync + 'a;

@@ -8,7 +8,7 @@
 //! reference = converged_reference(stratified, 2 × reference_samples)     (no disk cache)
 //! for each sampler: K renders (seeds 1..=K) at N points
 //!     heat = pixel_mse(renders, reference); MSE whole and penumbra, mean ± standard error over seeds
-//!     perceived = the error's spectrum, low band and blurred MSE (variance/perceived.rs)
+//!     perceived = the error's spectrum, low band and blurred MSE (variance/figures/perceived.rs)
 //! spectrum.png = both sides' spectra, one plot
 //! ```
 
@@ -20,11 +20,9 @@ use crate::render::film::{Film, ToneMap};
 use crate::render::sampling::LightSampler;
 use crate::render::scene::Scene;
 use crate::stats::median;
-use crate::variance::perceived::{self, Perceived};
-use crate::variance::{
-    StudyConfig, converged_reference, error_stats, penumbra_mask, pixel_mse, plot::heat_images,
-    spectrum_plot,
-};
+use crate::variance::figures::perceived::{self, Perceived};
+use crate::variance::report::{plot::heat_images, spectrum_plot};
+use crate::variance::{StudyConfig, converged_reference, error_stats, penumbra_mask, pixel_mse};
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 use std::collections::VecDeque;

@@ -268,7 +268,7 @@ fn doctored_records_do_not_validate() {
 #[test]
 fn the_study_file_schema_is_the_generated_one_and_judges_study_files() {
     let name = "study.schema.json";
-    let generated = raywave::variance::study_file::schema();
+    let generated = raywave::variance::study::study_file::schema();
     let path = schema_dir().join(name);
     if std::env::var_os("RAYWAVE_UPDATE_SCHEMA").is_some_and(|v| v == "1") {
         std::fs::write(&path, &generated).unwrap();

@@ -413,7 +413,7 @@ fn a_copy_of_a_shard_under_another_name_is_refused_naming_both() {
 #[test]
 fn merge_refuses_a_part_run_with_another_simd_path_naming_both() {
     use raywave::shard::{Part, read_part, write_part};
-    use raywave::variance::plan::Study;
+    use raywave::variance::study::plan::Study;
     let dir = flag_shards(&["--no-cache"]);
     let d = dir.path();
     // Shard 1 as a binary of the same commit built for the other kind of node would have

@@ -19,7 +19,7 @@ use crate::common;
 
 use glam::Vec3;
 use rand::RngExt;
-use raywave::variance::perceived::{Perceived, measure};
+use raywave::variance::figures::perceived::{Perceived, measure};
 
 /// Seeds per pattern.
 const K: usize = 8;

@@ -26,8 +26,8 @@ use raywave::render::scene::Scene;
 use raywave::render::settings::RenderSettings;
 use raywave::render::wavefront::{DEFAULT_BATCH_SIZE, Wavefront};
 use raywave::variance::StudyConfig;
-use raywave::variance::jobs::{self, Job, Setup};
-use raywave::variance::plan::{CaseIdentity, Study};
+use raywave::variance::study::jobs::{self, Job, Setup};
+use raywave::variance::study::plan::{CaseIdentity, Study};
 use std::sync::Mutex;
 
 /// A job's estimate is within this factor of the rays it traces (both ways).

@@ -9,7 +9,7 @@ use crate::common;
 use common::bin::{raywave, stderr, stdout};
 use raywave::output::false_colour::{MIN_SIDE, inferno};
 use raywave::variance::command::nearest_budget;
-use raywave::variance::sheet::{MIN_TILE, contact_sheet};
+use raywave::variance::report::sheet::{MIN_TILE, contact_sheet};
 use std::path::Path;
 
 /// A small, quick study: 16×16, 3 seeds, cheap reference and mask.

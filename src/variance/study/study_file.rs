@@ -11,10 +11,10 @@
 //! sizes = [[128, 128], [256, 256]]
 //! ```
 
-use super::command::VarianceOptions;
 use crate::render::engine::Engine;
 use crate::render::sampling::LightSampler;
 use crate::render::settings::LightModel;
+use crate::variance::command::VarianceOptions;
 use anyhow::{Context, Result};
 use serde::{Deserialize, Deserializer};
 use std::path::{Path, PathBuf};

@@ -1,8 +1,8 @@
 //! One job's result as a study's part keeps it: the [`JobResult`] with the per-seed values the
 //! report leaves out of its rows, so that a merge reproduces a single process's figures.
 
-use super::Row;
-use super::jobs::{Job, JobResult, Thumbnail};
+use crate::variance::Row;
+use crate::variance::study::jobs::{Job, JobResult, Thumbnail};
 use serde::{Deserialize, Serialize};
 
 /// A [`JobResult`] with the per-seed values the report leaves out of its rows.

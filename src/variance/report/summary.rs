@@ -12,10 +12,10 @@
 //! The cases are the study's, not a sample of all scenes: the interval does not say how another
 //! scene would fare.
 
-use super::fits::{fit_rows, fitted, mean_at};
-use super::{Region, Row, StudyResult};
 use crate::render::sampling::LightSampler;
 use crate::stats::{BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, grouped_bootstrap_interval};
+use crate::variance::figures::fits::{fit_rows, fitted, mean_at};
+use crate::variance::{Region, Row, StudyResult};
 use anyhow::{Context, Result};
 use serde::Serialize;
 use std::fmt::Write as _;
@@ -326,7 +326,10 @@ impl Summary {
             ("summary.csv", self.csv()),
             ("summary.json", json),
         ] {
-            written.push(super::report::write_text(&dir.join(name), &body)?);
+            written.push(crate::variance::report::tables::write_text(
+                &dir.join(name),
+                &body,
+            )?);
         }
         Ok(written)
     }

@@ -11,9 +11,9 @@
 //! Images smaller than [`MIN_TILE`] on their shorter side are enlarged by a whole factor
 //! (nearest neighbour: every pixel stays a visible square).
 
-use super::StudyResult;
 use crate::output::false_colour::register_font;
 use crate::output::image_file::write_rgb8;
+use crate::variance::StudyResult;
 use anyhow::{Result, anyhow};
 use image::RgbImage;
 use plotters::prelude::*;

@@ -11,10 +11,10 @@
 //! resample = K seeds drawn with replacement; MSE(N) = mean of the drawn seeds' MSE
 //! ```
 
-use super::{Region, Row};
 use crate::render::sampling::LightSampler;
 use crate::stats::{BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, bootstrap_interval, median};
 use crate::stats::{LogLogFit, loglog_fit};
+use crate::variance::{Region, Row};
 use serde::Serialize;
 
 /// The lab's budget of random points that [`Matching`] is about.

@@ -3,9 +3,10 @@
 //! `results.json` (schema, version, commit, machine, settings, rows, slopes, matching budgets,
 //! per-seed rows), plus the plots, heat maps and contact sheet.
 
-use super::{Region, Row, StudyConfig, StudyResult, plot, sheet};
+use super::{plot, sheet};
 use crate::output::machine::Machine;
 use crate::render::sampling::LightSampler;
+use crate::variance::{Region, Row, StudyConfig, StudyResult};
 use anyhow::{Context, Result};
 use serde::Serialize;
 use std::fmt::Write as _;
@@ -96,7 +97,7 @@ pub fn file_names(samplers: &[LightSampler], budgets: &[u32], heatmap_n: u32) ->
     for &n in budgets {
         if !seen.contains(&n) {
             seen.push(n);
-            names.push(super::spectrum_plot::file_name(n));
+            names.push(crate::variance::report::spectrum_plot::file_name(n));
         }
     }
     names
@@ -167,8 +168,8 @@ struct Document<'a> {
     reference_mse: std::collections::BTreeMap<&'static str, f64>,
     reference_cached: bool,
     rows: &'a [Row],
-    slopes: &'a [super::Slope],
-    matching: &'a [super::Matching],
+    slopes: &'a [crate::variance::Slope],
+    matching: &'a [crate::variance::Matching],
     seeds: Vec<SeedRow>,
     outputs: std::collections::BTreeMap<String, String>,
 }
@@ -364,7 +365,7 @@ impl StudyResult {
                 s,
                 "\nbudget matching the MSE of {} random points (the lab's choice), from the fits \
                  [95%]:",
-                super::fits::LAB_RANDOM_POINTS
+                crate::variance::figures::fits::LAB_RANDOM_POINTS
             );
             for sampler in self
                 .config
@@ -540,7 +541,7 @@ impl StudyResult {
             written.push(sheet_path);
         }
         written.extend(plot::heatmaps(self, dir)?);
-        written.extend(super::spectrum_plot::spectra(self, dir)?);
+        written.extend(crate::variance::report::spectrum_plot::spectra(self, dir)?);
         Ok(written)
     }
 }

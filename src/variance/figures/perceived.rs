@@ -3,10 +3,10 @@
 //! 95% interval (bootstrap over seeds, as every figure of the study), and the low band as a
 //! ratio to random's on the same seeds.
 
-use super::Row;
-use super::fits::{interval, mean_at};
-use super::spectrum::{LOWPASS_SIGMAS, RINGS, lowpass_mse, radial_power};
 use crate::render::sampling::LightSampler;
+use crate::variance::Row;
+use crate::variance::figures::fits::{interval, mean_at};
+use crate::variance::figures::spectrum::{LOWPASS_SIGMAS, RINGS, lowpass_mse, radial_power};
 use glam::Vec3;
 use serde::Serialize;
 
@@ -102,7 +102,7 @@ pub fn measure(
 
 /// Fills every row's low band relative to random's at the same N and region.
 pub(crate) fn low_band_vs_random(rows: &mut [Row], k: usize) {
-    let random: Vec<(u32, super::Region, Vec<f64>, f64)> = rows
+    let random: Vec<(u32, crate::variance::Region, Vec<f64>, f64)> = rows
         .iter()
         .filter(|r| r.sampler == LightSampler::Random.name())
         .map(|r| {

@@ -3,10 +3,10 @@
 //! maps on one log scale shared by all samplers (`crate::output::false_colour`: title and colour bar).
 //! The font is embedded (DejaVu Sans, via the `dejavu` crate), so plots need no system fonts.
 
-use super::{Region, Row, StudyResult};
 use crate::output::false_colour::{self, Scale, figure, register_font};
 use crate::output::image_file::write_rgb8;
 use crate::render::sampling::LightSampler;
+use crate::variance::{Region, Row, StudyResult};
 use anyhow::{Context, Result, anyhow};
 use plotters::coord::Shift;
 use plotters::prelude::*;

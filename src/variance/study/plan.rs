@@ -10,11 +10,11 @@
 //! shard i  = crate::shard::partition(costs of the jobs, count)[i]
 //! ```
 
-use super::StudyConfig;
-use super::job_record::JobRecord;
-use super::jobs::{self, CaseFacts, Job};
 use crate::render::scene::Scene;
 use crate::shard::{Identity, Work};
+use crate::variance::StudyConfig;
+use crate::variance::study::job_record::JobRecord;
+use crate::variance::study::jobs::{self, CaseFacts, Job};
 use serde::{Deserialize, Serialize};
 
 /// One case of a study: a scene at one size.

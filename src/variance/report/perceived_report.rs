@@ -1,9 +1,9 @@
 //! The perceived-error part of a study's report: a table of each sampler's low-pass error and
 //! low band against random's, per budget and region, and the CSV files behind the spectra.
 
-use super::spectrum::{LOWPASS_SIGMAS, RINGS, ring_frequency};
-use super::spectrum_plot::REGIONS;
-use super::{Region, StudyResult};
+use crate::variance::figures::spectrum::{LOWPASS_SIGMAS, RINGS, ring_frequency};
+use crate::variance::report::spectrum_plot::REGIONS;
+use crate::variance::{Region, StudyResult};
 use std::fmt::Write;
 
 /// `v` with its interval, scientific: `6.4e-5 [6.1e-5, 6.8e-5]`; `-` for a figure with nothing

@@ -13,12 +13,13 @@
 //!          the samplers rotated (timing drift falls on all alike), then each job's rows
 //! ```
 
-use super::{Converged, Region, RenderFn, Row, StudyConfig, StudyResult};
-use super::{converged_reference, deterministic, error_stats, fits, penumbra_mask, perceived};
-use super::{per_image_errors, pixel_mse};
 use crate::render::film::{Film, ToneMap};
 use crate::render::sampling::LightSampler;
 use crate::render::scene::Scene;
+use crate::variance::figures::{fits, perceived};
+use crate::variance::{Converged, Region, RenderFn, Row, StudyConfig, StudyResult};
+use crate::variance::{converged_reference, deterministic, error_stats, penumbra_mask};
+use crate::variance::{per_image_errors, pixel_mse};
 use anyhow::Result;
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
@@ -82,7 +83,7 @@ impl Setup {
         scene_id: &[u8],
         config: &StudyConfig,
         render: &RenderFn,
-        cache: Option<&super::Cache>,
+        cache: Option<&crate::variance::Cache>,
         notice: &(dyn Fn(&str) + Sync),
     ) -> Result<Setup> {
         let reference = converged_reference(scene, scene_id, config, render, cache, notice)?;

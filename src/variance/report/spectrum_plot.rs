@@ -3,13 +3,13 @@
 //! interval as a band, the low band (|f| ≤ 1/8) marked. A blue-noise error is a curve that
 //! starts low and rises; white noise is flat.
 
-use super::perceived::Perceived;
-use super::plot::{PALETTE, log_range};
-use super::spectrum::{LOW_BAND, RINGS, ring_frequency};
-use super::{Region, StudyResult};
 use crate::output::false_colour::register_font;
 use crate::output::image_file::write_rgb8;
 use crate::render::sampling::LightSampler;
+use crate::variance::figures::perceived::Perceived;
+use crate::variance::figures::spectrum::{LOW_BAND, RINGS, ring_frequency};
+use crate::variance::report::plot::{PALETTE, log_range};
+use crate::variance::{Region, StudyResult};
 use anyhow::{Context, Result, anyhow};
 use plotters::coord::Shift;
 use plotters::prelude::*;
