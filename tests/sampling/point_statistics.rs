@@ -16,8 +16,8 @@
 //! False alarms: each test compares its statistics with critical values from their exact
 //! distributions under a correct sampler (χ² for counts, the normal for means of bounded
 //! per-stream values over thousands of streams), with a Bonferroni split so that each `#[test]`
-//! fails a correct sampler with probability at most [`FAMILY_ALPHA`] = 1e-4: the module's six
-//! run tests together at most 6e-4. The streams are fixed (the seeds below), so every run
+//! fails a correct sampler with probability at most [`FAMILY_ALPHA`] = 1e-4: the module's seven
+//! statistical tests together at most 7e-4. The streams are fixed (the seeds below), so every run
 //! passes or fails the same way; a planted correlation gives statistics far past the limits.
 //!
 //! Every stream below has its own render seed, and the streams of a pair differ in one field:
@@ -228,9 +228,10 @@ fn every_point_index_is_uniform_on_the_square_over_streams() {
 #[test]
 fn pooled_points_are_uniform_on_a_32_by_32_grid() {
     // All the points of 2560 streams, pooled: χ² on 32 × 32 cells (1023 dof, at least 40
-    // expected per cell), 24 statistics. The rate is exact for independent points; a stream's
-    // points are stratified, so its counts vary less than independent points' and the χ² of
-    // a correct set is smaller still. A diagonal band of excess or deficit shows here.
+    // expected per cell), 24 statistics. The rate is exact for independent points (random,
+    // lab); the other sets spread a stream's points more evenly than independent ones, so their
+    // counts vary less and their χ² is smaller still. A diagonal band of excess or deficit
+    // shows here.
     let mut failures = Failures::default();
     let limit = chi2_limit(1023, FAMILY_ALPHA / 24.0);
     for sampler in LightSampler::ALL {
