@@ -176,7 +176,7 @@ static SOBOL_VECTORS: std::sync::LazyLock<[[u32; 16]; 2]> = std::sync::LazyLock:
 
 /// `sobol_burley::parts::owen_scramble_rev`, N lanes.
 #[inline(always)]
-fn owen_scramble_rev8<U: LanesU>(mut n: U, scramble: u32) -> U {
+pub(super) fn owen_scramble_rev8<U: LanesU>(mut n: U, scramble: u32) -> U {
     n = n ^ (n * U::splat(0x3d20_adea));
     n = n + U::splat(scramble);
     n = n * U::splat((scramble >> 16) | 1);

@@ -191,11 +191,7 @@ pub(super) fn zsobol<U: LanesU>(j: U, stream: &zsobol::StreamIndex) -> (U::F, U:
 /// `zsobol::owen_scramble` on lanes.
 #[inline(always)]
 fn owen_scramble<U: LanesU>(x: U, seed: u32) -> U {
-    let mut v = reverse_bits8(x) + U::splat(seed);
-    for m in [0x6c50_b47c, 0xb82f_1e52, 0xc7af_e638, 0x8d22_f6e6] {
-        v = v ^ (v * U::splat(m));
-    }
-    reverse_bits8(v)
+    reverse_bits8(super::light::owen_scramble_rev8(reverse_bits8(x), seed))
 }
 
 /// PMJ02 points `j0..j0 + N` of the stream reading `table` with the digital shift `masks`:
