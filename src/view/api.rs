@@ -3,7 +3,7 @@
 
 use super::compare::{CompareRequest, Comparisons};
 use super::http::{ApiError, Reply, number, query};
-use super::jobs::{ENGINES, Jobs, RENDER_BURST, RENDER_RATE, Status};
+use super::renders::{ENGINES, RENDER_BURST, RENDER_RATE, Renders, Status};
 use super::request::{Resolved, ViewSettings};
 use super::scene_json::{CameraFrame, SceneJson};
 use super::tree;
@@ -20,7 +20,7 @@ pub(crate) struct State {
     /// The settings the command line gave: what a request leaves out.
     pub base: Resolved,
     /// The render jobs.
-    pub jobs: Arc<Jobs>,
+    pub jobs: Arc<Renders>,
     /// The comparisons.
     pub comparisons: Comparisons,
     /// The worker threads renders run on.
@@ -75,11 +75,11 @@ pub(crate) fn render(state: &State, body: &[u8]) -> Result<Reply, ApiError> {
 }
 
 /// The job status with the render camera's frame, for the 3D view.
-fn with_frame(status: super::jobs::JobStatus, resolved: &Resolved) -> Reply {
+fn with_frame(status: super::renders::RenderStatus, resolved: &Resolved) -> Reply {
     #[derive(Serialize)]
     struct Body {
         #[serde(flatten)]
-        status: super::jobs::JobStatus,
+        status: super::renders::RenderStatus,
         frame: CameraFrame,
     }
     Reply::json(&Body {
@@ -97,15 +97,15 @@ fn job_id(text: &str) -> Result<u64, ApiError> {
         .map_err(|_| ApiError::bad(format!("expected a job number, found `{}`", quote(text))))
 }
 
-fn find_job(state: &State, text: &str) -> Result<Arc<super::jobs::Job>, ApiError> {
+fn find_job(state: &State, text: &str) -> Result<Arc<super::renders::RenderJob>, ApiError> {
     job_by_id(state, job_id(text)?)
 }
 
-fn job_by_id(state: &State, id: u64) -> Result<Arc<super::jobs::Job>, ApiError> {
+fn job_by_id(state: &State, id: u64) -> Result<Arc<super::renders::RenderJob>, ApiError> {
     state.jobs.get(id).ok_or_else(|| {
         ApiError::not_found(format!(
             "no render job {id}: only the last {} are kept",
-            super::jobs::KEPT_JOBS
+            super::renders::KEPT_RENDERS
         ))
     })
 }
@@ -184,7 +184,7 @@ pub(crate) fn pixel(state: &State, q: &str) -> Result<Reply, ApiError> {
         Status::Queued | Status::Running | Status::Done => {}
     }
     let (x, y): (u32, u32) = (number(&pairs, "x")?, number(&pairs, "y")?);
-    let scene = super::jobs::with_camera(&state.scene, &job.resolved.camera);
+    let scene = super::renders::with_camera(&state.scene, &job.resolved.camera);
     Ok(Reply::json(&tree::pixel_tree(
         &scene,
         &job.resolved.settings,

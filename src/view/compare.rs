@@ -230,7 +230,7 @@ impl Comparisons {
         })?;
         let start = Instant::now();
         let resolved = request.settings.resolve(base)?;
-        let scene = super::jobs::with_camera(scene, &resolved.camera);
+        let scene = super::renders::with_camera(scene, &resolved.camera);
         let (w, h) = (resolved.settings.width, resolved.settings.height);
         let longer = w.max(h) as f32;
         let base_settings = crate::render::settings::RenderSettings {

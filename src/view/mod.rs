@@ -12,7 +12,7 @@
 //! http.rs        errors as 4xx/5xx JSON, replies, query strings
 //! api.rs         the handlers
 //! request.rs     the settings a page sends (JSON) -> RenderSettings, checked
-//! jobs.rs        progressive render jobs on one render thread
+//! renders.rs     progressive render jobs on one render thread
 //! tree.rs        one pixel's ray tree
 //! compare.rs     two samplers side by side with their error heat maps
 //! scene_json.rs  the scene's geometry and the camera's frame for WebGL
@@ -24,7 +24,7 @@ pub(crate) mod assets;
 pub(crate) mod compare;
 pub(crate) mod connection;
 pub(crate) mod http;
-pub(crate) mod jobs;
+pub(crate) mod renders;
 pub mod request;
 pub(crate) mod routes;
 pub(crate) mod scene_json;
@@ -64,7 +64,7 @@ pub fn run(options: ViewOptions, say: &dyn Fn(&str) -> Result<()>) -> Result<i32
     let server = server::Server::bind(options.bind, options.port)?;
     let pool = Arc::new(crate::render::engine::thread_pool(options.threads)?);
     let scene = Arc::new(options.scene);
-    let jobs = jobs::Jobs::start(scene.clone(), pool.clone(), options.batch_size)
+    let jobs = renders::Renders::start(scene.clone(), pool.clone(), options.batch_size)
         .map_err(|e| anyhow::anyhow!("cannot start the render thread: {e}"))?;
     let port = server.addr.port();
     let state = Arc::new(api::State {

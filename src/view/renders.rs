@@ -6,13 +6,13 @@
 //! thread and becomes `superseded`.
 //!
 //! ```text
-//! POST /api/render -> rate limit (token bucket) -> Jobs::submit:
+//! POST /api/render -> rate limit (token bucket) -> Renders::submit:
 //!     the waiting job, if any, is superseded; the running job's cancel flag is set
 //!     -> the one waiting place -> render thread:
 //!     for level in 1/8, 1/4, 1/2, 1:
 //!         Engine::prepare(scene with the job's camera, settings at the level's size)
 //!             .render_until(progress, cancel)  -> None: superseded, stop
-//!         -> PNG + ray counts and seconds -> JobState (read by GET /api/render/{id})
+//!         -> PNG + ray counts and seconds -> RenderState (read by GET /api/render/{id})
 //! ```
 
 use crate::output::bench_record::KindRates;
@@ -29,7 +29,7 @@ use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 
 /// How many finished jobs are kept for their images and pixels.
-pub(crate) const KEPT_JOBS: usize = 8;
+pub(crate) const KEPT_RENDERS: usize = 8;
 
 /// Render starts admitted at once: the bucket's size.
 pub(crate) const RENDER_BURST: u32 = 20;
@@ -78,7 +78,7 @@ pub(crate) struct Level {
 
 /// What the page polls.
 #[derive(Clone, Debug, PartialEq, Serialize)]
-pub(crate) struct JobStatus {
+pub(crate) struct RenderStatus {
     /// The job's id.
     pub job: u64,
     /// Where it is.
@@ -95,7 +95,7 @@ pub(crate) struct JobStatus {
 }
 
 /// One job: its inputs, and what it has produced so far.
-pub(crate) struct Job {
+pub(crate) struct RenderJob {
     /// Its id (increasing).
     pub id: u64,
     /// The settings and camera at full resolution.
@@ -108,20 +108,20 @@ pub(crate) struct Job {
     superseded_by: AtomicU64,
     done_units: AtomicU64,
     total_units: AtomicU64,
-    state: Mutex<JobState>,
+    state: Mutex<RenderState>,
 }
 
-struct JobState {
+struct RenderState {
     status: Status,
     levels: Vec<Level>,
     pngs: Vec<Arc<Vec<u8>>>,
 }
 
-impl Job {
+impl RenderJob {
     /// The status for the page.
-    pub(crate) fn status(&self) -> JobStatus {
+    pub(crate) fn status(&self) -> RenderStatus {
         let state = self.lock();
-        JobStatus {
+        RenderStatus {
             job: self.id,
             status: state.status.clone(),
             sizes: self.sizes.clone(),
@@ -149,7 +149,7 @@ impl Job {
         self.lock().pngs.get(k).cloned()
     }
 
-    fn lock(&self) -> MutexGuard<'_, JobState> {
+    fn lock(&self) -> MutexGuard<'_, RenderState> {
         self.state.lock().unwrap_or_else(|e| e.into_inner())
     }
 
@@ -184,13 +184,13 @@ pub(crate) fn level_sizes(width: u32, height: u32) -> Vec<[u32; 2]> {
 /// job being rendered, whose cancel flag a newer job sets.
 #[derive(Default)]
 struct Inbox {
-    waiting: Option<Arc<Job>>,
-    running: Option<Arc<Job>>,
+    waiting: Option<Arc<RenderJob>>,
+    running: Option<Arc<RenderJob>>,
     /// The render thread has stopped, or must.
     closed: bool,
 }
 
-/// The inbox and the signal that a job is waiting, shared by [`Jobs`] and the render thread.
+/// The inbox and the signal that a job is waiting, shared by [`Renders`] and the render thread.
 #[derive(Default)]
 struct Queue {
     inbox: Mutex<Inbox>,
@@ -255,27 +255,27 @@ impl TokenBucket {
 }
 
 /// The jobs, the render thread's inbox and the rate limit on new jobs.
-pub(crate) struct Jobs {
+pub(crate) struct Renders {
     next: AtomicU64,
-    kept: Mutex<VecDeque<Arc<Job>>>,
+    kept: Mutex<VecDeque<Arc<RenderJob>>>,
     queue: Arc<Queue>,
     bucket: Mutex<TokenBucket>,
 }
 
-impl Jobs {
+impl Renders {
     /// Starts the render thread, which renders on `pool` with `batch_size` (the wavefront
     /// engine's tile) and reads `scene`.
     pub(crate) fn start(
         scene: Arc<Scene>,
         pool: Arc<rayon::ThreadPool>,
         batch_size: usize,
-    ) -> std::io::Result<Arc<Jobs>> {
+    ) -> std::io::Result<Arc<Renders>> {
         let queue = Arc::new(Queue::default());
         let inbox = queue.clone();
         std::thread::Builder::new()
             .name("render".into())
             .spawn(move || render_thread(&inbox, &scene, &pool, batch_size))?;
-        Ok(Arc::new(Jobs {
+        Ok(Arc::new(Renders {
             next: AtomicU64::new(1),
             kept: Mutex::new(VecDeque::new()),
             queue,
@@ -285,14 +285,14 @@ impl Jobs {
 
     /// Queues a job, unless the rate limit refuses it. It takes the place of the job waiting,
     /// which is superseded without starting, and cancels the job running.
-    pub(crate) fn submit(&self, resolved: Resolved) -> Result<Arc<Job>, RateLimited> {
+    pub(crate) fn submit(&self, resolved: Resolved) -> Result<Arc<RenderJob>, RateLimited> {
         self.bucket
             .lock()
             .unwrap_or_else(|e| e.into_inner())
             .take(Instant::now())?;
         let id = self.next.fetch_add(1, Ordering::Relaxed);
         let sizes = level_sizes(resolved.settings.width, resolved.settings.height);
-        let job = Arc::new(Job {
+        let job = Arc::new(RenderJob {
             id,
             resolved,
             sizes,
@@ -300,7 +300,7 @@ impl Jobs {
             superseded_by: AtomicU64::new(0),
             done_units: AtomicU64::new(0),
             total_units: AtomicU64::new(0),
-            state: Mutex::new(JobState {
+            state: Mutex::new(RenderState {
                 status: Status::Queued,
                 levels: Vec::new(),
                 pngs: Vec::new(),
@@ -308,7 +308,7 @@ impl Jobs {
         });
         let mut kept = self.kept.lock().unwrap_or_else(|e| e.into_inner());
         kept.push_back(job.clone());
-        while kept.len() > KEPT_JOBS {
+        while kept.len() > KEPT_RENDERS {
             kept.pop_front();
         }
         drop(kept);
@@ -330,7 +330,7 @@ impl Jobs {
     }
 
     /// The job `id`, while it is kept.
-    pub(crate) fn get(&self, id: u64) -> Option<Arc<Job>> {
+    pub(crate) fn get(&self, id: u64) -> Option<Arc<RenderJob>> {
         let kept = self.kept.lock().unwrap_or_else(|e| e.into_inner());
         kept.iter().find(|j| j.id == id).cloned()
     }
@@ -341,7 +341,7 @@ impl Jobs {
     }
 }
 
-impl Drop for Jobs {
+impl Drop for Renders {
     fn drop(&mut self) {
         self.queue.close();
     }
@@ -412,7 +412,7 @@ pub(crate) fn with_camera<'a>(
 
 /// Renders every level; false when superseded before the last was finished.
 fn render_levels(
-    job: &Job,
+    job: &RenderJob,
     scene: &Scene,
     pool: &rayon::ThreadPool,
     batch_size: usize,
@@ -485,7 +485,7 @@ mod tests {
     #[test]
     fn one_job_waits_a_newer_one_replaces_it_and_cancels_the_running_one() {
         // No render thread: the test plays its part on the queue.
-        let jobs = Jobs {
+        let jobs = Renders {
             next: AtomicU64::new(1),
             kept: Mutex::new(VecDeque::new()),
             queue: Arc::new(Queue::default()),
@@ -529,7 +529,7 @@ mod tests {
                 .all(|j| j.state() == Status::Superseded)
         );
         assert!(jobs.get(12).is_none() && jobs.get(13).is_some());
-        assert_eq!(jobs.kept.lock().unwrap().len(), KEPT_JOBS);
+        assert_eq!(jobs.kept.lock().unwrap().len(), KEPT_RENDERS);
     }
 
     #[test]
