@@ -23,6 +23,7 @@
 pub mod batch;
 pub mod bvh;
 pub mod context;
+pub mod cost;
 pub mod film;
 pub mod generate;
 pub mod intersect;
