@@ -16,7 +16,7 @@
 //! tested. The counts are integers and each pixel's are summed inside its tile, so they are
 //! the same for any thread count.
 
-use crate::render::per_kind::PerKind;
+use crate::render::per_kind::{PerKind, RayKind};
 use serde::{Deserialize, Serialize};
 use std::ops::{Add, AddAssign};
 
@@ -249,6 +249,29 @@ pub struct CostReport {
     pub pixels: Option<Vec<PerKind<Cost>>>,
 }
 
+/// What a tile's render counts: nothing ([`NoCount`], the renderer as it always runs) or each
+/// pixel's work ([`TileCosts`], the counted pass).
+pub(crate) trait Tally {
+    /// The sink of one batch's per-ray (or per-hit) counts.
+    type Sink<'a>: Remap
+    where
+        Self: 'a;
+    /// A zeroed sink for a batch of `n` rays (or hits).
+    fn batch(&mut self, n: usize) -> Self::Sink<'_>;
+    /// Adds the batch's counts to the pixels of `pixel` (ray i's pixel), as `kind`'s work.
+    fn settle(&mut self, pixel: &[u32], kind: RayKind);
+}
+
+impl Tally for NoCount {
+    type Sink<'a> = NoCount;
+    #[inline(always)]
+    fn batch(&mut self, _: usize) -> NoCount {
+        NoCount
+    }
+    #[inline(always)]
+    fn settle(&mut self, _: &[u32], _: RayKind) {}
+}
+
 /// One tile's counts while it renders: the current batch's per-ray column, and each of the
 /// tile's pixels by kind.
 pub(crate) struct TileCosts {
@@ -267,20 +290,6 @@ impl TileCosts {
         }
     }
 
-    /// A zeroed per-ray column for a batch of `n` rays (or hits).
-    pub(crate) fn batch(&mut self, n: usize) -> PerRay<'_> {
-        self.column.clear();
-        self.column.resize(n, Cost::default());
-        PerRay(&mut self.column)
-    }
-
-    /// Adds the batch column to the pixels of `pixel` (ray i's pixel), as `kind`'s work.
-    pub(crate) fn settle(&mut self, pixel: &[u32], kind: crate::render::per_kind::RayKind) {
-        for (&p, &c) in pixel.iter().zip(&self.column) {
-            self.pixels[(p - self.first) as usize][kind] += c;
-        }
-    }
-
     /// The tile's sums by kind.
     pub(crate) fn totals(&self) -> PerKind<CostSum> {
         let mut sum = PerKind::<CostSum>::default();
@@ -290,5 +299,19 @@ impl TileCosts {
             }
         }
         sum
+    }
+}
+
+impl Tally for TileCosts {
+    type Sink<'a> = PerRay<'a>;
+    fn batch(&mut self, n: usize) -> PerRay<'_> {
+        self.column.clear();
+        self.column.resize(n, Cost::default());
+        PerRay(&mut self.column)
+    }
+    fn settle(&mut self, pixel: &[u32], kind: RayKind) {
+        for (&p, &c) in pixel.iter().zip(&self.column) {
+            self.pixels[(p - self.first) as usize][kind] += c;
+        }
     }
 }
