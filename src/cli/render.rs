@@ -121,7 +121,13 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         check_hdr_path(hdr).map_err(|e| UsageError::from_error(&e))?;
     }
     if let Some(map) = &args.cost_map {
-        ldr_format(map).map_err(|e| UsageError(format!("--cost-map: {e:#}")))?;
+        if ldr_format(map).is_err() {
+            return Err(UsageError(format!(
+                "--cost-map {}: expected a file ending in .png or .ppm (an 8-bit figure)",
+                map.display()
+            ))
+            .into());
+        }
         if Engine::from(args.engine) == Engine::Reference {
             return Err(UsageError(
                 "--cost-map counts the wavefront engine's traversal: expected --engine wavefront (the default), not --engine reference".into(),
