@@ -212,6 +212,13 @@ impl<'a> Wavefront<'a> {
     /// and, when `per_pixel`, kept for each pixel. A separate instantiation of the stages:
     /// `render` runs none of the counting. Each pixel's counts are summed inside its tile, so
     /// they are the same for any thread count.
+    ///
+    /// `#[inline]` so that the counting instantiation of the stages is compiled in the crate
+    /// that calls this (the binary, a test), never beside the library's uncounted stages: in one
+    /// codegen unit, the second caller it gives the stages' helpers (`shadow::spawn`, `shade`)
+    /// made LLVM stop inlining them into the uncounted stage (+1.5% instructions on the
+    /// icount gate's mesh shadow stage, the BVH walk itself unchanged to the instruction).
+    #[inline]
     pub fn render_counted(
         &self,
         on_tile: &(dyn Fn() + Sync),
