@@ -90,6 +90,8 @@ pub fn run(args: &ViewArgs) -> Result<u8> {
         camera: scene.camera,
         settings,
         engine: Engine::from(args.engine),
+        cost_map: Default::default(),
+        cost_measure: Default::default(),
     };
     let signal = serve(
         ViewOptions {

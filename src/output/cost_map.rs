@@ -62,30 +62,32 @@ pub enum CostMeasure {
     Both,
 }
 
-/// One measure of a cost.
-#[derive(Clone, Copy)]
-enum One {
+/// One count a map shows: a panel of the figure, or the viewer's overlay.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Count {
+    /// BVH nodes visited.
     Nodes,
+    /// Primitives tested.
     Tests,
 }
 
-impl One {
+impl Count {
     fn of(self, c: &Cost) -> u32 {
         match self {
-            One::Nodes => c.nodes,
-            One::Tests => c.tests,
+            Count::Nodes => c.nodes,
+            Count::Tests => c.tests,
         }
     }
     fn of_sum(self, c: &CostSum) -> u64 {
         match self {
-            One::Nodes => c.nodes,
-            One::Tests => c.tests,
+            Count::Nodes => c.nodes,
+            Count::Tests => c.tests,
         }
     }
     fn name(self) -> &'static str {
         match self {
-            One::Nodes => "BVH nodes visited",
-            One::Tests => "primitives tested",
+            Count::Nodes => "BVH nodes visited",
+            Count::Tests => "primitives tested",
         }
     }
 }
@@ -109,17 +111,58 @@ pub struct CostInput<'a> {
 /// The cost map of `input`: `kind`'s rays, `measure` (two panels for `Both`).
 pub fn figure(input: &CostInput, kind: CostKind, measure: CostMeasure) -> Result<RgbImage> {
     match measure {
-        CostMeasure::Nodes => panel(input, kind, One::Nodes),
-        CostMeasure::Tests => panel(input, kind, One::Tests),
+        CostMeasure::Nodes => panel(input, kind, Count::Nodes),
+        CostMeasure::Tests => panel(input, kind, Count::Tests),
         CostMeasure::Both => Ok(side_by_side(
-            &panel(input, kind, One::Nodes)?,
-            &panel(input, kind, One::Tests)?,
+            &panel(input, kind, Count::Nodes)?,
+            &panel(input, kind, Count::Tests)?,
         )),
     }
 }
 
-/// One measure's figure.
-fn panel(input: &CostInput, kind: CostKind, one: One) -> Result<RgbImage> {
+/// One count's figure.
+fn panel(input: &CostInput, kind: CostKind, one: Count) -> Result<RgbImage> {
+    let map = overlay(input, kind, one);
+    let mean = match map.per_ray {
+        Some(m) => format!("{m:.2} per ray"),
+        None => "no rays".to_string(),
+    };
+    let title = format!("{}: {}", kind.title(), one.name());
+    let label = format!(
+        "per pixel and camera sample; {mean}, largest {}",
+        number(map.largest)
+    );
+    false_colour::figure(
+        &map.values,
+        input.width,
+        input.height,
+        &map.scale,
+        &title,
+        &label,
+    )
+}
+
+/// A map's values and what its legend says, without the figure around it.
+pub struct Overlay {
+    /// Each pixel's value (row-major): the count per camera sample.
+    pub values: Vec<f32>,
+    /// The colour scale (0 to the 99.9th percentile, rounded up to a multiple of 4).
+    pub scale: Scale,
+    /// The largest value.
+    pub largest: f32,
+    /// The frame's mean per ray of the kinds counted (`None` without rays).
+    pub per_ray: Option<f64>,
+}
+
+impl Overlay {
+    /// The map alone, one pixel per image pixel: what the viewer lays over the render.
+    pub fn image(&self, width: u32, height: u32) -> RgbImage {
+        false_colour::map_image(&self.values, width, height, &self.scale)
+    }
+}
+
+/// `kind`'s `one` count per pixel and camera sample, its scale and its legend's figures.
+pub fn overlay(input: &CostInput, kind: CostKind, one: Count) -> Overlay {
     let per_sample = input.aa_samples.max(1) as f32;
     let values: Vec<f32> = input
         .pixels
@@ -129,25 +172,18 @@ fn panel(input: &CostInput, kind: CostKind, one: One) -> Result<RgbImage> {
             sum as f32 / per_sample
         })
         .collect();
-    let scale = scale_of(&values);
-    let largest = values.iter().copied().fold(0.0f32, f32::max);
     let rays: u64 = kind.kinds().iter().map(|&k| input.rays[k]).sum();
     let work: u64 = kind
         .kinds()
         .iter()
         .map(|&k| one.of_sum(&input.totals[k]))
         .sum();
-    let mean = if rays > 0 {
-        format!("{:.2} per ray", work as f64 / rays as f64)
-    } else {
-        "no rays".to_string()
-    };
-    let title = format!("{}: {}", kind.title(), one.name());
-    let label = format!(
-        "per pixel and camera sample; {mean}, largest {}",
-        number(largest)
-    );
-    false_colour::figure(&values, input.width, input.height, &scale, &title, &label)
+    Overlay {
+        scale: scale_of(&values),
+        largest: values.iter().copied().fold(0.0f32, f32::max),
+        per_ray: (rays > 0).then(|| work as f64 / rays as f64),
+        values,
+    }
 }
 
 /// Linear from 0 to the 99.9th percentile, so that a few hot pixels do not flatten the map

@@ -224,6 +224,19 @@ impl<'a> Wavefront<'a> {
         on_tile: &(dyn Fn() + Sync),
         per_pixel: bool,
     ) -> (Film, RenderStats, CostReport) {
+        self.render_counted_until(on_tile, per_pixel, &AtomicBool::new(false))
+            .expect("a render whose cancel flag is never set renders every tile")
+    }
+
+    /// [`Wavefront::render_counted`] that stops early once `cancel` is set, as
+    /// [`Wavefront::render_until`] does: `None` when a tile was skipped.
+    #[inline]
+    pub fn render_counted_until(
+        &self,
+        on_tile: &(dyn Fn() + Sync),
+        per_pixel: bool,
+        cancel: &AtomicBool,
+    ) -> Option<(Film, RenderStats, CostReport)> {
         let s = self.ctx.settings;
         let mut film = Film::new(s.width, s.height);
         let tiles: Vec<_> = film
@@ -233,13 +246,16 @@ impl<'a> Wavefront<'a> {
             .map_init(
                 || self.pooled(),
                 |pooled, (tile, out)| {
+                    if cancel.load(Ordering::Relaxed) {
+                        return None;
+                    }
                     let first = (tile * self.tile_pixels) as u32;
                     let mut stats = RenderStats::default();
                     let mut costs = TileCosts::new(first, out.len());
                     self.render_tile_with(first, out, &mut pooled.ws, &mut stats, &mut costs);
                     on_tile();
                     let totals = costs.totals();
-                    (stats, totals, per_pixel.then_some(costs.pixels))
+                    Some((stats, totals, per_pixel.then_some(costs.pixels)))
                 },
             )
             .collect();
@@ -249,14 +265,15 @@ impl<'a> Wavefront<'a> {
             ..CostReport::default()
         };
         // In tile order: the pixels' counts come out row-major.
-        for (tile_stats, totals, pixels) in tiles {
+        for tile in tiles {
+            let (tile_stats, totals, pixels) = tile?;
             stats = stats + tile_stats;
             report.totals = report.totals + totals;
             if let (Some(all), Some(p)) = (&mut report.pixels, pixels) {
                 all.extend(p);
             }
         }
-        (film, stats, report)
+        Some((film, stats, report))
     }
 
     /// Renders pixels `first..first + out.len()` into `out`: the architecture diagram.
