@@ -99,6 +99,8 @@ pub fn run(args: &ViewArgs) -> Result<u8> {
             base,
             threads: args.workers.threads,
             batch_size: args.batch_size as usize,
+            // Compiled here, in the binary: see `ViewOptions::counted`.
+            counted: |w, progress, cancel| w.render_counted_until(progress, true, cancel),
             bind: args.bind,
             port: args.port,
             access,

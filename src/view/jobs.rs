@@ -22,6 +22,7 @@ use crate::render::engine::{Engine, Prepared, clamp_to_finite};
 use crate::render::film::ToneMap;
 use crate::render::per_kind::RayCounts;
 use crate::render::scene::Scene;
+use crate::view::CountedRender;
 use crate::view::request::{CostMeasureView, CostOverlay, Resolved, ViewSettings};
 use serde::Serialize;
 use std::collections::VecDeque;
@@ -295,12 +296,13 @@ impl Jobs {
         scene: Arc<Scene>,
         pool: Arc<rayon::ThreadPool>,
         batch_size: usize,
+        counted: CountedRender,
     ) -> std::io::Result<Arc<Jobs>> {
         let queue = Arc::new(Queue::default());
         let inbox = queue.clone();
         std::thread::Builder::new()
             .name("render".into())
-            .spawn(move || render_thread(&inbox, &scene, &pool, batch_size))?;
+            .spawn(move || render_thread(&inbox, &scene, &pool, batch_size, counted))?;
         Ok(Arc::new(Jobs {
             next: AtomicU64::new(1),
             kept: Mutex::new(VecDeque::new()),
@@ -384,7 +386,13 @@ impl Drop for CloseOnExit<'_> {
     }
 }
 
-fn render_thread(queue: &Queue, scene: &Scene, pool: &rayon::ThreadPool, batch_size: usize) {
+fn render_thread(
+    queue: &Queue,
+    scene: &Scene,
+    pool: &rayon::ThreadPool,
+    batch_size: usize,
+    counted: CountedRender,
+) {
     let _close = CloseOnExit(queue);
     loop {
         let job = {
@@ -403,7 +411,7 @@ fn render_thread(queue: &Queue, scene: &Scene, pool: &rayon::ThreadPool, batch_s
         job.set_status(Status::Running);
         // A panic in an engine must not take the viewer down: the job fails with the message.
         let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-            render_levels(&job, scene, pool, batch_size)
+            render_levels(&job, scene, pool, batch_size, counted)
         }));
         let status = match outcome {
             Ok(Ok(true)) => Status::Done,
@@ -443,6 +451,7 @@ fn render_levels(
     scene: &Scene,
     pool: &rayon::ThreadPool,
     batch_size: usize,
+    counted: CountedRender,
 ) -> anyhow::Result<bool> {
     let scene = with_camera(scene, &job.resolved.camera);
     for &[width, height] in &job.sizes {
@@ -464,7 +473,7 @@ fn render_levels(
         };
         let rendered = match (&prepared, job.resolved.cost_map.kind()) {
             (Prepared::Wavefront(w), Some(kind)) => pool
-                .install(|| w.render_counted_until(&progress, true, &job.cancel))
+                .install(|| counted(w, &progress, &job.cancel))
                 .map(|(mut film, stats, costs)| {
                     clamp_to_finite(&mut film);
                     let overlay = costs.pixels.as_ref().map(|pixels| {
