@@ -442,6 +442,7 @@ pub fn run(args: &BenchArgs, matches: Option<&ArgMatches>) -> Result<u8> {
             batch_size: raywave::render::wavefront::DEFAULT_BATCH_SIZE as u64,
             rgb8: false,
             exr_in_memory: false,
+            cost_map: false,
         },
         None,
     )?;

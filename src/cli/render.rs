@@ -4,18 +4,19 @@
 use super::image::scene_and_settings;
 use super::image::{ImageArgs, SeedArgs, ThreadsArg};
 use super::phases::Phases;
-use super::values::{EngineArg, LanesArg, ToneMapArg};
+use super::values::{CostKindArg, CostMeasureArg, EngineArg, LanesArg, ToneMapArg};
 use anyhow::Result;
 use clap::Args;
 use image::RgbImage;
 
 use raywave::diff::{self, Encoding, FileInfo, Image, Region, read_image};
 use raywave::output::OutputPlan;
-use raywave::output::image_file::{OutputFormat, check_hdr_path, output_format};
+use raywave::output::cost_map::{self, CostInput};
+use raywave::output::image_file::{OutputFormat, check_hdr_path, ldr_format, output_format};
 use raywave::output::machine::Machine;
 use raywave::output::memory::{self, RenderFootprint};
 use raywave::output::render_record::{
-    DefaultsUsed, KindFigures, KindTiming, RenderRecord, SceneFigures,
+    DefaultsUsed, KindFigures, KindTiming, RenderRecord, SceneFigures, TraversalFigures,
 };
 use raywave::output::terminal::progress_bar;
 use raywave::render::camera::CameraRays;
@@ -81,6 +82,17 @@ pub struct RenderArgs {
     /// standard output).
     #[arg(long, value_name = "FILE")]
     pub stats_json: Option<PathBuf>,
+    /// Also write a cost map (.png or .ppm): each pixel's BVH nodes visited and primitives
+    /// tested, in false colour with a colour bar. Counted, as the traversal figures of --stats
+    /// are, by a second render of the frame (the wavefront engine's; the first counts nothing).
+    #[arg(long, value_name = "FILE")]
+    pub cost_map: Option<PathBuf>,
+    /// Which rays the cost map counts.
+    #[arg(long, value_enum, default_value = "all", requires = "cost_map")]
+    pub cost_kind: CostKindArg,
+    /// What the cost map shows: nodes, tests, or both side by side.
+    #[arg(long, value_enum, default_value = "both", requires = "cost_map")]
+    pub cost_measure: CostMeasureArg,
     /// Refuse to start a render whose estimated peak memory exceeds SIZE (e.g. 512M, 2G);
     /// renders are also refused when they exceed the memory available.
     #[arg(long, value_name = "SIZE", value_parser = raywave::output::memory::parse_size)]
@@ -108,9 +120,24 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if let Some(hdr) = &args.hdr {
         check_hdr_path(hdr).map_err(|e| UsageError::from_error(&e))?;
     }
+    if let Some(map) = &args.cost_map {
+        if ldr_format(map).is_err() {
+            return Err(UsageError(format!(
+                "--cost-map {}: expected a file ending in .png or .ppm (an 8-bit figure)",
+                map.display()
+            ))
+            .into());
+        }
+        if Engine::from(args.engine) == Engine::Reference {
+            return Err(UsageError(
+                "--cost-map counts the wavefront engine's traversal: expected --engine wavefront (the default), not --engine reference".into(),
+            )
+            .into());
+        }
+    }
     let plan = output_plan(args);
     plan.check()?;
-    plan.refuse_binary_on_terminal(&["-o", "--hdr"])?;
+    plan.refuse_binary_on_terminal(&["-o", "--hdr", "--cost-map"])?;
     // Text meant for the terminal goes to stderr when an image or record goes to stdout.
     let say = |text: &str| super::image::say(&plan, text);
     let (scene, effective) = scene_and_settings(
@@ -166,6 +193,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             rgb8: matches!(format, OutputFormat::Ldr(_)),
             exr_in_memory: exr_to_stream(&args.output)
                 || args.hdr.as_ref().is_some_and(exr_to_stream),
+            cost_map: args.cost_map.is_some(),
         },
         args.max_memory,
     )?;
@@ -264,11 +292,49 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         debug_assert_eq!(counts, stats.counts);
         stats.kind_time = Some(times);
     }
+    // The traversal counters: a second render with the counting instantiation of the stages,
+    // so that the render timed above ran none of it.
+    let mut traversal = None;
+    if let (Prepared::Wavefront(wavefront), true) = (
+        &engine,
+        args.stats || args.stats_json.is_some() || args.cost_map.is_some(),
+    ) {
+        let progress = progress_bar(
+            units,
+            "{spinner} counting the traversal (a second pass) [{bar:40}] {pos}/{len} tiles, {elapsed} (eta {eta})",
+            args.quiet,
+        );
+        let start = Instant::now();
+        let (counted, counted_stats, costs) =
+            pool.install(|| wavefront.render_counted(&|| progress.inc(1), args.cost_map.is_some()));
+        let counted_seconds = start.elapsed().as_secs_f64();
+        progress.finish_and_clear();
+        drop(counted);
+        debug_assert_eq!(counted_stats.counts, stats.counts);
+        if let (Some(path), Some(pixels)) = (&args.cost_map, &costs.pixels) {
+            let input = CostInput {
+                pixels,
+                width: settings.width,
+                height: settings.height,
+                aa_samples: settings.aa_samples,
+                totals: &costs.totals,
+                rays: &stats.counts,
+            };
+            let map = cost_map::figure(&input, args.cost_kind.into(), args.cost_measure.into())?;
+            raywave::output::image_file::write_rgb8(&map, path)?;
+        }
+        traversal = Some(TraversalFigures::new(
+            &costs.totals,
+            &stats.counts,
+            counted_seconds,
+        ));
+    }
     let report = Report {
         stats,
         seconds,
         stages: engine.bvh_build_seconds().map(|bvh| (stats, bvh)),
         instrumented_seconds,
+        traversal,
     };
 
     let run = RunInfo {
@@ -287,11 +353,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     // Every output in place before the summary says it was written.
     raywave::output::commit_outputs()?;
     if !args.quiet {
-        let extra = args
-            .hdr
-            .as_ref()
-            .map(|h| format!(" and {}", h.display()))
-            .unwrap_or_default();
+        let extra: String = [&args.hdr, &args.cost_map]
+            .into_iter()
+            .flatten()
+            .map(|p| format!(" and {}", p.display()))
+            .collect();
         say(&format!(
             "{}wrote   {}{extra}\n",
             summary(&scene, &effective, &run, &report),
@@ -356,6 +422,9 @@ fn output_plan(args: &RenderArgs) -> OutputPlan {
     }
     if let Some(json) = &args.stats_json {
         plan = plan.output("--stats-json", json);
+    }
+    if let Some(map) = &args.cost_map {
+        plan = plan.output("--cost-map", map);
     }
     if let Some(reference) = &args.mse_reference {
         plan = plan.input("--mse-reference", reference);
@@ -494,6 +563,9 @@ struct Report {
     /// Reference only, with --stats or --stats-json: the wall-clock seconds of the second,
     /// instrumented pass that timed the kinds.
     instrumented_seconds: Option<f64>,
+    /// Wavefront only, with --stats, --stats-json or --cost-map: the traversal counters of a
+    /// second, counted pass.
+    traversal: Option<TraversalFigures>,
 }
 
 impl Report {
@@ -570,6 +642,30 @@ fn stats_table(report: &Report) -> String {
     if let Some((_, Some(build))) = &report.stages {
         let _ = writeln!(out, "bvh build {build:.3} s");
     }
+    if let Some(t) = &report.traversal {
+        let _ = writeln!(
+            out,
+            "{:<12} {:>14} {:>14} {:>14} {:>14}",
+            "traversal", "rays", "nodes/ray", "leaves/ray", "tests/ray"
+        );
+        for (kind, f) in t.kinds.iter() {
+            let _ = writeln!(
+                out,
+                "{:<12} {:>14} {:>14} {:>14} {:>14}",
+                kind.name(),
+                f.rays,
+                or_dash(f.nodes_per_ray, 1.0, 2),
+                or_dash(f.leaves_per_ray, 1.0, 2),
+                or_dash(f.primitive_tests_per_ray, 1.0, 2)
+            );
+        }
+        let _ = writeln!(
+            out,
+            "traversal counted by a second pass: {:.3} s; the render timed above counted nothing \
+             (tests: triangles of the leaves visited, spheres, and without a BVH every primitive)",
+            t.counted_seconds
+        );
+    }
     if let Some((stats, _)) = &report.stages {
         let _ = writeln!(
             out,
@@ -626,5 +722,6 @@ fn record(scene: &Scene, effective: &Effective, run: &RunInfo, report: &Report) 
         kinds_timed_by: report.kinds_timed_by(),
         instrumented_seconds: report.instrumented_seconds,
         stages,
+        traversal: report.traversal,
     }
 }

@@ -8,6 +8,7 @@
 
 use clap::builder::{StringValueParser, TypedValueParser};
 use raywave::bench::ab::VerdictForm;
+use raywave::output::cost_map::{CostKind, CostMeasure};
 use raywave::render::engine::Engine;
 use raywave::render::film::ToneMap;
 use raywave::render::sampling::LightSampler;
@@ -123,6 +124,32 @@ mirror! {
         /// f32x16 (two 256-bit halves without AVX-512).
         #[value(name = "16")]
         Sixteen,
+    }
+}
+
+mirror! {
+    /// Which rays a cost map counts.
+    CostKindArg => CostKind {
+        /// Camera rays' closest hits.
+        Camera,
+        /// Shadow rays' occlusion tests.
+        Shadow,
+        /// Mirror rays' closest hits.
+        Reflection,
+        /// Every ray.
+        All,
+    }
+}
+
+mirror! {
+    /// What a cost map shows.
+    CostMeasureArg => CostMeasure {
+        /// BVH nodes visited (each an 8-wide test of child boxes).
+        Nodes,
+        /// Primitives tested (triangles of the leaves visited, spheres, brute force's every one).
+        Tests,
+        /// Both figures, side by side.
+        Both,
     }
 }
 

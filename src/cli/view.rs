@@ -90,6 +90,8 @@ pub fn run(args: &ViewArgs) -> Result<u8> {
         camera: scene.camera,
         settings,
         engine: Engine::from(args.engine),
+        cost_map: Default::default(),
+        cost_measure: Default::default(),
     };
     let signal = serve(
         ViewOptions {
@@ -97,6 +99,8 @@ pub fn run(args: &ViewArgs) -> Result<u8> {
             base,
             threads: args.workers.threads,
             batch_size: args.batch_size as usize,
+            // Compiled here, in the binary: see `ViewOptions::counted`.
+            counted: |w, progress, cancel| w.render_counted_until(progress, true, cancel),
             bind: args.bind,
             port: args.port,
             access,

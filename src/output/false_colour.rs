@@ -217,10 +217,13 @@ pub fn figure(
     RgbImage::from_raw(fw, fh, buffer).ok_or_else(|| anyhow!("false-colour figure: buffer size"))
 }
 
-/// A short label for a tick value: three significant digits, scientific outside [0.01, 1000).
+/// A short label for a tick value: a whole number below a million as it is (a count), else
+/// three decimals, scientific outside [0.01, 1000).
 fn tick_label(v: f64) -> String {
     if v == 0.0 {
         "0".to_string()
+    } else if v.fract() == 0.0 && v.abs() < 1e6 {
+        format!("{v:.0}")
     } else if (0.01..1000.0).contains(&v.abs()) {
         format!("{v:.3}")
     } else {
@@ -261,6 +264,14 @@ mod tests {
         assert!(s.low < s.high);
         let s = Scale::from_values(&[0.5, 0.5], true).unwrap();
         assert!(s.low < s.high && s.low > 0.0);
+    }
+
+    #[test]
+    fn whole_ticks_print_as_counts() {
+        assert_eq!(tick_label(92.0), "92");
+        assert_eq!(tick_label(2500.0), "2500");
+        assert_eq!(tick_label(0.5), "0.500");
+        assert_eq!(tick_label(2.5e6), "2.50e6");
     }
 
     #[test]

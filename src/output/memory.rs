@@ -1,7 +1,8 @@
 //! A render's peak memory, estimated before rendering, and the memory there is to hold it.
 //!
 //! ```text
-//! peak ≈ base + scene + threads·workspace + pixels·(12 film + 3 if 8-bit + 12 if EXR to a stream)
+//! peak ≈ base + scene + threads·workspace
+//!        + pixels·(12 film + 3 if 8-bit + 12 if EXR to a stream + 48 with a cost map)
 //! ```
 //!
 //! Figures (`/usr/bin/time -v`, max RSS, built-in box, `--shadows off --bounces 0`, 2 threads)
@@ -23,6 +24,9 @@ pub(crate) const SLACK_BYTES_PER_PIXEL: u64 = 1;
 pub(crate) const BYTES_PER_PRIMITIVE: u64 = 400;
 /// Per camera sample of a wavefront tile (rays, hits, shadow queue, radiance, next rays).
 pub(crate) const WORKSPACE_BYTES_PER_SAMPLE: u64 = 512;
+/// Per pixel for `--cost-map`: its counts by kind (36 bytes), the map's values (4) and the
+/// figure's pixels, two panels of 3 bytes.
+pub(crate) const COST_MAP_BYTES_PER_PIXEL: u64 = 48;
 
 /// What a render holds at its peak.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -39,6 +43,8 @@ pub struct RenderFootprint {
     pub rgb8: bool,
     /// An EXR goes to a stream (stdout, a FIFO) and is encoded in memory first.
     pub exr_in_memory: bool,
+    /// A cost map is drawn (`render --cost-map`): each pixel's traversal counts are kept.
+    pub cost_map: bool,
 }
 
 impl RenderFootprint {
@@ -47,7 +53,12 @@ impl RenderFootprint {
         let per_pixel = FILM_BYTES_PER_PIXEL
             + SLACK_BYTES_PER_PIXEL
             + if self.rgb8 { RGB8_BYTES_PER_PIXEL } else { 0 }
-            + if self.exr_in_memory { 12 } else { 0 };
+            + if self.exr_in_memory { 12 } else { 0 }
+            + if self.cost_map {
+                COST_MAP_BYTES_PER_PIXEL
+            } else {
+                0
+            };
         BASE_BYTES
             + self.primitives * BYTES_PER_PRIMITIVE
             + self.threads * self.batch_size * WORKSPACE_BYTES_PER_SAMPLE
@@ -179,6 +190,7 @@ mod tests {
                 batch_size: 4096,
                 rgb8,
                 exr_in_memory: false,
+                cost_map: false,
             }
             .peak_bytes();
             let measured = kib * 1024;

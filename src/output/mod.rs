@@ -15,6 +15,7 @@
 
 pub mod bench_record;
 pub mod build_info;
+pub mod cost_map;
 pub mod cpu;
 pub mod false_colour;
 pub mod image_file;

@@ -7,8 +7,9 @@
 use crate::output::bench_record::{BenchRecord, KindRates};
 use crate::output::machine::Machine;
 use crate::render::engine::Engine;
-use crate::render::per_kind::PerKind;
+use crate::render::per_kind::{PerKind, RayCounts};
 use crate::render::settings::RenderSettings;
+use crate::render::wavefront::cost::CostSum;
 use crate::render::wavefront::stats::RenderStats;
 use crate::render::wavefront::stats::StageFigure;
 use schemars::JsonSchema;
@@ -54,6 +55,62 @@ pub struct RenderRecord {
     pub instrumented_seconds: Option<f64>,
     /// Per stage (null for the reference, which has no stages).
     pub stages: Option<Vec<StageFigure>>,
+    /// The wavefront engine's traversal work per ray, by kind, from a second, counted render
+    /// of the frame (null for the reference, which has no counters).
+    pub traversal: Option<TraversalFigures>,
+}
+
+/// Each kind's traversal work, counted by a second render of the frame (the render timed in
+/// `seconds` counted nothing).
+#[derive(Clone, Copy, Debug, Serialize, JsonSchema)]
+pub struct TraversalFigures {
+    /// Each kind: camera rays' and mirror rays' closest hits, shadow rays' occlusion tests.
+    #[serde(flatten)]
+    pub kinds: PerKind<TraversalFigure>,
+    /// Wall-clock seconds of the counted pass.
+    pub counted_seconds: f64,
+}
+
+/// One kind's BVH nodes, leaves and primitive tests, in all and per ray.
+#[derive(Clone, Copy, Debug, Serialize, JsonSchema)]
+pub struct TraversalFigure {
+    /// Rays cast.
+    pub rays: u64,
+    /// Interior nodes visited (each an 8-wide test of child boxes; 0 without a BVH).
+    pub nodes: u64,
+    /// Leaves visited (each a block of up to 8 triangles; 0 without a BVH).
+    pub leaves: u64,
+    /// Primitives tested: the leaves' triangles, spheres, and without a BVH every primitive
+    /// its 8- or 16-ray block tested.
+    pub primitive_tests: u64,
+    /// nodes / rays (null without rays).
+    pub nodes_per_ray: Option<f64>,
+    /// leaves / rays (null without rays).
+    pub leaves_per_ray: Option<f64>,
+    /// primitive_tests / rays (null without rays).
+    pub primitive_tests_per_ray: Option<f64>,
+}
+
+impl TraversalFigures {
+    /// The figures of a counted render's sums and its ray counts.
+    pub fn new(totals: &PerKind<CostSum>, rays: &RayCounts, counted_seconds: f64) -> Self {
+        TraversalFigures {
+            kinds: PerKind::from_fn(|kind| {
+                let (sum, n) = (totals[kind], rays[kind]);
+                let per = |x: u64| (n > 0).then(|| x as f64 / n as f64);
+                TraversalFigure {
+                    rays: n,
+                    nodes: sum.nodes,
+                    leaves: sum.leaves,
+                    primitive_tests: sum.tests,
+                    nodes_per_ray: per(sum.nodes),
+                    leaves_per_ray: per(sum.leaves),
+                    primitive_tests_per_ray: per(sum.tests),
+                }
+            }),
+            counted_seconds,
+        }
+    }
 }
 
 /// The scene's size, and the wavefront engine's BVH.
@@ -259,6 +316,7 @@ mod tests {
             kinds_timed_by: KindTiming::InstrumentedPass,
             instrumented_seconds: Some(2.5),
             stages: None,
+            traversal: None,
         };
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("s.json");

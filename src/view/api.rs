@@ -116,24 +116,35 @@ pub(crate) fn render_status(state: &State, job: &str) -> Result<Reply, ApiError>
     Ok(with_frame(job.status(), &job.resolved))
 }
 
-/// `GET /api/render/{job}/{level}.png`.
+/// `GET /api/render/{job}/{level}.png`, and `{level}.cost.png`: the level's cost-map overlay.
 pub(crate) fn render_png(state: &State, job: &str, level: &str) -> Result<Reply, ApiError> {
     let job = find_job(state, job)?;
-    let k: usize = level
-        .strip_suffix(".png")
-        .and_then(|k| k.parse().ok())
-        .ok_or_else(|| {
-            ApiError::bad(format!(
-                "expected a level as N.png, found `{}`",
-                quote(level)
-            ))
-        })?;
+    // `N.png` the level's image, `N.cost.png` its cost-map overlay.
+    let (k, cost) = match level.strip_suffix(".cost.png") {
+        Some(k) => (k, true),
+        None => (level.strip_suffix(".png").unwrap_or(""), false),
+    };
+    let k: usize = k.parse().map_err(|_| {
+        ApiError::bad(format!(
+            "expected a level as N.png or N.cost.png, found `{}`",
+            quote(level)
+        ))
+    })?;
     if k >= job.sizes.len() {
         return Err(ApiError::not_found(format!(
             "job {} has levels 0..{}, not {k}",
             job.id,
             job.sizes.len()
         )));
+    }
+    if cost {
+        let png = job.cost_png(k).ok_or_else(|| {
+            ApiError::not_found(format!(
+                "level {k} of job {} has no cost map: ask for one with cost_map in the settings (the level may not be rendered yet: see GET /api/render/{})",
+                job.id, job.id
+            ))
+        })?;
+        return Ok(Reply::bytes("image/png", png.as_ref().clone()));
     }
     let png = job.png(k).ok_or_else(|| {
         ApiError::not_found(format!(

@@ -56,7 +56,23 @@ pub struct ViewOptions {
     pub access: Access,
     /// Connections open at once; past it, 503.
     pub max_connections: usize,
+    /// How a level with a cost-map overlay is rendered: `Wavefront::render_counted_until` with
+    /// per-pixel counts, given by the binary so that the counting instantiation of the stages
+    /// is compiled there and not beside the library's uncounted ones (`render_counted`'s docs).
+    pub counted: CountedRender,
 }
+
+/// A counted render of every tile with per-pixel counts, stopped once the flag is set
+/// (`Wavefront::render_counted_until(progress, true, cancel)`); `None` when stopped.
+pub type CountedRender = fn(
+    &crate::render::wavefront::Wavefront,
+    &(dyn Fn() + Sync),
+    &std::sync::atomic::AtomicBool,
+) -> Option<(
+    crate::render::film::Film,
+    crate::render::wavefront::stats::RenderStats,
+    crate::render::wavefront::cost::CostReport,
+)>;
 
 /// Binds, prints the URL with `say`, and serves until SIGINT or SIGTERM; returns the signal's
 /// number.
@@ -64,8 +80,13 @@ pub fn run(options: ViewOptions, say: &dyn Fn(&str) -> Result<()>) -> Result<i32
     let server = server::Server::bind(options.bind, options.port)?;
     let pool = Arc::new(crate::render::engine::thread_pool(options.threads)?);
     let scene = Arc::new(options.scene);
-    let jobs = renders::Renders::start(scene.clone(), pool.clone(), options.batch_size)
-        .map_err(|e| anyhow::anyhow!("cannot start the render thread: {e}"))?;
+    let jobs = renders::Renders::start(
+        scene.clone(),
+        pool.clone(),
+        options.batch_size,
+        options.counted,
+    )
+    .map_err(|e| anyhow::anyhow!("cannot start the render thread: {e}"))?;
     let port = server.addr.port();
     let state = Arc::new(api::State {
         scene_json: api::scene_json(&scene, &options.base),

@@ -16,12 +16,14 @@
 //! ```
 
 use crate::output::bench_record::KindRates;
+use crate::output::cost_map::{CostInput, overlay};
 use crate::output::image_file::png_bytes;
-use crate::render::engine::Engine;
+use crate::render::engine::{Engine, Prepared, clamp_to_finite};
 use crate::render::film::ToneMap;
 use crate::render::per_kind::RayCounts;
 use crate::render::scene::Scene;
-use crate::view::request::{Resolved, ViewSettings};
+use crate::view::CountedRender;
+use crate::view::request::{CostMeasureView, CostOverlay, Resolved, ViewSettings};
 use serde::Serialize;
 use std::collections::VecDeque;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
@@ -74,6 +76,24 @@ pub(crate) struct Level {
     /// Each kind's rays per thread-second of its own work (null when not measured: the
     /// reference renders without kind timers), and all rays per wall-clock second.
     pub rays_per_second: KindRates,
+    /// The cost-map overlay's legend, when the job asked for one (the level was then rendered
+    /// with the traversal counted, and its times include the counting).
+    pub cost: Option<CostLegend>,
+}
+
+/// What the page prints beside a level's cost-map overlay (`GET /api/render/{job}/{k}.cost.png`).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub(crate) struct CostLegend {
+    /// The rays counted.
+    pub kind: CostOverlay,
+    /// The count shown.
+    pub measure: CostMeasureView,
+    /// The top of the linear scale (the scale starts at 0), per pixel and camera sample.
+    pub high: f64,
+    /// The largest value of the map.
+    pub largest: f32,
+    /// The frame's mean per ray (null without rays of the kind).
+    pub per_ray: Option<f64>,
 }
 
 /// What the page polls.
@@ -115,6 +135,8 @@ struct RenderState {
     status: Status,
     levels: Vec<Level>,
     pngs: Vec<Arc<Vec<u8>>>,
+    /// Each level's cost-map overlay, when the job asked for one.
+    cost_pngs: Vec<Option<Arc<Vec<u8>>>>,
 }
 
 impl RenderJob {
@@ -147,6 +169,11 @@ impl RenderJob {
     /// Level `k`'s PNG, once rendered.
     pub(crate) fn png(&self, k: usize) -> Option<Arc<Vec<u8>>> {
         self.lock().pngs.get(k).cloned()
+    }
+
+    /// Level `k`'s cost-map overlay, once rendered, when the job asked for one.
+    pub(crate) fn cost_png(&self, k: usize) -> Option<Arc<Vec<u8>>> {
+        self.lock().cost_pngs.get(k).cloned().flatten()
     }
 
     fn lock(&self) -> MutexGuard<'_, RenderState> {
@@ -269,12 +296,13 @@ impl Renders {
         scene: Arc<Scene>,
         pool: Arc<rayon::ThreadPool>,
         batch_size: usize,
+        counted: CountedRender,
     ) -> std::io::Result<Arc<Renders>> {
         let queue = Arc::new(Queue::default());
         let inbox = queue.clone();
         std::thread::Builder::new()
             .name("render".into())
-            .spawn(move || render_thread(&inbox, &scene, &pool, batch_size))?;
+            .spawn(move || render_thread(&inbox, &scene, &pool, batch_size, counted))?;
         Ok(Arc::new(Renders {
             next: AtomicU64::new(1),
             kept: Mutex::new(VecDeque::new()),
@@ -304,6 +332,7 @@ impl Renders {
                 status: Status::Queued,
                 levels: Vec::new(),
                 pngs: Vec::new(),
+                cost_pngs: Vec::new(),
             }),
         });
         let mut kept = self.kept.lock().unwrap_or_else(|e| e.into_inner());
@@ -357,7 +386,13 @@ impl Drop for CloseOnExit<'_> {
     }
 }
 
-fn render_thread(queue: &Queue, scene: &Scene, pool: &rayon::ThreadPool, batch_size: usize) {
+fn render_thread(
+    queue: &Queue,
+    scene: &Scene,
+    pool: &rayon::ThreadPool,
+    batch_size: usize,
+    counted: CountedRender,
+) {
     let _close = CloseOnExit(queue);
     loop {
         let job = {
@@ -376,7 +411,7 @@ fn render_thread(queue: &Queue, scene: &Scene, pool: &rayon::ThreadPool, batch_s
         job.set_status(Status::Running);
         // A panic in an engine must not take the viewer down: the job fails with the message.
         let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-            render_levels(&job, scene, pool, batch_size)
+            render_levels(&job, scene, pool, batch_size, counted)
         }));
         let status = match outcome {
             Ok(Ok(true)) => Status::Done,
@@ -416,6 +451,7 @@ fn render_levels(
     scene: &Scene,
     pool: &rayon::ThreadPool,
     batch_size: usize,
+    counted: CountedRender,
 ) -> anyhow::Result<bool> {
     let scene = with_camera(scene, &job.resolved.camera);
     for &[width, height] in &job.sizes {
@@ -432,17 +468,53 @@ fn render_levels(
         let (units, _) = prepared.work_units(&settings);
         job.done_units.store(0, Ordering::Relaxed);
         job.total_units.store(units, Ordering::Relaxed);
-        let rendered = pool.install(|| {
-            let progress = || {
-                job.done_units.fetch_add(1, Ordering::Relaxed);
-            };
-            prepared.render_until(&progress, &job.cancel)
-        });
-        let Some((film, stats)) = rendered else {
+        let progress = || {
+            job.done_units.fetch_add(1, Ordering::Relaxed);
+        };
+        let rendered = match (&prepared, job.resolved.cost_map.kind()) {
+            (Prepared::Wavefront(w), Some(kind)) => pool
+                .install(|| counted(w, &progress, &job.cancel))
+                .map(|(mut film, stats, costs)| {
+                    clamp_to_finite(&mut film);
+                    let overlay = costs.pixels.as_ref().map(|pixels| {
+                        let input = CostInput {
+                            pixels,
+                            width,
+                            height,
+                            aa_samples: settings.aa_samples,
+                            totals: &costs.totals,
+                            rays: &stats.counts,
+                        };
+                        (
+                            overlay(&input, kind, job.resolved.cost_measure.count()),
+                            width,
+                            height,
+                        )
+                    });
+                    (film, stats, overlay)
+                }),
+            _ => pool
+                .install(|| prepared.render_until(&progress, &job.cancel))
+                .map(|(film, stats)| (film, stats, None)),
+        };
+        let Some((film, stats, overlay)) = rendered else {
             return Ok(false);
         };
         let seconds = start.elapsed().as_secs_f64();
         let png = png_bytes(&film.to_rgb8(ToneMap::Clamp))?;
+        let (cost, cost_png) = match overlay {
+            Some((map, w, h)) => (
+                Some(CostLegend {
+                    kind: job.resolved.cost_map,
+                    measure: job.resolved.cost_measure,
+                    high: map.scale.high,
+                    largest: map.largest,
+                    per_ray: map.per_ray,
+                }),
+                Some(Arc::new(png_bytes(&map.image(w, h))?)),
+            ),
+            None => (None, None),
+        };
         let mut state = job.lock();
         state.levels.push(Level {
             width,
@@ -450,8 +522,10 @@ fn render_levels(
             seconds,
             rays: stats.counts,
             rays_per_second: KindRates::measured(&stats, seconds),
+            cost,
         });
         state.pngs.push(Arc::new(png));
+        state.cost_pngs.push(cost_png);
     }
     Ok(true)
 }
@@ -479,6 +553,8 @@ mod tests {
             settings,
             engine: Engine::Wavefront,
             camera: Scene::builtin_default().camera,
+            cost_map: CostOverlay::Off,
+            cost_measure: CostMeasureView::Nodes,
         }
     }
 

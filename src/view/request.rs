@@ -90,6 +90,58 @@ impl CameraJson {
     }
 }
 
+/// Which rays the render's cost-map overlay counts (`render --cost-kind`), or none.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum CostOverlay {
+    /// No overlay: the render is not counted.
+    #[default]
+    Off,
+    /// Camera rays' closest hits.
+    Camera,
+    /// Shadow rays' occlusion tests.
+    Shadow,
+    /// Mirror rays' closest hits.
+    Reflection,
+    /// Every ray.
+    All,
+}
+
+impl CostOverlay {
+    /// The cost map's kind, or `None` for no overlay.
+    pub(crate) fn kind(self) -> Option<crate::output::cost_map::CostKind> {
+        use crate::output::cost_map::CostKind;
+        match self {
+            CostOverlay::Off => None,
+            CostOverlay::Camera => Some(CostKind::Camera),
+            CostOverlay::Shadow => Some(CostKind::Shadow),
+            CostOverlay::Reflection => Some(CostKind::Reflection),
+            CostOverlay::All => Some(CostKind::All),
+        }
+    }
+}
+
+/// What the cost-map overlay shows (`render --cost-measure`, one count at a time).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum CostMeasureView {
+    /// BVH nodes visited.
+    #[default]
+    Nodes,
+    /// Primitives tested.
+    Tests,
+}
+
+impl CostMeasureView {
+    /// The cost map's count.
+    pub(crate) fn count(self) -> crate::output::cost_map::Count {
+        match self {
+            CostMeasureView::Nodes => crate::output::cost_map::Count::Nodes,
+            CostMeasureView::Tests => crate::output::cost_map::Count::Tests,
+        }
+    }
+}
+
 /// The settings a page sends: every field optional.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -116,6 +168,10 @@ pub struct ViewSettings {
     pub seed: Option<u32>,
     /// The render's camera (the scene's when left out).
     pub camera: Option<CameraJson>,
+    /// The cost-map overlay: off, camera, shadow, reflection or all (wavefront engine only).
+    pub cost_map: Option<CostOverlay>,
+    /// What the overlay shows: nodes or tests.
+    pub cost_measure: Option<CostMeasureView>,
 }
 
 /// Settings checked and filled in: what a render job or a ray tree is computed with.
@@ -127,6 +183,10 @@ pub struct Resolved {
     pub engine: Engine,
     /// The camera (the scene's, or the page's).
     pub camera: Camera,
+    /// The cost-map overlay (off: the render is not counted).
+    pub cost_map: CostOverlay,
+    /// What the overlay shows.
+    pub cost_measure: CostMeasureView,
 }
 
 impl ViewSettings {
@@ -190,10 +250,19 @@ impl ViewSettings {
             Some(c) => c.to_camera()?,
             None => base.camera,
         };
+        let engine = self.engine.unwrap_or(base.engine);
+        let cost_map = self.cost_map.unwrap_or(base.cost_map);
+        if cost_map != CostOverlay::Off && engine != Engine::Wavefront {
+            return Err(ApiError::bad(
+                "cost_map counts the wavefront engine's traversal: expected engine wavefront, or cost_map off",
+            ));
+        }
         Ok(Resolved {
             settings: s,
-            engine: self.engine.unwrap_or(base.engine),
+            engine,
             camera,
+            cost_map,
+            cost_measure: self.cost_measure.unwrap_or(base.cost_measure),
         })
     }
 }
@@ -214,6 +283,8 @@ impl Resolved {
             aa: Some(s.aa_samples),
             seed: Some(s.seed),
             camera: Some(CameraJson::from_camera(&self.camera)),
+            cost_map: Some(self.cost_map),
+            cost_measure: Some(self.cost_measure),
         }
     }
 }
@@ -227,6 +298,8 @@ mod tests {
             settings: RenderSettings::preview(),
             engine: Engine::Wavefront,
             camera: Camera::default(),
+            cost_map: CostOverlay::Off,
+            cost_measure: CostMeasureView::Nodes,
         }
     }
 
@@ -252,11 +325,18 @@ mod tests {
         assert_eq!(r.engine, Engine::Reference);
         let again = r.to_json().resolve(&base()).unwrap();
         assert_eq!(again.settings, r.settings);
+        let body = br#"{"cost_map": "shadow", "cost_measure": "tests"}"#;
+        let r = ViewSettings::parse(body).unwrap().resolve(&base()).unwrap();
+        assert_eq!(
+            (r.cost_map, r.cost_measure),
+            (CostOverlay::Shadow, CostMeasureView::Tests)
+        );
+        assert_eq!(r.to_json().resolve(&base()).unwrap(), r);
     }
 
     #[test]
     fn bad_settings_are_refused_with_the_reason() {
-        let cases: [(&[u8], &str); 8] = [
+        let cases: [(&[u8], &str); 10] = [
             (b"{", "EOF"),
             (br#"{"widht": 3}"#, "unknown field"),
             (br#"{"width": "x"}"#, "invalid type"),
@@ -267,6 +347,11 @@ mod tests {
                 "--sampler bluenoise with 300 points per light",
             ),
             (br#"{"width": 2048, "height": 2048, "aa": 4}"#, "camera samples"),
+            (
+                br#"{"cost_map": "shadow", "engine": "reference"}"#,
+                "cost_map counts the wavefront engine's traversal",
+            ),
+            (br#"{"cost_map": "sideways"}"#, "unknown variant"),
             (
                 br#"{"camera": {"position": [0,0,1], "look_at": [0,0,1], "up": [0,1,0], "fov_degrees": 30}}"#,
                 "same point",

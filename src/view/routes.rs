@@ -7,7 +7,7 @@
 //! GET  /api/scene                     geometry, camera, settings, choices
 //! POST /api/render                    settings -> a progressive job (supersedes the last)
 //! GET  /api/render/{job}              status, levels, rays/s by kind
-//! GET  /api/render/{job}/{level}.png  one level's image
+//! GET  /api/render/{job}/{level}.png  one level's image (N.cost.png: its cost-map overlay)
 //! GET  /api/pixel?job=J&x=X&y=Y       the pixel's ray tree (x, y from the top-left)
 //! POST /api/compare                   two samplers against the converged reference
 //! GET  /api/compare/{id}/{name}.png   its images

@@ -19,6 +19,7 @@ mod bench_trackers;
 mod bench_verdict;
 mod cli;
 mod cli_errors;
+mod cost_map;
 mod cpu_check;
 mod diff;
 mod docs_commands;

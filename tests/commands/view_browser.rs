@@ -306,6 +306,54 @@ fn drive(c: &Session, server: &ViewServer, screenshot: Option<PathBuf>) {
             .is_some_and(|k| k.contains(&json!("reflection"))),
         "{kinds}"
     );
+    // The cost-map overlay: the shadow rays' work laid over the render, whose own pixels are
+    // still the command line's; off again, and the overlay goes.
+    set_settings(c, &[("cost_map", "shadow"), ("cost_measure", "tests")]);
+    let job = wait_render(c, job);
+    let levels = wait_attr(c, "#render", "data-levels", |v| v != "0");
+    wait_attr(c, "#cost-overlay", "data-level", |v| v == levels);
+    let cost = text_of(c, "#cost-text");
+    assert!(
+        cost.starts_with("cost map, shadow rays: primitives tested per pixel"),
+        "{cost}"
+    );
+    // The overlay image loaded (it may still be on its way when the level is drawn).
+    let start = Instant::now();
+    let loaded = loop {
+        let size = c.execute(
+            "const o = document.getElementById('cost-overlay');
+             return o.complete && !o.hidden ? [o.naturalWidth, o.naturalHeight] : null;",
+            vec![],
+        );
+        if !size.is_null() || start.elapsed() > WAIT {
+            break size;
+        }
+        std::thread::sleep(Duration::from_millis(30));
+    };
+    assert_eq!(loaded, json!([64, 64]), "the overlay is the full-size map");
+    pixels::assert_canvas_is_cli_render(
+        c,
+        &[
+            "--bounces",
+            "2",
+            "--shadows",
+            "soft",
+            "--shadow-samples",
+            "4",
+            "--sampler",
+            "stratified",
+        ],
+    );
+    set_settings(c, &[("cost_map", "off")]);
+    let job = wait_render(c, job);
+    wait_attr(c, "#cost-overlay", "data-level", |v| v == "0");
+    assert_eq!(
+        c.execute(
+            "return document.getElementById('cost-overlay').hidden;",
+            vec![]
+        ),
+        json!(true)
+    );
     if let Some(path) = screenshot {
         let tmp = path.with_extension("png.tmp");
         std::fs::write(&tmp, c.screenshot()).unwrap();

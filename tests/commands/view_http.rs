@@ -150,6 +150,44 @@ fn every_endpoint_answers() {
     assert_eq!(png_size(&png.body), (640, 400), "{spectrum}");
 }
 
+#[test]
+fn the_cost_map_overlay_is_each_levels_map_and_leaves_the_image_as_it_is() {
+    let server = ViewServer::start(&["--size", "32", "16", "--bounces", "0", "--shadows", "hard"]);
+    let (plain, _) = server.render("{}", LIMIT);
+    let (job, status) = server.render(r#"{"cost_map": "camera", "cost_measure": "tests"}"#, LIMIT);
+    assert_eq!(status["settings"]["cost_map"], "camera");
+    let levels = status["levels"].as_array().unwrap();
+    for (k, (level, size)) in levels
+        .iter()
+        .zip([(4, 2), (8, 4), (16, 8), (32, 16)])
+        .enumerate()
+    {
+        // The built-in box has no BVH: every camera ray tests its 12 triangles and 3 spheres.
+        let cost = &level["cost"];
+        assert_eq!(cost["kind"], "camera", "{level}");
+        assert_eq!(cost["measure"], "tests");
+        assert_eq!(cost["per_ray"], 15.0);
+        assert_eq!(
+            (cost["largest"].as_f64(), cost["high"].as_f64()),
+            (Some(15.0), Some(16.0))
+        );
+        let png = server.get(&format!("/api/render/{job}/{k}.cost.png"));
+        assert_eq!(png.status, 200, "{}", png.text());
+        assert_eq!(png.header("content-type"), Some("image/png"));
+        assert_eq!(png_size(&png.body), size);
+        // The counted render's image is the uncounted one's, byte for byte.
+        let counted = server.get(&format!("/api/render/{job}/{k}.png")).body;
+        assert!(
+            counted == server.get(&format!("/api/render/{plain}/{k}.png")).body,
+            "level {k}"
+        );
+    }
+    let none = server.get(&format!("/api/render/{plain}/0.cost.png"));
+    assert_eq!(none.status, 404);
+    assert!(none.text().contains("has no cost map"), "{}", none.text());
+    assert!(server.get(&format!("/api/render/{plain}")).json()["levels"][0]["cost"].is_null());
+}
+
 /// A bad request: method, path, extra headers, body, the status and a part of the message.
 type Case<'a> = (
     &'a str,
@@ -186,6 +224,14 @@ fn bad_requests_get_their_4xx_and_a_message() {
             400,
             "same point",
         ),
+        (
+            "POST",
+            "/api/render".into(),
+            vec![],
+            br#"{"cost_map": "all", "engine": "reference"}"#,
+            400,
+            "cost_map counts the wavefront engine's traversal",
+        ),
         ("POST", "/api/render".into(), vec![], &big, 413, "too large"),
         ("POST", "/api/compare".into(), vec![], br#"{"seeds": 1}"#, 400, "seeds must be in 2..=16"),
         ("POST", "/api/compare".into(), vec![], &big, 413, "too large"),
@@ -193,6 +239,7 @@ fn bad_requests_get_their_4xx_and_a_message() {
         ("GET", "/api/render/999".into(), vec![], b"", 404, "no render job 999"),
         ("GET", format!("/api/render/{job}/9.png"), vec![], b"", 404, "not 9"),
         ("GET", format!("/api/render/{job}/1.gif"), vec![], b"", 400, "expected a level"),
+        ("GET", format!("/api/render/{job}/x.cost.png"), vec![], b"", 400, "N.cost.png"),
         ("GET", pixel(&format!("job={job}&x=32&y=0")), vec![], b"", 400, "outside the 32×16 image"),
         ("GET", pixel(&format!("job={job}&x=0&y=16")), vec![], b"", 400, "outside the 32×16 image"),
         ("GET", pixel(&format!("job={job}&x=-1&y=0")), vec![], b"", 400, "expected a whole number, found `-1`"),

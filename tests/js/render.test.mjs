@@ -2,7 +2,7 @@
 // the pointer, the lab's keys.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { KEYS, keyAction, pixelAt, progress } from '../../src/view/assets/render.mjs';
+import { KEYS, costLegend, keyAction, pixelAt, progress } from '../../src/view/assets/render.mjs';
 
 const SIZES = [[8, 8], [16, 16], [32, 32], [64, 64]];
 const level = () => ({ width: 1, height: 1 });
@@ -48,4 +48,17 @@ test('keys typed into a field, or with Ctrl, Alt or Meta, are the field\'s or th
   assert.equal(keyAction(key('r', { target: { tagName: 'DIV', isContentEditable: true } })), null);
   for (const m of ['ctrlKey', 'altKey', 'metaKey']) assert.equal(keyAction(key('r', { [m]: true })), null, m);
   assert.equal(keyAction(key('t', { shiftKey: true })), 'trace');
+});
+
+test('the cost-map legend names the rays, the count, the scale and the mean per ray', () => {
+  assert.equal(costLegend(null), null);
+  assert.equal(costLegend(undefined), null);
+  assert.equal(
+    costLegend({ kind: 'shadow', measure: 'nodes', high: 20, largest: 23, per_ray: 2.0231 }),
+    'cost map, shadow rays: BVH nodes visited per pixel and camera sample, 0 to 20 (largest 23); 2.02 per ray',
+  );
+  assert.equal(
+    costLegend({ kind: 'all', measure: 'tests', high: 4, largest: 0.5, per_ray: null }),
+    'cost map, all rays: primitives tested per pixel and camera sample, 0 to 4 (largest 0.50); no rays',
+  );
 });

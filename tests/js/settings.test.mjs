@@ -63,3 +63,15 @@ test('more camera samples than the viewer renders are refused', () => {
 test('fields the form does not have are left out, for the server to fill', () => {
   assert.deepEqual(validate({ width: '10' }, CHOICES), { settings: { width: 10 }, errors: [] });
 });
+
+test('the cost-map overlay takes its menus, and only with the wavefront engine', () => {
+  const on = { ...FORM, cost_map: 'shadow', cost_measure: 'tests' };
+  assert.deepEqual(validate(on, CHOICES).errors, []);
+  assert.equal(validate(on, CHOICES).settings.cost_map, 'shadow');
+  assert.deepEqual(validate({ ...on, cost_map: 'sideways' }, CHOICES).errors.map(e => e.field), ['cost_map']);
+  assert.deepEqual(validate({ ...on, cost_measure: 'both' }, CHOICES).errors.map(e => e.field), ['cost_measure']);
+  const reference = validate({ ...on, engine: 'reference' }, CHOICES).errors;
+  assert.deepEqual(reference.map(e => e.field), ['cost_map']);
+  assert.match(reference[0].message, /wavefront engine's traversal/);
+  assert.deepEqual(validate({ ...on, cost_map: 'off', engine: 'reference' }, CHOICES).errors, []);
+});

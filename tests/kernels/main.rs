@@ -18,4 +18,5 @@ mod shading_pixels;
 mod shadow_casters;
 mod spawn;
 mod texels;
+mod traversal_counts;
 mod wavefront_kernels;

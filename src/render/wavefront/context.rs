@@ -20,7 +20,7 @@ use glam::Vec3;
 
 /// At or above this many triangles, rays go through the engine's 8-wide BVH (`bvh::MeshBvh`);
 /// below it, the 8-wide kernels test every primitive. It equals the reference's `BVH_MIN_TRIANGLES`, so both
-/// engines find hits the same way; see docs/PERFORMANCE.md for the measurements behind it.
+/// engines find hits the same way; see docs/TRIED.md for the measurements behind it.
 pub const BVH_MIN_TRIANGLES: usize = crate::render::geometry::BVH_MIN_TRIANGLES;
 
 /// A light's terms, with the parallelogram (all the lab's lights) kept apart for the SIMD path.

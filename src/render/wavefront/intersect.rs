@@ -13,6 +13,7 @@
 use super::batch::{HitBatch, RayBatch};
 use super::bvh::MeshBvh;
 use super::context::Context;
+use super::cost::{Costs, Counter, NoCount};
 use super::simd::{self, RayColumns};
 use super::texels;
 use crate::render::scene::{NO_HIT, Scene};
@@ -40,36 +41,69 @@ pub fn mesh_hits(
     t: &mut [f32],
     prim: &mut [u32],
 ) {
+    mesh_hits_counted(bvh, scene, rays, two_sided, t, prim, &mut NoCount);
+}
+
+/// [`mesh_hits`], each ray's traversal work added to `costs`.
+fn mesh_hits_counted<S: Costs>(
+    bvh: &MeshBvh,
+    scene: &Scene,
+    rays: &RayBatch,
+    two_sided: bool,
+    t: &mut [f32],
+    prim: &mut [u32],
+    costs: &mut S,
+) {
     if rays.bounce == 0 {
-        bvh.closest_hits_coherent(scene, &columns(rays), two_sided, t, prim);
+        bvh.closest_hits_coherent_counted(scene, &columns(rays), two_sided, t, prim, costs);
     } else {
-        bvh.closest_hits(scene, &columns(rays), two_sided, t, prim);
+        bvh.closest_hits_counted(scene, &columns(rays), two_sided, t, prim, costs);
     }
 }
 
 /// Fills `hits` (same indices as `rays`).
 pub fn closest(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch) {
+    closest_counted(ctx, rays, hits, &mut NoCount);
+}
+
+/// [`closest`], each ray's traversal work added to `costs` (by ray index). Without a BVH every
+/// ray is charged every primitive: the brute-force kernel tests them all, so it is not
+/// instrumented.
+pub fn closest_counted<S: Costs>(
+    ctx: &Context,
+    rays: &RayBatch,
+    hits: &mut HitBatch,
+    costs: &mut S,
+) {
     let n = rays.len();
     hits.resize(n);
     let scene = ctx.scene;
     let two_sided = ctx.settings.two_sided;
     match &ctx.accel {
-        None => simd::closest_hits_at(
-            ctx.lane_width,
-            &scene.triangles,
-            &scene.spheres,
-            &columns(rays),
-            two_sided,
-            &mut hits.t,
-            &mut hits.prim,
-        ),
-        Some(bvh) => mesh_hits(
+        None => {
+            simd::closest_hits_at(
+                ctx.lane_width,
+                &scene.triangles,
+                &scene.spheres,
+                &columns(rays),
+                two_sided,
+                &mut hits.t,
+                &mut hits.prim,
+            );
+            let mut every = S::Counter::default();
+            every.tests((scene.triangles.len() + scene.spheres.len()) as u32);
+            for i in 0..n {
+                costs.add(i, every);
+            }
+        }
+        Some(bvh) => mesh_hits_counted(
             bvh,
             scene,
             rays,
             two_sided,
             &mut hits.t[..n],
             &mut hits.prim[..n],
+            costs,
         ),
     }
     // Every column cut to n first, so that the loop's indexing needs no bounds checks.

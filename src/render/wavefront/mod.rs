@@ -19,10 +19,15 @@
 //! dimension, seed), and each pixel is summed inside one tile in a fixed order, so the image
 //! does not depend on scheduling: `--threads 1` and `--threads 2` give the same bytes. Memory
 //! is the film plus one `Workspace` per worker, bounded by the batch size.
+//!
+//! [`Wavefront::render_counted`] runs the same loop with the intersect and shadow stages'
+//! traversal counted (`cost.rs`): a second instantiation of the stages, for `--stats` and
+//! `--cost-map`; [`Wavefront::render`] counts nothing.
 
 pub mod batch;
 pub mod bvh;
 pub mod context;
+pub mod cost;
 pub mod film;
 pub mod generate;
 pub mod intersect;
@@ -40,6 +45,7 @@ use crate::render::scene::Scene;
 use crate::render::settings::RenderSettings;
 use batch::{HitBatch, Radiance, RayBatch, ShadowQueue};
 use context::Context;
+use cost::{CostReport, NoCount, Tally, TileCosts};
 use glam::Vec3;
 use rayon::prelude::*;
 use stats::{RenderStats, Stage};
@@ -166,16 +172,7 @@ impl<'a> Wavefront<'a> {
             .par_chunks_mut(self.tile_pixels)
             .enumerate()
             .map_init(
-                || Pooled {
-                    ws: self
-                        .pool
-                        .lock()
-                        .map(|mut p| p.pop())
-                        .ok()
-                        .flatten()
-                        .unwrap_or_default(),
-                    pool: &self.pool,
-                },
+                || self.pooled(),
                 |pooled, (tile, out)| {
                     let mut stats = RenderStats::default();
                     if cancel.load(Ordering::Relaxed) {
@@ -196,6 +193,89 @@ impl<'a> Wavefront<'a> {
         (!skipped.into_inner()).then_some((film, stats))
     }
 
+    /// A workspace from the pool (or a new one) for one rayon job.
+    fn pooled(&self) -> Pooled<'_> {
+        Pooled {
+            ws: self
+                .pool
+                .lock()
+                .map(|mut p| p.pop())
+                .ok()
+                .flatten()
+                .unwrap_or_default(),
+            pool: &self.pool,
+        }
+    }
+
+    /// [`Wavefront::render`] with the traversal counted (`cost.rs`): the same image and ray
+    /// counts, and every ray's nodes, leaves and primitive tests by kind, summed over the frame
+    /// and, when `per_pixel`, kept for each pixel. A separate instantiation of the stages:
+    /// `render` runs none of the counting. Each pixel's counts are summed inside its tile, so
+    /// they are the same for any thread count.
+    ///
+    /// `#[inline]` so that the counting instantiation of the stages is compiled in the crate
+    /// that calls this (the binary, a test), never beside the library's uncounted stages: in one
+    /// codegen unit, the second caller it gives the stages' helpers (`shadow::spawn`, `shade`)
+    /// made LLVM stop inlining them into the uncounted stage (+1.5% instructions on the
+    /// icount gate's mesh shadow stage, the BVH walk itself unchanged to the instruction).
+    #[inline]
+    pub fn render_counted(
+        &self,
+        on_tile: &(dyn Fn() + Sync),
+        per_pixel: bool,
+    ) -> (Film, RenderStats, CostReport) {
+        self.render_counted_until(on_tile, per_pixel, &AtomicBool::new(false))
+            .expect("a render whose cancel flag is never set renders every tile")
+    }
+
+    /// [`Wavefront::render_counted`] that stops early once `cancel` is set, as
+    /// [`Wavefront::render_until`] does: `None` when a tile was skipped.
+    #[inline]
+    pub fn render_counted_until(
+        &self,
+        on_tile: &(dyn Fn() + Sync),
+        per_pixel: bool,
+        cancel: &AtomicBool,
+    ) -> Option<(Film, RenderStats, CostReport)> {
+        let s = self.ctx.settings;
+        let mut film = Film::new(s.width, s.height);
+        let tiles: Vec<_> = film
+            .pixels
+            .par_chunks_mut(self.tile_pixels)
+            .enumerate()
+            .map_init(
+                || self.pooled(),
+                |pooled, (tile, out)| {
+                    if cancel.load(Ordering::Relaxed) {
+                        return None;
+                    }
+                    let first = (tile * self.tile_pixels) as u32;
+                    let mut stats = RenderStats::default();
+                    let mut costs = TileCosts::new(first, out.len());
+                    self.render_tile_with(first, out, &mut pooled.ws, &mut stats, &mut costs);
+                    on_tile();
+                    let totals = costs.totals();
+                    Some((stats, totals, per_pixel.then_some(costs.pixels)))
+                },
+            )
+            .collect();
+        let mut stats = RenderStats::default();
+        let mut report = CostReport {
+            pixels: per_pixel.then(Vec::new),
+            ..CostReport::default()
+        };
+        // In tile order: the pixels' counts come out row-major.
+        for tile in tiles {
+            let (tile_stats, totals, pixels) = tile?;
+            stats = stats + tile_stats;
+            report.totals = report.totals + totals;
+            if let (Some(all), Some(p)) = (&mut report.pixels, pixels) {
+                all.extend(p);
+            }
+        }
+        Some((film, stats, report))
+    }
+
     /// Renders pixels `first..first + out.len()` into `out`: the architecture diagram.
     pub fn render_tile(
         &self,
@@ -203,6 +283,19 @@ impl<'a> Wavefront<'a> {
         out: &mut [Vec3],
         ws: &mut Workspace,
         st: &mut RenderStats,
+    ) {
+        self.render_tile_with(first, out, ws, st, &mut NoCount);
+    }
+
+    /// [`Wavefront::render_tile`], the traversal work of every ray added to `tally` by its
+    /// pixel and kind (`NoCount`: nothing is counted, and no counting code runs).
+    fn render_tile_with<T: Tally>(
+        &self,
+        first: u32,
+        out: &mut [Vec3],
+        ws: &mut Workspace,
+        st: &mut RenderStats,
+        tally: &mut T,
     ) {
         let ctx = &self.ctx;
         st.time_kind(Stage::Generate, RayKind::Camera, || {
@@ -214,12 +307,23 @@ impl<'a> Wavefront<'a> {
         let mut traced = RayKind::Camera;
         while !ws.rays.is_empty() {
             st.time_kind(Stage::Intersect, traced, || {
-                intersect::closest(ctx, &ws.rays, &mut ws.hits);
+                let costs = &mut tally.batch(ws.rays.len());
+                intersect::closest_counted(ctx, &ws.rays, &mut ws.hits, costs);
             });
+            tally.settle(&ws.rays.pixel, traced);
             st.counts.shadow += st.time_kind(Stage::Shadow, RayKind::Shadow, || {
                 let capacity = self.queue_capacity;
-                shadow::direct_light(ctx, &ws.rays, &mut ws.hits, &mut ws.shadow, capacity)
+                let costs = &mut tally.batch(ws.rays.len());
+                shadow::direct_light_counted(
+                    ctx,
+                    &ws.rays,
+                    &mut ws.hits,
+                    &mut ws.shadow,
+                    capacity,
+                    costs,
+                )
             });
+            tally.settle(&ws.rays.pixel, RayKind::Shadow);
             st.time(Stage::Film, || {
                 film::accumulate(ctx, &ws.rays, &ws.hits, &mut ws.radiance);
             });

@@ -28,6 +28,7 @@
 
 use super::batch::{HitBatch, RayBatch, ShadowQueue};
 use super::context::Context;
+use super::cost::{Costs, Counter, NoCount, Remap};
 use super::lanes::{LaneWidth, Lanes, f32x8, f32x16, set_bits};
 use super::shade::{
     HitLight, ShadowLanes, ShadowRegisters, shade_lanes, shade_registers, shade_terms,
@@ -116,9 +117,24 @@ pub fn direct_light(
     queue: &mut ShadowQueue,
     capacity: usize,
 ) -> u64 {
+    direct_light_counted(ctx, rays, hits, queue, capacity, &mut NoCount)
+}
+
+/// [`direct_light`], each shadow ray's traversal work added to `costs` at the index of the hit
+/// that cast it.
+pub fn direct_light_counted<S: Remap>(
+    ctx: &Context,
+    rays: &RayBatch,
+    hits: &mut HitBatch,
+    queue: &mut ShadowQueue,
+    capacity: usize,
+    costs: &mut S,
+) -> u64 {
     match ctx.lane_width {
-        LaneWidth::Sixteen => direct_light_lanes::<f32x16>(ctx, rays, hits, queue, capacity),
-        _ => direct_light_lanes::<f32x8>(ctx, rays, hits, queue, capacity),
+        LaneWidth::Sixteen => {
+            direct_light_lanes::<f32x16, S>(ctx, rays, hits, queue, capacity, costs)
+        }
+        _ => direct_light_lanes::<f32x8, S>(ctx, rays, hits, queue, capacity, costs),
     }
 }
 
@@ -126,18 +142,19 @@ pub fn direct_light(
 /// function as it was before the 16-lane path, whatever codegen unit the dispatcher lands in
 /// (inlined, its instruction count in tests/gates/icount.rs moved by 0.5–2.2% from build to build).
 #[inline(never)]
-fn direct_light_lanes<V: Lanes>(
+fn direct_light_lanes<V: Lanes, S: Remap>(
     ctx: &Context,
     rays: &RayBatch,
     hits: &mut HitBatch,
     queue: &mut ShadowQueue,
     capacity: usize,
+    costs: &mut S,
 ) -> u64 {
     let n = rays.len();
     hits.direct.fill(0..n, glam::Vec3::ZERO);
     let across = match ctx.shadow_path {
-        ShadowPath::FusedSoft => return fused::<V>(ctx, rays, hits),
-        ShadowPath::FusedHard => return fused_hard::<V>(ctx, rays, hits),
+        ShadowPath::FusedSoft => return fused::<V, S>(ctx, rays, hits, costs),
+        ShadowPath::FusedHard => return fused_hard::<V, S>(ctx, rays, hits, costs),
         ShadowPath::QueuedAcross => true,
         ShadowPath::QueuedPerHit => false,
     };
@@ -163,7 +180,7 @@ fn direct_light_lanes<V: Lanes>(
             }
         }
         if ctx.casts_shadow_rays() {
-            occlude::<V>(ctx, queue); // writes every entry
+            occlude::<V, S>(ctx, queue, costs); // writes every entry
         } else {
             queue.blocked[..queue.len].fill(false);
         }
@@ -207,7 +224,12 @@ fn first_block<'c>(
 /// [`shade`] adds a queued block. Returns the rays cast. Never inlined, so that profiles name
 /// it apart from the queued stage.
 #[inline(never)]
-fn fused<V: Lanes>(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch) -> u64 {
+fn fused<V: Lanes, S: Costs>(
+    ctx: &Context,
+    rays: &RayBatch,
+    hits: &mut HitBatch,
+    costs: &mut S,
+) -> u64 {
     let scene = ctx.scene;
     let two_sided = ctx.settings.two_sided;
     let triangles = casters(scene, &ctx.shadow_casters, two_sided);
@@ -248,8 +270,15 @@ fn fused<V: Lanes>(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch) -> u64 {
                     continue;
                 }
                 cast += block.live.count_ones() as u64;
-                let blockers =
-                    simd::block_occluded::<V>(triangles, &scene.spheres, &block, two_sided);
+                let mut c = S::Counter::default();
+                let blockers = simd::block_occluded_counted::<V, S::Counter>(
+                    triangles,
+                    &scene.spheres,
+                    &block,
+                    two_sided,
+                    &mut c,
+                );
+                costs.add(i, c.times(block.live.count_ones()));
                 let lanes = ShadowRegisters {
                     l: block.l.map(V::from_array),
                     n_dot_l: V::from_array(block.n_dot_l),
@@ -271,7 +300,12 @@ fn fused<V: Lanes>(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch) -> u64 {
 /// hit as [`shade`] adds a queued one. Each hit's rays come in light order, so its sum is the
 /// queue's, bit for bit. Returns the rays cast. Never inlined, as [`fused`] is not.
 #[inline(never)]
-fn fused_hard<V: Lanes>(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch) -> u64 {
+fn fused_hard<V: Lanes, S: Costs>(
+    ctx: &Context,
+    rays: &RayBatch,
+    hits: &mut HitBatch,
+    costs: &mut S,
+) -> u64 {
     let scene = ctx.scene;
     let two_sided = ctx.settings.two_sided;
     let triangles = casters(scene, &ctx.shadow_casters, two_sided);
@@ -291,7 +325,17 @@ fn fused_hard<V: Lanes>(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch) -> 
             let live = block.live & present;
             cast += live.count_ones() as u64;
             let blocked = if occludes {
-                simd::hit_rays_occluded::<V>(triangles, &scene.spheres, &block, live, two_sided)
+                let mut c = S::Counter::default();
+                let blocked = simd::hit_rays_occluded_counted::<V, S::Counter>(
+                    triangles,
+                    &scene.spheres,
+                    &block,
+                    live,
+                    two_sided,
+                    &mut c,
+                );
+                costs.add_lanes(i0, live, c);
+                blocked
             } else {
                 0
             };
@@ -407,8 +451,9 @@ fn spawn<V: Lanes>(
     cast
 }
 
-/// Sets `queue.blocked` for every queued ray (both kernels write every entry).
-fn occlude<V: Lanes>(ctx: &Context, queue: &mut ShadowQueue) {
+/// Sets `queue.blocked` for every queued ray (both kernels write every entry); each ray's work
+/// goes to `costs` at its hit's index.
+fn occlude<V: Lanes, S: Remap>(ctx: &Context, queue: &mut ShadowQueue, costs: &mut S) {
     let scene = ctx.scene;
     let two_sided = ctx.settings.two_sided;
     let n = queue.len;
@@ -418,26 +463,29 @@ fn occlude<V: Lanes>(ctx: &Context, queue: &mut ShadowQueue) {
         tmax: &queue.tmax[..n],
     };
     let blocked = &mut queue.blocked[..n];
+    let costs = &mut costs.mapped(&queue.path);
     match &ctx.accel {
         // At 8 lanes the 8-lane entry point, a function of its own as it always was (`V::N` is a
         // constant, so only one arm is compiled in each instantiation).
-        None if V::N == 8 => simd::occluded(
+        None if V::N == 8 => simd::occluded_counted(
             casters(scene, &ctx.shadow_casters, two_sided),
             &scene.spheres,
             &cols,
             two_sided,
             blocked,
+            costs,
         ),
-        None => simd::occluded_lanes::<V>(
+        None => simd::occluded_lanes_counted::<V, _>(
             casters(scene, &ctx.shadow_casters, two_sided),
             &scene.spheres,
             &cols,
             two_sided,
             blocked,
+            costs,
         ),
         // Dead entries (no ray: `spawn::shadow_ray` gave none) carry tmax = 0, which
         // `MeshBvh::occluded` skips.
-        Some(bvh) => bvh.occluded(scene, &cols, two_sided, blocked),
+        Some(bvh) => bvh.occluded_counted(scene, &cols, two_sided, blocked, costs),
     }
 }
 

@@ -6,7 +6,7 @@ import { initCompare } from './compare.mjs';
 import { debounce } from './debounce.mjs';
 import { createView } from './gl.mjs';
 import { renderFrame } from './orbit.mjs';
-import { KEYS, keyAction, pixelAt, progress } from './render.mjs';
+import { KEYS, costLegend, keyAction, pixelAt, progress } from './render.mjs';
 import { validate } from './settings.mjs';
 import { api, errorMessage, urlWithoutToken } from './token.mjs';
 import { rows, title } from './tree.mjs';
@@ -97,6 +97,19 @@ async function showLevel(status, k) {
   canvas.style.height = `${512 * full[1] / full[0]}px`;
   $('render-info').textContent = `job ${status.job}: level ${k + 1} of ${status.sizes.length}, ` +
     `${status.sizes[k][0]}×${status.sizes[k][1]} of ${full[0]}×${full[1]}`;
+  showCost(status, k);
+}
+
+/** Lays level k's cost map over the render, or takes the overlay away when it has none. */
+function showCost(status, k) {
+  const overlay = $('cost-overlay');
+  const legend = costLegend(status.levels[k] && status.levels[k].cost);
+  overlay.hidden = legend === null;
+  $('cost-legend').hidden = legend === null;
+  if (legend === null) { overlay.removeAttribute('src'); overlay.dataset.level = '0'; return; }
+  overlay.src = `/api/render/${status.job}/${k}.cost.png`;
+  overlay.dataset.level = String(k + 1);
+  $('cost-text').textContent = legend;
 }
 
 function pollJob(id) {

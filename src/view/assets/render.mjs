@@ -17,6 +17,17 @@ export function progress(status) {
   return { fraction, text, level, levels: n, done, total };
 }
 
+/** What the cost-map overlay's legend says for a level's `cost` (its status's `cost`: kind,
+ * measure, high, largest, per_ray), or null when the level has none. */
+export function costLegend(cost) {
+  if (!cost) return null;
+  const rays = { camera: 'camera rays', shadow: 'shadow rays', reflection: 'mirror rays', all: 'all rays' }[cost.kind] || cost.kind;
+  const what = { nodes: 'BVH nodes visited', tests: 'primitives tested' }[cost.measure] || cost.measure;
+  const mean = cost.per_ray === null || cost.per_ray === undefined ? 'no rays' : `${cost.per_ray.toFixed(2)} per ray`;
+  const largest = Number.isInteger(cost.largest) ? String(cost.largest) : cost.largest.toFixed(2);
+  return `cost map, ${rays}: ${what} per pixel and camera sample, 0 to ${cost.high} (largest ${largest}); ${mean}`;
+}
+
 /** The pixel (x, y) of a `width` × `height` image, from the top-left, under client point
  * (cx, cy) over an element whose box is `rect` ({left, top, width, height}); null off it. */
 export function pixelAt(cx, cy, rect, width, height) {

@@ -11,7 +11,10 @@ export const RANGES = {
 /** The most camera samples (width × height × aa) one render may take. */
 export const MAX_CAMERA_SAMPLES = 4 * 1024 * 1024;
 /** Fields with fixed choices; the samplers and engines come from GET /api/scene. */
-export const CHOICES = { shadows: ['off', 'hard', 'soft'], light_model: ['lab', 'rpi'] };
+export const CHOICES = {
+  shadows: ['off', 'hard', 'soft'], light_model: ['lab', 'rpi'],
+  cost_map: ['off', 'camera', 'shadow', 'reflection', 'all'], cost_measure: ['nodes', 'tests'],
+};
 
 /** `values` (field name → the form's text) as settings: `{settings, errors}`, `errors` a list
  * of `{field, message}` (empty when the settings can be sent). `choices` adds the menus the
@@ -43,6 +46,12 @@ export function validate(values, choices = {}) {
     errors.push({
       field: 'width',
       message: `width × height × aa = ${width * height * aa} camera samples: the viewer renders at most ${MAX_CAMERA_SAMPLES}`,
+    });
+  }
+  if (settings.cost_map && settings.cost_map !== 'off' && settings.engine === 'reference') {
+    errors.push({
+      field: 'cost_map',
+      message: "cost_map counts the wavefront engine's traversal: expected engine wavefront, or cost_map off",
     });
   }
   return { settings, errors };

@@ -57,6 +57,7 @@ mod traverse;
 use super::simd::{RayColumns, TriangleLanes};
 use crate::render::geometry::{Hit, Ray, T_MIN, intersect_sphere};
 use crate::render::scene::{NO_HIT, Scene, Triangle};
+use crate::render::wavefront::cost::{Costs, Counter, NoCount};
 use crate::render::wavefront::lanes::{LANES, f32x8};
 use std::time::Duration;
 use traverse::{RayLanes, Stack, triangles8, triangles8_block};
@@ -156,6 +157,20 @@ impl MeshBvh {
         t_out: &mut [f32],
         prim_out: &mut [u32],
     ) {
+        self.closest_hits_counted(scene, rays, two_sided, t_out, prim_out, &mut NoCount);
+    }
+
+    /// [`Self::closest_hits`], each ray's nodes, leaves and primitive tests added to `costs`
+    /// (`cost::NoCount`: the uncounted kernel itself).
+    pub fn closest_hits_counted<S: Costs>(
+        &self,
+        scene: &Scene,
+        rays: &RayColumns,
+        two_sided: bool,
+        t_out: &mut [f32],
+        prim_out: &mut [u32],
+        costs: &mut S,
+    ) {
         let mut stack = Stack::new(self);
         let rays = cut(rays);
         let n = rays.len();
@@ -164,8 +179,10 @@ impl MeshBvh {
             let ray = rays.ray(i);
             let r = RayLanes::new(&ray);
             let best = (rays.tmax[i], NO_HIT);
-            let found = self.closest_from(self.root, &r, best, two_sided, &mut stack);
-            let best = with_spheres(scene, &ray, found);
+            let mut c = S::Counter::default();
+            let found = self.closest_from(self.root, &r, best, two_sided, &mut stack, &mut c);
+            let best = with_spheres(scene, &ray, found, &mut c);
+            costs.add(i, c);
             t_out[i] = best.t;
             prim_out[i] = best.prim;
         }
@@ -183,9 +200,23 @@ impl MeshBvh {
         t_out: &mut [f32],
         prim_out: &mut [u32],
     ) {
+        self.closest_hits_coherent_counted(scene, rays, two_sided, t_out, prim_out, &mut NoCount);
+    }
+
+    /// [`Self::closest_hits_coherent`], each ray's nodes, leaves and primitive tests added to
+    /// `costs`: a ray of a packet visits the nodes and leaves it is active in.
+    pub fn closest_hits_coherent_counted<S: Costs>(
+        &self,
+        scene: &Scene,
+        rays: &RayColumns,
+        two_sided: bool,
+        t_out: &mut [f32],
+        prim_out: &mut [u32],
+        costs: &mut S,
+    ) {
         if self.root & LEAF != 0 {
             // A tree of one leaf (or none) has nothing to share.
-            return self.closest_hits(scene, rays, two_sided, t_out, prim_out);
+            return self.closest_hits_counted(scene, rays, two_sided, t_out, prim_out, costs);
         }
         let mut walk = packet::Walk::new(self, two_sided);
         let rays = cut(rays);
@@ -193,9 +224,11 @@ impl MeshBvh {
         let (t_out, prim_out) = (&mut t_out[..n], &mut prim_out[..n]);
         for i in (0..n).step_by(WIDTH) {
             let live = (n - i).min(WIDTH);
-            let best = walk.closest(&rays, i, live);
+            let mut counts = [S::Counter::default(); WIDTH];
+            let best = walk.closest(&rays, i, live, &mut counts);
             for k in 0..live {
-                let best = with_spheres(scene, &rays.ray(i + k), best.lane(k));
+                let best = with_spheres(scene, &rays.ray(i + k), best.lane(k), &mut counts[k]);
+                costs.add(i + k, counts[k]);
                 t_out[i + k] = best.t;
                 prim_out[i + k] = best.prim;
             }
@@ -209,6 +242,19 @@ impl MeshBvh {
     /// (An occluder cache, a ray after a blocked one testing the leaf that blocked that one
     /// first, cost 6.6% more instructions on the gate's mesh tile: docs/TRIED.md, "The mesh BVH".)
     pub fn occluded(&self, scene: &Scene, rays: &RayColumns, two_sided: bool, out: &mut [bool]) {
+        self.occluded_counted(scene, rays, two_sided, out, &mut NoCount);
+    }
+
+    /// [`Self::occluded`], each traced ray's spheres tested, nodes, leaves and triangle tests
+    /// added to `costs` (rays not traced, tmax ≤ T_MIN, add nothing).
+    pub fn occluded_counted<S: Costs>(
+        &self,
+        scene: &Scene,
+        rays: &RayColumns,
+        two_sided: bool,
+        out: &mut [bool],
+        costs: &mut S,
+    ) {
         let mut stack = Stack::new(self);
         let rays = cut(rays);
         for (i, blocked) in out[..rays.len()].iter_mut().enumerate() {
@@ -219,15 +265,18 @@ impl MeshBvh {
                 continue;
             }
             let ray = rays.ray(i);
-            if scene
-                .spheres
-                .iter()
-                .any(|s| crate::render::geometry::sphere_blocks(s, &ray, tmax))
-            {
+            let mut c = S::Counter::default();
+            if scene.spheres.iter().any(|s| {
+                c.tests(1);
+                crate::render::geometry::sphere_blocks(s, &ray, tmax)
+            }) {
                 *blocked = true;
+                costs.add(i, c);
                 continue;
             }
-            *blocked = self.blocker(&RayLanes::new(&ray), tmax, two_sided, &mut stack) != EMPTY;
+            *blocked =
+                self.blocker(&RayLanes::new(&ray), tmax, two_sided, &mut stack, &mut c) != EMPTY;
+            costs.add(i, c);
         }
     }
 }
@@ -236,7 +285,13 @@ impl MeshBvh {
 /// and the scene's spheres, tested after the tree as `Accel::closest` does (sphere ids follow
 /// the triangles'); `Hit::MISS` when neither is hit.
 #[inline(always)]
-fn with_spheres(scene: &Scene, ray: &Ray, (mut t, mut prim): (f32, u32)) -> Hit {
+fn with_spheres<C: Counter>(
+    scene: &Scene,
+    ray: &Ray,
+    (mut t, mut prim): (f32, u32),
+    c: &mut C,
+) -> Hit {
+    c.tests(scene.spheres.len() as u32);
     let base = scene.triangles.len() as u32;
     for (k, s) in scene.spheres.iter().enumerate() {
         let ts = intersect_sphere(s, ray, t);

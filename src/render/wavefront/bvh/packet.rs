@@ -21,6 +21,7 @@ use super::traverse::{RayLanes, Stack};
 use super::{Block, EMPTY, LEAF, MeshBvh, Node, WIDTH};
 use crate::render::geometry::{T_MIN, closer};
 use crate::render::scene::NO_HIT;
+use crate::render::wavefront::cost::Counter;
 use crate::render::wavefront::lanes::{
     MASK_LANES, f32_bits, f32_bits_signed, f32_from_bits, f32_from_signed, f32x8, i32x8, ids,
     load_live, set_bits, u32x8, view,
@@ -206,16 +207,30 @@ impl<'b> Walk<'b> {
     }
 
     /// Closest triangle hits of rays `i..i + live` (live ≤ 8) as one packet: per lane the best
-    /// (t, triangle), `(tmax, NO_HIT)` for a miss.
+    /// (t, triangle), `(tmax, NO_HIT)` for a miss; lane k's nodes and leaves counted in
+    /// `counts[k]`.
     #[inline(always)]
-    pub(super) fn closest(&mut self, rays: &RayColumns, i: usize, live: usize) -> PacketBest {
+    pub(super) fn closest<C: Counter>(
+        &mut self,
+        rays: &RayColumns,
+        i: usize,
+        live: usize,
+        counts: &mut [C; WIDTH],
+    ) -> PacketBest {
         let p = Packet::load(rays, i, live);
         let tmax = load_live(rays.tmax, i, live);
-        self.closest_packet(&p, tmax, (1 << live) - 1)
+        self.closest_packet(&p, tmax, (1 << live) - 1, counts)
     }
 
-    /// The walk of the module docs for live lanes `live` (a bitmask).
-    fn closest_packet(&mut self, p: &Packet, tmax: f32x8, live: u32) -> PacketBest {
+    /// The walk of the module docs for live lanes `live` (a bitmask). A lane visits the nodes
+    /// and leaves it is active in.
+    fn closest_packet<C: Counter>(
+        &mut self,
+        p: &Packet,
+        tmax: f32x8,
+        live: u32,
+        counts: &mut [C; WIDTH],
+    ) -> PacketBest {
         let Walk { stack, alone } = self;
         let bvh = alone.bvh;
         let mut best = PacketBest {
@@ -230,8 +245,9 @@ impl<'b> Walk<'b> {
         let mut active = live;
         loop {
             if splits(bvh, cur, active) {
-                alone.finish(cur, active, p, &mut best);
+                alone.finish(cur, active, p, &mut best, counts);
             } else if cur & LEAF == 0 {
+                C::node_lanes(counts, active);
                 let e = entered_children(&bvh.nodes[cur as usize], active, p, &best);
                 if e.n > 0 {
                     for j in 0..e.n - 1 {
@@ -244,6 +260,7 @@ impl<'b> Walk<'b> {
                 }
             } else if cur != EMPTY {
                 let block = &bvh.blocks[(cur & !LEAF) as usize];
+                C::leaf_lanes(counts, active, block_len(block));
                 leaf_against_packet(block, active, p, &mut best, alone.two_sided);
             }
             // Pop the next entry that some lane may still find a closer hit in.
@@ -266,7 +283,14 @@ impl<'b> Walk<'b> {
 impl Alone<'_> {
     /// Each active lane alone through the rest of subtree `cur`, from its best so far.
     #[inline(always)]
-    fn finish(&mut self, cur: u32, active: u32, p: &Packet, best: &mut PacketBest) {
+    fn finish<C: Counter>(
+        &mut self,
+        cur: u32,
+        active: u32,
+        p: &Packet,
+        best: &mut PacketBest,
+        counts: &mut [C; WIDTH],
+    ) {
         for k in set_bits(active) {
             let found = self.bvh.closest_from(
                 cur,
@@ -274,6 +298,7 @@ impl Alone<'_> {
                 best.lane(k),
                 self.two_sided,
                 &mut self.stack,
+                &mut counts[k],
             );
             best.set_lane(k, found);
         }
@@ -349,7 +374,7 @@ fn leaf_against_packet(
 /// Number of triangles in a block: its lanes before the first unused one (id `NO_HIT`). From
 /// the ids, not the vertices: a triangle built in code may have a NaN vertex.
 #[inline(always)]
-fn block_len(block: &Block) -> u32 {
+pub(super) fn block_len(block: &Block) -> u32 {
     let unused = ids(block.prim)
         .simd_eq(i32x8::splat(NO_HIT as i32))
         .to_bitmask();

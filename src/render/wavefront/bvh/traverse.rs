@@ -10,9 +10,11 @@
 //!           blocker
 //! ```
 
+use super::packet::block_len;
 use super::{Block, EMPTY, LEAF, MeshBvh, Node, WIDTH, hit};
 use crate::render::geometry::{Hit, Ray, closer};
 use crate::render::scene::NO_HIT;
+use crate::render::wavefront::cost::{Counter, NoCount};
 use crate::render::wavefront::lanes::{f32x8, set_bits, view};
 use crate::render::wavefront::simd;
 use glam::Vec3A;
@@ -120,21 +122,24 @@ impl MeshBvh {
             (tmax, NO_HIT),
             two_sided,
             &mut Stack::new(self),
+            &mut NoCount,
         ))
     }
 
     /// The closest hit of one ray in the subtree `start`, given the best (t, triangle) found
     /// so far (`(tmax, NO_HIT)` for none): the better of the two, as a pair. Inlined into its
     /// callers: as a call per ray it ran the primary set at 15 Mrays/s instead of 22, and with
-    /// 12% more instructions (callgrind, incoherent rays; docs/TRIED.md).
+    /// 12% more instructions (callgrind, incoherent rays; docs/TRIED.md). `c` counts the
+    /// nodes and leaves visited (`NoCount`: nothing, and no code).
     #[inline(always)]
-    pub(super) fn closest_from(
+    pub(super) fn closest_from<C: Counter>(
         &self,
         start: u32,
         r: &RayLanes,
         (mut best_t, mut best_prim): (f32, u32),
         two_sided: bool,
         stack: &mut Stack,
+        c: &mut C,
     ) -> (f32, u32) {
         let stack = &mut stack.0[..];
         let mut sp = 0;
@@ -142,6 +147,7 @@ impl MeshBvh {
         loop {
             if cur & LEAF == 0 {
                 let node = &self.nodes[cur as usize];
+                c.node();
                 let (mask, near) = r.boxes(node, best_t);
                 if mask != 0 {
                     if mask.is_power_of_two() {
@@ -172,6 +178,7 @@ impl MeshBvh {
                 }
             } else if cur != EMPTY {
                 let block = &self.blocks[(cur & !LEAF) as usize];
+                c.leaf(block_len(block));
                 (best_t, best_prim) = block_closest(block, r, (best_t, best_prim), two_sided);
             }
             // Pop the next entry that may still hold a closer hit.
@@ -191,18 +198,20 @@ impl MeshBvh {
     /// True when a triangle blocks the ray in (T_MIN, tmax); stops at the first blocker.
     pub fn occluded_triangle(&self, ray: &Ray, tmax: f32, two_sided: bool) -> bool {
         let r = RayLanes::new(ray);
-        self.blocker(&r, tmax, two_sided, &mut Stack::new(self)) != EMPTY
+        self.blocker(&r, tmax, two_sided, &mut Stack::new(self), &mut NoCount) != EMPTY
     }
 
     /// The first leaf found that blocks the ray in (T_MIN, tmax), as a child reference
-    /// (`LEAF | block`), or `EMPTY` when none does; stops at that leaf.
+    /// (`LEAF | block`), or `EMPTY` when none does; stops at that leaf. `c` counts the nodes
+    /// and leaves visited.
     #[inline(always)]
-    pub(super) fn blocker(
+    pub(super) fn blocker<C: Counter>(
         &self,
         r: &RayLanes,
         tmax: f32,
         two_sided: bool,
         stack: &mut Stack,
+        c: &mut C,
     ) -> u32 {
         let stack = &mut stack.0[..];
         let tmax8 = f32x8::splat(tmax);
@@ -211,6 +220,7 @@ impl MeshBvh {
         loop {
             if cur & LEAF == 0 {
                 let node = &self.nodes[cur as usize];
+                c.node();
                 let (mask, _) = r.boxes(node, tmax);
                 if mask != 0 {
                     // Go on with the last child entered and push the others, lowest first: the
@@ -226,8 +236,12 @@ impl MeshBvh {
                     cur = node.child[last];
                     continue;
                 }
-            } else if cur != EMPTY && self.leaf_blocks(cur, r, tmax8, two_sided) {
-                return cur;
+            } else if cur != EMPTY {
+                let block = &self.blocks[(cur & !LEAF) as usize];
+                c.leaf(block_len(block));
+                if triangles8_block(block, r, tmax8, two_sided) {
+                    return cur;
+                }
             }
             if sp == 0 {
                 return EMPTY;
@@ -235,18 +249,6 @@ impl MeshBvh {
             sp -= 1;
             cur = stack[sp].0;
         }
-    }
-
-    /// Whether a triangle of the leaf `leaf` (`LEAF | block`) blocks the ray before `tmax`.
-    #[inline(always)]
-    pub(super) fn leaf_blocks(
-        &self,
-        leaf: u32,
-        r: &RayLanes,
-        tmax: f32x8,
-        two_sided: bool,
-    ) -> bool {
-        triangles8_block(&self.blocks[(leaf & !LEAF) as usize], r, tmax, two_sided)
     }
 }
 

@@ -6,6 +6,7 @@ use super::{RayColumns, Rays};
 use crate::render::geometry::{EDGE_EPSILON, MISS_MARGIN, T_MIN};
 use crate::render::scene::{NO_HIT, Sphere, Triangle};
 use crate::render::wavefront::batch::{HitRays, ShadowBlock};
+use crate::render::wavefront::cost::{Costs, Counter, NoCount};
 use crate::render::wavefront::lanes::{LaneWidth, Lanes, f32x8, f32x16, live_lanes, store_mask};
 use glam::Vec3;
 
@@ -328,6 +329,19 @@ pub fn occluded(
     occluded_lanes::<f32x8>(triangles, spheres, rays, two_sided, out);
 }
 
+/// [`occluded`], each ray charged the primitives its block of 8 tested (a block stops when all
+/// its live lanes are blocked), added to `costs`.
+pub fn occluded_counted<S: Costs>(
+    triangles: &[Triangle],
+    spheres: &[Sphere],
+    rays: &RayColumns,
+    two_sided: bool,
+    out: &mut [bool],
+    costs: &mut S,
+) {
+    occluded_lanes_counted::<f32x8, S>(triangles, spheres, rays, two_sided, out, costs);
+}
+
 /// [`occluded`] at lane width `width` (`Auto` as the build's native width), dispatched in a
 /// function of its own as [`closest_hits_at`] is.
 #[inline(never)]
@@ -353,6 +367,19 @@ pub fn occluded_lanes<V: Lanes>(
     two_sided: bool,
     out: &mut [bool],
 ) {
+    occluded_lanes_counted::<V, NoCount>(triangles, spheres, rays, two_sided, out, &mut NoCount);
+}
+
+/// [`occluded_lanes`], each live ray charged the primitives its block tested.
+#[inline(always)]
+pub fn occluded_lanes_counted<V: Lanes, S: Costs>(
+    triangles: &[Triangle],
+    spheres: &[Sphere],
+    rays: &RayColumns,
+    two_sided: bool,
+    out: &mut [bool],
+    costs: &mut S,
+) {
     let n = rays.len();
     debug_assert!(out.len() == n);
     for i in (0..n).step_by(V::N) {
@@ -364,13 +391,17 @@ pub fn occluded_lanes<V: Lanes>(
         let blocked = if live == 0 {
             0
         } else {
-            occluded8(
+            let mut c = S::Counter::default();
+            let blocked = occluded8(
                 triangles,
                 spheres,
                 live,
                 |s| sphere8_blocks(s, &r, tmax),
                 |tri| triangle8_blocks(tri, &r, tmax, two_sided),
-            )
+                &mut c,
+            );
+            costs.add_lanes(i, live, c);
+            blocked
         };
         let lanes = (n - i).min(V::N);
         store_mask::<V>(&mut out[i..i + lanes], blocked);
@@ -388,6 +419,19 @@ pub fn block_occluded<V: Lanes>(
     block: &ShadowBlock<V::Array>,
     two_sided: bool,
 ) -> u32 {
+    block_occluded_counted::<V, NoCount>(triangles, spheres, block, two_sided, &mut NoCount)
+}
+
+/// [`block_occluded`], the primitives the block tested counted in `c` (once for the block:
+/// each of its live rays did those tests).
+#[inline(always)]
+pub fn block_occluded_counted<V: Lanes, C: Counter>(
+    triangles: &[Triangle],
+    spheres: &[Sphere],
+    block: &ShadowBlock<V::Array>,
+    two_sided: bool,
+    c: &mut C,
+) -> u32 {
     let o = block.origin;
     let r = Rays {
         ox: V::splat(o.x),
@@ -399,7 +443,7 @@ pub fn block_occluded<V: Lanes>(
     };
     let tmax = V::from_array(block.tmax);
     let live = tmax.simd_gt(V::ZERO).to_bitmask();
-    rays_occluded(triangles, spheres, &r, tmax, live, two_sided)
+    rays_occluded(triangles, spheres, &r, tmax, live, two_sided, c)
 }
 
 /// The `live` lanes of one ray per hit (`simd::hit_shadow_rays`) that something blocks, as a
@@ -412,6 +456,20 @@ pub fn hit_rays_occluded<V: Lanes>(
     rays: &HitRays<V::Array>,
     live: u32,
     two_sided: bool,
+) -> u32 {
+    hit_rays_occluded_counted::<V, NoCount>(triangles, spheres, rays, live, two_sided, &mut NoCount)
+}
+
+/// [`hit_rays_occluded`], the primitives the block tested counted in `c` (once for the block:
+/// each live lane did those tests).
+#[inline(always)]
+pub fn hit_rays_occluded_counted<V: Lanes, C: Counter>(
+    triangles: &[Triangle],
+    spheres: &[Sphere],
+    rays: &HitRays<V::Array>,
+    live: u32,
+    two_sided: bool,
+    c: &mut C,
 ) -> u32 {
     let r = Rays {
         ox: V::from_array(rays.origin[0]),
@@ -428,18 +486,20 @@ pub fn hit_rays_occluded<V: Lanes>(
         V::from_array(rays.tmax),
         live,
         two_sided,
+        c,
     )
 }
 
 /// [`occluded8`] on rays in registers, `live` the lanes that count.
 #[inline(always)]
-fn rays_occluded<V: Lanes>(
+fn rays_occluded<V: Lanes, C: Counter>(
     triangles: &[Triangle],
     spheres: &[Sphere],
     r: &Rays<V>,
     tmax: V,
     live: u32,
     two_sided: bool,
+    c: &mut C,
 ) -> u32 {
     if live == 0 {
         return 0;
@@ -450,26 +510,31 @@ fn rays_occluded<V: Lanes>(
         live,
         |s| sphere8_blocks(s, r, tmax),
         |tri| triangle8_blocks(tri, r, tmax, two_sided),
+        c,
     )
 }
 
-/// Spheres, then triangles, until every live lane is blocked; returns the blocked lanes.
+/// Spheres, then triangles, until every live lane is blocked; returns the blocked lanes. `c`
+/// counts the primitives tested.
 #[inline(always)]
-fn occluded8(
+fn occluded8<C: Counter>(
     triangles: &[Triangle],
     spheres: &[Sphere],
     live: u32,
     sphere_blocks: impl Fn(&Sphere) -> u32,
     triangle_blocks: impl Fn(&Triangle) -> u32,
+    c: &mut C,
 ) -> u32 {
     let mut blocked = 0;
     for s in spheres {
+        c.tests(1);
         blocked |= sphere_blocks(s);
         if blocked & live == live {
             return blocked;
         }
     }
     for tri in triangles {
+        c.tests(1);
         blocked |= triangle_blocks(tri);
         if blocked & live == live {
             return blocked;

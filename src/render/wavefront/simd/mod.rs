@@ -38,8 +38,9 @@ mod point_sets;
 
 pub(crate) use geometry::{TriangleLanes, moller_trumbore8, moller_trumbore8_blocks};
 pub use geometry::{
-    block_occluded, closest_hits, closest_hits_at, closest_hits_lanes, hit_rays_occluded, occluded,
-    occluded_at, occluded_lanes, sphere8, triangle8,
+    block_occluded, block_occluded_counted, closest_hits, closest_hits_at, closest_hits_lanes,
+    hit_rays_occluded, hit_rays_occluded_counted, occluded, occluded_at, occluded_counted,
+    occluded_lanes, occluded_lanes_counted, sphere8, triangle8,
 };
 pub use hit_rays::{HitLanes, hit_shadow_rays};
 pub use light::{BlockSampler, LightBlock, light_points, light_points8, shadow_rays, shadow_rays8};
