@@ -36,7 +36,7 @@
 //! With `--until-decided` the rounds go on until the verdict is decided, judged at planned
 //! looks with narrower levels (`sequential`), within `--max-rounds` and `--max-time`.
 
-use super::sequential::{self, Budget};
+use super::running::sequential::{self, Budget};
 pub use super::verdict::{Rule, Verdict, VerdictForm};
 use super::{EXIT_REGRESSION, EXIT_UNDECIDED};
 use crate::render::engine::Engine;

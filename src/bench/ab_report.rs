@@ -2,7 +2,7 @@
 //! plan of looks and each engine's rounds and looks.
 
 use super::ab::{AbOptions, EngineAb, Verdict, VerdictForm};
-use super::sequential::{self, Budget, Stop};
+use super::running::sequential::{self, Budget, Stop};
 use crate::stats::looks::{self, LookPlan};
 use crate::stats::median;
 use std::time::Duration;

@@ -12,8 +12,8 @@
 //! and then every report, row and exported name carries its host, the points grouped by host.
 
 use super::export::Exports;
+use super::running::sweep::record_name;
 use super::shard::SweepPoints;
-use super::sweep::record_name;
 use crate::output::OutputPlan;
 use crate::output::bench_record::{self as record, BenchRecord};
 use crate::shard::{HostSummary, Machines};
@@ -88,7 +88,7 @@ pub fn merge(args: &MergeOptions) -> Result<Merged> {
     let mut to_save = Vec::new();
     if let Some(name) = &args.save {
         for label in &labels {
-            let point = super::sweep::Point {
+            let point = super::running::sweep::Point {
                 size: None,
                 shadow_samples: None,
                 threads: None,

@@ -24,13 +24,13 @@ pub(crate) mod adopt;
 pub mod compare;
 pub mod export;
 pub mod list;
-pub(crate) mod measure;
 pub mod merge;
 pub(crate) mod report;
-pub mod sequential;
+pub mod running;
 pub mod shard;
-pub mod sweep;
 pub mod verdict;
+
+use running::{measure, sweep};
 
 use crate::output::bench_record::{self as record, BenchRecord, SceneId, Setup};
 use crate::output::machine::Machine;

@@ -10,9 +10,9 @@ use clap::{ArgAction, ArgMatches, Args, Subcommand, ValueEnum};
 use raywave::bench::ab::{self, AbOptions, MIN_ROUNDS};
 use raywave::bench::export::Exports;
 use raywave::bench::merge::{self, MergeOptions};
-use raywave::bench::sequential;
+use raywave::bench::running::sequential;
+use raywave::bench::running::sweep::{Sweep, record_name};
 use raywave::bench::shard::SweepPoints;
-use raywave::bench::sweep::{Sweep, record_name};
 use raywave::bench::{BenchOptions, DEFAULT_RUNS, DEFAULT_THRESHOLD_PCT, EXIT_REGRESSION, list};
 use raywave::output::OutputPlan;
 use raywave::output::bench_record::record_path;
@@ -342,7 +342,7 @@ const AB_THRESHOLD_PCT: f64 = 5.0;
 /// `labels`, or one), `--json` and the exports (outputs). `--save` may name the `--compare`
 /// record (see below), no other input. Names `record_path` refuses are left to the bench,
 /// which reports them.
-fn output_plan(args: &BenchArgs, points: &[raywave::bench::sweep::Point]) -> OutputPlan {
+fn output_plan(args: &BenchArgs, points: &[raywave::bench::running::sweep::Point]) -> OutputPlan {
     let mut plan = OutputPlan::new();
     if let Some(scene) = args.scene.as_ref().or(args.input.as_ref()) {
         plan = plan.input("SCENE", scene);

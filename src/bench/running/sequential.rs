@@ -47,7 +47,7 @@
 //! `ab`); a ratio of two measured times equal to 1 + t to the bit is rare enough that the
 //! choice matters for the statement, not for a run.
 
-use super::ab::{RatioSummary, Rule, Verdict, summarize_at};
+use crate::bench::ab::{RatioSummary, Rule, Verdict, summarize_at};
 use crate::stats::looks::LookPlan;
 use anyhow::Result;
 use std::time::Duration;
