@@ -361,7 +361,14 @@ fn drive(c: &Session, server: &ViewServer, screenshot: Option<PathBuf>) {
         eprintln!("screenshot: {}", path.display());
     }
 
-    // Re-render as I orbit: one drag of several moves is one render, from the 3D camera.
+    // Re-render as I orbit: one drag of several moves is one render, from the 3D camera. A
+    // render the settings above started late (each field's change may start one) lands first,
+    // so that the drag's is the only new one.
+    std::thread::sleep(Duration::from_millis(500));
+    wait_attr(c, "#render", "data-state", |v| v == "done");
+    let job: u64 = wait_attr(c, "#render", "data-job", |v| v.parse::<u64>().is_ok())
+        .parse()
+        .unwrap_or(job);
     c.click(&c.find("#follow").expect("the orbit option"));
     let view = c.find("#view3d").expect("the 3D view");
     let mut drag = vec![
