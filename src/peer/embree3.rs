@@ -125,11 +125,7 @@ impl Embree3Mesh {
                 scene: rtc_scene,
                 quality,
                 build_time: start.elapsed(),
-                memory: EmbreeMemory {
-                    buffers,
-                    bvh: count.now() - buffers,
-                    peak: count.peak(),
-                },
+                memory: count.after_commit(buffers),
                 _count: count,
             })
         }

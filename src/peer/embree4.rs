@@ -334,11 +334,7 @@ impl Embree4Mesh {
                 scene: rtc_scene,
                 quality,
                 build_time: start.elapsed(),
-                memory: EmbreeMemory {
-                    buffers,
-                    bvh: count.now() - buffers,
-                    peak: count.peak(),
-                },
+                memory: count.after_commit(buffers),
                 _count: count,
             })
         }

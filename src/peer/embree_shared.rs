@@ -410,6 +410,15 @@ impl MemoryCount {
     pub(crate) fn peak(&self) -> i64 {
         self.peak.load(Ordering::Relaxed)
     }
+
+    /// A committed build's bytes, `buffers` being what was held before `rtcCommitScene`.
+    pub(crate) fn after_commit(&self, buffers: i64) -> EmbreeMemory {
+        EmbreeMemory {
+            buffers,
+            bvh: self.now() - buffers,
+            peak: self.peak(),
+        }
+    }
 }
 
 /// The `RTCMemoryMonitorFunction` of both versions: `ptr` is a `MemoryCount`, `bytes` > 0 for
