@@ -12,6 +12,7 @@ pub mod info;
 pub mod meshgen;
 pub mod phases;
 pub mod render;
+mod render_report;
 pub mod trace_pixel;
 pub mod values;
 pub mod variance;

@@ -1,0 +1,318 @@
+//! What `raywave render` prints and records once the frame is rendered: the summary, the
+//! `--stats` tables and the `--stats-json` record, from what the render measured.
+
+use raywave::output::machine::Machine;
+use raywave::output::render_record::{
+    DefaultsUsed, KindFigures, KindTiming, RenderRecord, SceneFigures, TraversalFigures,
+};
+use raywave::render::engine::Engine;
+use raywave::render::quote::escape;
+use raywave::render::scene::Scene;
+use raywave::render::settings::options::{BackgroundSource, Effective};
+use raywave::render::settings::{LightModel, ShadowMode};
+use raywave::render::wavefront::stats::RenderStats;
+use std::fmt::Write as _;
+
+/// The summary printed after a render: engine, scene, settings, rays and time.
+pub(super) fn summary(
+    scene: &Scene,
+    effective: &Effective,
+    run: &RunInfo,
+    report: &Report,
+) -> String {
+    let mut out = String::new();
+    let s = &effective.settings;
+    let shadows = match s.shadows {
+        ShadowMode::Off => "off (every light visible)".to_string(),
+        ShadowMode::Hard => "hard (light centroids)".to_string(),
+        ShadowMode::Soft => format!(
+            "soft, {} {} points per light",
+            s.shadow_samples,
+            s.sampler.name()
+        ),
+    };
+    let _ = writeln!(
+        out,
+        "raywave {} · engine {} · simd {} · {} thread(s)",
+        env!("CARGO_PKG_VERSION"),
+        run.engine.name(),
+        run.simd,
+        run.threads
+    );
+    let rings = match scene.ring_count {
+        0 => String::new(),
+        n => format!("; {n} ring(s) cut into faces"),
+    };
+    let _ = writeln!(
+        out,
+        "scene   {}: {} faces ({} triangles{rings}), {} spheres, {} light(s), {} camera",
+        scene.source,
+        scene.face_count,
+        scene.triangles.len(),
+        scene.spheres.len(),
+        scene.lights.len(),
+        if scene.camera_from_file {
+            "file"
+        } else {
+            "lab default"
+        }
+    );
+    for t in &scene.textures {
+        let outside = if t.outside_folder {
+            " (outside the scene file's folder)"
+        } else {
+            ""
+        };
+        let _ = writeln!(
+            out,
+            "texture {}: {}×{} texels from {}{outside}",
+            escape(&t.name),
+            t.width,
+            t.height,
+            escape(&t.path.display().to_string())
+        );
+    }
+    let _ = writeln!(
+        out,
+        "render  {}×{}, {} bounces, shadows {shadows}, {} aa sample(s), seed {}, {} faces",
+        s.width,
+        s.height,
+        s.bounces,
+        s.aa_samples,
+        s.seed,
+        if s.two_sided {
+            "two-sided"
+        } else {
+            "one-sided"
+        }
+    );
+    let model = match s.light_model {
+        LightModel::Lab => "lab (no fall-off)",
+        LightModel::Rpi => "rpi (divided by π·d²)",
+    };
+    let background = match effective.background {
+        BackgroundSource::Flag => "flag",
+        BackgroundSource::Scene => "scene",
+        BackgroundSource::Defaults => "default",
+    };
+    let [r, g, b] = s.background;
+    let [ar, ag, ab] = s.ambient;
+    let _ = writeln!(
+        out,
+        "light   model {model}, ambient {ar} {ag} {ab}, background {r} {g} {b} ({background})"
+    );
+    let defaulted = if effective.defaulted.is_empty() {
+        "none needed: flags set every setting".to_string()
+    } else {
+        format!(
+            "{} (--defaults {}) for {}",
+            effective.defaults.owner(),
+            effective.defaults.name(),
+            effective.defaulted.join(", ")
+        )
+    };
+    let _ = writeln!(out, "default {defaulted}");
+    let counts = &report.stats.counts;
+    let _ = writeln!(
+        out,
+        "rays    {} total: {} camera, {} shadow, {} reflection",
+        counts.total(),
+        counts.camera,
+        counts.shadow,
+        counts.reflection
+    );
+    let _ = writeln!(
+        out,
+        "time    {:.3} s, {:.2} Mrays/s",
+        report.seconds,
+        report.kinds().total.rays_per_second / 1e6
+    );
+    out
+}
+
+/// How the render ran, for the summary and the JSON.
+pub(super) struct RunInfo {
+    pub(super) engine: Engine,
+    /// The SIMD path the engine ran on (`Prepared::simd_path`).
+    pub(super) simd: &'static str,
+    pub(super) threads: usize,
+    pub(super) batch_size: u32,
+}
+
+/// What a render measured.
+pub(super) struct Report {
+    /// Ray counts, and each kind's thread-time when measured.
+    pub(super) stats: RenderStats,
+    pub(super) seconds: f64,
+    /// Wavefront only: per-stage figures, and the BVH build time if a BVH was used.
+    pub(super) stages: Option<(RenderStats, Option<f64>)>,
+    /// Reference only, with --stats or --stats-json: the wall-clock seconds of the second,
+    /// instrumented pass that timed the kinds.
+    pub(super) instrumented_seconds: Option<f64>,
+    /// Wavefront only, with --stats, --stats-json or --cost-map: the traversal counters of a
+    /// second, counted pass.
+    pub(super) traversal: Option<TraversalFigures>,
+}
+
+impl Report {
+    /// Rays by kind, each kind per thread-second of its work, the total per wall-clock second,
+    /// as the JSON gives them.
+    pub(super) fn kinds(&self) -> KindFigures {
+        KindFigures::new(&self.stats, self.seconds)
+    }
+
+    /// How the kinds' thread-time was measured, as the JSON names it.
+    fn kinds_timed_by(&self) -> KindTiming {
+        match self.instrumented_seconds {
+            Some(_) => KindTiming::InstrumentedPass,
+            None => KindTiming::StageTimers,
+        }
+    }
+}
+
+/// The `--stats` tables: rays by kind (each kind over the thread-time of its own work, the
+/// total over the wall clock), then (wavefront) the BVH build and each stage.
+pub(super) fn stats_table(report: &Report) -> String {
+    let mut out = String::new();
+    let kinds = report.kinds();
+    let _ = writeln!(
+        out,
+        "{:<12} {:>14} {:>14} {:>20}",
+        "kind", "rays", "thread-s", "Mrays/thread-s"
+    );
+    let or_dash = |x: Option<f64>, scale: f64, digits: usize| {
+        x.map_or("-".to_string(), |x| format!("{:.digits$}", x * scale))
+    };
+    for (kind, figure) in kinds.kinds.iter() {
+        let _ = writeln!(
+            out,
+            "{:<12} {:>14} {:>14} {:>20}",
+            kind.name(),
+            figure.rays,
+            or_dash(figure.thread_seconds, 1.0, 4),
+            or_dash(figure.rays_per_thread_second, 1e-6, 2)
+        );
+    }
+    let total = kinds.total;
+    let _ = writeln!(
+        out,
+        "{:<12} {:>14} {:>14} {:>20}",
+        "", "", "wall s", "Mrays/s"
+    );
+    let _ = writeln!(
+        out,
+        "{:<12} {:>14} {:>14.3} {:>20.2}",
+        "total",
+        total.rays,
+        total.seconds,
+        total.rays_per_second / 1e6
+    );
+    match report.instrumented_seconds {
+        Some(pass) => {
+            let _ = writeln!(
+                out,
+                "kinds timed by a second pass with timers: {pass:.3} s against the render's \
+                 {:.3} s ({:+.1}%); the render itself had no timers",
+                report.seconds,
+                (pass / report.seconds.max(1e-9) - 1.0) * 100.0
+            );
+        }
+        None => {
+            let _ = writeln!(
+                out,
+                "kinds timed by the stage timers: camera = generate + intersect of camera rays, \
+                 reflection = reflect + intersect of mirror rays, shadow = shadow; film in none"
+            );
+        }
+    }
+    if let Some((_, Some(build))) = &report.stages {
+        let _ = writeln!(out, "bvh build {build:.3} s");
+    }
+    if let Some(t) = &report.traversal {
+        let _ = writeln!(
+            out,
+            "{:<12} {:>14} {:>14} {:>14} {:>14}",
+            "traversal", "rays", "nodes/ray", "leaves/ray", "tests/ray"
+        );
+        for (kind, f) in t.kinds.iter() {
+            let _ = writeln!(
+                out,
+                "{:<12} {:>14} {:>14} {:>14} {:>14}",
+                kind.name(),
+                f.rays,
+                or_dash(f.nodes_per_ray, 1.0, 2),
+                or_dash(f.leaves_per_ray, 1.0, 2),
+                or_dash(f.primitive_tests_per_ray, 1.0, 2)
+            );
+        }
+        let _ = writeln!(
+            out,
+            "traversal counted by a second pass: {:.3} s; the render timed above counted nothing \
+             (tests: triangles of the leaves visited, spheres, and without a BVH every primitive)",
+            t.counted_seconds
+        );
+    }
+    if let Some((stats, _)) = &report.stages {
+        let _ = writeln!(
+            out,
+            "{:<12} {:>14} {:>14} {:>20}",
+            "stage", "rays", "thread-s", "Mrays/thread-s"
+        );
+        for row in stats.stage_figures() {
+            let _ = writeln!(
+                out,
+                "{:<12} {:>14} {:>14.4} {:>20.2}",
+                row.stage,
+                row.rays,
+                row.thread_seconds,
+                row.rays_per_thread_second / 1e6
+            );
+        }
+    }
+    out
+}
+
+/// The `--stats-json` record of a render.
+pub(super) fn record(
+    scene: &Scene,
+    effective: &Effective,
+    run: &RunInfo,
+    report: &Report,
+) -> RenderRecord {
+    let (stages, bvh) = match &report.stages {
+        Some((stats, bvh)) => (Some(stats.stage_figures()), Some(*bvh)),
+        None => (None, None),
+    };
+    RenderRecord {
+        format: raywave::output::bench_record::FORMAT,
+        raywave: env!("CARGO_PKG_VERSION"),
+        // The record has never named the host.
+        machine: Machine {
+            hostname: String::new(),
+            ..Machine::current()
+        },
+        simd: run.simd,
+        threads: run.threads,
+        engine: run.engine,
+        batch_size: run.batch_size,
+        scene: SceneFigures {
+            source: scene.source.clone(),
+            triangles: scene.triangles.len(),
+            spheres: scene.spheres.len(),
+            lights: scene.lights.len(),
+            bvh: bvh.map(|b| b.is_some()),
+            bvh_build_seconds: bvh.flatten(),
+        },
+        settings: effective.settings.clone(),
+        defaults: DefaultsUsed {
+            from: effective.defaults.name(),
+            settings: effective.defaulted.clone(),
+        },
+        seconds: report.seconds,
+        rays: report.kinds(),
+        kinds_timed_by: report.kinds_timed_by(),
+        instrumented_seconds: report.instrumented_seconds,
+        stages,
+        traversal: report.traversal,
+    }
+}
