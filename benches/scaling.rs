@@ -19,6 +19,7 @@
 
 mod common;
 
+use raywave::render::progress::Progress;
 use raywave::render::scene::Scene;
 use raywave::render::settings::RenderSettings;
 use raywave::render::wavefront::{DEFAULT_BATCH_SIZE, Wavefront};
@@ -81,7 +82,7 @@ fn main() {
             let mut thread_s = [0.0; 2];
             for (k, pool) in pools.iter().enumerate() {
                 let start = Instant::now();
-                let (film, stats) = pool.install(|| engine.render(&|| {}));
+                let (film, stats) = pool.install(|| engine.render(&Progress::SILENT));
                 wall[k] = start.elapsed().as_secs_f64();
                 black_box(film);
                 thread_s[k] = stats.stage_time.iter().sum::<Duration>().as_secs_f64();

@@ -12,6 +12,7 @@
 mod common;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use raywave::render::progress::Progress;
 use raywave::render::sampling::{LightSampler, SampleKey};
 use raywave::render::scene::Scene;
 use raywave::render::settings::RenderSettings;
@@ -93,11 +94,11 @@ fn frame(c: &mut Criterion) {
             continue;
         };
         let engine = Wavefront::new(&scene, &settings, 4096);
-        let rays = engine.render(&|| {}).1.counts.total();
+        let rays = engine.render(&Progress::SILENT).1.counts.total();
         g.throughput(Throughput::Elements(rays));
         let name = path.file_stem().map(|s| s.to_string_lossy().into_owned());
         g.bench_function(name.unwrap_or_default(), |b| {
-            b.iter(|| black_box(engine.render(&|| {})))
+            b.iter(|| black_box(engine.render(&Progress::SILENT)))
         });
     }
     g.finish();

@@ -19,6 +19,7 @@
 //!
 //! ```
 //! use raywave::render::engine::Engine;
+//! use raywave::render::progress::Progress;
 //! use raywave::render::scene::parse_scene_str;
 //! use raywave::render::settings::{RenderSettings, ShadowMode};
 //!
@@ -39,8 +40,8 @@
 //!     shadow_samples: 4,
 //!     ..RenderSettings::default()
 //! };
-//! let (wavefront, stats) = Engine::Wavefront.render(&scene, &settings, 64, &|| {});
-//! let (reference, _) = Engine::Reference.render(&scene, &settings, 64, &|| {});
+//! let (wavefront, stats) = Engine::Wavefront.render(&scene, &settings, 64, &Progress::SILENT);
+//! let (reference, _) = Engine::Reference.render(&scene, &settings, 64, &Progress::SILENT);
 //! assert_eq!(stats.counts.camera, 16 * 16);
 //! // The floor is lit: some pixel is brighter than the ambient term alone.
 //! assert!(wavefront.pixels.iter().any(|p| p.x > 0.2 * 0.8));
@@ -73,6 +74,8 @@ pub mod stats;
 pub mod bench;
 #[cfg(feature = "tools")]
 pub mod diff;
+#[cfg(feature = "tools")]
+pub mod frame;
 #[cfg(feature = "tools")]
 pub mod peer;
 #[cfg(feature = "tools")]

@@ -18,7 +18,7 @@ fn main() -> ExitCode {
     // Exit 2, naming them, when this CPU lacks instructions the build uses: before any code
     // that might use them.
     raywave::output::cpu::exit_unless_supported();
-    cli::phases::start();
+    raywave::frame::phases::start();
     let normalized = match cli::foreign::normalize_args(std::env::args_os()) {
         Ok(n) => n,
         Err(e) => {

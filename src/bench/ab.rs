@@ -36,6 +36,7 @@
 //! With `--until-decided` the rounds go on until the verdict is decided, judged at planned
 //! looks with narrower levels (`sequential`), within `--max-rounds` and `--max-time`.
 
+use crate::render::progress::{Progress, Steps};
 use super::running::sequential::{self, Budget};
 pub use super::verdict::{Rule, Verdict, VerdictForm};
 use super::{EXIT_REGRESSION, EXIT_UNDECIDED};
@@ -255,13 +256,13 @@ struct Builds<'a> {
 
 impl Builds<'_> {
     /// Round `round` (counted from 0, warm-up included) of `engine`: this build's seconds and
-    /// the other's. Ray counts that differ are noted in `result`; `tick` follows each run.
+    /// the other's. Ray counts that differ are noted in `result`; `runs` steps after each run.
     fn round(
         &self,
         engine: Engine,
         round: u32,
         result: &mut EngineAb,
-        tick: &mut dyn FnMut(),
+        runs: &Steps,
     ) -> Result<(f64, f64)> {
         // Alternate which build goes first, so that neither always runs on a warmer or cooler
         // machine.
@@ -273,7 +274,7 @@ impl Builds<'_> {
         let mut times = [(0.0, String::new()), (0.0, String::new())];
         for (slot, binary) in order.into_iter().enumerate() {
             times[slot] = time_one(binary, self.options, engine, self.scratch.path())?;
-            tick();
+            runs.step();
         }
         let (mine, theirs) = if round.is_multiple_of(2) {
             (&times[0], &times[1])
@@ -287,9 +288,9 @@ impl Builds<'_> {
     }
 }
 
-/// Runs the rounds; `progress` is called after each run with (runs done, runs in all; with
-/// `until_decided`, all that `max_rounds` allows).
-pub fn run(options: &AbOptions, progress: &dyn Fn(u64, u64)) -> Result<Vec<EngineAb>> {
+/// Runs the rounds, reporting each run to `progress` (of the runs in all; with `until_decided`,
+/// all that `max_rounds` allows).
+pub fn run(options: &AbOptions, progress: &Progress) -> Result<Vec<EngineAb>> {
     let timed = match options.until_decided {
         None => ("--rounds", options.rounds),
         Some(budget) => ("--max-rounds", budget.max_rounds),
@@ -309,11 +310,7 @@ pub fn run(options: &AbOptions, progress: &dyn Fn(u64, u64)) -> Result<Vec<Engin
     };
     let engines = options.engines.len();
     let total = engines as u64 * u64::from(options.warmup + timed.1) * 2;
-    let mut done = 0;
-    let mut tick = || {
-        done += 1;
-        progress(done, total);
-    };
+    let runs = progress.steps(total, "runs");
     let start = Instant::now();
     let mut results = Vec::new();
     for (i, &engine) in options.engines.iter().enumerate() {
@@ -326,11 +323,11 @@ pub fn run(options: &AbOptions, progress: &dyn Fn(u64, u64)) -> Result<Vec<Engin
         };
         let engine_start = Instant::now();
         for round in 0..options.warmup {
-            builds.round(engine, round, &mut result, &mut tick)?;
+            builds.round(engine, round, &mut result, &runs)?;
         }
         let Some(budget) = options.until_decided else {
             for round in options.warmup..options.warmup + options.rounds {
-                let (mine, theirs) = builds.round(engine, round, &mut result, &mut tick)?;
+                let (mine, theirs) = builds.round(engine, round, &mut result, &runs)?;
                 result.this.push(mine);
                 result.other.push(theirs);
             }
@@ -351,7 +348,7 @@ pub fn run(options: &AbOptions, progress: &dyn Fn(u64, u64)) -> Result<Vec<Engin
                 {
                     return Ok(None);
                 }
-                let (mine, theirs) = builds.round(engine, round, &mut result, &mut tick)?;
+                let (mine, theirs) = builds.round(engine, round, &mut result, &runs)?;
                 round += 1;
                 result.this.push(mine);
                 result.other.push(theirs);

@@ -34,7 +34,8 @@ use running::{measure, sweep};
 
 use crate::output::bench_record::{self as record, BenchRecord, SceneId, Setup};
 use crate::output::machine::Machine;
-use crate::render::engine::{Engine, Hooks, thread_pool};
+use crate::render::engine::{Engine, thread_pool};
+use crate::render::progress::Progress;
 use crate::render::scene::{SceneFile, load_scene};
 use crate::render::settings::options::ImageOptions;
 use crate::render::wavefront::DEFAULT_BATCH_SIZE;
@@ -144,7 +145,7 @@ struct Plan {
 }
 
 /// Runs the bench as the flags say and writes its files; errors name the file or flag.
-pub fn run(args: &BenchOptions, hooks: &Hooks) -> Result<Outcome> {
+pub fn run(args: &BenchOptions, progress: &Progress) -> Result<Outcome> {
     // Everything that can fail cheaply happens before the timed part.
     let points = args.sweep.points();
     if points.len() > 1 && (args.compare.is_some() || args.json.is_some()) {
@@ -166,7 +167,7 @@ pub fn run(args: &BenchOptions, hooks: &Hooks) -> Result<Outcome> {
     let SceneFile { scene, bytes } =
         load_scene(args.scene.as_deref(), &args.image.parse_options())?;
     for w in &scene.warnings {
-        (hooks.notice)(&w.to_string());
+        (progress.notice)(&w.to_string());
     }
     args.plan.check_scene_files("SCENE", &scene)?;
     let baseline = match &args.compare {
@@ -296,18 +297,13 @@ pub fn run(args: &BenchOptions, hooks: &Hooks) -> Result<Outcome> {
     let host = crate::shard::Host::start(rayon::current_num_threads());
 
     if let Some(w) = report::load_warning() {
-        (hooks.notice)(&format!("warning: {w}"));
+        (progress.notice)(&format!("warning: {w}"));
     }
     let total: u64 = plans
         .iter()
         .map(|p| u64::from(args.warmup + args.runs) * p.engines.len() as u64)
         .sum();
-    let done = std::sync::atomic::AtomicU64::new(0);
-    let tick = || {
-        let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-        (hooks.progress)(n, total, "");
-    };
-    (hooks.progress)(0, total, "");
+    let runs = progress.steps(total, "runs");
     let mut records = Vec::new();
     for plan in &plans {
         let engines = measure::measure(
@@ -318,8 +314,8 @@ pub fn run(args: &BenchOptions, hooks: &Hooks) -> Result<Outcome> {
             args.lanes,
             args.warmup,
             args.runs,
-            &tick,
-            hooks.notice,
+            &runs,
+            progress.notice,
         );
         let record = BenchRecord {
             format: record::FORMAT,
@@ -342,7 +338,7 @@ pub fn run(args: &BenchOptions, hooks: &Hooks) -> Result<Outcome> {
             engines,
         };
         for w in report::warnings(&record, &plan.point.label) {
-            (hooks.notice)(&format!("warning: {w}"));
+            (progress.notice)(&format!("warning: {w}"));
         }
         records.push(record);
     }
@@ -367,7 +363,7 @@ pub fn run(args: &BenchOptions, hooks: &Hooks) -> Result<Outcome> {
     for (plan, record) in plans.iter().zip(&records) {
         let Some(path) = &plan.save else { continue };
         if regressed && args.save == args.compare {
-            (hooks.notice)(&format!(
+            (progress.notice)(&format!(
                 "warning: not saved: this run regressed against {}, which is kept as it was; \
                  save under another name to keep this run",
                 path.display()

@@ -17,7 +17,8 @@ use raywave::bench::{BenchOptions, DEFAULT_RUNS, DEFAULT_THRESHOLD_PCT, EXIT_REG
 use raywave::output::OutputPlan;
 use raywave::output::bench_record::record_path;
 use raywave::output::memory::{self, RenderFootprint};
-use raywave::render::engine::{Engine, Hooks};
+use raywave::output::terminal::with_bar;
+use raywave::render::engine::Engine;
 use raywave::render::error::UsageError;
 use raywave::shard::Shard;
 use raywave::shard::part_name;
@@ -447,25 +448,11 @@ pub fn run(args: &BenchArgs, matches: Option<&ArgMatches>) -> Result<u8> {
         None,
     )?;
     let Some(other) = &args.against else {
-        let bar = raywave::output::terminal::progress_bar(
-            0,
+        let outcome = with_bar(
             "{elapsed_precise} [{bar:40}] {pos}/{len} runs (warm-up included), engines alternating",
             args.quiet,
-        );
-        let progress = |done: u64, total: u64, _: &str| {
-            bar.set_length(total);
-            bar.set_position(done);
-        };
-        let notice = |line: &str| bar.suspend(|| eprintln!("{line}"));
-        let outcome = raywave::bench::run(
-            &options,
-            &Hooks {
-                progress: &progress,
-                notice: &notice,
-            },
-        );
-        bar.finish_and_clear();
-        let outcome = outcome?;
+            |progress| raywave::bench::run(&options, progress),
+        )?;
         let text = outcome.text(args.quiet, options.compare.as_deref());
         // Standard output may carry an export (`--json -`); the report then goes to stderr.
         if output_plan(args, &[]).uses_stdout() {
@@ -504,16 +491,11 @@ pub fn run(args: &BenchArgs, matches: Option<&ArgMatches>) -> Result<u8> {
         },
         quiet: args.quiet,
     };
-    let bar = raywave::output::terminal::progress_bar(
-        0,
+    let results = with_bar(
         "{elapsed_precise} [{bar:40}] {pos}/{len} runs, both builds alternating",
         args.quiet,
-    );
-    let results = ab::run(&options, &|done, total| {
-        bar.set_length(total);
-        bar.set_position(done);
-    })?;
-    bar.finish_and_clear();
+        |progress| ab::run(&options, progress),
+    )?;
     raywave::output::terminal::print(&ab::report(&options, &results))?;
     Ok(ab::exit_code(&options, &results))
 }

@@ -3,10 +3,7 @@
 use super::values::{DefaultsArg, LightModelArg, SamplerArg, ShadowArg, colour_component};
 use clap::Args;
 use raywave::output::OutputPlan;
-use raywave::render::error::UsageError;
-use raywave::render::scene::{Scene, load_scene};
-use raywave::render::settings::options::{Effective, ImageOptions};
-use std::path::Path;
+use raywave::render::settings::options::ImageOptions;
 
 /// The flags that shape the image, shared by `render` and `bench` so that both default alike
 /// (a bench record then measures what the same flags render). The defaults are the same with
@@ -55,6 +52,15 @@ pub struct ImageArgs {
 }
 
 impl ImageArgs {
+    /// The flags, with the seed and the facing, as the library's options.
+    pub fn with_seed(&self, seed: &SeedArgs) -> ImageOptions {
+        ImageOptions {
+            seed: seed.seed,
+            two_sided: seed.two_sided,
+            ..self.options()
+        }
+    }
+
     /// The flags as the library's options.
     pub fn options(&self) -> ImageOptions {
         ImageOptions {
@@ -151,30 +157,6 @@ impl ThreadsArg {
     pub fn pool(&self) -> anyhow::Result<rayon::ThreadPool> {
         raywave::render::engine::thread_pool(self.threads)
     }
-}
-
-/// Loads the scene at `path` (the built-in one for `None`; its warnings go to stderr) and
-/// resolves `image` against it, with the seed and the facing that the image flags do not hold:
-/// the one way `render`, `trace-pixel` and `view` turn their flags into a scene and settings.
-pub fn scene_and_settings(
-    path: Option<&Path>,
-    image: &ImageArgs,
-    seed: &SeedArgs,
-    plan: &OutputPlan,
-) -> anyhow::Result<(Scene, Effective)> {
-    let options = ImageOptions {
-        seed: seed.seed,
-        two_sided: seed.two_sided,
-        ..image.options()
-    };
-    let scene = load_scene(path, &options.parse_options())?.scene;
-    for w in &scene.warnings {
-        eprintln!("{w}");
-    }
-    plan.check_scene_files("SCENE", &scene)?;
-    let effective = options.resolve(scene.background.map(|c| c.to_array()));
-    raywave::render::sampling::check(&effective.settings).map_err(|e| UsageError(e.to_string()))?;
-    Ok((scene, effective))
 }
 
 /// Prints text meant for the terminal: on stdout, or on stderr when one of `plan`'s outputs

@@ -2,13 +2,13 @@
 //! render of that pixel, written as JSON, OBJ, PLY and a PNG from a debug camera, or printed
 //! as a readable summary when no output is asked for.
 
-use super::image::scene_and_settings;
+use raywave::frame::scene_and_settings;
 use super::image::{ImageArgs, SeedArgs, ThreadsArg};
 use super::values::{ToneMapArg, float};
 use anyhow::{Context, Result};
 use clap::Args;
 use raywave::output::image_file::ldr_format;
-use raywave::output::terminal::progress_bar;
+use raywave::output::terminal::with_bar;
 use raywave::output::{OutputPlan, write_output};
 use raywave::render::camera::CameraRays;
 use raywave::render::engine::{Engine, clamped_warning};
@@ -86,7 +86,12 @@ pub fn run(args: &TracePixelArgs) -> Result<()> {
     plan.refuse_binary_on_terminal(&["--png"])?;
 
     let (scene, effective) =
-        scene_and_settings(args.scene.as_deref(), &args.image, &args.seed, &plan)?;
+        scene_and_settings(
+            args.scene.as_deref(),
+            &args.image.with_seed(&args.seed),
+            &plan,
+            &|w| eprintln!("{w}"),
+        )?;
     let settings = effective.settings;
     let mut tree =
         trace_pixel(&scene, &settings, args.x, args.y).map_err(|e| UsageError(e.to_string()))?;
@@ -148,21 +153,17 @@ pub fn run(args: &TracePixelArgs) -> Result<()> {
             &view_settings,
             raywave::render::wavefront::DEFAULT_BATCH_SIZE,
         );
-        let (units, unit) = engine.work_units(&view_settings);
-        let progress = progress_bar(
-            units,
-            &format!("{{spinner}} rendering the debug view [{{bar:40}}] {{pos}}/{{len}} {unit}"),
-            false,
-        );
-        let (film, depth) = pool.install(|| {
-            let (film, stats) = engine.render(&|| progress.inc(1));
-            if let Some(w) = clamped_warning(&stats) {
-                progress.suspend(|| eprintln!("{w}"));
-            }
-            let rays = CameraRays::new(&camera, width, height);
-            (film, depth_buffer(&view_scene, &rays, settings.two_sided))
+        let template = "{spinner} rendering the debug view [{bar:40}] {pos}/{len} {msg}";
+        let (film, depth) = with_bar(template, false, |progress| {
+            pool.install(|| {
+                let (film, stats) = engine.render(progress);
+                if let Some(w) = clamped_warning(&stats) {
+                    (progress.notice)(&w);
+                }
+                let rays = CameraRays::new(&camera, width, height);
+                (film, depth_buffer(&view_scene, &rays, settings.two_sided))
+            })
         });
-        progress.finish_and_clear();
         let mut img = film.to_rgb8(args.tonemap.into());
         let (lo, hi) = scene_bounds(&scene);
         Overlay {

@@ -6,8 +6,9 @@ use super::values::{EngineArg, LightModelArg, SamplerArg};
 use anyhow::Result;
 use clap::{Args, Subcommand};
 use raywave::output::OutputPlan;
-use raywave::output::terminal::{print, progress_bar};
-use raywave::render::engine::{Hooks, clamped_warning};
+use raywave::output::terminal::{print, with_bar};
+use raywave::render::engine::clamped_warning;
+use raywave::render::progress::Progress;
 use raywave::render::scene::Scene;
 use raywave::render::settings::RenderSettings;
 use raywave::render::wavefront::DEFAULT_BATCH_SIZE;
@@ -207,36 +208,24 @@ fn cases(options: &VarianceOptions) -> Result<Vec<Case>> {
 fn with_progress<T>(
     options: &VarianceOptions,
     prefix: String,
-    work: impl FnOnce(&raywave::variance::RenderFn, &Hooks) -> Result<T>,
+    work: impl FnOnce(&raywave::variance::RenderFn, &Progress) -> Result<T>,
 ) -> Result<T> {
-    let bar = progress_bar(
-        0,
-        "{spinner} {prefix} [{bar:30}] ~{human_pos}/{human_len} rays, {msg} ({elapsed}, eta {eta})",
-        options.quiet,
+    let template = format!(
+        "{{spinner}} {prefix} [{{bar:30}}] ~{{human_pos}}/{{human_len}} rays, {{msg}} ({{elapsed}}, eta {{eta}})"
     );
-    bar.set_prefix(prefix);
-    let progress = |done: u64, total: u64, label: &str| {
-        bar.set_length(total);
-        bar.set_position(done);
-        bar.set_message(label.to_string());
-    };
-    let notice = |line: &str| bar.suspend(|| eprintln!("{line}"));
-    let render = |scene: &Scene, settings: &RenderSettings| {
-        let (film, stats) = options
-            .engine
-            .render(scene, settings, DEFAULT_BATCH_SIZE, &|| {});
-        if let Some(w) = clamped_warning(&stats) {
-            notice(&w);
-        }
-        (film, stats.counts)
-    };
-    let hooks = Hooks {
-        progress: &progress,
-        notice: &notice,
-    };
-    let out = work(&render, &hooks);
-    bar.finish_and_clear();
-    out
+    with_bar(&template, options.quiet, |progress| {
+        let render = |scene: &Scene, settings: &RenderSettings| {
+            let (film, stats) =
+                options
+                    .engine
+                    .render(scene, settings, DEFAULT_BATCH_SIZE, &Progress::SILENT);
+            if let Some(w) = clamped_warning(&stats) {
+                (progress.notice)(&w);
+            }
+            (film, stats.counts)
+        };
+        work(&render, progress)
+    })
 }
 
 /// No output of `plan` is a texture one of the cases' scenes read.
@@ -284,8 +273,8 @@ pub fn run(args: &VarianceArgs) -> Result<()> {
         let identity = raywave::variance::study::plan::identity(&cases, options.engine.name());
         let jobs = identity.work.assignment(shard.count)[shard.index].len();
         let prefix = format!("variance shard {shard}, {jobs} jobs");
-        let (path, jobs) = with_progress(&options, prefix, |render, hooks| {
-            pool.install(|| run_shard(&options, &cases, shard, render, hooks))
+        let (path, jobs) = with_progress(&options, prefix, |render, progress| {
+            pool.install(|| run_shard(&options, &cases, shard, render, progress))
         })?;
         return print(&format!(
             "shard {shard}: ran {jobs} job{} of the study\nwrote   {}\n",
@@ -304,8 +293,8 @@ pub fn run(args: &VarianceArgs) -> Result<()> {
         .jobs()
         .len();
     let prefix = format!("variance, {jobs} jobs");
-    let outcome = with_progress(&options, prefix, |render, hooks| {
-        pool.install(|| study(&options, &cases, render, hooks))
+    let outcome = with_progress(&options, prefix, |render, progress| {
+        pool.install(|| study(&options, &cases, render, progress))
     })?;
     let cached = outcome
         .results
@@ -346,8 +335,8 @@ fn run_prepare(args: &PrepareArgs) -> Result<()> {
         .options(Path::new("variance-report"), args.quiet)?;
     let cases = cases(&options)?;
     let pool = args.workers.pool()?;
-    let prepared = with_progress(&options, "prepare".into(), |render, hooks| {
-        pool.install(|| prepare(&options, &cases, render, hooks))
+    let prepared = with_progress(&options, "prepare".into(), |render, progress| {
+        pool.install(|| prepare(&options, &cases, render, progress))
     })?;
     let mut text = String::new();
     for (name, cached) in prepared {

@@ -1,6 +1,6 @@
 //! `raywave view` flags, turned into `raywave::view::ViewOptions`.
 
-use super::image::scene_and_settings;
+use raywave::frame::scene_and_settings;
 use super::image::{ImageArgs, SeedArgs, ThreadsArg};
 use super::values::EngineArg;
 use anyhow::Result;
@@ -66,10 +66,10 @@ pub fn run(args: &ViewArgs) -> Result<u8> {
     let access = access(args)?;
     let (scene, effective) = scene_and_settings(
         args.scene.as_deref(),
-        &args.image,
-        &args.seed,
+        &args.image.with_seed(&args.seed),
         // The viewer writes no file.
         &raywave::output::OutputPlan::new(),
+        &|w| eprintln!("{w}"),
     )?;
     let settings = effective.settings;
     if settings.width > MAX_SIDE || settings.height > MAX_SIDE {

@@ -1,23 +1,40 @@
 //! What the commands show while they run: progress bars on standard error and text on standard
 //! output, each made in one place.
 
+use crate::render::progress::Progress;
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::Write;
 
-/// A progress bar of `len` steps on standard error drawn with indicatif's `template`, or a
-/// hidden one when `quiet`. indicatif draws nothing when standard error is not a terminal.
-pub fn progress_bar(len: u64, template: &str, quiet: bool) -> ProgressBar {
-    if quiet {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::stderr());
+/// Runs `work` with a progress bar on standard error, drawn with indicatif's `template` (its
+/// `{msg}` is what the job says it is doing), and the job's notices printed above the bar. No
+/// bar when `quiet`; indicatif draws none when standard error is not a terminal.
+pub fn with_bar<T>(template: &str, quiet: bool, work: impl FnOnce(&Progress) -> T) -> T {
+    let bar = match quiet {
+        true => ProgressBar::hidden(),
+        false => ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr()),
+    };
     bar.set_style(
         ProgressStyle::with_template(template)
             .expect("valid template")
             .progress_chars("=> "),
     );
-    bar
+    let report = |done, total, what: &str| {
+        if done == 0 {
+            // A new count (the next pass of a render): its own elapsed time and estimate.
+            bar.reset();
+        }
+        bar.set_length(total);
+        bar.set_position(done);
+        bar.set_message(what.to_owned());
+    };
+    let notice = |line: &str| bar.suspend(|| eprintln!("{line}"));
+    let out = work(&Progress {
+        report: &report,
+        notice: &notice,
+    });
+    bar.finish_and_clear();
+    out
 }
 
 /// Writes `text` to standard output and flushes it. A closed pipe (`raywave ... | head`) or a

@@ -12,6 +12,7 @@
 
 use crate::render::film::Film;
 use crate::render::per_kind::RayCounts;
+use crate::render::progress::Progress;
 use crate::render::reference::Reference;
 use crate::render::scene::Scene;
 use crate::render::settings::RenderSettings;
@@ -69,15 +70,15 @@ impl Engine {
         }
     }
 
-    /// Renders one image on the current rayon pool; `progress` is called after each unit of
-    /// work (see [`Prepared::work_units`]). The reference has no stages: its `stage_time` is
+    /// Renders one image on the current rayon pool, reporting each unit of work (a wavefront
+    /// tile, a reference row) to `progress`. The reference has no stages: its `stage_time` is
     /// zero.
     pub fn render(
         self,
         scene: &Scene,
         settings: &RenderSettings,
         batch_size: usize,
-        progress: &(dyn Fn() + Sync),
+        progress: &Progress,
     ) -> (Film, RenderStats) {
         self.prepare(scene, settings, batch_size).render(progress)
     }
@@ -90,30 +91,10 @@ impl Engine {
             scene,
             settings,
             crate::render::wavefront::DEFAULT_BATCH_SIZE,
-            &|| {},
+            &Progress::SILENT,
         );
         (film, stats.counts)
     }
-}
-
-/// How a long job reports while it runs. The library never prints: the command line turns
-/// `progress` into a progress bar and `notice` into lines on stderr, and tests, benches and the
-/// viewer pass [`Hooks::SILENT`].
-#[derive(Clone, Copy)]
-pub struct Hooks<'a> {
-    /// Steps done, steps in all, and what is being done now.
-    pub progress: &'a (dyn Fn(u64, u64, &str) + Sync),
-    /// One line for the user, whole: `warning: ...`, `note: ...`, or a scene's
-    /// `file:line: warning: ...`.
-    pub notice: &'a (dyn Fn(&str) + Sync),
-}
-
-impl Hooks<'static> {
-    /// Hooks that show nothing.
-    pub const SILENT: Hooks<'static> = Hooks {
-        progress: &|_, _, _| {},
-        notice: &|_| {},
-    };
 }
 
 /// An engine set up for one scene and one set of settings.
@@ -142,15 +123,6 @@ impl Prepared<'_> {
         }
     }
 
-    /// How many times `render` calls `progress`, and what one call stands for ("tiles" or
-    /// "rows").
-    pub fn work_units(&self, settings: &RenderSettings) -> (u64, &'static str) {
-        match self {
-            Prepared::Wavefront(w) => (w.tile_count() as u64, "tiles"),
-            Prepared::Reference(_) => (settings.height as u64, "rows"),
-        }
-    }
-
     /// Seconds spent building the wavefront engine's mesh BVH: `None` for the reference, and
     /// `Some(None)` when the scene needs no BVH.
     pub fn bvh_build_seconds(&self) -> Option<Option<f64>> {
@@ -165,13 +137,13 @@ impl Prepared<'_> {
         }
     }
 
-    /// Renders the image on the current rayon pool, calling `progress` after each work unit.
+    /// Renders the image on the current rayon pool, reporting each work unit to `progress`.
     ///
     /// Every pixel comes out finite: a scene's numbers are bounded by the parser, but a mirror
     /// that reflects more than it receives, over many bounces, or a bright light next to a
     /// surface can still overflow f32; such pixels are clamped (see [`clamp_to_finite`]) and
     /// counted in `clamped_pixels`, for the caller to warn with [`clamped_warning`].
-    pub fn render(&self, progress: &(dyn Fn() + Sync)) -> (Film, RenderStats) {
+    pub fn render(&self, progress: &Progress) -> (Film, RenderStats) {
         self.render_until(progress, &AtomicBool::new(false))
             .expect("a render whose cancel flag is never set renders every unit")
     }
@@ -182,7 +154,7 @@ impl Prepared<'_> {
     /// was skipped; otherwise the image and statistics are `render`'s, bit for bit.
     pub fn render_until(
         &self,
-        progress: &(dyn Fn() + Sync),
+        progress: &Progress,
         cancel: &AtomicBool,
     ) -> Option<(Film, RenderStats)> {
         let (mut film, mut stats) = match self {
@@ -255,17 +227,20 @@ mod tests {
             shadow_samples: 2,
             ..RenderSettings::default()
         };
-        let calls = std::sync::atomic::AtomicU64::new(0);
-        let count = || {
-            calls.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        };
         for engine in [Engine::Wavefront, Engine::Reference] {
-            calls.store(0, std::sync::atomic::Ordering::Relaxed);
+            let last = std::sync::Mutex::new(Vec::new());
+            let report = |done, total, what: &str| last.lock().unwrap().push((done, total, what.to_owned()));
+            let progress = Progress { report: &report, ..Progress::SILENT };
             let prepared = engine.prepare(&scene, &settings, 16);
             assert_eq!(prepared.engine(), engine);
-            let (units, _) = prepared.work_units(&settings);
-            let (film, stats) = prepared.render(&count);
-            assert_eq!(calls.load(std::sync::atomic::Ordering::Relaxed), units);
+            let units = match &prepared {
+                Prepared::Wavefront(w) => w.tile_count() as u64,
+                Prepared::Reference(_) => 8,
+            };
+            let (film, stats) = prepared.render(&progress);
+            let reports = last.into_inner().unwrap();
+            assert_eq!(reports.len() as u64, units + 1, "{engine:?} reports none done, then each unit");
+            assert_eq!(reports.last().map(|r| (r.0, r.1)), Some((units, units)));
             assert_eq!((film.width, film.height), (12, 8));
             assert_eq!(stats.counts.camera, 96);
             assert_eq!(engine.image(&scene, &settings).1, stats.counts);
@@ -278,7 +253,7 @@ mod tests {
         );
         assert_eq!(
             Engine::Reference
-                .render(&scene, &settings, 16, &|| {})
+                .render(&scene, &settings, 16, &Progress::SILENT)
                 .1
                 .stage_time,
             RenderStats::default().stage_time

@@ -22,6 +22,7 @@ pub mod wavefront;
 pub mod engine;
 pub mod film;
 pub mod per_kind;
+pub mod progress;
 
 #[cfg(feature = "textures")]
 pub mod digest;

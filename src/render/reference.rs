@@ -16,6 +16,7 @@ use crate::render::camera::CameraRays;
 use crate::render::film::Film;
 use crate::render::geometry::{Accel, Hit, Ray};
 use crate::render::per_kind::{KindClock, PerKind, RayCounts, RayKind};
+use crate::render::progress::Progress;
 use crate::render::sampling::{PointSet, SampleKey};
 use crate::render::scene::{Material, Scene};
 use crate::render::settings::{RenderSettings, ShadowMode};
@@ -114,9 +115,9 @@ impl<'a> Reference<'a> {
         &self.accel
     }
 
-    /// Renders the image on the current rayon pool; `on_row` is called after each row.
-    pub fn render(&self, on_row: &(dyn Fn() + Sync)) -> (Film, RayCounts) {
-        self.render_until(on_row, &AtomicBool::new(false))
+    /// Renders the image on the current rayon pool, reporting each row to `progress`.
+    pub fn render(&self, progress: &Progress) -> (Film, RayCounts) {
+        self.render_until(progress, &AtomicBool::new(false))
             .expect("a render whose cancel flag is never set renders every row")
     }
 
@@ -126,10 +127,11 @@ impl<'a> Reference<'a> {
     /// got every row is the same, bit for bit, as `render`'s.
     pub fn render_until(
         &self,
-        on_row: &(dyn Fn() + Sync),
+        progress: &Progress,
         cancel: &AtomicBool,
     ) -> Option<(Film, RayCounts)> {
         let (w, h) = (self.settings.width as usize, self.settings.height as usize);
+        let rows = progress.steps(h as u64, "rows");
         let mut film = Film::new(self.settings.width, self.settings.height);
         // Set only on the skip path: a row costs one relaxed load more.
         let skipped = AtomicBool::new(false);
@@ -144,7 +146,7 @@ impl<'a> Reference<'a> {
                     return counts;
                 }
                 self.pixels((row * w) as u32, out, &mut counts);
-                on_row();
+                rows.step();
                 counts
             })
             .reduce(RayCounts::default, |a, b| a + b);
@@ -159,8 +161,9 @@ impl<'a> Reference<'a> {
     /// two or three times per path segment (a reading that ends one interval starts the
     /// next), which costs time: docs/SCHEMA.md gives the measured overhead. Same image, same
     /// counts.
-    pub fn render_timed(&self, on_row: &(dyn Fn() + Sync)) -> (Film, RayCounts, PerKind<Duration>) {
+    pub fn render_timed(&self, progress: &Progress) -> (Film, RayCounts, PerKind<Duration>) {
         let w = self.settings.width as usize;
+        let rows = progress.steps(self.settings.height as u64, "rows");
         let mut film = Film::new(self.settings.width, self.settings.height);
         let (counts, times) = film
             .pixels
@@ -173,7 +176,7 @@ impl<'a> Reference<'a> {
                 for (i, px) in out.iter_mut().enumerate() {
                     *px = self.pixel_clocked(first + i as u32, &mut counts, &mut (), &mut times);
                 }
-                on_row();
+                rows.step();
                 (counts, times)
             })
             .reduce(Default::default, |a, b| (a.0 + b.0, a.1 + b.1));

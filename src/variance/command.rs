@@ -6,7 +6,8 @@ use super::study::job_record::JobRecord;
 use super::study::jobs::{self, CaseFacts, Job, JobResult, Setup};
 use super::study::plan::{Case, Study, case_names, identity};
 use super::{Cache, Region, RenderFn, StudyConfig};
-use crate::render::engine::{Engine, Hooks};
+use crate::render::engine::Engine;
+use crate::render::progress::Progress;
 use crate::render::error::UsageError;
 use crate::render::sampling::LightSampler;
 use crate::render::scene::{ParseOptions, SceneFile, load_scene};
@@ -259,20 +260,6 @@ pub(crate) fn open_cache(options: &VarianceOptions, notice: &dyn Fn(&str)) -> Op
     }
 }
 
-/// A progress counter over estimated rays, for `hooks.progress`.
-struct Progress<'a> {
-    done: std::cell::Cell<f64>,
-    total: f64,
-    hooks: &'a Hooks<'a>,
-}
-
-impl Progress<'_> {
-    fn add(&self, rays: f64, label: &str) {
-        self.done.set(self.done.get() + rays);
-        (self.hooks.progress)(self.done.get() as u64, self.total as u64, label);
-    }
-}
-
 /// Runs the jobs `selected` (numbers in `identity.jobs()`) of `cases`, each case's setup first;
 /// returns per case touched its number, facts and results.
 fn run_selected(
@@ -281,15 +268,12 @@ fn run_selected(
     selected: &[usize],
     cache: Option<&Cache>,
     render: &RenderFn,
-    hooks: &Hooks,
+    progress: &Progress,
 ) -> Result<Vec<(usize, CaseFacts, Vec<JobResult>)>> {
     let all = identity.work.jobs();
     let costs = identity.work.costs();
-    let progress = Progress {
-        done: std::cell::Cell::new(0.0),
-        total: selected.iter().map(|&j| costs[j]).sum(),
-        hooks,
-    };
+    let total: f64 = selected.iter().map(|&j| costs[j]).sum();
+    let rays = progress.steps(total as u64, "rays");
     let host = crate::output::machine::hostname();
     let mut out = Vec::new();
     for (c, case) in cases.iter().enumerate() {
@@ -301,20 +285,16 @@ fn run_selected(
         if jobs.is_empty() {
             continue;
         }
-        (hooks.progress)(
-            progress.done.get() as u64,
-            progress.total as u64,
-            &format!("{}: converged reference and regions", case.name),
-        );
+        rays.advance(0, &format!("{}: converged reference and regions", case.name));
         let setup = Setup::new(
             &case.scene,
             &case.bytes,
             &case.config,
             render,
             cache,
-            hooks.notice,
+            progress.notice,
         )?;
-        let label = |rays: f64, what: &str| progress.add(rays, &format!("{}: {what}", case.name));
+        let label = |done: f64, what: &str| rays.advance(done as u64, &format!("{}: {what}", case.name));
         let results = jobs::run_jobs(
             &case.scene,
             &case.config,
@@ -351,19 +331,19 @@ impl Outcome {
 }
 
 /// Runs the whole study of `cases` in this process, on the current rayon pool, and writes its
-/// report into `options.out`. Reports through `hooks`; prints nothing.
+/// report into `options.out`. Reports through `progress`; prints nothing.
 pub fn study(
     options: &VarianceOptions,
     cases: &[Case],
     render: &RenderFn,
-    hooks: &Hooks,
+    progress: &Progress,
 ) -> Result<Outcome> {
     options.validate()?;
     create_out(&options.out)?;
-    let cache = open_cache(options, hooks.notice);
+    let cache = open_cache(options, progress.notice);
     let identity = identity(cases, options.engine.name());
     let selected: Vec<usize> = (0..identity.work.jobs().len()).collect();
-    let ran = run_selected(cases, &identity, &selected, cache.as_ref(), render, hooks)?;
+    let ran = run_selected(cases, &identity, &selected, cache.as_ref(), render, progress)?;
     let threads = rayon::current_num_threads();
     let results = ran
         .into_iter()
@@ -380,7 +360,7 @@ pub fn study(
         })
         .collect::<Vec<_>>();
     let names: Vec<String> = cases.iter().map(|c| c.name.clone()).collect();
-    write_report(&names, results, &options.out, hooks.notice)
+    write_report(&names, results, &options.out, progress.notice)
 }
 
 /// Makes the output directory, failing now rather than after minutes of rendering.
@@ -441,16 +421,16 @@ pub fn run_shard(
     cases: &[Case],
     shard: Shard,
     render: &RenderFn,
-    hooks: &Hooks,
+    progress: &Progress,
 ) -> Result<(PathBuf, usize)> {
     options.validate()?;
     create_out(&options.out)?;
-    let cache = open_cache(options, hooks.notice);
+    let cache = open_cache(options, progress.notice);
     let identity = identity(cases, options.engine.name());
     let assignment = identity.work.assignment(shard.count);
     let selected = &assignment[shard.index];
     let host = Host::start(rayon::current_num_threads());
-    let ran = run_selected(cases, &identity, selected, cache.as_ref(), render, hooks)?;
+    let ran = run_selected(cases, &identity, selected, cache.as_ref(), render, progress)?;
     let mut part = Part {
         identity,
         shard,
@@ -475,7 +455,7 @@ pub fn prepare(
     options: &VarianceOptions,
     cases: &[Case],
     render: &RenderFn,
-    hooks: &Hooks,
+    progress: &Progress,
 ) -> Result<Vec<(String, bool)>> {
     options.validate()?;
     if options.no_cache {
@@ -484,7 +464,7 @@ pub fn prepare(
         )
         .into());
     }
-    let Some(cache) = open_cache(options, hooks.notice) else {
+    let Some(cache) = open_cache(options, progress.notice) else {
         bail!(
             "cannot use the cache directory {}: nothing prepared",
             options.cache.display()
@@ -492,14 +472,14 @@ pub fn prepare(
     };
     let mut out = Vec::new();
     for (i, case) in cases.iter().enumerate() {
-        (hooks.progress)(i as u64, cases.len() as u64, &case.name);
+        (progress.report)(i as u64, cases.len() as u64, &case.name);
         let reference = super::converged_reference(
             &case.scene,
             &case.bytes,
             &case.config,
             render,
             Some(&cache),
-            hooks.notice,
+            progress.notice,
         )?;
         out.push((case.name.clone(), reference.cached));
     }

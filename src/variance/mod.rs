@@ -24,7 +24,7 @@ pub mod merge;
 pub mod report;
 pub mod study;
 
-use crate::render::engine::Hooks;
+use crate::render::progress::Progress;
 use crate::render::film::Film;
 use crate::render::per_kind::RayCounts;
 use crate::render::sampling::LightSampler;
@@ -320,7 +320,7 @@ pub struct StudyResult {
 }
 
 /// Runs the study of one scene in this process: the reference and masks, every job, then the
-/// figures across them. `hooks.progress` counts estimated rays.
+/// figures across them. `progress` counts estimated rays.
 pub fn run_study(
     scene: &Scene,
     scene_id: &[u8],
@@ -328,18 +328,14 @@ pub fn run_study(
     engine: &str,
     render: &RenderFn,
     cache: Option<&Cache>,
-    hooks: &Hooks,
+    progress: &Progress,
 ) -> Result<StudyResult> {
     let all = jobs::case_jobs(0, config);
     let lights = scene.lights.len();
     let total: f64 = all.iter().map(|j| jobs::cost(config, lights, j)).sum();
-    let done = std::cell::Cell::new(0.0f64);
-    (hooks.progress)(0, total as u64, "converged reference and regions");
-    let setup = jobs::Setup::new(scene, scene_id, config, render, cache, hooks.notice)?;
-    let progress = |rays: f64, label: &str| {
-        done.set(done.get() + rays);
-        (hooks.progress)(done.get() as u64, total as u64, label);
-    };
+    let rays = progress.steps(total as u64, "converged reference and regions");
+    let setup = jobs::Setup::new(scene, scene_id, config, render, cache, progress.notice)?;
+    let progress = |done: f64, label: &str| rays.advance(done as u64, label);
     let host = crate::output::machine::hostname();
     let results = jobs::run_jobs(scene, config, &setup, &all, render, &host, &progress);
     Ok(jobs::assemble(

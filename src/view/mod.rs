@@ -66,7 +66,7 @@ pub struct ViewOptions {
 /// (`Wavefront::render_counted_until(progress, true, cancel)`); `None` when stopped.
 pub type CountedRender = fn(
     &crate::render::wavefront::Wavefront,
-    &(dyn Fn() + Sync),
+    &crate::render::progress::Progress,
     &std::sync::atomic::AtomicBool,
 ) -> Option<(
     crate::render::film::Film,

@@ -22,6 +22,7 @@ use crate::render::engine::{Engine, Prepared, clamp_to_finite};
 use crate::render::film::ToneMap;
 use crate::render::per_kind::RayCounts;
 use crate::render::scene::Scene;
+use crate::render::progress::Progress;
 use crate::view::CountedRender;
 use crate::view::request::{CostMeasureView, CostOverlay, Resolved, ViewSettings};
 use serde::Serialize;
@@ -465,11 +466,17 @@ fn render_levels(
         };
         let start = Instant::now();
         let prepared = job.resolved.engine.prepare(&scene, &settings, batch_size);
-        let (units, _) = prepared.work_units(&settings);
-        job.done_units.store(0, Ordering::Relaxed);
-        job.total_units.store(units, Ordering::Relaxed);
-        let progress = || {
-            job.done_units.fetch_add(1, Ordering::Relaxed);
+        // Steps come from every worker: the count only grows within a level.
+        let report = |done, total, _: &str| {
+            job.total_units.store(total, Ordering::Relaxed);
+            match done {
+                0 => job.done_units.store(0, Ordering::Relaxed),
+                _ => _ = job.done_units.fetch_max(done, Ordering::Relaxed),
+            }
+        };
+        let progress = Progress {
+            report: &report,
+            ..Progress::SILENT
         };
         let rendered = match (&prepared, job.resolved.cost_map.kind()) {
             (Prepared::Wavefront(w), Some(kind)) => pool

@@ -9,6 +9,7 @@ use crate::trace_demo;
 
 use common::bin::{dir_with, files_in, raywave, stderr, stdout};
 use glam::{DVec3, Vec3};
+use raywave::render::progress::Progress;
 use raywave::render::engine::Engine;
 use raywave::render::scene::Scene;
 use raywave::render::settings::{RenderSettings, ShadowMode};
@@ -151,7 +152,7 @@ fn blocked_flags_match_the_scene_geometry() {
 /// The pixel as each engine's whole-image render gives it.
 fn rendered(scene: &Scene, settings: &RenderSettings, x: u32, y: u32) -> [Vec3; 2] {
     [Engine::Reference, Engine::Wavefront].map(|engine| {
-        let (film, _) = engine.render(scene, settings, 256, &|| {});
+        let (film, _) = engine.render(scene, settings, 256, &Progress::SILENT);
         film.pixels[(y * settings.width + x) as usize]
     })
 }

@@ -3,6 +3,7 @@
 //! same bytes, in the library and through the binary (both engines).
 
 use crate::common;
+use raywave::render::progress::Progress;
 use raywave::render::reference::Reference;
 use raywave::render::sampling::LightSampler;
 use raywave::render::scene::Scene;
@@ -36,7 +37,7 @@ fn render_on(threads: usize, scene: &Scene, settings: &RenderSettings) -> Vec<[u
         .num_threads(threads)
         .build()
         .unwrap();
-    let (film, _) = pool.install(|| Reference::new(scene, settings).render(&|| {}));
+    let (film, _) = pool.install(|| Reference::new(scene, settings).render(&Progress::SILENT));
     // Compare bit patterns: -0.0 vs 0.0 or NaN payloads would count as differences.
     film.pixels
         .iter()
@@ -120,7 +121,7 @@ fn textured_scenes_do_not_depend_on_the_thread_count() {
                     .num_threads(threads)
                     .build()
                     .unwrap();
-                let (film, _) = pool.install(|| engine.render(&scene, settings, 64, &|| {}));
+                let (film, _) = pool.install(|| engine.render(&scene, settings, 64, &Progress::SILENT));
                 film.pixels
                     .iter()
                     .map(|c| [c.x.to_bits(), c.y.to_bits(), c.z.to_bits()])
@@ -136,8 +137,8 @@ fn textured_scenes_do_not_depend_on_the_thread_count() {
             ..soft_settings(5)
         };
         assert_eq!(
-            Engine::Wavefront.render(&scene, &flat, 64, &|| {}).0,
-            Engine::Reference.render(&scene, &flat, 64, &|| {}).0,
+            Engine::Wavefront.render(&scene, &flat, 64, &Progress::SILENT).0,
+            Engine::Reference.render(&scene, &flat, 64, &Progress::SILENT).0,
             "{name}: the engines differ without mirrors"
         );
     }
@@ -191,8 +192,8 @@ fn a_textured_mesh_renders_alike_through_both_engines_bvhs() {
         bounces: 0,
         ..soft_settings(3)
     };
-    let (wavefront, _) = Engine::Wavefront.render(&scene, &settings, 64, &|| {});
-    let (reference, _) = Engine::Reference.render(&scene, &settings, 64, &|| {});
+    let (wavefront, _) = Engine::Wavefront.render(&scene, &settings, 64, &Progress::SILENT);
+    let (reference, _) = Engine::Reference.render(&scene, &settings, 64, &Progress::SILENT);
     assert_eq!(wavefront, reference);
     // The texture shows: the floor is not one colour.
     let lit: Vec<_> = wavefront

@@ -20,6 +20,7 @@ use common::bundled_scenes;
 
 use glam::{DVec3, Vec3};
 use oracle::{ILL_CONDITIONED, Oracle, OracleImage, TOLERANCE, scaled, scaled_under};
+use raywave::render::progress::Progress;
 use raywave::render::film::Film;
 use raywave::render::per_kind::RayCounts;
 use raywave::render::reference::Reference;
@@ -72,14 +73,14 @@ pub(crate) fn modes() -> Vec<(&'static str, RenderSettings)> {
 
 /// The reference renderer's linear image.
 pub(crate) fn reference(scene: &Scene, s: &RenderSettings) -> Film {
-    let (film, _): (Film, RayCounts) = Reference::new(scene, s).render(&|| {});
+    let (film, _): (Film, RayCounts) = Reference::new(scene, s).render(&Progress::SILENT);
     film
 }
 
 /// The wavefront engine's linear image.
 pub(crate) fn wavefront(scene: &Scene, s: &RenderSettings) -> Film {
     Wavefront::new(scene, s, DEFAULT_BATCH_SIZE)
-        .render(&|| {})
+        .render(&Progress::SILENT)
         .0
 }
 

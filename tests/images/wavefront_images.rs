@@ -9,6 +9,7 @@ use crate::common;
 
 use common::bundled_scenes;
 use glam::Vec3;
+use raywave::render::progress::Progress;
 use raywave::render::film::Film;
 use raywave::render::per_kind::RayCounts;
 use raywave::render::reference::Reference;
@@ -73,11 +74,11 @@ fn modes() -> Vec<RenderSettings> {
 }
 
 fn reference(scene: &Scene, s: &RenderSettings) -> (Film, RayCounts) {
-    Reference::new(scene, s).render(&|| {})
+    Reference::new(scene, s).render(&Progress::SILENT)
 }
 
 fn wavefront(scene: &Scene, s: &RenderSettings, batch: usize) -> (Film, RayCounts) {
-    let (film, stats) = Wavefront::new(scene, s, batch).render(&|| {});
+    let (film, stats) = Wavefront::new(scene, s, batch).render(&Progress::SILENT);
     (film, stats.counts)
 }
 
@@ -216,7 +217,7 @@ fn sixteen_and_eight_lanes_give_the_same_bytes_on_every_scene() {
                 let render = |width| {
                     let w = Wavefront::new(&scene, s, batch).with_lane_width(width);
                     assert_eq!(w.lane_width(), width);
-                    let (film, stats) = w.render(&|| {});
+                    let (film, stats) = w.render(&Progress::SILENT);
                     (film_bits(&film), stats.counts)
                 };
                 let (eight, c8) = render(LaneWidth::Eight);
@@ -287,7 +288,7 @@ fn every_shadow_path_gives_the_per_hit_path_s_bytes() {
                 for width in [LaneWidth::Eight, LaneWidth::Sixteen] {
                     let engine = || Wavefront::new(&scene, s, batch).with_lane_width(width);
                     let render = |path| {
-                        let (film, stats) = engine().with_shadow_path(path).render(&|| {});
+                        let (film, stats) = engine().with_shadow_path(path).render(&Progress::SILENT);
                         (film_bits(&film), stats.counts)
                     };
                     let (per_hit, cp) = render(ShadowPath::QueuedPerHit);

@@ -7,6 +7,7 @@
 //! the peers. With an Embree feature, the hit records of `peer::embree_shared` are checked
 //! against what each library writes.
 
+use raywave::render::progress::Progress;
 #[cfg(any(feature = "embree", feature = "embree4"))]
 use raywave::peer::embree_shared::{BuildQuality, EmbreeCalls};
 use raywave::peer::stage::ShadowStage;
@@ -726,7 +727,7 @@ fn shadow_stage_casts_what_a_frame_casts() {
             let s = ShadowStage::settings(&base, set.kind).expect("a shadow set has a stage");
             let mut stage = ShadowStage::new(&scene, &s, &sets.primary);
             let cast = stage.run(&sets.primary);
-            let (_, stats) = Wavefront::new(&scene, &s, 4096).render(&|| {});
+            let (_, stats) = Wavefront::new(&scene, &s, 4096).render(&Progress::SILENT);
             assert_eq!(stats.counts.camera, sets.primary.len() as u64, "{name}");
             assert!(cast > 0, "{name}, {}: no shadow ray", set.kind.title());
             assert_eq!(

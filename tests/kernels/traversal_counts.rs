@@ -7,6 +7,7 @@ use crate::common;
 
 use common::{scene_of, triangle};
 use glam::Vec3;
+use raywave::render::progress::Progress;
 use raywave::render::scene::{NO_HIT, Scene, Sphere, Triangle, parse_scene_str};
 use raywave::render::settings::{RenderSettings, ShadowMode};
 use raywave::render::wavefront::Wavefront;
@@ -294,8 +295,8 @@ fn a_counted_render_is_the_render_with_every_kind_counted() {
             ..RenderSettings::default()
         };
         let engine = Wavefront::new(&scene, &settings, 64);
-        let (film, stats) = engine.render(&|| {});
-        let (counted, counted_stats, report) = engine.render_counted(&|| {}, true);
+        let (film, stats) = engine.render(&Progress::SILENT);
+        let (counted, counted_stats, report) = engine.render_counted(&Progress::SILENT, true);
         assert_eq!(film.pixels, counted.pixels, "{shadows:?}: the same image");
         assert_eq!(stats.counts, counted_stats.counts);
         let pixels = report.pixels.expect("per-pixel counts were asked for");
@@ -308,7 +309,7 @@ fn a_counted_render_is_the_render_with_every_kind_counted() {
             // Every ray of a mesh scene visits the root at least.
             assert!(total.nodes >= stats.counts[kind], "{kind:?}: {total:?}");
         }
-        let (_, _, again) = engine.render_counted(&|| {}, false);
+        let (_, _, again) = engine.render_counted(&Progress::SILENT, false);
         assert_eq!(again.totals, report.totals);
         assert!(again.pixels.is_none());
     }
@@ -325,7 +326,7 @@ fn small_scenes_charge_every_camera_ray_every_primitive() {
         ..RenderSettings::default()
     };
     let engine = Wavefront::new(&scene, &settings, 16);
-    let (_, stats, report) = engine.render_counted(&|| {}, false);
+    let (_, stats, report) = engine.render_counted(&Progress::SILENT, false);
     let every = (scene.triangles.len() + scene.spheres.len()) as u64;
     assert_eq!(report.totals.camera.tests, stats.counts.camera * every);
     assert_eq!(report.totals.camera.nodes, 0);

@@ -11,6 +11,7 @@ use common::analytic::{self, SIZE, floor_point, settings};
 
 use glam::{DVec3, Vec3};
 use oracle::Oracle;
+use raywave::render::progress::Progress;
 use raywave::render::per_kind::RayCounts;
 use raywave::render::reference::Reference;
 use raywave::render::sampling::{LightSampler, PointSet, SampleKey, strata_grid};
@@ -300,7 +301,7 @@ fn the_study_meets_its_floor_and_writes_its_outputs() {
         "wavefront",
         &render,
         None,
-        &raywave::render::engine::Hooks::SILENT,
+        &Progress::SILENT,
     )
     .unwrap();
     let slope = |sampler: &str| {

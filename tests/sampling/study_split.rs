@@ -19,6 +19,7 @@
 //! the cost blind to N, 16 of the 28 splits are 1.106× to 1.787× over the bound, and from N = 16
 //! up a job is estimated at 0.18× its traced rays or less.
 
+use raywave::render::progress::Progress;
 use raywave::render::film::Film;
 use raywave::render::per_kind::RayCounts;
 use raywave::render::sampling::LightSampler;
@@ -58,7 +59,7 @@ fn config(samplers: &[LightSampler]) -> StudyConfig {
 }
 
 fn render(scene: &Scene, s: &RenderSettings) -> (Film, RayCounts) {
-    let (film, stats) = Wavefront::new(scene, s, DEFAULT_BATCH_SIZE).render(&|| {});
+    let (film, stats) = Wavefront::new(scene, s, DEFAULT_BATCH_SIZE).render(&Progress::SILENT);
     (film, stats.counts)
 }
 

@@ -14,6 +14,7 @@ use crate::common;
 
 use common::{Draw, seeded};
 use glam::Vec3;
+use raywave::render::progress::Progress;
 use raywave::render::film::Film;
 use raywave::render::per_kind::RayCounts;
 use raywave::render::sampling::LightSampler;
@@ -183,7 +184,7 @@ fn a_small_known_bias_is_flagged_and_measured() {
 /// channel: an unbiased sampler made biased by a known amount.
 fn render_with_bias(delta: f32) -> impl Fn(&Scene, &RenderSettings) -> (Film, RayCounts) + Sync {
     move |scene: &Scene, s: &RenderSettings| {
-        let (mut film, stats) = Wavefront::new(scene, s, DEFAULT_BATCH_SIZE).render(&|| {});
+        let (mut film, stats) = Wavefront::new(scene, s, DEFAULT_BATCH_SIZE).render(&Progress::SILENT);
         if s.sampler == LightSampler::Random {
             for px in &mut film.pixels {
                 *px += Vec3::splat(delta);
@@ -229,7 +230,7 @@ fn the_study_flags_biased_samplers_and_only_them() {
         "wavefront",
         &render,
         None,
-        &raywave::render::engine::Hooks::SILENT,
+        &Progress::SILENT,
     )
     .unwrap();
     assert!(result.region_pixels[1] > 200, "{:?}", result.region_pixels);

@@ -17,13 +17,14 @@ use crate::render::scene::Scene;
 use crate::render::settings::RenderSettings;
 use crate::render::wavefront::DEFAULT_BATCH_SIZE;
 use crate::render::wavefront::lanes::LaneWidth;
+use crate::render::progress::{Progress, Steps};
 use std::time::Instant;
 
-/// Warm-up and timed runs of `engines` on `pool`, the wavefront engine `lanes` wide; `tick` is
-/// called after each run (warm-up included), `notice` for a run that clamped pixels. Records
+/// Warm-up and timed runs of `engines` on `pool`, the wavefront engine `lanes` wide; `runs_done`
+/// steps after each run (warm-up included), `notice` for a run that clamped pixels. Records
 /// come back in `engines`' order.
 // More than clippy's 7: the point's settings are the arguments' natural split (a struct for
-// them would only be unpacked again below), and the two hooks are the caller's.
+// them would only be unpacked again below), and the two reports are the caller's.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn measure(
     pool: &rayon::ThreadPool,
@@ -33,10 +34,10 @@ pub(crate) fn measure(
     lanes: LaneWidth,
     warmup: u32,
     runs: u32,
-    tick: &(dyn Fn() + Sync),
+    runs_done: &Steps,
     notice: &(dyn Fn(&str) + Sync),
 ) -> Vec<EngineRecord> {
-    pool.install(|| timed(scene, settings, engines, lanes, warmup, runs, tick, notice))
+    pool.install(|| timed(scene, settings, engines, lanes, warmup, runs, runs_done, notice))
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -47,7 +48,7 @@ fn timed(
     lanes: LaneWidth,
     warmup: u32,
     runs: u32,
-    tick: &(dyn Fn() + Sync),
+    runs_done: &Steps,
     notice: &(dyn Fn(&str) + Sync),
 ) -> Vec<EngineRecord> {
     let prepared: Vec<Prepared> = engines
@@ -56,7 +57,7 @@ fn timed(
         .collect();
     let time = |engine: &Prepared| {
         let start = Instant::now();
-        let (film, stats) = engine.render(&|| {});
+        let (film, stats) = engine.render(&Progress::SILENT);
         let seconds = start.elapsed().as_secs_f64();
         drop::<Film>(film);
         if let Some(w) = clamped_warning(&stats) {
@@ -76,14 +77,14 @@ fn timed(
     for _ in 0..warmup {
         for engine in &prepared {
             time(engine);
-            tick();
+            runs_done.step();
         }
     }
     let mut measured: Vec<Vec<Measurement>> = vec![Vec::new(); prepared.len()];
     for round in 0..runs as usize {
         for i in round_order(prepared.len(), round) {
             measured[i].push(time(&prepared[i]));
-            tick();
+            runs_done.step();
         }
     }
     prepared

@@ -41,6 +41,7 @@ pub mod texels;
 
 use crate::render::film::Film;
 use crate::render::per_kind::RayKind;
+use crate::render::progress::Progress;
 use crate::render::scene::Scene;
 use crate::render::settings::RenderSettings;
 use batch::{HitBatch, Radiance, RayBatch, ShadowQueue};
@@ -148,9 +149,9 @@ impl<'a> Wavefront<'a> {
         self.ctx.settings.width as usize * self.ctx.settings.height as usize
     }
 
-    /// Renders on the current rayon pool; `on_tile` is called after each tile.
-    pub fn render(&self, on_tile: &(dyn Fn() + Sync)) -> (Film, RenderStats) {
-        self.render_until(on_tile, &AtomicBool::new(false))
+    /// Renders on the current rayon pool, reporting each tile to `progress`.
+    pub fn render(&self, progress: &Progress) -> (Film, RenderStats) {
+        self.render_until(progress, &AtomicBool::new(false))
             .expect("a render whose cancel flag is never set renders every tile")
     }
 
@@ -160,10 +161,11 @@ impl<'a> Wavefront<'a> {
     /// that got every tile is the same, bit for bit, as `render`'s, whatever the flag did.
     pub fn render_until(
         &self,
-        on_tile: &(dyn Fn() + Sync),
+        progress: &Progress,
         cancel: &AtomicBool,
     ) -> Option<(Film, RenderStats)> {
         let s = self.ctx.settings;
+        let tiles = progress.steps(self.tile_count() as u64, "tiles");
         let mut film = Film::new(s.width, s.height);
         // Set only on the skip path: the loop itself adds one relaxed load per tile.
         let skipped = AtomicBool::new(false);
@@ -185,7 +187,7 @@ impl<'a> Wavefront<'a> {
                         &mut pooled.ws,
                         &mut stats,
                     );
-                    on_tile();
+                    tiles.step();
                     stats
                 },
             )
@@ -221,10 +223,10 @@ impl<'a> Wavefront<'a> {
     #[inline]
     pub fn render_counted(
         &self,
-        on_tile: &(dyn Fn() + Sync),
+        progress: &Progress,
         per_pixel: bool,
     ) -> (Film, RenderStats, CostReport) {
-        self.render_counted_until(on_tile, per_pixel, &AtomicBool::new(false))
+        self.render_counted_until(progress, per_pixel, &AtomicBool::new(false))
             .expect("a render whose cancel flag is never set renders every tile")
     }
 
@@ -233,11 +235,12 @@ impl<'a> Wavefront<'a> {
     #[inline]
     pub fn render_counted_until(
         &self,
-        on_tile: &(dyn Fn() + Sync),
+        progress: &Progress,
         per_pixel: bool,
         cancel: &AtomicBool,
     ) -> Option<(Film, RenderStats, CostReport)> {
         let s = self.ctx.settings;
+        let steps = progress.steps(self.tile_count() as u64, "tiles");
         let mut film = Film::new(s.width, s.height);
         let tiles: Vec<_> = film
             .pixels
@@ -253,7 +256,7 @@ impl<'a> Wavefront<'a> {
                     let mut stats = RenderStats::default();
                     let mut costs = TileCosts::new(first, out.len());
                     self.render_tile_with(first, out, &mut pooled.ws, &mut stats, &mut costs);
-                    on_tile();
+                    steps.step();
                     let totals = costs.totals();
                     Some((stats, totals, per_pixel.then_some(costs.pixels)))
                 },

@@ -1,20 +1,25 @@
-//! What `raywave render` prints and records once the frame is rendered: the summary, the
+//! What a render prints and records once the frame is rendered: the summary, the
 //! `--stats` tables and the `--stats-json` record, from what the render measured.
 
-use raywave::output::machine::Machine;
-use raywave::output::render_record::{
+use crate::output::machine::Machine;
+use crate::output::render_record::{
     DefaultsUsed, KindFigures, KindTiming, RenderRecord, SceneFigures, TraversalFigures,
 };
-use raywave::render::engine::Engine;
-use raywave::render::quote::escape;
-use raywave::render::scene::Scene;
-use raywave::render::settings::options::{BackgroundSource, Effective};
-use raywave::render::settings::{LightModel, ShadowMode};
-use raywave::render::wavefront::stats::RenderStats;
+use crate::render::engine::Engine;
+use crate::render::quote::escape;
+use crate::render::scene::Scene;
+use crate::render::settings::options::{BackgroundSource, Effective};
+use crate::render::settings::{LightModel, ShadowMode};
+use crate::render::wavefront::stats::RenderStats;
+use crate::diff::{self, Encoding, FileInfo, Image, Region};
+use crate::render::film::{Film, ToneMap};
+use anyhow::Result;
+use image::RgbImage;
 use std::fmt::Write as _;
+use std::path::Path;
 
 /// The summary printed after a render: engine, scene, settings, rays and time.
-pub(super) fn summary(
+pub fn summary(
     scene: &Scene,
     effective: &Effective,
     run: &RunInfo,
@@ -131,33 +136,37 @@ pub(super) fn summary(
 }
 
 /// How the render ran, for the summary and the JSON.
-pub(super) struct RunInfo {
-    pub(super) engine: Engine,
+pub struct RunInfo {
+    /// The engine that rendered.
+    pub engine: Engine,
     /// The SIMD path the engine ran on (`Prepared::simd_path`).
-    pub(super) simd: &'static str,
-    pub(super) threads: usize,
-    pub(super) batch_size: u32,
+    pub simd: &'static str,
+    /// Worker threads.
+    pub threads: usize,
+    /// Camera samples per wavefront tile.
+    pub batch_size: u32,
 }
 
 /// What a render measured.
-pub(super) struct Report {
+pub struct Report {
     /// Ray counts, and each kind's thread-time when measured.
-    pub(super) stats: RenderStats,
-    pub(super) seconds: f64,
+    pub stats: RenderStats,
+    /// Wall-clock seconds of the render (for the reference, its set-up included).
+    pub seconds: f64,
     /// Wavefront only: per-stage figures, and the BVH build time if a BVH was used.
-    pub(super) stages: Option<(RenderStats, Option<f64>)>,
+    pub stages: Option<(RenderStats, Option<f64>)>,
     /// Reference only, with --stats or --stats-json: the wall-clock seconds of the second,
     /// instrumented pass that timed the kinds.
-    pub(super) instrumented_seconds: Option<f64>,
+    pub instrumented_seconds: Option<f64>,
     /// Wavefront only, with --stats, --stats-json or --cost-map: the traversal counters of a
     /// second, counted pass.
-    pub(super) traversal: Option<TraversalFigures>,
+    pub traversal: Option<TraversalFigures>,
 }
 
 impl Report {
     /// Rays by kind, each kind per thread-second of its work, the total per wall-clock second,
     /// as the JSON gives them.
-    pub(super) fn kinds(&self) -> KindFigures {
+    pub fn kinds(&self) -> KindFigures {
         KindFigures::new(&self.stats, self.seconds)
     }
 
@@ -172,7 +181,7 @@ impl Report {
 
 /// The `--stats` tables: rays by kind (each kind over the thread-time of its own work, the
 /// total over the wall clock), then (wavefront) the BVH build and each stage.
-pub(super) fn stats_table(report: &Report) -> String {
+pub fn stats_table(report: &Report) -> String {
     let mut out = String::new();
     let kinds = report.kinds();
     let _ = writeln!(
@@ -273,7 +282,7 @@ pub(super) fn stats_table(report: &Report) -> String {
 }
 
 /// The `--stats-json` record of a render.
-pub(super) fn record(
+pub fn record(
     scene: &Scene,
     effective: &Effective,
     run: &RunInfo,
@@ -284,7 +293,7 @@ pub(super) fn record(
         None => (None, None),
     };
     RenderRecord {
-        format: raywave::output::bench_record::FORMAT,
+        format: crate::output::bench_record::FORMAT,
         raywave: env!("CARGO_PKG_VERSION"),
         // The record has never named the host.
         machine: Machine {
@@ -315,4 +324,37 @@ pub(super) fn record(
         stages,
         traversal: report.traversal,
     }
+}
+
+/// The render's error against `--mse-reference`, as text and as JSON: the linear image against
+/// a float reference, the 8-bit image written (`rgb8`, else the film tone mapped) against an
+/// 8- or 16-bit one, so that `raywave diff` on the files gives the same figures.
+pub(super) fn reference_error(
+    path: &Path,
+    reference: &Image,
+    film: &Film,
+    rgb8: Option<&RgbImage>,
+    tone: ToneMap,
+) -> Result<(String, serde_json::Value)> {
+    let (render, compared_as) = if reference.encoding == Encoding::Float {
+        (Image::from_film(film.clone(), "render"), "linear floats")
+    } else {
+        let image = match rgb8 {
+            Some(img) => Image::from_rgb8(img, "render"),
+            None => Image::from_rgb8(&film.to_rgb8(tone), "render"),
+        };
+        (image, "the 8-bit image")
+    };
+    let region = Region::whole(render.film.width, render.film.height);
+    let comparison = diff::compare(&render, reference, &region)?;
+    let info = FileInfo::of(path, reference);
+    let text = format!(
+        "error of the render ({compared_as}) against --mse-reference {}\n{}",
+        info.describe(),
+        diff::text::table(&comparison)
+    );
+    let mut json = serde_json::to_value(&comparison)?;
+    json["reference"] = serde_json::to_value(&info)?;
+    json["compared_as"] = compared_as.into();
+    Ok((text, json))
 }
