@@ -81,7 +81,7 @@ impl<W: Work> Identity<W> {
 
     /// How the build of `other` differs from this one's, one line per field (`commit: X in A,
     /// Y in B`); the SIMD path is among them.
-    pub fn build_differences(&self, other: &Identity<W>, a: &str, b: &str) -> Vec<String> {
+    fn build_differences(&self, other: &Identity<W>, a: &str, b: &str) -> Vec<String> {
         let describe = |s: &Identity<W>| {
             [
                 ("raywave", s.raywave.clone()),

@@ -72,11 +72,6 @@ impl Host {
     pub fn seconds(&self) -> f64 {
         (self.finished - self.started).max(0.0)
     }
-
-    /// Whether `other` is the same machine: the same host name and CPU.
-    pub fn same_machine(&self, other: &Host) -> bool {
-        (&self.hostname, &self.cpu) == (&other.hostname, &other.cpu)
-    }
 }
 
 /// Seconds since the Unix epoch.
