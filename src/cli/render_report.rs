@@ -1,9 +1,10 @@
 //! What `raywave render` prints and records once the frame is rendered: the summary, the
 //! `--stats` tables and the `--stats-json` record, from what the render measured.
 
+use raywave::output::bench_record::KindFigures;
 use raywave::output::machine::Machine;
 use raywave::output::render_record::{
-    DefaultsUsed, KindFigures, KindTiming, RenderRecord, SceneFigures, TraversalFigures,
+    DefaultsUsed, KindTiming, RenderRecord, SceneFigures, TraversalFigures,
 };
 use raywave::render::engine::Engine;
 use raywave::render::quote::escape;

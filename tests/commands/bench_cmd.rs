@@ -389,6 +389,33 @@ fn a_missing_record_names_the_file_and_how_to_create_it() {
 }
 
 #[test]
+fn a_record_of_an_earlier_raywave_is_refused_not_misread() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir(dir.path().join(".raywave-bench")).unwrap();
+    // A measurement as format 2 wrote it: seconds, counts and flat rates apart.
+    let old = r#"{"format": 2, "engines": [{"engine": "wavefront", "median": {"seconds": 0.5,
+        "rays": {"camera": 1024, "shadow": 16384, "reflection": 100},
+        "rates": {"camera_per_thread_second": 1.0, "shadow_per_thread_second": 1.0,
+                  "reflection_per_thread_second": 1.0, "total_per_second": 35016.0},
+        "stages": []}}]}"#;
+    std::fs::write(dir.path().join(".raywave-bench/old.json"), old).unwrap();
+    let why = "old.json: bench record format 2, expected 3: written by an earlier raywave";
+    let out = common::bin::raywave(dir.path(), &["bench", "compare", "old", "old"]);
+    let (_, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains(why), "{stderr}");
+    assert!(
+        stderr.contains("re-record it with this build, `raywave bench --save old`"),
+        "{stderr}"
+    );
+    let out = common::bin::raywave(dir.path(), &["bench", "list"]);
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stderr.contains(why), "{stderr}");
+    assert!(stdout.contains("no bench records"), "{stdout}");
+}
+
+#[test]
 fn exports_may_not_overwrite_inputs_or_each_other_and_a_scene_named_list_is_dot_slash_list() {
     let dir = common::bin::dir_with(&["cornell_box.obj"]);
     let out = raywave(
