@@ -233,7 +233,16 @@ fn compare_adopts_the_records_settings_unless_a_flag_is_given() {
         "{}",
         text(&out).1
     );
-    let out = bench(&["--compare", "small", "--runs", "6", "--engine", "both"]);
+    let out = bench(&[
+        "--compare",
+        "small",
+        "--runs",
+        "6",
+        "--engine",
+        "wavefront",
+        "--engine",
+        "reference",
+    ]);
     assert_eq!(out.status.code(), Some(1));
     assert!(
         text(&out).1.contains("no figures for engine reference"),
@@ -362,6 +371,27 @@ fn one_engine_and_sweep_flags_that_take_one_point() {
         serde_json::from_str(&std::fs::read_to_string(dir.path().join("r.json")).unwrap()).unwrap();
     assert_eq!(r["engines"].as_array().unwrap().len(), 1);
     assert_eq!(r["engines"][0]["engine"], "reference");
+    // A list in any order, a name twice: each engine once, in record order.
+    let out = raywave(
+        dir.path(),
+        &[
+            "--engine",
+            "wavefront,reference,wavefront",
+            "--json",
+            "b.json",
+            "-q",
+        ],
+    );
+    assert!(out.status.success(), "{}", text(&out).1);
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("b.json")).unwrap()).unwrap();
+    let names: Vec<&str> = r["engines"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e["engine"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["reference", "wavefront"]);
     let out = raywave(dir.path(), &["--threads", "1,2", "--json", "x.json"]);
     assert_eq!(out.status.code(), Some(2));
     assert!(
