@@ -58,15 +58,17 @@ pub fn report(r: &BenchRecord) -> String {
         "engine", "kind", "rays", "seconds", "Mrays/thread-s"
     );
     for e in &r.engines {
-        let m = &e.median;
-        let k = &m.rays_per_second;
-        for (kind, rays) in m.rays.iter() {
-            let rate = k.kinds[kind].map_or("-".to_string(), |r| format!("{:.2}", r / 1e6));
+        let (m, total) = (&e.median, &e.median.rays.total);
+        for (kind, figure) in m.rays.kinds.iter() {
+            let rate = figure
+                .rays_per_thread_second
+                .map_or("-".to_string(), |r| format!("{:.2}", r / 1e6));
             let _ = writeln!(
                 out,
-                "{:<10} {:<12} {rays:>12} {:>10} {rate:>16}",
+                "{:<10} {:<12} {:>12} {:>10} {rate:>16}",
                 e.engine,
                 kind.name(),
+                figure.rays,
                 ""
             );
         }
@@ -75,9 +77,9 @@ pub fn report(r: &BenchRecord) -> String {
             "{:<10} {:<12} {:>12} {:>10.3} {:>16.2}  (Mrays/s, wall clock)",
             e.engine,
             "total",
-            m.rays.total(),
-            m.seconds,
-            k.total / 1e6
+            total.rays,
+            total.seconds,
+            total.rays_per_second / 1e6
         );
     }
     if r.engines.iter().any(|e| !e.median.stages.is_empty()) {
@@ -158,7 +160,7 @@ pub(crate) fn warnings(r: &BenchRecord, point: &str) -> Vec<String> {
                     .map(|&i| {
                         let run = &e.runs[i.min(e.runs.len().saturating_sub(1))];
                         let v = if f.figure == "total" {
-                            run.rays_per_second.total
+                            run.rays.total.rays_per_second
                         } else {
                             let name = f.figure.trim_start_matches("stage ");
                             run.stages

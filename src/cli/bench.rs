@@ -3,10 +3,10 @@
 //! of `--shard`.
 
 use super::image::ImageArgs;
-use super::values::float;
+use super::values::{EngineArg, float};
 use anyhow::Result;
 use clap::parser::ValueSource;
-use clap::{ArgAction, ArgMatches, Args, Subcommand, ValueEnum};
+use clap::{ArgAction, ArgMatches, Args, Subcommand};
 use raywave::bench::ab::{self, AbOptions, MIN_ROUNDS};
 use raywave::bench::export::Exports;
 use raywave::bench::merge::{self, MergeOptions};
@@ -52,9 +52,10 @@ pub struct BenchArgs {
     /// Worker threads; a comma-separated list sweeps them (1,2) [default: all cores].
     #[arg(long, value_delimiter = ',', value_parser = clap::value_parser!(u32).range(1..=1024))]
     pub threads: Vec<u32>,
-    /// Which engines to time.
-    #[arg(long, value_enum, default_value = "both")]
-    pub engine: BenchEngine,
+    /// Which engines to time: a comma-separated list or the flag repeated (wavefront,reference).
+    #[arg(long, value_enum, value_delimiter = ',',
+          default_values_t = [EngineArg::Reference, EngineArg::Wavefront])]
+    pub engine: Vec<EngineArg>,
     /// Lanes of the wavefront engine's kernels: auto (16 on an AVX-512 build, else 8), 8 or 16;
     /// the record's `simd` names the path that ran.
     #[arg(long, value_enum, default_value = "auto")]
@@ -145,28 +146,6 @@ pub struct BenchArgs {
     /// Print only the comparison (or nothing but errors without --compare); no progress bar.
     #[arg(short, long)]
     pub quiet: bool,
-}
-
-/// Which engines `raywave bench` times.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub(crate) enum BenchEngine {
-    /// The SIMD wavefront engine only.
-    Wavefront,
-    /// The scalar reference only.
-    Reference,
-    /// Both, alternating.
-    Both,
-}
-
-impl BenchEngine {
-    /// The engines, in record order.
-    pub fn engines(self) -> Vec<Engine> {
-        match self {
-            BenchEngine::Wavefront => vec![Engine::Wavefront],
-            BenchEngine::Reference => vec![Engine::Reference],
-            BenchEngine::Both => vec![Engine::Reference, Engine::Wavefront],
-        }
-    }
 }
 
 /// `raywave bench compare` and `raywave bench list`.
@@ -279,6 +258,15 @@ const ADOPTABLE: [&str; 12] = [
 ];
 
 impl BenchArgs {
+    /// The engines `--engine` names, each once, in record order (reference, then wavefront).
+    fn engines(&self) -> Vec<Engine> {
+        let given: Vec<Engine> = self.engine.iter().map(|&e| e.into()).collect();
+        [Engine::Reference, Engine::Wavefront]
+            .into_iter()
+            .filter(|e| given.contains(e))
+            .collect()
+    }
+
     /// The swept values: every `--size W H`, every shadow-sample count, every thread count.
     fn sweep(&self) -> Sweep {
         let sizes = self
@@ -315,7 +303,7 @@ impl BenchArgs {
             scene: self.scene.clone().or_else(|| self.input.clone()),
             image: self.image.options(),
             sweep,
-            engines: self.engine.engines(),
+            engines: self.engines(),
             lanes: self.lanes.into(),
             runs: self.runs,
             warmup: self.warmup,
@@ -474,10 +462,8 @@ pub fn run(args: &BenchArgs, matches: Option<&ArgMatches>) -> Result<u8> {
         other: other.clone(),
         scene: args.scene.clone().or_else(|| args.input.clone()),
         render_flags: args.image.flags(),
-        engines: match args.engine {
-            BenchEngine::Both => vec![Engine::Wavefront, Engine::Reference],
-            one => one.engines(),
-        },
+        // The wavefront engine first: it gets its share of --max-time before the reference.
+        engines: args.engines().into_iter().rev().collect(),
         threads: args.threads.first().copied(),
         rounds: args.rounds,
         until_decided: args.until_decided.then_some(sequential::Budget {

@@ -1,9 +1,10 @@
 //! What a render prints and records once the frame is rendered: the summary, the
 //! `--stats` tables and the `--stats-json` record, from what the render measured.
 
+use crate::output::bench_record::KindFigures;
 use crate::output::machine::Machine;
 use crate::output::render_record::{
-    DefaultsUsed, KindFigures, KindTiming, RenderRecord, SceneFigures, TraversalFigures,
+    DefaultsUsed, KindTiming, RenderRecord, SceneFigures, TraversalFigures,
 };
 use crate::render::engine::Engine;
 use crate::render::quote::escape;

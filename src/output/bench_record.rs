@@ -2,9 +2,10 @@
 //! (machine, build, scene, settings), as it is saved to `.raywave-bench/NAME.json`.
 
 use crate::output::machine::Machine;
-use crate::render::per_kind::{PerKind, RayCounts};
+use crate::render::per_kind::PerKind;
 use crate::render::settings::RenderSettings;
 use crate::render::wavefront::stats::{RenderStats, StageFigure};
+use crate::stats::median;
 use anyhow::{Context, Result, bail};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -13,11 +14,9 @@ use std::path::Path;
 
 /// The layout version of bench records and `--stats-json` files (both carry it as `format`),
 /// bumped when either layout changes; records of another version are refused with a message.
-/// 2: per-kind rates per thread-second of the kind's own work (were: per wall-clock second of
-/// the whole frame), and `--stats-json` carries `format` too. Bench records also keep
-/// every run's summary (min, median, 95% interval, max, outliers), the warm-up and the build.
-/// docs/SCHEMA.md has the rule.
-pub const FORMAT: u32 = 2;
+/// 3: a bench measurement's `seconds`, `rays` and `rates` became one `rays`, the
+/// [`KindFigures`] of `--stats-json`. docs/SCHEMA.md has the rule and the history.
+pub const FORMAT: u32 = 3;
 
 /// One `raywave bench` invocation.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
@@ -162,7 +161,7 @@ pub fn summarise(runs: &[Measurement]) -> Vec<FigureSummary> {
     let Some(first) = runs.first() else {
         return out;
     };
-    let totals: Vec<f64> = runs.iter().map(|r| r.rays_per_second.total).collect();
+    let totals: Vec<f64> = runs.iter().map(|r| r.rays.total.rays_per_second).collect();
     out.push(FigureSummary::of("total", "rays/s", &totals));
     for st in first.stages.iter().filter(|st| st.rays > 0) {
         let values: Vec<f64> = runs
@@ -180,139 +179,109 @@ pub fn summarise(runs: &[Measurement]) -> Vec<FigureSummary> {
 }
 
 /// What one render measured (or the medians of several).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct Measurement {
-    /// Wall-clock seconds of the render.
-    pub seconds: f64,
-    /// Rays cast, by kind.
-    pub rays: RayCounts,
-    /// The total per wall-clock second; each kind per thread-second of its own work.
-    #[serde(rename = "rates")]
-    pub rays_per_second: KindRates,
+    /// Rays by kind with each kind's thread-seconds and rate, and the total over the
+    /// wall-clock seconds of the render: the `rays` of `--stats-json`.
+    pub rays: KindFigures,
     /// Per stage (wavefront only; empty for the reference, which has no stages).
     pub stages: Vec<StageFigure>,
 }
 
-/// How fast each kind of ray was handled. A kind's rate is its rays per thread-second of
-/// that kind's own work (`RenderStats::kind_time`: for the wavefront engine from its stage
-/// timers), so it says how fast that work went whatever else the frame did; the total is all
-/// rays per wall-clock second of the frame, the headline figure. A kind is null (`None`) when
-/// its time was not measured (the reference in `raywave bench`, which times it without
-/// timers) or it cast no rays.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(from = "RatesRecord", into = "RatesRecord")]
-pub struct KindRates {
-    /// Each kind's rays per thread-second of its own work.
-    pub kinds: PerKind<Option<f64>>,
-    /// All rays per wall-clock second: the headline figure.
-    pub total: f64,
+/// One kind's rays, the thread-time of its work, and its rate over that time. The time is
+/// `RenderStats::kind_time` (for the wavefront engine from its stage timers), so the rate
+/// says how fast that work went whatever else the frame did. Both are null when the time was
+/// not measured (the reference in `raywave bench`, which times it without timers), the rate
+/// also without rays.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct KindFigure {
+    /// Rays cast.
+    pub rays: u64,
+    /// Thread-seconds of this kind's work, summed over worker threads (null: not measured).
+    pub thread_seconds: Option<f64>,
+    /// rays / thread_seconds (null: not measured, or no rays).
+    pub rays_per_thread_second: Option<f64>,
 }
 
-/// [`KindRates`] as records spell it: one flat object whose keys name their units.
-#[derive(Clone, Copy, Serialize, Deserialize, JsonSchema)]
-#[schemars(rename = "KindRates")]
-struct RatesRecord {
-    /// Camera rays per thread-second of camera work.
-    camera_per_thread_second: Option<f64>,
-    /// Shadow rays per thread-second of shadow work.
-    shadow_per_thread_second: Option<f64>,
-    /// Mirror rays per thread-second of mirror work.
-    reflection_per_thread_second: Option<f64>,
-    /// All rays per wall-clock second: the headline figure.
-    total_per_second: f64,
+/// All rays over the frame's wall-clock time.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct TotalFigure {
+    /// Rays cast, all kinds.
+    pub rays: u64,
+    /// Wall-clock seconds of the render.
+    pub seconds: f64,
+    /// rays / seconds: the headline figure.
+    pub rays_per_second: f64,
 }
 
-impl From<RatesRecord> for KindRates {
-    fn from(r: RatesRecord) -> KindRates {
-        KindRates {
-            kinds: PerKind {
-                camera: r.camera_per_thread_second,
-                shadow: r.shadow_per_thread_second,
-                reflection: r.reflection_per_thread_second,
-            },
-            total: r.total_per_second,
-        }
-    }
+/// [`KindFigure`] for each kind, and the total: how many rays of each kind a render cast and
+/// how fast, in `--stats-json`, in bench records and on the viewer's page.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct KindFigures {
+    /// Each kind: camera rays (making them and their closest hits), shadow rays (spawning
+    /// them, the occlusion tests and the Shade sums), mirror rays (making them and their
+    /// closest hits).
+    #[serde(flatten)]
+    pub kinds: PerKind<KindFigure>,
+    /// All rays per wall-clock second.
+    pub total: TotalFigure,
 }
 
-impl From<KindRates> for RatesRecord {
-    fn from(r: KindRates) -> RatesRecord {
-        RatesRecord {
-            camera_per_thread_second: r.kinds.camera,
-            shadow_per_thread_second: r.kinds.shadow,
-            reflection_per_thread_second: r.kinds.reflection,
-            total_per_second: r.total,
-        }
-    }
-}
-
-impl KindRates {
-    /// The total rate alone: `rays.total()` per wall-clock `seconds`, no kind measured.
-    pub fn new(rays: &RayCounts, seconds: f64) -> KindRates {
-        KindRates {
-            kinds: PerKind::default(),
-            total: rays.total() as f64 / seconds.max(1e-9),
-        }
-    }
-
-    /// The total per wall-clock `seconds`, and each kind per thread-second of its work when
-    /// `stats` measured it.
-    pub fn measured(stats: &RenderStats, seconds: f64) -> KindRates {
-        KindRates {
-            kinds: match &stats.kind_time {
-                Some(times) => PerKind::from_fn(|k| per_thread_second(stats.counts[k], times[k])),
-                None => PerKind::default(),
-            },
-            ..KindRates::new(&stats.counts, seconds)
-        }
-    }
-
-    /// (kind, rate) in report order, for the kinds that have one, then the total.
-    pub fn rows(&self) -> Vec<(&'static str, f64)> {
-        self.kinds
-            .iter()
-            .filter_map(|(kind, rate)| Some((kind.name(), (*rate)?)))
-            .chain([("total", self.total)])
-            .collect()
-    }
-
-    /// Each rate's median over `rates` (a kind only when every run measured it).
-    pub fn median_of(rates: &[KindRates]) -> KindRates {
-        KindRates {
+impl KindFigures {
+    /// The counts of `stats`, each kind over its thread-time when `stats` measured it, the
+    /// total over wall-clock `seconds`.
+    pub fn new(stats: &RenderStats, seconds: f64) -> KindFigures {
+        KindFigures {
             kinds: PerKind::from_fn(|kind| {
-                rates
-                    .iter()
-                    .map(|r| r.kinds[kind])
-                    .collect::<Option<Vec<f64>>>()
-                    .filter(|v| !v.is_empty())
-                    .map(|v| median(&v))
+                let rays = stats.counts[kind];
+                let seconds = stats.kind_time.map(|t| t[kind].as_secs_f64());
+                KindFigure {
+                    rays,
+                    thread_seconds: seconds,
+                    rays_per_thread_second: seconds
+                        .filter(|&s| rays > 0 && s > 0.0)
+                        .map(|s| rays as f64 / s),
+                }
             }),
-            total: median(&rates.iter().map(|r| r.total).collect::<Vec<_>>()),
+            total: TotalFigure {
+                rays: stats.counts.total(),
+                seconds,
+                rays_per_second: stats.counts.total() as f64 / seconds.max(1e-9),
+            },
+        }
+    }
+
+    /// Each figure's median over `runs`, taken separately (a kind's time and rate only when
+    /// every run measured it; ray counts from the first run: they do not vary).
+    pub fn median_of(runs: &[KindFigures]) -> KindFigures {
+        let Some(first) = runs.first() else {
+            return KindFigures::default();
+        };
+        let col = |f: &dyn Fn(&KindFigures) -> Option<f64>| {
+            let v: Option<Vec<f64>> = runs.iter().map(f).collect();
+            v.map(|v| median(&v))
+        };
+        KindFigures {
+            kinds: PerKind::from_fn(|kind| KindFigure {
+                rays: first.kinds[kind].rays,
+                thread_seconds: col(&|r| r.kinds[kind].thread_seconds),
+                rays_per_thread_second: col(&|r| r.kinds[kind].rays_per_thread_second),
+            }),
+            total: TotalFigure {
+                rays: first.total.rays,
+                seconds: col(&|r| Some(r.total.seconds)).unwrap_or_default(),
+                rays_per_second: col(&|r| Some(r.total.rays_per_second)).unwrap_or_default(),
+            },
         }
     }
 }
-
-/// `rays` per thread-second of `time`: `None` without rays or time.
-pub(crate) fn per_thread_second(rays: u64, time: std::time::Duration) -> Option<f64> {
-    let seconds = time.as_secs_f64();
-    (rays > 0 && seconds > 0.0).then(|| rays as f64 / seconds)
-}
-
-use crate::stats::median;
 
 impl Measurement {
     /// Each figure's median over `runs` (ray counts from the first run: they do not vary).
     pub fn median_of(runs: &[Measurement]) -> Measurement {
         let Some(first) = runs.first() else {
-            return Measurement {
-                seconds: 0.0,
-                rays: RayCounts::default(),
-                rays_per_second: KindRates::new(&RayCounts::default(), 1.0),
-                stages: Vec::new(),
-            };
+            return Measurement::default();
         };
-        let pick =
-            |f: &dyn Fn(&Measurement) -> f64| median(&runs.iter().map(f).collect::<Vec<_>>());
         let stages = first
             .stages
             .iter()
@@ -335,13 +304,8 @@ impl Measurement {
                 }
             })
             .collect();
-        let seconds = pick(&|r| r.seconds);
         Measurement {
-            seconds,
-            rays: first.rays,
-            rays_per_second: KindRates::median_of(
-                &runs.iter().map(|r| r.rays_per_second).collect::<Vec<_>>(),
-            ),
+            rays: KindFigures::median_of(&runs.iter().map(|r| r.rays).collect::<Vec<_>>()),
             stages,
         }
     }
@@ -404,10 +368,16 @@ pub fn load(path: &Path, name: &str) -> Result<BenchRecord> {
     let value: serde_json::Value = serde_json::from_str(&text)
         .with_context(|| format!("{}: not a JSON bench record", path.display()))?;
     let format = value.get("format").and_then(|f| f.as_u64());
-    if format != Some(FORMAT as u64) {
+    if format != Some(FORMAT.into()) {
+        let by = match format {
+            Some(f) if f < FORMAT.into() => ": written by an earlier raywave",
+            Some(_) => ": written by a later raywave",
+            None => "",
+        };
         bail!(
-            "{}: bench record format {}, expected {FORMAT}: its figures mean other things \
-             (docs/SCHEMA.md); save it again with `raywave bench --save {name}`",
+            "{}: bench record format {}, expected {FORMAT}{by}; its figures are laid out or \
+             mean other things (docs/SCHEMA.md): re-record it with this build, \
+             `raywave bench --save {name}`",
             path.display(),
             format.map_or("missing".to_string(), |f| f.to_string())
         );
@@ -482,8 +452,21 @@ mod tests {
         assert!(e.contains("a.json: not a JSON bench record"), "{e}");
         std::fs::write(&path, r#"{"format": 99}"#).unwrap();
         let e = format!("{:#}", load(&path, "a").unwrap_err());
-        assert!(e.contains("format 99, expected 2"), "{e}");
+        assert!(
+            e.contains("format 99, expected 3: written by a later"),
+            "{e}"
+        );
         std::fs::write(&path, r#"{"format": 2}"#).unwrap();
+        let e = format!("{:#}", load(&path, "a").unwrap_err());
+        assert!(
+            e.contains("format 2, expected 3: written by an earlier raywave"),
+            "{e}"
+        );
+        assert!(
+            e.contains("re-record it with this build, `raywave bench --save a`"),
+            "{e}"
+        );
+        std::fs::write(&path, r#"{"format": 3}"#).unwrap();
         let e = format!("{:#}", load(&path, "a").unwrap_err());
         assert!(e.contains("a.json: not a valid bench record"), "{e}");
     }

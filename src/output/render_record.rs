@@ -1,16 +1,15 @@
 //! The `--stats-json` file of `raywave render`: one render's figures, with the machine, the
-//! build and the settings. It shares [`Machine`], [`KindRates`], [`StageFigure`] and the
-//! layout version ([`FORMAT`](crate::output::bench_record::FORMAT)) with `raywave bench`'s records, so both describe a machine, a
-//! kind and a stage alike; docs/SCHEMA.md describes both and docs/schema/ holds their JSON
-//! Schemas, generated from these types by [`schemas`].
+//! build and the settings. It shares [`Machine`], [`KindFigures`], [`StageFigure`] and the
+//! layout version ([`FORMAT`](crate::output::bench_record::FORMAT)) with `raywave bench`'s
+//! records, so both describe a machine, a kind and a stage alike; docs/SCHEMA.md describes both
+//! and docs/schema/ holds their JSON Schemas, generated from these types by [`schemas`].
 
-use crate::output::bench_record::{BenchRecord, KindRates};
+use crate::output::bench_record::{BenchRecord, KindFigures};
 use crate::output::machine::Machine;
 use crate::render::engine::Engine;
 use crate::render::per_kind::{PerKind, RayCounts};
 use crate::render::settings::RenderSettings;
 use crate::render::wavefront::cost::CostSum;
-use crate::render::wavefront::stats::RenderStats;
 use crate::render::wavefront::stats::StageFigure;
 use schemars::JsonSchema;
 use serde::Serialize;
@@ -151,60 +150,6 @@ pub enum KindTiming {
     InstrumentedPass,
 }
 
-/// One kind's rays, the thread-time of its work, and its rate over that time.
-#[derive(Clone, Copy, Debug, Serialize, JsonSchema)]
-pub struct KindFigure {
-    /// Rays cast.
-    pub rays: u64,
-    /// Thread-seconds of this kind's work, summed over worker threads (null: not measured).
-    pub thread_seconds: Option<f64>,
-    /// rays / thread_seconds (null: not measured, or no rays).
-    pub rays_per_thread_second: Option<f64>,
-}
-
-/// All rays over the frame's wall-clock time.
-#[derive(Clone, Copy, Debug, Serialize, JsonSchema)]
-pub struct TotalFigure {
-    /// Rays cast, all kinds.
-    pub rays: u64,
-    /// Wall-clock seconds of the render.
-    pub seconds: f64,
-    /// rays / seconds: the headline figure.
-    pub rays_per_second: f64,
-}
-
-/// [`KindFigure`] for each kind, and the total.
-#[derive(Clone, Copy, Debug, Serialize, JsonSchema)]
-pub struct KindFigures {
-    /// Each kind: camera rays (making them and their closest hits), shadow rays (spawning
-    /// them, the occlusion tests and the Shade sums), mirror rays (making them and their
-    /// closest hits).
-    #[serde(flatten)]
-    pub kinds: PerKind<KindFigure>,
-    /// All rays per wall-clock second.
-    pub total: TotalFigure,
-}
-
-impl KindFigures {
-    /// The counts of `stats`, each kind over its thread-time when `stats` measured it
-    /// ([`KindRates::measured`], as bench records do it), the total over wall-clock `seconds`.
-    pub fn new(stats: &RenderStats, seconds: f64) -> KindFigures {
-        let rates = KindRates::measured(stats, seconds);
-        KindFigures {
-            kinds: PerKind::from_fn(|kind| KindFigure {
-                rays: stats.counts[kind],
-                thread_seconds: stats.kind_time.map(|t| t[kind].as_secs_f64()),
-                rays_per_thread_second: rates.kinds[kind],
-            }),
-            total: TotalFigure {
-                rays: stats.counts.total(),
-                seconds,
-                rays_per_second: rates.total,
-            },
-        }
-    }
-}
-
 /// The JSON Schemas of the `--stats-json` file and of a bench record, as (file name, pretty
 /// JSON with a final newline): docs/schema/ holds these, and tests/commands/schema.rs checks that
 /// it still does.
@@ -271,6 +216,7 @@ impl RenderRecord {
 mod tests {
     use super::*;
     use crate::output::bench_record::FORMAT;
+    use crate::render::wavefront::stats::RenderStats;
 
     #[test]
     fn the_file_keeps_its_keys_sorted_and_names_no_host() {

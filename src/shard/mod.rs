@@ -7,7 +7,7 @@
 //! split.rs     Shard (I/N), partition(costs, N): longest processing time first
 //! identity.rs  Identity<W> = raywave version, build, SIMD path, executable hash + the work W
 //! part.rs      Part<W> = identity, shard, items, Host, extra, results; the one file format:
-//!                magic "RWPART2\n" · kind (8 bytes) · length u64 · FNV-1a u64 · CBOR payload
+//!                magic "RWPART3\n" · kind (8 bytes) · length u64 · FNV-1a u64 · CBOR payload
 //! merge.rs     merge::<W>(inputs): every part read and checked, then checked against the
 //!              others: shard counts, SIMD path, build, work, each shard once, none missing,
 //!              one machine unless the command allows several

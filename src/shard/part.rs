@@ -3,7 +3,7 @@
 //!
 //! ```text
 //! name     KIND-shard-I-of-N.part                  (bench-shard-0-of-3.part)
-//! magic    8 bytes  "RWPART2\n"
+//! magic    8 bytes  "RWPART3\n"
 //! kind     8 bytes  the work's kind, ASCII, NUL-padded ("bench", "variance")
 //! length   u64 LE   bytes of the payload
 //! fnv      u64 LE   FNV-1a (64-bit) of the payload
@@ -22,11 +22,13 @@ use serde::{Deserialize, Serialize};
 use std::io::{Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 
-/// The first bytes of every part.
-const MAGIC: &[u8; 8] = b"RWPART2\n";
+/// The first bytes of every part: bumped with the bench record's `FORMAT`, which bench parts
+/// hold.
+const MAGIC: &[u8; 8] = b"RWPART3\n";
 
-/// The magic of the variance parts of raywave before the one format.
-const EARLIER_MAGIC: &[u8; 8] = b"RWPART1\n";
+/// The magics of earlier raywaves' parts: variance's before the one format, then the one
+/// format's with bench records of format 2.
+const EARLIER_MAGICS: [&[u8; 8]; 2] = [b"RWPART1\n", b"RWPART2\n"];
 
 /// Bytes before the payload: magic, kind, length, checksum.
 const HEADER_LEN: usize = 32;
@@ -155,7 +157,7 @@ pub fn read_part<W: Work>(path: &Path) -> Result<Part<W>> {
     let mut head = [0u8; 64];
     let got = read_up_to(&mut file, &mut head).with_context(|| format!("cannot read {shown}"))?;
     let head = &head[..got];
-    let earlier = head.starts_with(EARLIER_MAGIC)
+    let earlier = EARLIER_MAGICS.iter().any(|m| head.starts_with(*m))
         || (head.trim_ascii_start().starts_with(b"{")
             && head.windows(19).any(|w| w == b"raywave-bench-shard"));
     if earlier {
@@ -294,12 +296,13 @@ mod tests {
         flipped[last] ^= 1;
         refused(&flipped, "corrupt: its checksum does not match");
         refused(b"RWPART1\n and the rest", "written by an earlier raywave");
+        refused(b"RWPART2\n and the rest", "written by an earlier raywave");
         refused(
             b"{\n  \"format\": \"raywave-bench-shard\",\n  \"version\": 1",
             "written by an earlier raywave",
         );
         refused(b"{\"format\": 2}", "not a raywave part");
-        refused(b"RWPART2\n", "not a raywave part");
+        refused(b"RWPART3\n", "not a raywave part");
         let mut other = whole.clone();
         other[8..16].copy_from_slice(b"bench\0\0\0");
         refused(

@@ -15,12 +15,11 @@
 //!         -> PNG + ray counts and seconds -> RenderState (read by GET /api/render/{id})
 //! ```
 
-use crate::output::bench_record::KindRates;
+use crate::output::bench_record::KindFigures;
 use crate::output::cost_map::{CostInput, overlay};
 use crate::output::image_file::png_bytes;
 use crate::render::engine::{Engine, Prepared, clamp_to_finite};
 use crate::render::film::ToneMap;
-use crate::render::per_kind::RayCounts;
 use crate::render::scene::Scene;
 use crate::render::progress::Progress;
 use crate::view::CountedRender;
@@ -70,13 +69,10 @@ pub(crate) struct Level {
     pub width: u32,
     /// Image height.
     pub height: u32,
-    /// Seconds the engine took (set-up included).
-    pub seconds: f64,
-    /// Rays cast, by kind.
-    pub rays: RayCounts,
-    /// Each kind's rays per thread-second of its own work (null when not measured: the
-    /// reference renders without kind timers), and all rays per wall-clock second.
-    pub rays_per_second: KindRates,
+    /// Rays by kind, each kind per thread-second of its own work (null when not measured: the
+    /// reference renders without kind timers), and all rays over the seconds the engine took
+    /// (set-up included).
+    pub rays: KindFigures,
     /// The cost-map overlay's legend, when the job asked for one (the level was then rendered
     /// with the traversal counted, and its times include the counting).
     pub cost: Option<CostLegend>,
@@ -526,9 +522,7 @@ fn render_levels(
         state.levels.push(Level {
             width,
             height,
-            seconds,
-            rays: stats.counts,
-            rays_per_second: KindRates::measured(&stats, seconds),
+            rays: KindFigures::new(&stats, seconds),
             cost,
         });
         state.pngs.push(Arc::new(png));

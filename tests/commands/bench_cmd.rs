@@ -233,7 +233,16 @@ fn compare_adopts_the_records_settings_unless_a_flag_is_given() {
         "{}",
         text(&out).1
     );
-    let out = bench(&["--compare", "small", "--runs", "6", "--engine", "both"]);
+    let out = bench(&[
+        "--compare",
+        "small",
+        "--runs",
+        "6",
+        "--engine",
+        "wavefront",
+        "--engine",
+        "reference",
+    ]);
     assert_eq!(out.status.code(), Some(1));
     assert!(
         text(&out).1.contains("no figures for engine reference"),
@@ -362,6 +371,27 @@ fn one_engine_and_sweep_flags_that_take_one_point() {
         serde_json::from_str(&std::fs::read_to_string(dir.path().join("r.json")).unwrap()).unwrap();
     assert_eq!(r["engines"].as_array().unwrap().len(), 1);
     assert_eq!(r["engines"][0]["engine"], "reference");
+    // A list in any order, a name twice: each engine once, in record order.
+    let out = raywave(
+        dir.path(),
+        &[
+            "--engine",
+            "wavefront,reference,wavefront",
+            "--json",
+            "b.json",
+            "-q",
+        ],
+    );
+    assert!(out.status.success(), "{}", text(&out).1);
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("b.json")).unwrap()).unwrap();
+    let names: Vec<&str> = r["engines"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e["engine"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["reference", "wavefront"]);
     let out = raywave(dir.path(), &["--threads", "1,2", "--json", "x.json"]);
     assert_eq!(out.status.code(), Some(2));
     assert!(
@@ -386,6 +416,33 @@ fn a_missing_record_names_the_file_and_how_to_create_it() {
     let out = raywave(dir.path(), &["--save", "../x"]);
     assert_eq!(out.status.code(), Some(2));
     assert!(text(&out).1.contains("not usable"));
+}
+
+#[test]
+fn a_record_of_an_earlier_raywave_is_refused_not_misread() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir(dir.path().join(".raywave-bench")).unwrap();
+    // A measurement as format 2 wrote it: seconds, counts and flat rates apart.
+    let old = r#"{"format": 2, "engines": [{"engine": "wavefront", "median": {"seconds": 0.5,
+        "rays": {"camera": 1024, "shadow": 16384, "reflection": 100},
+        "rates": {"camera_per_thread_second": 1.0, "shadow_per_thread_second": 1.0,
+                  "reflection_per_thread_second": 1.0, "total_per_second": 35016.0},
+        "stages": []}}]}"#;
+    std::fs::write(dir.path().join(".raywave-bench/old.json"), old).unwrap();
+    let why = "old.json: bench record format 2, expected 3: written by an earlier raywave";
+    let out = common::bin::raywave(dir.path(), &["bench", "compare", "old", "old"]);
+    let (_, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains(why), "{stderr}");
+    assert!(
+        stderr.contains("re-record it with this build, `raywave bench --save old`"),
+        "{stderr}"
+    );
+    let out = common::bin::raywave(dir.path(), &["bench", "list"]);
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stderr.contains(why), "{stderr}");
+    assert!(stdout.contains("no bench records"), "{stdout}");
 }
 
 #[test]

@@ -70,6 +70,9 @@ fn csv_points(dir: &Path, name: &str) -> Vec<String> {
 /// What of a record does not depend on timing: setup (scene hash, settings, threads), run
 /// counts, and per engine its ray counts and the names of its headline figures.
 fn deterministic(record: &Value) -> Value {
+    // A measurement's ray counts, without its times and rates.
+    let counts =
+        |rays: &Value| json!(["camera", "shadow", "reflection", "total"].map(|k| &rays[k]["rays"]));
     let mut setup = record["setup"].clone();
     setup["scene"]["source"] = Value::Null;
     let engines: Vec<Value> = record["engines"]
@@ -83,13 +86,13 @@ fn deterministic(record: &Value) -> Value {
                 .iter()
                 .map(|f| &f["figure"])
                 .collect();
-            let runs: Vec<&Value> = e["runs"]
+            let runs: Vec<Value> = e["runs"]
                 .as_array()
                 .unwrap()
                 .iter()
-                .map(|r| &r["rays"])
+                .map(|r| counts(&r["rays"]))
                 .collect();
-            json!({"engine": e["engine"], "rays": e["median"]["rays"], "run_rays": runs, "figures": figures})
+            json!({"engine": e["engine"], "rays": counts(&e["median"]["rays"]), "run_rays": runs, "figures": figures})
         })
         .collect();
     json!({"setup": setup, "runs": record["runs"], "warmup": record["warmup"], "engines": engines})

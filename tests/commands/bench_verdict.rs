@@ -28,9 +28,11 @@ fn figure(name: &str, median: f64, low: f64, high: f64) -> Value {
 fn record(total: (f64, f64, f64), shadow_stage: (f64, f64, f64)) -> Value {
     let m = |(a, b, c): (f64, f64, f64)| (a * 1e6, b * 1e6, c * 1e6);
     let (t, s) = (m(total), m(shadow_stage));
-    let rays = json!({"camera": 1024, "shadow": 16384, "reflection": 100});
+    let kind = |rays: u64| json!({"rays": rays, "thread_seconds": rays as f64, "rays_per_thread_second": 1.0});
+    let rays = json!({"camera": kind(1024), "shadow": kind(16384), "reflection": kind(100),
+                      "total": {"rays": 17508, "seconds": 17508.0 / t.0, "rays_per_second": t.0}});
     json!({
-        "format": 2,
+        "format": 3,
         "raywave": "0.1.0",
         "git_commit": "0123456789abcdef0123456789abcdef01234567",
         "git_dirty": false,
@@ -59,9 +61,7 @@ fn record(total: (f64, f64, f64), shadow_stage: (f64, f64, f64)) -> Value {
         "engines": [{
             "engine": "wavefront",
             "median": {
-                "seconds": 17508.0 / t.0, "rays": rays,
-                "rates": {"camera_per_thread_second": 1.0, "shadow_per_thread_second": 1.0,
-                          "reflection_per_thread_second": 1.0, "total_per_second": t.0},
+                "rays": rays,
                 "stages": [{"stage": "shadow", "rays": 16384, "thread_seconds": 16384.0 / s.0,
                             "rays_per_thread_second": s.0}]
             },

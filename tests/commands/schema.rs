@@ -221,12 +221,12 @@ fn bench_json_and_saved_records_validate() {
     // The wavefront engine's kinds are measured by its stage timers; the reference's are not
     // (the bench times it without timers) and say so with null.
     for (i, measured) in [(0, false), (1, true)] {
-        let rates = &printed["engines"][i]["median"]["rates"];
+        let rays = &printed["engines"][i]["median"]["rays"];
         for kind in ["camera", "shadow", "reflection"] {
-            let rate = &rates[format!("{kind}_per_thread_second")];
-            assert_eq!(rate.is_number(), measured, "engine {i} {kind}: {rates}");
+            let rate = &rays[kind]["rays_per_thread_second"];
+            assert_eq!(rate.is_number(), measured, "engine {i} {kind}: {rays}");
         }
-        assert!(rates["total_per_second"].as_f64().unwrap() > 0.0);
+        assert!(rays["total"]["rays_per_second"].as_f64().unwrap() > 0.0);
     }
 }
 
@@ -236,7 +236,7 @@ fn doctored_records_do_not_validate() {
     let record = stats_json("wavefront");
     type Doctor = fn(&mut Value);
     let doctored: [(&str, Doctor); 6] = [
-        ("an older format", |r| r["format"] = json!(1)),
+        ("an older format", |r| r["format"] = json!(2)),
         ("no format", |r| {
             r.as_object_mut().unwrap().remove("format");
         }),

@@ -58,7 +58,9 @@ fn a_superseded_render_stops_within_a_tile_and_the_newer_one_finishes() {
         levels(s) == 3 || !matches!(s["state"].as_str(), Some("running" | "queued"))
     });
     assert_eq!(running["state"], "running", "{running}");
-    let half = running["levels"][2]["seconds"].as_f64().unwrap();
+    let half = running["levels"][2]["rays"]["total"]["seconds"]
+        .as_f64()
+        .unwrap();
     let asked = Instant::now();
     let tiny = start_job(&server, TINY);
     let stopped = wait_for(&server, big, |s| s["state"] != "running");

@@ -164,12 +164,14 @@ fn records_that_do_not_parse_name_the_file_and_what_was_expected() {
         unreadable(
             "a record of another format version",
             |d| doctored_record(d, |j| j["format"] = 99.into()),
-            "bench record format 99, expected 2",
+            "bench record format 99, expected 3: written by a later raywave",
         ),
         unreadable(
-            "a record of format 1 (its kind rates were per wall-clock second of the frame)",
-            |d| doctored_record(d, |j| j["format"] = 1.into()),
-            "bench record format 1, expected 2: its figures mean other things (docs/SCHEMA.md)",
+            "a record of format 2 (its kinds' figures were apart from the counts and seconds)",
+            |d| doctored_record(d, |j| j["format"] = 2.into()),
+            "bench record format 2, expected 3: written by an earlier raywave; its figures are \
+             laid out or mean other things (docs/SCHEMA.md): re-record it with this build, \
+             `raywave bench --save good`",
         ),
         Case {
             name: "a record that is a FIFO (must not hang)",

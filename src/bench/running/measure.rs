@@ -10,7 +10,7 @@
 //! per engine: medians of every figure, and the summary of the headline figures
 //! ```
 
-use crate::output::bench_record::{EngineRecord, KindRates, Measurement, summarise};
+use crate::output::bench_record::{EngineRecord, KindFigures, Measurement, summarise};
 use crate::render::engine::{Engine, Prepared, clamped_warning};
 use crate::render::film::Film;
 use crate::render::scene::Scene;
@@ -68,9 +68,7 @@ fn timed(
             Engine::Reference => Vec::new(),
         };
         Measurement {
-            seconds,
-            rays: stats.counts,
-            rays_per_second: KindRates::measured(&stats, seconds),
+            rays: KindFigures::new(&stats, seconds),
             stages,
         }
     };

@@ -57,9 +57,9 @@ function showStats(status) {
   const body = $('stats').querySelector('tbody');
   body.innerHTML = '';
   status.levels.forEach((l, k) => {
-    const r = l.rays_per_second;
+    const r = l.rays;
     const tr = document.createElement('tr');
-    for (const v of [k, `${l.width}×${l.height}`, l.seconds.toFixed(3), mega(r.camera_per_thread_second), mega(r.shadow_per_thread_second), mega(r.reflection_per_thread_second), mega(r.total_per_second)]) {
+    for (const v of [k, `${l.width}×${l.height}`, r.total.seconds.toFixed(3), mega(r.camera.rays_per_thread_second), mega(r.shadow.rays_per_thread_second), mega(r.reflection.rays_per_thread_second), mega(r.total.rays_per_second)]) {
       const td = document.createElement('td'); td.textContent = v; tr.appendChild(td);
     }
     body.appendChild(tr);
