@@ -1,8 +1,7 @@
 //! Mesh rays: raywave's wavefront intersect stage and occlusion pass (its own 8-wide BVH,
 //! `wavefront::bvh::MeshBvh`, or its brute-force kernels below 64 triangles) against obvhs's
-//! one-ray CWBVH traversal, (with `--features embree4`, `--features embree`) Embree 4's and
-//! Embree 3's single rays and 8-ray packets and (with `--features tinybvh`) tinybvh's plain BVH
-//! and BVH8_CPU, on the same camera, shadow, soft-shadow and incoherent rays of the lab's box
+//! one-ray CWBVH traversal, (with `--features embree4`) Embree 4's single rays and 8-ray packets
+//! and (with `--features tinybvh`) tinybvh's plain BVH and BVH8_CPU, on the same camera, shadow, soft-shadow and incoherent rays of the lab's box
 //! (triangles only) and the generated ~12k and ~1M triangle Cornell boxes.
 //!
 //! ```text
@@ -12,7 +11,7 @@
 //!         group "<set>_<scene>", throughput in rays:
 //!         obvhs_one_ray, wavefront, wavefront_bvh (closest-hit sets, meshes),
 //!         wavefront_one_ray (primary, meshes), embree4_single, embree4_packet8,
-//!         embree3_single, embree3_packet8, tinybvh_bvh, tinybvh_bvh8_cpu
+//!         tinybvh_bvh, tinybvh_bvh8_cpu
 //! ```
 //!
 //! `wavefront` is the engine's intersect stage (hit search, then point, normal and material for
@@ -41,7 +40,7 @@
 //! to each, checked for agreement with raywave before any timing.
 //!
 //! `RAYWAVE_MESH=lab` (or `12k`, `1M`) limits any mode but the test mode to one scene;
-//! `RAYWAVE_EMBREE_QUALITY=low|medium|high` (default high) sets both Embrees' build quality.
+//! `RAYWAVE_EMBREE_QUALITY=low|medium|high` (default high) sets Embree's build quality.
 //! The test mode ignores all four switches.
 
 #[path = "../common/mod.rs"]
@@ -72,26 +71,24 @@ const TEST_SIZE: u32 = 32;
 /// Seed of the shadow and incoherent rays.
 const SEED: u64 = 2026;
 
-#[cfg(any(feature = "embree", feature = "embree4"))]
+#[cfg(feature = "embree4")]
 use raywave::peer::embree_shared::{BuildQuality, EmbreeCalls};
-#[cfg(feature = "embree")]
-use raywave::peer::embree3::Embree3Mesh;
 #[cfg(feature = "embree4")]
 use raywave::peer::embree4::Embree4Mesh;
 #[cfg(feature = "tinybvh")]
 use raywave::peer::tinybvh::{TinybvhLayout, TinybvhMesh};
 
-/// Embree's build quality (`RAYWAVE_EMBREE_QUALITY`); nothing without an Embree feature.
-#[cfg(any(feature = "embree", feature = "embree4"))]
+/// Embree's build quality (`RAYWAVE_EMBREE_QUALITY`); nothing without the `embree4` feature.
+#[cfg(feature = "embree4")]
 type Quality = BuildQuality;
-/// Embree's build quality (`RAYWAVE_EMBREE_QUALITY`); nothing without an Embree feature.
-#[cfg(not(any(feature = "embree", feature = "embree4")))]
+/// Embree's build quality (`RAYWAVE_EMBREE_QUALITY`); nothing without the `embree4` feature.
+#[cfg(not(feature = "embree4"))]
 #[derive(Clone, Copy)]
 struct Quality;
 
 /// The quality `RAYWAVE_EMBREE_QUALITY` names (exits on a bad value), the default in the
 /// test mode.
-#[cfg(any(feature = "embree", feature = "embree4"))]
+#[cfg(feature = "embree4")]
 fn embree_quality(test_mode: bool) -> Quality {
     if test_mode {
         return BuildQuality::High;
@@ -99,8 +96,8 @@ fn embree_quality(test_mode: bool) -> Quality {
     BuildQuality::from_env().unwrap_or_else(|e| exit_with(&format!("{e:#}")))
 }
 
-/// Nothing to choose without an Embree feature.
-#[cfg(not(any(feature = "embree", feature = "embree4")))]
+/// Nothing to choose without the `embree4` feature.
+#[cfg(not(feature = "embree4"))]
 fn embree_quality(_test_mode: bool) -> Quality {
     Quality
 }
@@ -130,8 +127,6 @@ struct Setup {
     sets: RaySets,
     #[cfg(feature = "embree4")]
     embree4: Embree4Mesh,
-    #[cfg(feature = "embree")]
-    embree3: Embree3Mesh,
     #[cfg(feature = "tinybvh")]
     tinybvh: TinybvhMesh,
 }
@@ -163,7 +158,7 @@ fn load(label: &'static str, source: Source) -> Scene {
 }
 
 #[cfg_attr(
-    not(any(feature = "embree", feature = "embree4")),
+    not(feature = "embree4"),
     allow(unused_variables)
 )]
 fn setup(label: &'static str, source: Source, size: u32, quality: Quality) -> Setup {
@@ -181,8 +176,6 @@ fn setup(label: &'static str, source: Source, size: u32, quality: Quality) -> Se
         settings,
         #[cfg(feature = "embree4")]
         embree4: Embree4Mesh::new(&scene, quality).unwrap_or_else(|e| exit_with(&format!("{e:#}"))),
-        #[cfg(feature = "embree")]
-        embree3: Embree3Mesh::new(&scene, quality).expect("Embree 3 builds the scene"),
         #[cfg(feature = "tinybvh")]
         tinybvh: TinybvhMesh::new(&scene).expect("tinybvh builds the scene"),
         scene,
@@ -219,13 +212,6 @@ fn builds(s: &Setup, ctx: &Context) -> Vec<String> {
         s.embree4.describe(),
         s.embree4.build_time.as_secs_f64(),
         s.embree4.memory.describe()
-    ));
-    #[cfg(feature = "embree")]
-    lines.push(format!(
-        "{}: {:.3} s, {}",
-        s.embree3.describe(),
-        s.embree3.build_time.as_secs_f64(),
-        s.embree3.memory.describe()
     ));
     #[cfg(feature = "tinybvh")]
     lines.push(format!(
@@ -377,14 +363,6 @@ fn trace<'s>(
         ("embree4_packet8", true) => s.embree4.occluded_packet8(set, &mut out.blocked),
         #[cfg(feature = "embree4")]
         ("embree4_packet8", false) => s.embree4.closest_packet8(set, &mut out.hits),
-        #[cfg(feature = "embree")]
-        ("embree3_single", true) => s.embree3.occluded_single(set, &mut out.blocked),
-        #[cfg(feature = "embree")]
-        ("embree3_single", false) => s.embree3.closest_single(set, &mut out.hits),
-        #[cfg(feature = "embree")]
-        ("embree3_packet8", true) => s.embree3.occluded_packet8(set, &mut out.blocked),
-        #[cfg(feature = "embree")]
-        ("embree3_packet8", false) => s.embree3.closest_packet8(set, &mut out.hits),
         _ => unreachable!("engine {engine}"),
     }
     black_box(&*out);
@@ -422,11 +400,6 @@ fn peers() -> Vec<(&'static str, &'static str)> {
     peers.extend([
         ("embree4_single", "Embree 4 single"),
         ("embree4_packet8", "Embree 4 packet8"),
-    ]);
-    #[cfg(feature = "embree")]
-    peers.extend([
-        ("embree3_single", "Embree 3 single"),
-        ("embree3_packet8", "Embree 3 packet8"),
     ]);
     #[cfg(feature = "tinybvh")]
     peers.extend(TinybvhLayout::ALL.iter().map(|l| (l.name(), l.title())));
@@ -509,9 +482,6 @@ fn interleaved(s: &Setup, ctx: &Context, rounds: usize) {
             ("wavefront", "embree4_single"),
             ("wavefront_bvh", "embree4_single"),
             ("wavefront", "embree4_packet8"),
-            ("wavefront", "embree3_single"),
-            ("wavefront_bvh", "embree3_single"),
-            ("wavefront", "embree3_packet8"),
             ("wavefront_bvh", "wavefront_one_ray"),
         ] {
             let at = |name| engines.iter().position(|&e| e == name);

@@ -1,14 +1,13 @@
 //! The peer comparison's engines find the same hits on the same rays: obvhs's one-ray CWBVH
 //! traversal equals an all-triangles brute force, raywave's wavefront stage equals obvhs, and
-//! the peers equal raywave: (with `--features embree4`, `--features embree`) Embree 4's and
-//! Embree 3's single rays and 8-ray packets, (with `--features tinybvh`) tinybvh's plain BVH
-//! and BVH8_CPU, each on more than 99.99% of the rays of every set, on a small generated mesh
-//! and on the lab's box without its spheres (raywave's brute-force path), all two-sided like
-//! the peers. With an Embree feature, the hit records of `peer::embree_shared` are checked
-//! against what each library writes.
+//! the peers equal raywave: (with `--features embree4`) Embree 4's single rays and 8-ray
+//! packets, (with `--features tinybvh`) tinybvh's plain BVH and BVH8_CPU, each on more than
+//! 99.99% of the rays of every set, on a small generated mesh and on the lab's box without its
+//! spheres (raywave's brute-force path), all two-sided like the peers. With `embree4`, the hit
+//! records of `peer::embree_shared` are checked against what the library writes.
 
 use raywave::render::progress::Progress;
-#[cfg(any(feature = "embree", feature = "embree4"))]
+#[cfg(feature = "embree4")]
 use raywave::peer::embree_shared::{BuildQuality, EmbreeCalls};
 use raywave::peer::stage::ShadowStage;
 use raywave::peer::{
@@ -293,7 +292,7 @@ fn agreement_counts_edges_and_real_differences() {
 /// Every set's raywave answer (`raywave_closest`, `wavefront_occluded`) against a peer's, on
 /// `scene`. On meshes the shadow sets must hold both blocked and free rays, so that their
 /// agreement says something (in the lab's box without spheres nothing blocks a light).
-#[cfg(any(feature = "embree", feature = "embree4", feature = "tinybvh"))]
+#[cfg(any(feature = "embree4", feature = "tinybvh"))]
 fn check_peer_against_raywave(
     what: &str,
     scene: &Scene,
@@ -345,7 +344,7 @@ fn check_peer_against_raywave(
 /// benchmark's image size and on the lab's box. (Before the kernels' edge slack, the two crack
 /// rays of `camera_rays_entering_the_closed_box_hit_it` were 2 of 9216 at 96×96, under the
 /// 99.99% bar.)
-#[cfg(any(feature = "embree", feature = "embree4"))]
+#[cfg(feature = "embree4")]
 fn check_embree<E: EmbreeCalls>(version: &str, build: &dyn Fn(&Scene) -> E) {
     for (scene, size) in [(mesh_scene(), 256), (lab_scene(), SIZE)] {
         let embree = build(&scene);
@@ -375,16 +374,6 @@ fn check_embree<E: EmbreeCalls>(version: &str, build: &dyn Fn(&Scene) -> E) {
     }
 }
 
-/// Embree 3.13 (Debian's), at the peer table's default quality.
-#[cfg(feature = "embree")]
-#[test]
-fn embree3_single_and_packet8_equal_raywave() {
-    use raywave::peer::embree3::Embree3Mesh;
-    check_embree("Embree 3", &|scene| {
-        Embree3Mesh::new(scene, BuildQuality::High).expect("Embree 3 builds the scene")
-    });
-}
-
 /// Embree 4 (`RAYWAVE_EMBREE4_DIR`'s), at every build quality the peer table can be set to.
 #[cfg(feature = "embree4")]
 #[test]
@@ -399,7 +388,7 @@ fn embree4_single_and_packet8_equal_raywave() {
 
 /// One Embree call's hit record and what lies after it: a guard that the library must leave
 /// as it was.
-#[cfg(any(feature = "embree", feature = "embree4"))]
+#[cfg(feature = "embree4")]
 #[repr(C)]
 struct Guarded<T> {
     record: T,
@@ -410,7 +399,7 @@ struct Guarded<T> {
 /// the fields the bindings declare, each where the library writes it, and nothing past them.
 /// Returns whether the library wrote the instance-array field `inst_prim_id` (Embree 4's
 /// `RTC_GEOMETRY_INSTANCE_ARRAY`, which Embree 3 lacks).
-#[cfg(any(feature = "embree", feature = "embree4"))]
+#[cfg(feature = "embree4")]
 fn hit_records_written(embree: &impl EmbreeCalls, scene: &Scene) -> bool {
     use raywave::peer::embree_shared::{Hit1, Hit8, Ray1, RayHit1, RayHit8, Valid8};
     /// Neither a valid id nor `RTC_INVALID_GEOMETRY_ID`: a field still holding it was not written.
@@ -585,42 +574,6 @@ fn embree4_writes_the_hit_records_the_bindings_declare() {
     assert!(
         hit_records_written(&embree, &scene),
         "Embree 4 left instPrimID unwritten"
-    );
-}
-
-/// Embree 3.13's records are a prefix of the shared (Embree 4) ones: it writes every field but
-/// `inst_prim_id`, and nothing past its own record.
-#[cfg(feature = "embree")]
-#[test]
-fn embree3_writes_a_prefix_of_the_hit_records() {
-    use raywave::peer::embree3::Embree3Mesh;
-    let scene = lab_scene();
-    let embree = Embree3Mesh::new(&scene, BuildQuality::High).expect("Embree 3 builds the scene");
-    assert!(
-        !hit_records_written(&embree, &scene),
-        "Embree 3 wrote instPrimID"
-    );
-}
-
-/// Both libraries in one process answer as themselves: Embree 4 is loaded with its own symbols
-/// (dlopen, deep binding), so Embree 3's same-named C functions do not capture its calls.
-#[cfg(all(feature = "embree", feature = "embree4"))]
-#[test]
-fn embree3_and_embree4_coexist() {
-    use raywave::peer::embree3::Embree3Mesh;
-    use raywave::peer::embree4::Embree4Mesh;
-    let scene = lab_scene();
-    let three = Embree3Mesh::new(&scene, BuildQuality::High).expect("Embree 3 builds the scene");
-    let four = Embree4Mesh::new(&scene, BuildQuality::High).unwrap_or_else(|e| panic!("{e:#}"));
-    assert!(
-        three.describe().starts_with("Embree 3."),
-        "{}",
-        three.describe()
-    );
-    assert!(
-        four.describe().starts_with("Embree 4."),
-        "{}",
-        four.describe()
     );
 }
 
