@@ -27,8 +27,6 @@
 
 #[cfg(feature = "embree4")]
 pub mod embree4;
-#[cfg(feature = "embree4")]
-pub mod embree_shared;
 pub mod stage;
 #[cfg(feature = "tinybvh")]
 pub mod tinybvh;
