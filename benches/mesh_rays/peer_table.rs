@@ -133,16 +133,16 @@ pub fn print_peer_table(rounds: usize, size: u32, tables: &Tables) {
          two-sided, on the scene without its light wall (and the lab box without its spheres: \
          the peers trace triangles)."
     );
-    #[cfg(any(feature = "embree", feature = "embree4"))]
+    #[cfg(feature = "embree4")]
     println!(
         "\nEmbree single: `rtcIntersect1`/`rtcOccluded1`. Embree packet8: \
          `rtcIntersect8`/`rtcOccluded8` on 8 consecutive rays of the set (one origin per packet \
          on soft-shadow rows). Both with the `COHERENT` flag on every set but the incoherent \
          one, after a build at the quality the notes give (`RAYWAVE_EMBREE_QUALITY`, default \
          high: SAH with spatial splits). Embree 4: the library of `RAYWAVE_EMBREE4_DIR` \
-         (the embreex wheel's), loaded with dlopen; Embree 3: Debian's, through the `embree` \
-         crate's `sys` bindings. Bytes: raywave's nodes and triangle blocks; Embree's from its \
-         memory monitor, what the commit left held (the BVH and its Triangle4 leaves)."
+         (the embreex wheel's), loaded with dlopen. Bytes: raywave's nodes and triangle \
+         blocks; Embree's from its memory monitor, what the commit left held (the BVH and its \
+         Triangle4 leaves)."
     );
     #[cfg(feature = "tinybvh")]
     println!(

@@ -1,6 +1,6 @@
 //! Peer comparison on mesh scenes: the same rays traced by obvhs's CWBVH one ray at a time, by
-//! raywave's wavefront stages, and by Embree 4 (feature `embree4`), Embree 3 (feature
-//! `embree`) and tinybvh (feature `tinybvh`), with the hits compared.
+//! raywave's wavefront stages, and by Embree 4 (feature `embree4`) and tinybvh (feature
+//! `tinybvh`), with the hits compared.
 //!
 //! ```text
 //! RaySets::new(scene, seed):                      built once, from a fixed seed
@@ -15,7 +15,7 @@
 //! agreement: same prim, or both hit with |Δt| ≤ 1e-4·max(1, t) (shared edges), or both miss.
 //! ```
 //!
-//! Every comparison is **two-sided**: Embree (as Debian and Intel's release build it, without
+//! Every comparison is **two-sided**: Embree (as Intel's release builds it, without
 //! `EMBREE_BACKFACE_CULLING`) and tinybvh report hits on both sides of a triangle, so raywave's
 //! kernels are called with `two_sided = true` here, whatever the lab's one-sided convention
 //! says; and the scene is `without_emitters`, since a two-sided light wall would hide the lab's
@@ -25,12 +25,8 @@
 //! structure-of-arrays columns and the wavefront stage gets its own input type without a copy
 //! inside the timed loop.
 
-#[cfg(feature = "embree")]
-pub mod embree3;
 #[cfg(feature = "embree4")]
 pub mod embree4;
-#[cfg(any(feature = "embree", feature = "embree4"))]
-pub mod embree_shared;
 pub mod stage;
 #[cfg(feature = "tinybvh")]
 pub mod tinybvh;

@@ -1,21 +1,20 @@
 //! The peer comparison's engines find the same hits on the same rays: obvhs's one-ray CWBVH
 //! traversal equals an all-triangles brute force, raywave's wavefront stage equals obvhs, and
-//! the peers equal raywave: (with `--features embree4`, `--features embree`) Embree 4's and
-//! Embree 3's single rays and 8-ray packets, (with `--features tinybvh`) tinybvh's plain BVH
-//! and BVH8_CPU, each on more than 99.99% of the rays of every set, on a small generated mesh
-//! and on the lab's box without its spheres (raywave's brute-force path), all two-sided like
-//! the peers. With an Embree feature, the hit records of `peer::embree_shared` are checked
-//! against what each library writes.
+//! the peers equal raywave: (with `--features embree4`) Embree 4's single rays and 8-ray
+//! packets, (with `--features tinybvh`) tinybvh's plain BVH and BVH8_CPU, each on more than
+//! 99.99% of the rays of every set, on a small generated mesh and on the lab's box without its
+//! spheres (raywave's brute-force path), all two-sided like the peers. With `embree4`, the hit
+//! records of `peer::embree4` are checked against what the library writes.
 
-use raywave::render::progress::Progress;
-#[cfg(any(feature = "embree", feature = "embree4"))]
-use raywave::peer::embree_shared::{BuildQuality, EmbreeCalls};
+#[cfg(feature = "embree4")]
+use raywave::peer::embree4::{BuildQuality, Embree4Mesh};
 use raywave::peer::stage::ShadowStage;
 use raywave::peer::{
     Agreement, FAN_SIZES, Hits, ObvhsMesh, RaySet, RaySets, blocker_agreement, brute_force_closest,
     hit_agreement, occlusion_agreement, raywave_closest, wavefront_closest, wavefront_occluded,
     without_emitters, without_spheres,
 };
+use raywave::render::progress::Progress;
 use raywave::render::scene::meshgen::cornell_box_mesh_spheres;
 use raywave::render::scene::{NO_HIT, Scene, parse_scene_str};
 use raywave::render::settings::RenderSettings;
@@ -293,7 +292,7 @@ fn agreement_counts_edges_and_real_differences() {
 /// Every set's raywave answer (`raywave_closest`, `wavefront_occluded`) against a peer's, on
 /// `scene`. On meshes the shadow sets must hold both blocked and free rays, so that their
 /// agreement says something (in the lab's box without spheres nothing blocks a light).
-#[cfg(any(feature = "embree", feature = "embree4", feature = "tinybvh"))]
+#[cfg(any(feature = "embree4", feature = "tinybvh"))]
 fn check_peer_against_raywave(
     what: &str,
     scene: &Scene,
@@ -341,85 +340,74 @@ fn check_peer_against_raywave(
     }
 }
 
-/// An Embree version's single rays and 8-ray packets against raywave, on the mesh at the
-/// benchmark's image size and on the lab's box. (Before the kernels' edge slack, the two crack
-/// rays of `camera_rays_entering_the_closed_box_hit_it` were 2 of 9216 at 96×96, under the
-/// 99.99% bar.)
-#[cfg(any(feature = "embree", feature = "embree4"))]
-fn check_embree<E: EmbreeCalls>(version: &str, build: &dyn Fn(&Scene) -> E) {
-    for (scene, size) in [(mesh_scene(), 256), (lab_scene(), SIZE)] {
-        let embree = build(&scene);
-        let n = scene.triangles.len();
-        check_peer_against_raywave(
-            &format!("{version} single, {n} triangles"),
-            &scene,
-            size,
-            &|set, out| embree.closest_single(set, out),
-            &|set, ours| {
-                let mut theirs = Vec::new();
-                embree.occluded_single(set, &mut theirs);
-                occlusion_agreement(ours, &theirs)
-            },
-        );
-        check_peer_against_raywave(
-            &format!("{version} packet8, {n} triangles"),
-            &scene,
-            size,
-            &|set, out| embree.closest_packet8(set, out),
-            &|set, ours| {
-                let mut theirs = Vec::new();
-                embree.occluded_packet8(set, &mut theirs);
-                occlusion_agreement(ours, &theirs)
-            },
-        );
-    }
-}
-
-/// Embree 3.13 (Debian's), at the peer table's default quality.
-#[cfg(feature = "embree")]
-#[test]
-fn embree3_single_and_packet8_equal_raywave() {
-    use raywave::peer::embree3::Embree3Mesh;
-    check_embree("Embree 3", &|scene| {
-        Embree3Mesh::new(scene, BuildQuality::High).expect("Embree 3 builds the scene")
-    });
-}
-
-/// Embree 4 (`RAYWAVE_EMBREE4_DIR`'s), at every build quality the peer table can be set to.
+/// Embree 4's (`RAYWAVE_EMBREE4_DIR`'s) single rays and 8-ray packets against raywave, at
+/// every build quality the peer table can be set to, on the mesh at the benchmark's image size
+/// and on the lab's box. (Before the kernels' edge slack, the two crack rays of
+/// `camera_rays_entering_the_closed_box_hit_it` were 2 of 9216 at 96×96, under the 99.99% bar.)
 #[cfg(feature = "embree4")]
 #[test]
 fn embree4_single_and_packet8_equal_raywave() {
-    use raywave::peer::embree4::Embree4Mesh;
     for quality in BuildQuality::ALL {
-        check_embree(&format!("Embree 4 ({})", quality.name()), &|scene| {
-            Embree4Mesh::new(scene, quality).unwrap_or_else(|e| panic!("{e:#}"))
-        });
+        for (scene, size) in [(mesh_scene(), 256), (lab_scene(), SIZE)] {
+            let embree = Embree4Mesh::new(&scene, quality).unwrap_or_else(|e| panic!("{e:#}"));
+            let what = |calls: &str| {
+                let n = scene.triangles.len();
+                format!("Embree 4 ({}) {calls}, {n} triangles", quality.name())
+            };
+            check_peer_against_raywave(
+                &what("single"),
+                &scene,
+                size,
+                &|set, out| embree.closest_single(set, out),
+                &|set, ours| {
+                    let mut theirs = Vec::new();
+                    embree.occluded_single(set, &mut theirs);
+                    occlusion_agreement(ours, &theirs)
+                },
+            );
+            check_peer_against_raywave(
+                &what("packet8"),
+                &scene,
+                size,
+                &|set, out| embree.closest_packet8(set, out),
+                &|set, ours| {
+                    let mut theirs = Vec::new();
+                    embree.occluded_packet8(set, &mut theirs);
+                    occlusion_agreement(ours, &theirs)
+                },
+            );
+        }
     }
 }
 
 /// One Embree call's hit record and what lies after it: a guard that the library must leave
 /// as it was.
-#[cfg(any(feature = "embree", feature = "embree4"))]
+#[cfg(feature = "embree4")]
 #[repr(C)]
 struct Guarded<T> {
     record: T,
     guard: [u32; 16],
 }
 
-/// What Embree wrote into `embree_shared`'s hit records of camera rays that hit the lab box:
-/// the fields the bindings declare, each where the library writes it, and nothing past them.
-/// Returns whether the library wrote the instance-array field `inst_prim_id` (Embree 4's
-/// `RTC_GEOMETRY_INSTANCE_ARRAY`, which Embree 3 lacks).
-#[cfg(any(feature = "embree", feature = "embree4"))]
-fn hit_records_written(embree: &impl EmbreeCalls, scene: &Scene) -> bool {
-    use raywave::peer::embree_shared::{Hit1, Hit8, Ray1, RayHit1, RayHit8, Valid8};
+/// Embree 4.4's hit records are the bindings' (`peer::embree4`'s sizes and offsets were read
+/// off its headers with gcc; this checks them against the library itself): on camera rays that
+/// hit the lab box every field lands where declared, nothing is written past the record, and
+/// the release's instance-array field `inst_prim_id` is there and written.
+#[cfg(feature = "embree4")]
+#[test]
+fn embree4_writes_the_hit_records_the_bindings_declare() {
+    use raywave::peer::embree4::{
+        Hit1, Hit8, QueryArguments, Ray1, Ray8, RayHit1, RayHit8, Valid8,
+    };
     /// Neither a valid id nor `RTC_INVALID_GEOMETRY_ID`: a field still holding it was not written.
     const UNWRITTEN: u32 = 0x5eed_0000;
     const GUARD: u32 = 0xdead_beef;
-    let bvh = ObvhsMesh::new(scene);
-    let sets = RaySets::new(scene, &bvh, SIZE, SIZE, SEED);
+    let scene = lab_scene();
+    let embree = Embree4Mesh::new(&scene, BuildQuality::High).unwrap_or_else(|e| panic!("{e:#}"));
+    let bvh = ObvhsMesh::new(&scene);
+    let sets = RaySets::new(&scene, &bvh, SIZE, SIZE, SEED);
     let mut hits = Hits::default();
-    bvh.closest(scene, &sets.primary, &mut hits);
+    bvh.closest(&scene, &sets.primary, &mut hits);
     let batch = &sets.primary.batches[0];
     let hit_rays: Vec<usize> = (0..batch.len())
         .filter(|&i| hits.prim[i] != NO_HIT)
@@ -473,8 +461,7 @@ fn hit_records_written(embree: &impl EmbreeCalls, scene: &Scene) -> bool {
                 "ray {i}: Ng {ng}"
             );
         };
-    let mut args = embree.args(true);
-    let mut inst_prim_written = Vec::new();
+    let mut args = QueryArguments::new(true);
     for &i in &hit_rays[..8] {
         let mut rh = Guarded {
             record: RayHit1 {
@@ -499,19 +486,14 @@ fn hit_records_written(embree: &impl EmbreeCalls, scene: &Scene) -> bool {
             rh.guard, [GUARD; 16],
             "ray {i}: rtcIntersect1 wrote past RTCRayHit"
         );
-        assert!(
-            matches!(h.inst_prim_id, UNWRITTEN | u32::MAX),
-            "ray {i}: instPrimID {:#x}",
-            h.inst_prim_id
-        );
-        inst_prim_written.push(h.inst_prim_id == u32::MAX);
+        assert_eq!(h.inst_prim_id, u32::MAX, "ray {i}: instPrimID");
     }
     // Eight hitting rays in one packet.
     let lanes: [usize; 8] = std::array::from_fn(|k| hit_rays[k]);
     let column = |f: &dyn Fn(&Ray1) -> f32| lanes.map(|i| f(&ray(i)));
     let mut rh8 = Guarded {
         record: RayHit8 {
-            ray: raywave::peer::embree_shared::Ray8 {
+            ray: Ray8 {
                 org: [
                     column(&|r| r.org_x),
                     column(&|r| r.org_y),
@@ -555,72 +537,11 @@ fn hit_records_written(embree: &impl EmbreeCalls, scene: &Scene) -> bool {
             h.geom_id[k],
             h.inst_id[k],
         );
-        assert_eq!(
-            h.inst_prim_id[k] == u32::MAX,
-            inst_prim_written[k],
-            "lane {k}: instPrimID"
-        );
+        assert_eq!(h.inst_prim_id[k], u32::MAX, "lane {k}: instPrimID");
     }
     assert_eq!(
         rh8.guard, [GUARD; 16],
         "rtcIntersect8 wrote past RTCRayHit8"
-    );
-    assert!(
-        inst_prim_written.iter().all(|&w| w == inst_prim_written[0]),
-        "instPrimID written on some rays only: {inst_prim_written:?}"
-    );
-    inst_prim_written[0]
-}
-
-/// Embree 4.4's hit records are the bindings' (`embree_shared`'s sizes and offsets were read
-/// off its headers with gcc; this checks them against the library itself): every field lands
-/// where declared, nothing is written past the record, and the release's instance-array field
-/// is there and written.
-#[cfg(feature = "embree4")]
-#[test]
-fn embree4_writes_the_hit_records_the_bindings_declare() {
-    use raywave::peer::embree4::Embree4Mesh;
-    let scene = lab_scene();
-    let embree = Embree4Mesh::new(&scene, BuildQuality::High).unwrap_or_else(|e| panic!("{e:#}"));
-    assert!(
-        hit_records_written(&embree, &scene),
-        "Embree 4 left instPrimID unwritten"
-    );
-}
-
-/// Embree 3.13's records are a prefix of the shared (Embree 4) ones: it writes every field but
-/// `inst_prim_id`, and nothing past its own record.
-#[cfg(feature = "embree")]
-#[test]
-fn embree3_writes_a_prefix_of_the_hit_records() {
-    use raywave::peer::embree3::Embree3Mesh;
-    let scene = lab_scene();
-    let embree = Embree3Mesh::new(&scene, BuildQuality::High).expect("Embree 3 builds the scene");
-    assert!(
-        !hit_records_written(&embree, &scene),
-        "Embree 3 wrote instPrimID"
-    );
-}
-
-/// Both libraries in one process answer as themselves: Embree 4 is loaded with its own symbols
-/// (dlopen, deep binding), so Embree 3's same-named C functions do not capture its calls.
-#[cfg(all(feature = "embree", feature = "embree4"))]
-#[test]
-fn embree3_and_embree4_coexist() {
-    use raywave::peer::embree3::Embree3Mesh;
-    use raywave::peer::embree4::Embree4Mesh;
-    let scene = lab_scene();
-    let three = Embree3Mesh::new(&scene, BuildQuality::High).expect("Embree 3 builds the scene");
-    let four = Embree4Mesh::new(&scene, BuildQuality::High).unwrap_or_else(|e| panic!("{e:#}"));
-    assert!(
-        three.describe().starts_with("Embree 3."),
-        "{}",
-        three.describe()
-    );
-    assert!(
-        four.describe().starts_with("Embree 4."),
-        "{}",
-        four.describe()
     );
 }
 
@@ -630,7 +551,6 @@ fn embree3_and_embree4_coexist() {
 #[cfg(feature = "embree4")]
 #[test]
 fn embree4_memory_counts_buffers_and_bvh() {
-    use raywave::peer::embree4::Embree4Mesh;
     let scene = mesh_scene();
     let n = scene.triangles.len() as i64;
     let m = Embree4Mesh::new(&scene, BuildQuality::High)
