@@ -36,12 +36,12 @@
 //! With `--until-decided` the rounds go on until the verdict is decided, judged at planned
 //! looks with narrower levels (`sequential`), within `--max-rounds` and `--max-time`.
 
-use crate::render::progress::{Progress, Steps};
 use super::running::sequential::{self, Budget};
 pub use super::verdict::{Rule, Verdict, VerdictForm};
 use super::{EXIT_REGRESSION, EXIT_UNDECIDED};
 use crate::render::engine::Engine;
 use crate::render::error::UsageError;
+use crate::render::progress::{Progress, Steps};
 use crate::stats::looks::LookPlan;
 use crate::stats::{MIN_FOR_INTERVAL, median, median_with_interval_at};
 use anyhow::{Context, Result, bail};

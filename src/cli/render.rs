@@ -133,7 +133,12 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             .collect();
         say(&format!(
             "{}wrote   {}{extra}\n",
-            summary(&outcome.scene, &outcome.effective, &outcome.run, &outcome.report),
+            summary(
+                &outcome.scene,
+                &outcome.effective,
+                &outcome.run,
+                &outcome.report
+            ),
             args.output.display()
         ))?;
     }

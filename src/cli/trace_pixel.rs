@@ -2,11 +2,11 @@
 //! render of that pixel, written as JSON, OBJ, PLY and a PNG from a debug camera, or printed
 //! as a readable summary when no output is asked for.
 
-use raywave::frame::scene_and_settings;
 use super::image::{ImageArgs, SeedArgs, ThreadsArg};
 use super::values::{ToneMapArg, float};
 use anyhow::{Context, Result};
 use clap::Args;
+use raywave::frame::scene_and_settings;
 use raywave::output::image_file::ldr_format;
 use raywave::output::terminal::with_bar;
 use raywave::output::{OutputPlan, write_output};
@@ -85,13 +85,12 @@ pub fn run(args: &TracePixelArgs) -> Result<()> {
     plan.check()?;
     plan.refuse_binary_on_terminal(&["--png"])?;
 
-    let (scene, effective) =
-        scene_and_settings(
-            args.scene.as_deref(),
-            &args.image.with_seed(&args.seed),
-            &plan,
-            &|w| eprintln!("{w}"),
-        )?;
+    let (scene, effective) = scene_and_settings(
+        args.scene.as_deref(),
+        &args.image.with_seed(&args.seed),
+        &plan,
+        &|w| eprintln!("{w}"),
+    )?;
     let settings = effective.settings;
     let mut tree =
         trace_pixel(&scene, &settings, args.x, args.y).map_err(|e| UsageError(e.to_string()))?;

@@ -1,10 +1,10 @@
 //! `raywave view` flags, turned into `raywave::view::ViewOptions`.
 
-use raywave::frame::scene_and_settings;
 use super::image::{ImageArgs, SeedArgs, ThreadsArg};
 use super::values::EngineArg;
 use anyhow::Result;
 use clap::Args;
+use raywave::frame::scene_and_settings;
 use raywave::render::engine::Engine;
 use raywave::render::error::UsageError;
 use raywave::view::request::{MAX_CAMERA_SAMPLES, MAX_SIDE, Resolved};

@@ -152,12 +152,10 @@ pub fn run(
     // The reference's set-up (its BVH for meshes) is timed with its render; the wavefront
     // engine's BVH build is reported on its own.
     let setup_start = Instant::now();
-    let engine = options.engine.prepare_lanes(
-        &scene,
-        settings,
-        options.batch_size as usize,
-        options.lanes,
-    );
+    let engine =
+        options
+            .engine
+            .prepare_lanes(&scene, settings, options.batch_size as usize, options.lanes);
     phases.mark("tables, BVH, progress bar");
     let start = match options.engine {
         Engine::Reference => setup_start,
@@ -219,8 +217,8 @@ pub fn run(
     let mut instrumented_seconds = None;
     if let (Prepared::Reference(reference), true) = (&engine, options.figures) {
         let start = Instant::now();
-        let (_, counts, times) =
-            progress.within("timing ray kinds (a second pass, with timers)", |p| {
+        let (_, counts, times) = progress
+            .within("timing ray kinds (a second pass, with timers)", |p| {
                 pool.install(|| reference.render_timed(p))
             });
         instrumented_seconds = Some(start.elapsed().as_secs_f64());
@@ -234,8 +232,8 @@ pub fn run(
         (&engine, options.figures || options.cost_map.is_some())
     {
         let start = Instant::now();
-        let (_, counted_stats, costs) =
-            progress.within("counting the traversal (a second pass)", |p| {
+        let (_, counted_stats, costs) = progress
+            .within("counting the traversal (a second pass)", |p| {
                 pool.install(|| wavefront.render_counted(p, options.cost_map.is_some()))
             });
         let counted_seconds = start.elapsed().as_secs_f64();

@@ -1,31 +1,26 @@
 //! What a render prints and records once the frame is rendered: the summary, the
 //! `--stats` tables and the `--stats-json` record, from what the render measured.
 
+use crate::diff::{self, Encoding, FileInfo, Image, Region};
 use crate::output::bench_record::KindFigures;
 use crate::output::machine::Machine;
 use crate::output::render_record::{
     DefaultsUsed, KindTiming, RenderRecord, SceneFigures, TraversalFigures,
 };
 use crate::render::engine::Engine;
+use crate::render::film::{Film, ToneMap};
 use crate::render::quote::escape;
 use crate::render::scene::Scene;
 use crate::render::settings::options::{BackgroundSource, Effective};
 use crate::render::settings::{LightModel, ShadowMode};
 use crate::render::wavefront::stats::RenderStats;
-use crate::diff::{self, Encoding, FileInfo, Image, Region};
-use crate::render::film::{Film, ToneMap};
 use anyhow::Result;
 use image::RgbImage;
 use std::fmt::Write as _;
 use std::path::Path;
 
 /// The summary printed after a render: engine, scene, settings, rays and time.
-pub fn summary(
-    scene: &Scene,
-    effective: &Effective,
-    run: &RunInfo,
-    report: &Report,
-) -> String {
+pub fn summary(scene: &Scene, effective: &Effective, run: &RunInfo, report: &Report) -> String {
     let mut out = String::new();
     let s = &effective.settings;
     let shadows = match s.shadows {

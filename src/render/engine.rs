@@ -229,8 +229,12 @@ mod tests {
         };
         for engine in [Engine::Wavefront, Engine::Reference] {
             let last = std::sync::Mutex::new(Vec::new());
-            let report = |done, total, what: &str| last.lock().unwrap().push((done, total, what.to_owned()));
-            let progress = Progress { report: &report, ..Progress::SILENT };
+            let report =
+                |done, total, what: &str| last.lock().unwrap().push((done, total, what.to_owned()));
+            let progress = Progress {
+                report: &report,
+                ..Progress::SILENT
+            };
             let prepared = engine.prepare(&scene, &settings, 16);
             assert_eq!(prepared.engine(), engine);
             let units = match &prepared {
@@ -239,7 +243,11 @@ mod tests {
             };
             let (film, stats) = prepared.render(&progress);
             let reports = last.into_inner().unwrap();
-            assert_eq!(reports.len() as u64, units + 1, "{engine:?} reports none done, then each unit");
+            assert_eq!(
+                reports.len() as u64,
+                units + 1,
+                "{engine:?} reports none done, then each unit"
+            );
             assert_eq!(reports.last().map(|r| (r.0, r.1)), Some((units, units)));
             assert_eq!((film.width, film.height), (12, 8));
             assert_eq!(stats.counts.camera, 96);

@@ -7,8 +7,8 @@ use super::study::jobs::{self, CaseFacts, Job, JobResult, Setup};
 use super::study::plan::{Case, Study, case_names, identity};
 use super::{Cache, Region, RenderFn, StudyConfig};
 use crate::render::engine::Engine;
-use crate::render::progress::Progress;
 use crate::render::error::UsageError;
+use crate::render::progress::Progress;
 use crate::render::sampling::LightSampler;
 use crate::render::scene::{ParseOptions, SceneFile, load_scene};
 use crate::render::settings::{LightModel, RenderSettings, ShadowMode};
@@ -285,7 +285,10 @@ fn run_selected(
         if jobs.is_empty() {
             continue;
         }
-        rays.advance(0, &format!("{}: converged reference and regions", case.name));
+        rays.advance(
+            0,
+            &format!("{}: converged reference and regions", case.name),
+        );
         let setup = Setup::new(
             &case.scene,
             &case.bytes,
@@ -294,7 +297,8 @@ fn run_selected(
             cache,
             progress.notice,
         )?;
-        let label = |done: f64, what: &str| rays.advance(done as u64, &format!("{}: {what}", case.name));
+        let label =
+            |done: f64, what: &str| rays.advance(done as u64, &format!("{}: {what}", case.name));
         let results = jobs::run_jobs(
             &case.scene,
             &case.config,
@@ -343,7 +347,14 @@ pub fn study(
     let cache = open_cache(options, progress.notice);
     let identity = identity(cases, options.engine.name());
     let selected: Vec<usize> = (0..identity.work.jobs().len()).collect();
-    let ran = run_selected(cases, &identity, &selected, cache.as_ref(), render, progress)?;
+    let ran = run_selected(
+        cases,
+        &identity,
+        &selected,
+        cache.as_ref(),
+        render,
+        progress,
+    )?;
     let threads = rayon::current_num_threads();
     let results = ran
         .into_iter()

@@ -24,9 +24,9 @@ pub mod merge;
 pub mod report;
 pub mod study;
 
-use crate::render::progress::Progress;
 use crate::render::film::Film;
 use crate::render::per_kind::RayCounts;
+use crate::render::progress::Progress;
 use crate::render::sampling::LightSampler;
 use crate::render::scene::Scene;
 use crate::render::settings::{RenderSettings, ShadowMode};

@@ -9,8 +9,8 @@ use crate::trace_demo;
 
 use common::bin::{dir_with, files_in, raywave, stderr, stdout};
 use glam::{DVec3, Vec3};
-use raywave::render::progress::Progress;
 use raywave::render::engine::Engine;
+use raywave::render::progress::Progress;
 use raywave::render::scene::Scene;
 use raywave::render::settings::{RenderSettings, ShadowMode};
 use raywave::trace::{RayTree, SegmentKind, trace_pixel};

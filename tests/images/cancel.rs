@@ -7,9 +7,9 @@
 //! at most `K + threads - 1` units can be rendered in all. Each image has many times more units
 //! than that, so a worker that did not read the flag before each unit would render them all.
 
-use raywave::render::progress::Progress;
 use raywave::render::engine::{Engine, Prepared};
 use raywave::render::film::Film;
+use raywave::render::progress::Progress;
 use raywave::render::scene::Scene;
 use raywave::render::settings::{RenderSettings, ShadowMode};
 use raywave::render::wavefront::stats::RenderStats;

@@ -121,7 +121,8 @@ fn textured_scenes_do_not_depend_on_the_thread_count() {
                     .num_threads(threads)
                     .build()
                     .unwrap();
-                let (film, _) = pool.install(|| engine.render(&scene, settings, 64, &Progress::SILENT));
+                let (film, _) =
+                    pool.install(|| engine.render(&scene, settings, 64, &Progress::SILENT));
                 film.pixels
                     .iter()
                     .map(|c| [c.x.to_bits(), c.y.to_bits(), c.z.to_bits()])
@@ -137,8 +138,12 @@ fn textured_scenes_do_not_depend_on_the_thread_count() {
             ..soft_settings(5)
         };
         assert_eq!(
-            Engine::Wavefront.render(&scene, &flat, 64, &Progress::SILENT).0,
-            Engine::Reference.render(&scene, &flat, 64, &Progress::SILENT).0,
+            Engine::Wavefront
+                .render(&scene, &flat, 64, &Progress::SILENT)
+                .0,
+            Engine::Reference
+                .render(&scene, &flat, 64, &Progress::SILENT)
+                .0,
             "{name}: the engines differ without mirrors"
         );
     }

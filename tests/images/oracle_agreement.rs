@@ -20,9 +20,9 @@ use common::bundled_scenes;
 
 use glam::{DVec3, Vec3};
 use oracle::{ILL_CONDITIONED, Oracle, OracleImage, TOLERANCE, scaled, scaled_under};
-use raywave::render::progress::Progress;
 use raywave::render::film::Film;
 use raywave::render::per_kind::RayCounts;
+use raywave::render::progress::Progress;
 use raywave::render::reference::Reference;
 use raywave::render::sampling::LightSampler;
 use raywave::render::scene::{LightShape, Scene, parse_scene_str};

@@ -9,9 +9,9 @@ use crate::common;
 
 use common::bundled_scenes;
 use glam::Vec3;
-use raywave::render::progress::Progress;
 use raywave::render::film::Film;
 use raywave::render::per_kind::RayCounts;
+use raywave::render::progress::Progress;
 use raywave::render::reference::Reference;
 use raywave::render::sampling::LightSampler;
 use raywave::render::scene::{Scene, parse_scene_str};
@@ -288,7 +288,8 @@ fn every_shadow_path_gives_the_per_hit_path_s_bytes() {
                 for width in [LaneWidth::Eight, LaneWidth::Sixteen] {
                     let engine = || Wavefront::new(&scene, s, batch).with_lane_width(width);
                     let render = |path| {
-                        let (film, stats) = engine().with_shadow_path(path).render(&Progress::SILENT);
+                        let (film, stats) =
+                            engine().with_shadow_path(path).render(&Progress::SILENT);
                         (film_bits(&film), stats.counts)
                     };
                     let (per_hit, cp) = render(ShadowPath::QueuedPerHit);

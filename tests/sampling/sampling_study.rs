@@ -11,8 +11,8 @@ use common::analytic::{self, SIZE, floor_point, settings};
 
 use glam::{DVec3, Vec3};
 use oracle::Oracle;
-use raywave::render::progress::Progress;
 use raywave::render::per_kind::RayCounts;
+use raywave::render::progress::Progress;
 use raywave::render::reference::Reference;
 use raywave::render::sampling::{LightSampler, PointSet, SampleKey, strata_grid};
 use raywave::render::scene::{Scene, parse_scene_str};

@@ -19,9 +19,9 @@
 //! the cost blind to N, 16 of the 28 splits are 1.106× to 1.787× over the bound, and from N = 16
 //! up a job is estimated at 0.18× its traced rays or less.
 
-use raywave::render::progress::Progress;
 use raywave::render::film::Film;
 use raywave::render::per_kind::RayCounts;
+use raywave::render::progress::Progress;
 use raywave::render::sampling::LightSampler;
 use raywave::render::scene::Scene;
 use raywave::render::settings::RenderSettings;

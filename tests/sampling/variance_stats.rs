@@ -14,9 +14,9 @@ use crate::common;
 
 use common::{Draw, seeded};
 use glam::Vec3;
-use raywave::render::progress::Progress;
 use raywave::render::film::Film;
 use raywave::render::per_kind::RayCounts;
+use raywave::render::progress::Progress;
 use raywave::render::sampling::LightSampler;
 use raywave::render::scene::Scene;
 use raywave::render::settings::RenderSettings;
@@ -184,7 +184,8 @@ fn a_small_known_bias_is_flagged_and_measured() {
 /// channel: an unbiased sampler made biased by a known amount.
 fn render_with_bias(delta: f32) -> impl Fn(&Scene, &RenderSettings) -> (Film, RayCounts) + Sync {
     move |scene: &Scene, s: &RenderSettings| {
-        let (mut film, stats) = Wavefront::new(scene, s, DEFAULT_BATCH_SIZE).render(&Progress::SILENT);
+        let (mut film, stats) =
+            Wavefront::new(scene, s, DEFAULT_BATCH_SIZE).render(&Progress::SILENT);
         if s.sampler == LightSampler::Random {
             for px in &mut film.pixels {
                 *px += Vec3::splat(delta);

@@ -13,11 +13,11 @@
 use crate::output::bench_record::{EngineRecord, KindFigures, Measurement, summarise};
 use crate::render::engine::{Engine, Prepared, clamped_warning};
 use crate::render::film::Film;
+use crate::render::progress::{Progress, Steps};
 use crate::render::scene::Scene;
 use crate::render::settings::RenderSettings;
 use crate::render::wavefront::DEFAULT_BATCH_SIZE;
 use crate::render::wavefront::lanes::LaneWidth;
-use crate::render::progress::{Progress, Steps};
 use std::time::Instant;
 
 /// Warm-up and timed runs of `engines` on `pool`, the wavefront engine `lanes` wide; `runs_done`
@@ -37,7 +37,11 @@ pub(crate) fn measure(
     runs_done: &Steps,
     notice: &(dyn Fn(&str) + Sync),
 ) -> Vec<EngineRecord> {
-    pool.install(|| timed(scene, settings, engines, lanes, warmup, runs, runs_done, notice))
+    pool.install(|| {
+        timed(
+            scene, settings, engines, lanes, warmup, runs, runs_done, notice,
+        )
+    })
 }
 
 #[allow(clippy::too_many_arguments)]
