@@ -18,6 +18,7 @@ use raywave::render::scene::Scene;
 use raywave::render::settings::RenderSettings;
 use raywave::render::wavefront::batch::{HitBatch, Radiance, RayBatch, ShadowQueue};
 use raywave::render::wavefront::context::Context;
+use raywave::render::wavefront::cost::NoCount;
 use raywave::render::wavefront::lanes::{Lanes, f32x8, f32x16};
 use raywave::render::wavefront::simd::{self, LightBlock};
 use raywave::render::wavefront::{Wavefront, film, generate, intersect, reflect, shadow};
@@ -34,9 +35,16 @@ fn stages(c: &mut Criterion) {
     let mut rays = RayBatch::default();
     generate::camera_rays(&ctx, first, TILE, &mut rays);
     let mut hits = HitBatch::default();
-    intersect::closest(&ctx, &rays, &mut hits);
+    intersect::closest(&ctx, &rays, &mut hits, &mut NoCount);
     let mut queue = ShadowQueue::default();
-    let shadow_rays = shadow::direct_light(&ctx, &rays, &mut hits, &mut queue, TILE as usize);
+    let shadow_rays = shadow::direct_light(
+        &ctx,
+        &rays,
+        &mut hits,
+        &mut queue,
+        TILE as usize,
+        &mut NoCount,
+    );
     let mut next = RayBatch::default();
     let mirror_rays = reflect::mirror_rays(&ctx, &rays, &hits, &mut next);
 
@@ -49,13 +57,22 @@ fn stages(c: &mut Criterion) {
     g.throughput(Throughput::Elements(rays.len() as u64));
     g.bench_function("intersect", |b| {
         let mut out = HitBatch::default();
-        b.iter(|| intersect::closest(&ctx, black_box(&rays), &mut out))
+        b.iter(|| intersect::closest(&ctx, black_box(&rays), &mut out, &mut NoCount))
     });
     g.throughput(Throughput::Elements(shadow_rays));
     g.bench_function("shadow", |b| {
         let mut h = hits.clone();
         let mut q = ShadowQueue::default();
-        b.iter(|| shadow::direct_light(&ctx, black_box(&rays), &mut h, &mut q, TILE as usize))
+        b.iter(|| {
+            shadow::direct_light(
+                &ctx,
+                black_box(&rays),
+                &mut h,
+                &mut q,
+                TILE as usize,
+                &mut NoCount,
+            )
+        })
     });
     g.throughput(Throughput::Elements(mirror_rays.max(1)));
     g.bench_function("reflect", |b| {

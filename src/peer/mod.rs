@@ -39,7 +39,8 @@ use crate::render::spawn::surface_hit;
 use crate::render::wavefront::batch::{HitBatch, PathId, RayBatch};
 use crate::render::wavefront::bvh::MeshBvh;
 use crate::render::wavefront::context::Context;
-use crate::render::wavefront::lanes::LaneWidth;
+use crate::render::wavefront::cost::NoCount;
+use crate::render::wavefront::lanes::{LaneWidth, at_width};
 use crate::render::wavefront::{DEFAULT_BATCH_SIZE, intersect, simd};
 use glam::Vec3;
 use obvhs::{cwbvh::CwBvh, ray::RayHit};
@@ -411,7 +412,7 @@ impl ObvhsMesh {
 pub fn wavefront_closest(ctx: &Context, set: &RaySet, scratch: &mut HitBatch, out: &mut Hits) {
     out.clear();
     for batch in &set.batches {
-        intersect::closest(ctx, batch, scratch);
+        intersect::closest(ctx, batch, scratch, &mut NoCount);
         out.t.extend_from_slice(&scratch.t[..batch.len()]);
         out.prim.extend_from_slice(&scratch.prim[..batch.len()]);
     }
@@ -442,7 +443,7 @@ fn mesh_bvh<'c>(ctx: &'c Context) -> &'c MeshBvh {
 /// shading columns (point, normal, material) on top.
 pub fn wavefront_bvh_closest(ctx: &Context, set: &RaySet, out: &mut Hits) {
     traverse(ctx, set, out, |bvh, scene, batch, two_sided, t, prim| {
-        intersect::mesh_hits(bvh, scene, batch, two_sided, t, prim)
+        intersect::mesh_hits(bvh, scene, batch, two_sided, t, prim, &mut NoCount)
     });
 }
 
@@ -450,7 +451,14 @@ pub fn wavefront_bvh_closest(ctx: &Context, set: &RaySet, out: &mut Hits) {
 /// the stage traces all but camera rays: on camera rays, what the packets buy.
 pub fn wavefront_bvh_closest_one_ray(ctx: &Context, set: &RaySet, out: &mut Hits) {
     traverse(ctx, set, out, |bvh, scene, batch, two_sided, t, prim| {
-        bvh.closest_hits(scene, &intersect::columns(batch), two_sided, t, prim)
+        bvh.closest_hits(
+            scene,
+            &intersect::columns(batch),
+            two_sided,
+            t,
+            prim,
+            &mut NoCount,
+        )
     });
 }
 
@@ -483,7 +491,7 @@ fn traverse(
 /// shading columns), over the set's batches: for meshes the BVH traversal
 /// (`intersect::mesh_hits`: camera rays in packets, others one at a time), for scenes below
 /// `BVH_MIN_TRIANGLES` the brute-force kernel over every primitive at the build's native lane
-/// width, as the stage runs it (`simd::closest_hits_at`, 16 lanes with AVX-512). t and prim into `out`, what the peers' calls produce.
+/// width, as the stage runs it (`simd::closest_hits`, 16 lanes with AVX-512). t and prim into `out`, what the peers' calls produce.
 pub fn raywave_closest(ctx: &Context, set: &RaySet, out: &mut Hits) {
     if ctx.accel.is_some() {
         return wavefront_bvh_closest(ctx, set, out);
@@ -494,22 +502,21 @@ pub fn raywave_closest(ctx: &Context, set: &RaySet, out: &mut Hits) {
         let start = out.t.len();
         out.t.resize(start + batch.len(), f32::INFINITY);
         out.prim.resize(start + batch.len(), NO_HIT);
-        simd::closest_hits_at(
-            LaneWidth::Auto,
+        at_width!(LaneWidth::Auto, V => simd::closest_hits::<V>(
             &scene.triangles,
             &scene.spheres,
             &intersect::columns(batch),
             ctx.settings.two_sided,
             &mut out.t[start..],
             &mut out.prim[start..],
-        );
+        ));
     }
 }
 
 /// The wavefront engine's occlusion path, over the set's batches.
 ///
 /// `wavefront::shadow`'s occlusion pass hands the shadow queue's columns to
-/// `MeshBvh::occluded` for meshes, and to the brute-force `simd::occluded_at` (the build's
+/// `MeshBvh::occluded` for meshes, and to the brute-force `simd::occluded` (the build's
 /// native lane width, as the stage runs it) over the shadow
 /// casters (`geometry::casters`: every triangle when two-sided) and spheres for smaller scenes;
 /// this hands the same function each batch's columns.
@@ -522,15 +529,15 @@ pub fn wavefront_occluded(ctx: &Context, set: &RaySet, out: &mut Vec<bool>) {
         out.resize(start + batch.len(), false);
         let (rays, blocked) = (intersect::columns(batch), &mut out[start..]);
         match &ctx.accel {
-            Some(bvh) => bvh.occluded(scene, &rays, two_sided, blocked),
-            None => simd::occluded_at(
-                LaneWidth::Auto,
+            Some(bvh) => bvh.occluded(scene, &rays, two_sided, blocked, &mut NoCount),
+            None => at_width!(LaneWidth::Auto, V => simd::occluded::<V, _>(
                 casters(scene, &ctx.shadow_casters, two_sided),
                 &scene.spheres,
                 &rays,
                 two_sided,
                 blocked,
-            ),
+                &mut NoCount,
+            )),
         }
     }
 }

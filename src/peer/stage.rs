@@ -20,6 +20,7 @@ use crate::render::scene::Scene;
 use crate::render::settings::{RenderSettings, ShadowMode};
 use crate::render::wavefront::batch::{HitBatch, ShadowQueue};
 use crate::render::wavefront::context::Context;
+use crate::render::wavefront::cost::NoCount;
 use crate::render::wavefront::{intersect, shadow};
 
 /// The shadow stage of one ray kind, ready to run over the camera hits it was built with.
@@ -56,7 +57,7 @@ impl<'s> ShadowStage<'s> {
             .iter()
             .map(|batch| {
                 let mut hits = HitBatch::default();
-                intersect::closest(&ctx, batch, &mut hits);
+                intersect::closest(&ctx, batch, &mut hits, &mut NoCount);
                 hits
             })
             .collect();
@@ -82,7 +83,14 @@ impl<'s> ShadowStage<'s> {
             .iter()
             .zip(&mut self.hits)
             .map(|(batch, hits)| {
-                shadow::direct_light(&self.ctx, batch, hits, &mut self.queue, capacity)
+                shadow::direct_light(
+                    &self.ctx,
+                    batch,
+                    hits,
+                    &mut self.queue,
+                    capacity,
+                    &mut NoCount,
+                )
             })
             .sum()
     }

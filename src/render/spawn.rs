@@ -208,8 +208,8 @@ pub struct ShadowRay {
 /// ends where it meets the light's plane moved towards the hit by the two offsets. At a
 /// grazing angle the error of where a ray crosses the light's plane grows as 1/|l·n_L|, and so
 /// does the distance between that crossing and the ray's end: the light, and faces coplanar
-/// with it, never block their own points. Written once, for every engine: the 8-wide twin is
-/// `wavefront::simd::shadow_rays8`.
+/// with it, never block their own points. Written once, for every engine: the lane twin is
+/// `wavefront::simd::shadow_rays`.
 #[inline]
 #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(x > y)` is on purpose: NaN casts no ray
 pub fn shadow_ray(hit: &SurfaceHit, target: Vec3, end: &LightEnd) -> Option<ShadowRay> {

@@ -27,6 +27,7 @@ use raywave::render::scene::Scene;
 use raywave::render::settings::{RenderSettings, ShadowMode};
 use raywave::render::wavefront::batch::{HitBatch, Radiance, RayBatch, ShadowQueue};
 use raywave::render::wavefront::context::Context;
+use raywave::render::wavefront::cost::NoCount;
 use raywave::render::wavefront::{film, generate, intersect, reflect, shadow};
 use std::hint::black_box;
 use std::path::Path;
@@ -66,7 +67,7 @@ fn icount_region_generate(ctx: &Context, rays: &mut RayBatch) {
 
 #[inline(never)]
 fn icount_region_intersect(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch) {
-    intersect::closest(ctx, black_box(rays), hits);
+    intersect::closest(ctx, black_box(rays), hits, &mut NoCount);
     black_box(1u8);
 }
 
@@ -77,7 +78,14 @@ fn icount_region_shadow(
     hits: &mut HitBatch,
     queue: &mut ShadowQueue,
 ) -> u64 {
-    let cast = shadow::direct_light(ctx, black_box(rays), hits, queue, TILE as usize);
+    let cast = shadow::direct_light(
+        ctx,
+        black_box(rays),
+        hits,
+        queue,
+        TILE as usize,
+        &mut NoCount,
+    );
     black_box(2u8);
     cast
 }
@@ -122,7 +130,7 @@ fn icount_region_reference(reference: &Reference, out: &mut [glam::Vec3]) {
 // callgrind counts the mesh scene's BVH walk apart from the lab scene's.
 #[inline(never)]
 fn icount_region_intersect_mesh(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch) {
-    intersect::closest(ctx, black_box(rays), hits);
+    intersect::closest(ctx, black_box(rays), hits, &mut NoCount);
     black_box(7u8);
 }
 
@@ -133,7 +141,14 @@ fn icount_region_shadow_mesh(
     hits: &mut HitBatch,
     queue: &mut ShadowQueue,
 ) -> u64 {
-    let cast = shadow::direct_light(ctx, black_box(rays), hits, queue, TILE as usize);
+    let cast = shadow::direct_light(
+        ctx,
+        black_box(rays),
+        hits,
+        queue,
+        TILE as usize,
+        &mut NoCount,
+    );
     black_box(8u8);
     cast
 }
@@ -152,12 +167,12 @@ fn workloads() {
     icount_region_generate(&ctx, &mut rays);
 
     let mut hits = HitBatch::default();
-    intersect::closest(&ctx, &rays, &mut hits);
+    intersect::closest(&ctx, &rays, &mut hits, &mut NoCount);
     icount_region_intersect(&ctx, &rays, &mut hits);
 
     let mut queue = ShadowQueue::default();
     let mut h = hits.clone();
-    shadow::direct_light(&ctx, &rays, &mut h, &mut queue, TILE as usize);
+    shadow::direct_light(&ctx, &rays, &mut h, &mut queue, TILE as usize, &mut NoCount);
     let cast = icount_region_shadow(&ctx, &rays, &mut hits, &mut queue);
     assert!(cast > 0, "the lab tile casts shadow rays");
 
@@ -201,10 +216,17 @@ fn workloads() {
     let mut mesh_rays = RayBatch::default();
     generate::camera_rays(&mesh_ctx, FIRST, TILE, &mut mesh_rays);
     let mut mesh_hits = HitBatch::default();
-    intersect::closest(&mesh_ctx, &mesh_rays, &mut mesh_hits);
+    intersect::closest(&mesh_ctx, &mesh_rays, &mut mesh_hits, &mut NoCount);
     icount_region_intersect_mesh(&mesh_ctx, &mesh_rays, &mut mesh_hits);
     let mut h = mesh_hits.clone();
-    shadow::direct_light(&mesh_ctx, &mesh_rays, &mut h, &mut queue, TILE as usize);
+    shadow::direct_light(
+        &mesh_ctx,
+        &mesh_rays,
+        &mut h,
+        &mut queue,
+        TILE as usize,
+        &mut NoCount,
+    );
     icount_region_shadow_mesh(&mesh_ctx, &mesh_rays, &mut mesh_hits, &mut queue);
     black_box((&hits, &pixels, &next, &prims, &out, &mesh_hits));
 }

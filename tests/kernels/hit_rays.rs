@@ -14,6 +14,7 @@ use raywave::render::geometry::{self, shadow_casters};
 use raywave::render::scene::{Light, Scene};
 use raywave::render::spawn::{SurfaceHit, light_end, light_offset, shadow_ray};
 use raywave::render::wavefront::batch::HitBatch;
+use raywave::render::wavefront::cost::NoCount;
 use raywave::render::wavefront::lanes::{Lanes, f32x8, f32x16};
 use raywave::render::wavefront::simd::{
     self, HitLanes, RayColumns, hit_rays_occluded, hit_shadow_rays,
@@ -169,7 +170,14 @@ fn check_occlusion<V: Lanes>(rng: &mut TestRng, len: usize, two_sided: bool) {
         );
         let lanes = (len - i0).min(V::N);
         let live = rays.live & ((1u32 << lanes) - 1);
-        let got = hit_rays_occluded::<V>(triangles, &scene.spheres, &rays, live, two_sided);
+        let got = hit_rays_occluded::<V, _>(
+            triangles,
+            &scene.spheres,
+            &rays,
+            live,
+            two_sided,
+            &mut NoCount,
+        );
         // The live rays as columns, dead ones with tmax 0 (the queue holds no dead rays; a
         // tmax of 0 cannot be blocked).
         let col = |c: &V::Array| -> Vec<f32> { c.as_ref()[..lanes].to_vec() };
@@ -189,7 +197,14 @@ fn check_occlusion<V: Lanes>(rng: &mut TestRng, len: usize, two_sided: bool) {
             tmax: &tmax,
         };
         let mut want = vec![false; lanes];
-        simd::occluded(triangles, &scene.spheres, &cols, two_sided, &mut want);
+        simd::occluded::<f32x8, _>(
+            triangles,
+            &scene.spheres,
+            &cols,
+            two_sided,
+            &mut want,
+            &mut NoCount,
+        );
         for k in (0..lanes).filter(|k| live >> k & 1 == 1) {
             assert_eq!(
                 got >> k & 1 == 1,

@@ -13,6 +13,7 @@ use raywave::render::geometry::{Accel, Ray, intersect_triangle};
 use raywave::render::scene::meshgen::cornell_box_mesh_spheres;
 use raywave::render::scene::{NO_HIT, Scene, Sphere, Triangle, parse_scene_str};
 use raywave::render::wavefront::bvh::MeshBvh;
+use raywave::render::wavefront::cost::NoCount;
 use raywave::render::wavefront::simd::RayColumns;
 
 const NAN: f32 = f32::NAN;
@@ -152,7 +153,14 @@ fn packet_hits(
 ) -> Vec<(f32, u32)> {
     let c = columns_of(rays);
     let (mut t, mut prim) = (vec![0.0; rays.len()], vec![0; rays.len()]);
-    bvh.closest_hits_coherent(scene, &ray_columns(&c), two_sided, &mut t, &mut prim);
+    bvh.closest_hits_coherent(
+        scene,
+        &ray_columns(&c),
+        two_sided,
+        &mut t,
+        &mut prim,
+        &mut NoCount,
+    );
     t.into_iter().zip(prim).collect()
 }
 
@@ -328,11 +336,18 @@ fn batch_entry_points_equal_brute_force_for_lengths_around_the_lane_width() {
         let cols = ray_columns(&c);
         for two_sided in [false, true] {
             let (mut t, mut prim, mut blocked) = (vec![0.0; n], vec![0; n], vec![false; n]);
-            bvh.closest_hits(&scene, &cols, two_sided, &mut t, &mut prim);
-            bvh.occluded(&scene, &cols, two_sided, &mut blocked);
+            bvh.closest_hits(&scene, &cols, two_sided, &mut t, &mut prim, &mut NoCount);
+            bvh.occluded(&scene, &cols, two_sided, &mut blocked, &mut NoCount);
             // Random rays as packets: lanes part at once and finish one ray at a time.
             let (mut packet_t, mut packet_prim) = (vec![0.0; n], vec![0; n]);
-            bvh.closest_hits_coherent(&scene, &cols, two_sided, &mut packet_t, &mut packet_prim);
+            bvh.closest_hits_coherent(
+                &scene,
+                &cols,
+                two_sided,
+                &mut packet_t,
+                &mut packet_prim,
+                &mut NoCount,
+            );
             for (i, (r, tmax)) in rays.iter().enumerate() {
                 let (want_t, want_prim) = brute_force_with_spheres(&scene, r, *tmax, two_sided);
                 assert_eq!(t[i].to_bits(), want_t.to_bits(), "ray {i} {r:?}");

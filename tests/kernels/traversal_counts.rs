@@ -13,6 +13,7 @@ use raywave::render::settings::{RenderSettings, ShadowMode};
 use raywave::render::wavefront::Wavefront;
 use raywave::render::wavefront::bvh::MeshBvh;
 use raywave::render::wavefront::cost::{Cost, PerRay};
+use raywave::render::wavefront::lanes::f32x8;
 use raywave::render::wavefront::simd::{self, RayColumns};
 
 const INF: f32 = f32::INFINITY;
@@ -120,7 +121,7 @@ fn one_ray_at_a_time_counts_the_nodes_leaves_and_tests_of_the_walk() {
     let c = join(down(&[THROUGH, GAP, BESIDE], INF), slant(&[THROUGH, GAP]));
     let (mut t, mut prim) = (vec![0.0; 5], vec![0; 5]);
     let mut costs = vec![Cost::default(); 5];
-    bvh.closest_hits_counted(
+    bvh.closest_hits(
         &scene,
         &columns(&c),
         false,
@@ -152,7 +153,7 @@ fn packets_count_each_lane_at_the_nodes_and_leaves_it_is_active_in() {
     let c = down(&xs, INF);
     let (mut t, mut prim) = (vec![0.0; 8], vec![0; 8]);
     let mut costs = vec![Cost::default(); 8];
-    bvh.closest_hits_coherent_counted(
+    bvh.closest_hits_coherent(
         &scene,
         &columns(&c),
         false,
@@ -166,7 +167,7 @@ fn packets_count_each_lane_at_the_nodes_and_leaves_it_is_active_in() {
     // triangles, 5 lanes) and each lane finishes alone; the two that miss go on to B's leaf.
     let c = slant(&[0.1, GAP + 0.5, 1.1, GAP + 1.5, 2.1]);
     let mut costs = vec![Cost::default(); 5];
-    bvh.closest_hits_coherent_counted(
+    bvh.closest_hits_coherent(
         &scene,
         &columns(&c),
         false,
@@ -200,7 +201,7 @@ fn occlusion_counts_the_sphere_first_and_stops_at_the_first_blocking_leaf() {
     c[6][2] = 5.0;
     let mut blocked = vec![false; 5];
     let mut costs = vec![Cost::default(); 5];
-    bvh.occluded_counted(
+    bvh.occluded(
         &scene,
         &columns(&c),
         true,
@@ -222,7 +223,7 @@ fn occlusion_counts_the_sphere_first_and_stops_at_the_first_blocking_leaf() {
     let mut c = down(&[THROUGH], 0.0);
     c[6][0] = 0.0;
     let mut costs = vec![Cost::default(); 1];
-    bvh.occluded_counted(
+    bvh.occluded(
         &scene,
         &columns(&c),
         true,
@@ -261,7 +262,7 @@ fn brute_force_blocks_charge_every_live_lane_what_the_block_tested() {
     c[6][15] = 0.0;
     let mut blocked = vec![false; 16];
     let mut costs = vec![Cost::default(); 16];
-    simd::occluded_counted(
+    simd::occluded::<f32x8, _>(
         &tris,
         &[],
         &columns(&c),

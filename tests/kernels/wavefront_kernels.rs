@@ -21,9 +21,10 @@ use raywave::render::scene::{Light, LightShape, Material, NO_HIT, Scene, Sphere}
 use raywave::render::shading::shade;
 use raywave::render::spawn::{SurfaceHit, light_end, shadow_ray};
 use raywave::render::wavefront::batch::ShadowBlock;
+use raywave::render::wavefront::cost::NoCount;
 use raywave::render::wavefront::lanes::{Lanes, f32x8, f32x16};
 use raywave::render::wavefront::shade::{
-    HitLight, MaterialTerms, ShadowLanes, shade_lanes, shade_terms, shade8,
+    HitLight, MaterialTerms, ShadowLanes, shade_lanes, shade_terms,
 };
 use raywave::render::wavefront::shadow::key_prefix;
 use raywave::render::wavefront::simd::{self, BlockSampler, LightBlock, RayColumns, arrays};
@@ -202,7 +203,7 @@ fn check_batch(scene: &Scene, rays: &[(Ray, f32)], two_sided: bool) {
     let n = rays.len();
     let (mut t, mut prim) = (vec![0.0; n], vec![0; n]);
     let (mut blocked, mut blocked_by_casters) = (vec![false; n], vec![false; n]);
-    simd::closest_hits(
+    simd::closest_hits::<f32x8>(
         &scene.triangles,
         &scene.spheres,
         &cols.view(),
@@ -210,26 +211,28 @@ fn check_batch(scene: &Scene, rays: &[(Ray, f32)], two_sided: bool) {
         &mut t,
         &mut prim,
     );
-    simd::occluded(
+    simd::occluded::<f32x8, _>(
         &scene.triangles,
         &scene.spheres,
         &cols.view(),
         two_sided,
         &mut blocked,
+        &mut NoCount,
     );
     // What the engines run: only the triangles that can shadow a light (all when two-sided).
     let casters = shadow_casters(scene);
-    simd::occluded(
+    simd::occluded::<f32x8, _>(
         geometry::casters(scene, &casters, two_sided),
         &scene.spheres,
         &cols.view(),
         two_sided,
         &mut blocked_by_casters,
+        &mut NoCount,
     );
     // The same loops 16 lanes wide give the same answers, entry by entry.
     let (mut t16, mut prim16) = (vec![0.0; n], vec![0; n]);
     let (mut blocked16, mut by_casters16) = (vec![false; n], vec![false; n]);
-    simd::closest_hits_lanes::<f32x16>(
+    simd::closest_hits::<f32x16>(
         &scene.triangles,
         &scene.spheres,
         &cols.view(),
@@ -237,19 +240,21 @@ fn check_batch(scene: &Scene, rays: &[(Ray, f32)], two_sided: bool) {
         &mut t16,
         &mut prim16,
     );
-    simd::occluded_lanes::<f32x16>(
+    simd::occluded::<f32x16, _>(
         &scene.triangles,
         &scene.spheres,
         &cols.view(),
         two_sided,
         &mut blocked16,
+        &mut NoCount,
     );
-    simd::occluded_lanes::<f32x16>(
+    simd::occluded::<f32x16, _>(
         geometry::casters(scene, &casters, two_sided),
         &scene.spheres,
         &cols.view(),
         two_sided,
         &mut by_casters16,
+        &mut NoCount,
     );
     let bits = |t: &[f32]| t.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
     assert_eq!(bits(&t16), bits(&t), "16-lane closest t, {n} rays");
@@ -299,12 +304,13 @@ fn check_blocks<V: Lanes>(scene: &Scene, n: usize, offset: usize, two_sided: boo
         geometry::casters(scene, &casters, two_sided),
     ] {
         let mut want = vec![false; rays.len()];
-        simd::occluded(
+        simd::occluded::<f32x8, _>(
             triangles,
             &scene.spheres,
             &cols.view(),
             two_sided,
             &mut want,
+            &mut NoCount,
         );
         for (b, chunk) in rays.chunks(V::N).enumerate() {
             let mut block = ShadowBlock {
@@ -327,7 +333,13 @@ fn check_blocks<V: Lanes>(scene: &Scene, n: usize, offset: usize, two_sided: boo
                     block.live |= 1 << k;
                 }
             }
-            let got = simd::block_occluded::<V>(triangles, &scene.spheres, &block, two_sided);
+            let got = simd::block_occluded::<V, _>(
+                triangles,
+                &scene.spheres,
+                &block,
+                two_sided,
+                &mut NoCount,
+            );
             for (k, (r, tmax)) in chunk.iter().enumerate() {
                 if block.live >> k & 1 == 1 {
                     assert_eq!(
@@ -498,7 +510,7 @@ proptest! {
     }
 
     #[test]
-    fn shade8_equals_shade_terms_lane_by_lane(
+    fn shade_lanes_equal_shade_terms_lane_by_lane(
         kd in vec3(HALF), kr in prop_oneof![Just(Vec3::ZERO), vec3(HALF)], ke in vec3(HALF),
         g in prop_oneof![Just(0.0f32), Just(1.0f32), 0.0f32..1.0, -0.5f32..0.0],
         n in vec3(HALF), e in vec3(HALF), ls in proptest::collection::vec(vec3(HALF), 16), lc in vec3(HALF),
@@ -509,8 +521,7 @@ proptest! {
     ) {
         let m = Material { diffuse: kd.abs(), texture: None, reflective: kr.abs(), emitted: ke.abs(), glossiness: g };
         let case = ShadeCase { m, n, e, ls, lc, weight, blocked_bits, dead_bits, falloffs };
-        // shade8 is the 8-lane kernel; shade_lanes the same source at 8 and at 16 lanes.
-        check_shade(&case, 8, |at, rays| shade8(at, rays).map(|c| c.to_vec()))?;
+        // One source at 8 and at 16 lanes.
         check_shade(&case, 8, |at, rays| shade_lanes::<f32x8>(at, rays).map(|c| c.to_vec()))?;
         check_shade(&case, 16, |at, rays| shade_lanes::<f32x16>(at, rays).map(|c| c.to_vec()))?;
     }
@@ -533,9 +544,9 @@ proptest! {
         let sampler = LightSampler::ALL[which];
         let count = if sampler == LightSampler::Lab { count.max(2) } else { count };
         let case = LightCase { key, sampler, count, origin, edge_u, edge_v, point, n: n.normalize_or(Vec3::Z), offset, end_offset };
-        check_light_points::<f32x8>(&case, |b| simd::light_points8(b).map(|c| c.to_vec()), |hit, pts, end, lanes| {
+        check_light_points::<f32x8>(&case, |b| simd::light_points::<f32x8>(b).map(|c| c.to_vec()), |hit, pts, end, lanes| {
             let p: [[f32; 8]; 3] = std::array::from_fn(|a| pts[a].clone().try_into().expect("8 lanes"));
-            let b = simd::shadow_rays8(hit, &p, end, lanes);
+            let b = simd::shadow_rays::<f32x8>(hit, &p, end, lanes);
             BlockOut { origin: b.origin, l: b.l.map(|c| c.to_vec()), tmax: b.tmax.to_vec(), n_dot_l: b.n_dot_l.to_vec(), dist: b.dist.to_vec(), live: b.live }
         })?;
         check_light_points::<f32x16>(&case, |b| simd::light_points::<f32x16>(b).map(|c| c.to_vec()), |hit, pts, end, lanes| {
@@ -771,7 +782,7 @@ fn miss_sentinels_are_the_scalar_ones() {
     let scene = scene_of(vec![], vec![]);
     let cols = Columns::new(&[(ray([0.0; 3], [0.0, 0.0, 1.0]), INF)]);
     let (mut t, mut prim) = (vec![0.0], vec![0]);
-    simd::closest_hits(
+    simd::closest_hits::<f32x8>(
         &scene.triangles,
         &scene.spheres,
         &cols.view(),
@@ -833,7 +844,7 @@ fn simd_sobol_points_equal_scalar_up_to_the_largest_index() {
                     "16 lanes, seed {seed}, sample {j}"
                 );
             }
-            let pts = simd::light_points8(&LightBlock {
+            let pts = simd::light_points::<f32x8>(&LightBlock {
                 prefix: key_prefix(&key),
                 j0,
                 sampler: BlockSampler::Sobol { scramble },

@@ -32,6 +32,7 @@ use raywave::render::settings::{RenderSettings, ShadowMode};
 use raywave::render::spawn::{ShadowRay, SurfaceHit};
 use raywave::render::wavefront::batch::{HitBatch, RayBatch, ShadowQueue};
 use raywave::render::wavefront::context::Context;
+use raywave::render::wavefront::cost::NoCount;
 use raywave::render::wavefront::shadow::ShadowPath;
 use raywave::render::wavefront::{generate, intersect, reflect, shadow};
 use std::collections::BTreeMap;
@@ -249,9 +250,9 @@ fn wavefront_draws(scene: &Scene, s: &RenderSettings) -> Drawn {
         drawn.camera.insert((rays.pixel[i], rays.sample[i]), ray);
     }
     while !rays.is_empty() {
-        intersect::closest(&ctx, &rays, &mut hits);
+        intersect::closest(&ctx, &rays, &mut hits, &mut NoCount);
         let capacity = rays.len() * scene.lights.len() * (n as usize).div_ceil(8) * 8;
-        shadow::direct_light(&ctx, &rays, &mut hits, &mut queue, capacity);
+        shadow::direct_light(&ctx, &rays, &mut hits, &mut queue, capacity, &mut NoCount);
         for q in 0..queue.len {
             // Dead lanes (no ray: the point is below the tangent plane, or padding) have n·l 0.
             if queue.n_dot_l[q] <= 0.0 {

@@ -13,7 +13,8 @@
 use super::batch::{HitBatch, RayBatch};
 use super::bvh::MeshBvh;
 use super::context::Context;
-use super::cost::{Costs, Counter, NoCount};
+use super::cost::{Costs, Counter};
+use super::lanes::at_width;
 use super::simd::{self, RayColumns};
 use super::texels;
 use crate::render::scene::{NO_HIT, Scene};
@@ -29,23 +30,12 @@ pub fn columns(rays: &RayBatch) -> RayColumns<'_> {
     }
 }
 
-/// t and primitive id of every ray's closest hit through the mesh BVH. Camera rays (depth 0:
-/// 8 consecutive rays are neighbouring pixels) go through the tree 8 at a time; mirror rays,
-/// which fan out, one at a time (docs/TRIED.md, "The mesh BVH"). Both give brute force's
-/// hits, except on the rare grazing triangle (`bvh` module docs).
-pub fn mesh_hits(
-    bvh: &MeshBvh,
-    scene: &Scene,
-    rays: &RayBatch,
-    two_sided: bool,
-    t: &mut [f32],
-    prim: &mut [u32],
-) {
-    mesh_hits_counted(bvh, scene, rays, two_sided, t, prim, &mut NoCount);
-}
-
-/// [`mesh_hits`], each ray's traversal work added to `costs`.
-fn mesh_hits_counted<S: Costs>(
+/// t and primitive id of every ray's closest hit through the mesh BVH, each ray's traversal
+/// work added to `costs`. Camera rays (depth 0: 8 consecutive rays are neighbouring pixels) go
+/// through the tree 8 at a time; mirror rays, which fan out, one at a time (docs/TRIED.md,
+/// "The mesh BVH"). Both give brute force's hits, except on the rare grazing triangle (`bvh`
+/// module docs).
+pub fn mesh_hits<S: Costs>(
     bvh: &MeshBvh,
     scene: &Scene,
     rays: &RayBatch,
@@ -55,48 +45,37 @@ fn mesh_hits_counted<S: Costs>(
     costs: &mut S,
 ) {
     if rays.bounce == 0 {
-        bvh.closest_hits_coherent_counted(scene, &columns(rays), two_sided, t, prim, costs);
+        bvh.closest_hits_coherent(scene, &columns(rays), two_sided, t, prim, costs);
     } else {
-        bvh.closest_hits_counted(scene, &columns(rays), two_sided, t, prim, costs);
+        bvh.closest_hits(scene, &columns(rays), two_sided, t, prim, costs);
     }
 }
 
-/// Fills `hits` (same indices as `rays`).
-pub fn closest(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch) {
-    closest_counted(ctx, rays, hits, &mut NoCount);
-}
-
-/// [`closest`], each ray's traversal work added to `costs` (by ray index). Without a BVH every
-/// ray is charged every primitive: the brute-force kernel tests them all, so it is not
-/// instrumented.
-pub fn closest_counted<S: Costs>(
-    ctx: &Context,
-    rays: &RayBatch,
-    hits: &mut HitBatch,
-    costs: &mut S,
-) {
+/// Fills `hits` (same indices as `rays`), each ray's traversal work added to `costs` (by ray
+/// index; `cost::NoCount` counts nothing). Without a BVH every ray is charged every primitive:
+/// the brute-force kernel tests them all, so it is not instrumented.
+pub fn closest<S: Costs>(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch, costs: &mut S) {
     let n = rays.len();
     hits.resize(n);
     let scene = ctx.scene;
     let two_sided = ctx.settings.two_sided;
     match &ctx.accel {
         None => {
-            simd::closest_hits_at(
-                ctx.lane_width,
+            at_width!(ctx.lane_width, V => simd::closest_hits::<V>(
                 &scene.triangles,
                 &scene.spheres,
                 &columns(rays),
                 two_sided,
                 &mut hits.t,
                 &mut hits.prim,
-            );
+            ));
             let mut every = S::Counter::default();
             every.tests((scene.triangles.len() + scene.spheres.len()) as u32);
             for i in 0..n {
                 costs.add(i, every);
             }
         }
-        Some(bvh) => mesh_hits_counted(
+        Some(bvh) => mesh_hits(
             bvh,
             scene,
             rays,

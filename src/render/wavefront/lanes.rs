@@ -155,6 +155,26 @@ impl LaneWidth {
     }
 }
 
+/// Evaluates `$body` with the type `$V` standing for the lane type of `$width` (`Auto` resolved
+/// for this build): `at_width!(ctx.lane_width, V => simd::closest_hits::<V>(..))`. The one
+/// place a lane width chosen at run time becomes a type; only the arm of each width is
+/// compiled for it.
+macro_rules! at_width {
+    ($width:expr, $V:ident => $body:expr) => {
+        match $width.resolve() {
+            $crate::render::wavefront::lanes::LaneWidth::Sixteen => {
+                type $V = $crate::render::wavefront::lanes::f32x16;
+                $body
+            }
+            _ => {
+                type $V = $crate::render::wavefront::lanes::f32x8;
+                $body
+            }
+        }
+    };
+}
+pub(crate) use at_width;
+
 /// A float lane vector, as the width-generic kernels use it: lane k of every operation is the
 /// scalar operation on lane k (no fused multiply-add, no reordering), so a kernel written once
 /// gives the same bits per lane at either width. Implemented for `f32x8` and `f32x16` only.

@@ -311,20 +311,13 @@ impl<'a> Wavefront<'a> {
         while !ws.rays.is_empty() {
             st.time_kind(Stage::Intersect, traced, || {
                 let costs = &mut tally.batch(ws.rays.len());
-                intersect::closest_counted(ctx, &ws.rays, &mut ws.hits, costs);
+                intersect::closest(ctx, &ws.rays, &mut ws.hits, costs);
             });
             tally.settle(&ws.rays.pixel, traced);
             st.counts.shadow += st.time_kind(Stage::Shadow, RayKind::Shadow, || {
                 let capacity = self.queue_capacity;
                 let costs = &mut tally.batch(ws.rays.len());
-                shadow::direct_light_counted(
-                    ctx,
-                    &ws.rays,
-                    &mut ws.hits,
-                    &mut ws.shadow,
-                    capacity,
-                    costs,
-                )
+                shadow::direct_light(ctx, &ws.rays, &mut ws.hits, &mut ws.shadow, capacity, costs)
             });
             tally.settle(&ws.rays.pixel, RayKind::Shadow);
             st.time(Stage::Film, || {

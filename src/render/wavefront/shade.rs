@@ -1,13 +1,13 @@
 //! The lab's Shade in the wavefront engine: each material's terms computed once, the scalar
 //! Shade over them ([`shade_terms`], twin of `shading::shade`) and its SIMD twin
-//! ([`shade_lanes`], 8 or 16 lanes; [`shade8`] at 8), side by side so that the twins read
+//! ([`shade_lanes`], 8 or 16 lanes), side by side so that the twins read
 //! alike.
 //!
 //! These live here rather than in `crate::render::shading`: the terms are the wavefront engine's
 //! per-render table (the reference shades from `Material` directly), and the SIMD twin names
 //! lane types, which stay inside the wavefront engine's kernels.
 
-use super::lanes::{LANES, Lanes, f32x8};
+use super::lanes::Lanes;
 use crate::render::scene::Material;
 use crate::render::shading::AMBIENT;
 use glam::Vec3;
@@ -118,18 +118,12 @@ pub struct ShadowLanes<'a> {
     pub falloff: Option<&'a [f32]>,
 }
 
-/// Shade · weight of 8 shadow rays cast from one hit towards one light: lane k equals
-/// `shade_terms(m, n, e, l_k, n·l_k, light_color · falloff_k) * weight` bit for bit (`powf`
-/// runs per lane, in scalar, only where the scalar twin calls it). Lanes that add nothing (dead,
-/// n·l ≤ 0, or `blocked`) come back as −0.0, the exact identity of IEEE addition (x + −0 = x for
-/// every x, −0 included), so the caller adds all 8 lanes in order without a branch.
-#[inline]
-pub fn shade8(at: &HitLight, rays: &ShadowLanes) -> [[f32; LANES]; 3] {
-    shade_lanes::<f32x8>(at, rays)
-}
-
-/// [`shade8`] on N lanes (8 or 16): lane k equals `shade_terms(..) * weight` bit for bit, as
-/// there; `rays` holds N entries per column.
+/// Shade · weight of N shadow rays (8 or 16) cast from one hit towards one light: lane k
+/// equals `shade_terms(m, n, e, l_k, n·l_k, light_color · falloff_k) * weight` bit for bit
+/// (`powf` runs per lane, in scalar, only where the scalar twin calls it); `rays` holds N
+/// entries per column. Lanes that add nothing (dead, n·l ≤ 0, or `blocked`) come back as
+/// −0.0, the exact identity of IEEE addition (x + −0 = x for every x, −0 included), so the
+/// caller adds all N lanes in order without a branch.
 #[inline]
 pub fn shade_lanes<V: Lanes>(at: &HitLight, rays: &ShadowLanes) -> [V::Array; 3] {
     let ShadowLanes {

@@ -28,8 +28,8 @@
 
 use super::batch::{HitBatch, RayBatch, ShadowQueue};
 use super::context::Context;
-use super::cost::{Costs, Counter, NoCount, Remap};
-use super::lanes::{LaneWidth, Lanes, f32x8, f32x16, set_bits};
+use super::cost::{Costs, Counter, Remap};
+use super::lanes::{Lanes, at_width, set_bits};
 use super::shade::{
     HitLight, ShadowLanes, ShadowRegisters, shade_lanes, shade_registers, shade_terms,
 };
@@ -109,20 +109,10 @@ pub fn key_prefix(key: &SampleKey) -> u32 {
 }
 
 /// Fills every hit's `direct` column; returns the number of shadow rays cast (queued rays: a
-/// point behind the surface casts none, and no ray is cast with shadows off).
-pub fn direct_light(
-    ctx: &Context,
-    rays: &RayBatch,
-    hits: &mut HitBatch,
-    queue: &mut ShadowQueue,
-    capacity: usize,
-) -> u64 {
-    direct_light_counted(ctx, rays, hits, queue, capacity, &mut NoCount)
-}
-
-/// [`direct_light`], each shadow ray's traversal work added to `costs` at the index of the hit
-/// that cast it.
-pub fn direct_light_counted<S: Remap>(
+/// point behind the surface casts none, and no ray is cast with shadows off). Each shadow
+/// ray's traversal work is added to `costs` at the index of the hit that cast it
+/// (`cost::NoCount` counts nothing).
+pub fn direct_light<S: Remap>(
     ctx: &Context,
     rays: &RayBatch,
     hits: &mut HitBatch,
@@ -130,12 +120,7 @@ pub fn direct_light_counted<S: Remap>(
     capacity: usize,
     costs: &mut S,
 ) -> u64 {
-    match ctx.lane_width {
-        LaneWidth::Sixteen => {
-            direct_light_lanes::<f32x16, S>(ctx, rays, hits, queue, capacity, costs)
-        }
-        _ => direct_light_lanes::<f32x8, S>(ctx, rays, hits, queue, capacity, costs),
-    }
+    at_width!(ctx.lane_width, V => direct_light_lanes::<V, S>(ctx, rays, hits, queue, capacity, costs))
 }
 
 /// [`direct_light`] at the lane width of `V`. Never inlined, so that the 8-lane stage is one
@@ -271,7 +256,7 @@ fn fused<V: Lanes, S: Costs>(
                 }
                 cast += block.live.count_ones() as u64;
                 let mut c = S::Counter::default();
-                let blockers = simd::block_occluded_counted::<V, S::Counter>(
+                let blockers = simd::block_occluded::<V, S::Counter>(
                     triangles,
                     &scene.spheres,
                     &block,
@@ -326,7 +311,7 @@ fn fused_hard<V: Lanes, S: Costs>(
             cast += live.count_ones() as u64;
             let blocked = if occludes {
                 let mut c = S::Counter::default();
-                let blocked = simd::hit_rays_occluded_counted::<V, S::Counter>(
+                let blocked = simd::hit_rays_occluded::<V, S::Counter>(
                     triangles,
                     &scene.spheres,
                     &block,
@@ -465,17 +450,7 @@ fn occlude<V: Lanes, S: Remap>(ctx: &Context, queue: &mut ShadowQueue, costs: &m
     let blocked = &mut queue.blocked[..n];
     let costs = &mut costs.mapped(&queue.path);
     match &ctx.accel {
-        // At 8 lanes the 8-lane entry point, a function of its own as it always was (`V::N` is a
-        // constant, so only one arm is compiled in each instantiation).
-        None if V::N == 8 => simd::occluded_counted(
-            casters(scene, &ctx.shadow_casters, two_sided),
-            &scene.spheres,
-            &cols,
-            two_sided,
-            blocked,
-            costs,
-        ),
-        None => simd::occluded_lanes_counted::<V, _>(
+        None => simd::occluded::<V, _>(
             casters(scene, &ctx.shadow_casters, two_sided),
             &scene.spheres,
             &cols,
@@ -485,7 +460,7 @@ fn occlude<V: Lanes, S: Remap>(ctx: &Context, queue: &mut ShadowQueue, costs: &m
         ),
         // Dead entries (no ray: `spawn::shadow_ray` gave none) carry tmax = 0, which
         // `MeshBvh::occluded` skips.
-        Some(bvh) => bvh.occluded_counted(scene, &cols, two_sided, blocked, costs),
+        Some(bvh) => bvh.occluded(scene, &cols, two_sided, blocked, costs),
     }
 }
 
@@ -549,7 +524,7 @@ fn shade<V: Lanes>(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch, queue: &
                 f
             });
             // In the order the kernel's operands were always evaluated: the hit, the rays, the
-            // light (`shade8`'s instruction count moves with it).
+            // light (`shade_lanes`'s instruction count moves with it).
             let (normal, to_eye) = (hits.normal.get(i), -rays.direction.get(i));
             let lanes = ShadowLanes {
                 l: queue.direction.slices(q..end),

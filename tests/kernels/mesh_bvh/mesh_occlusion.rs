@@ -10,6 +10,7 @@ use raywave::render::geometry::{Ray, T_MIN, intersect_triangle};
 use raywave::render::scene::meshgen::cornell_box_mesh_spheres;
 use raywave::render::scene::{Scene, parse_scene_str};
 use raywave::render::wavefront::bvh::MeshBvh;
+use raywave::render::wavefront::cost::NoCount;
 use raywave::render::wavefront::simd::RayColumns;
 
 /// A ray with its tmax.
@@ -55,7 +56,7 @@ fn check(scene: &Scene, bvh: &MeshBvh, segments: &[Segment], what: &str) -> usiz
     for two_sided in [false, true] {
         let n = segments.len();
         let mut got = vec![false; n];
-        bvh.occluded(scene, &rays, two_sided, &mut got);
+        bvh.occluded(scene, &rays, two_sided, &mut got, &mut NoCount);
         for (i, (r, tmax)) in segments.iter().enumerate() {
             let want = brute_force(scene, r, *tmax, two_sided);
             assert_eq!(

@@ -57,7 +57,7 @@ mod traverse;
 use super::simd::{RayColumns, TriangleLanes};
 use crate::render::geometry::{Hit, Ray, T_MIN, intersect_sphere};
 use crate::render::scene::{NO_HIT, Scene, Triangle};
-use crate::render::wavefront::cost::{Costs, Counter, NoCount};
+use crate::render::wavefront::cost::{Costs, Counter};
 use crate::render::wavefront::lanes::{LANES, f32x8};
 use std::time::Duration;
 use traverse::{RayLanes, Stack, triangles8, triangles8_block};
@@ -148,21 +148,10 @@ impl MeshBvh {
     }
 
     /// Closest hit (triangles through the tree, then spheres, as `Accel::closest`) of every
-    /// ray: writes t (`f32::INFINITY` on a miss) and the global primitive id (`NO_HIT`).
-    pub fn closest_hits(
-        &self,
-        scene: &Scene,
-        rays: &RayColumns,
-        two_sided: bool,
-        t_out: &mut [f32],
-        prim_out: &mut [u32],
-    ) {
-        self.closest_hits_counted(scene, rays, two_sided, t_out, prim_out, &mut NoCount);
-    }
-
-    /// [`Self::closest_hits`], each ray's nodes, leaves and primitive tests added to `costs`
-    /// (`cost::NoCount`: the uncounted kernel itself).
-    pub fn closest_hits_counted<S: Costs>(
+    /// ray: writes t (`f32::INFINITY` on a miss) and the global primitive id (`NO_HIT`). Each
+    /// ray's nodes, leaves and primitive tests are added to `costs` (`cost::NoCount`: nothing
+    /// is counted, and no counting code runs).
+    pub fn closest_hits<S: Costs>(
         &self,
         scene: &Scene,
         rays: &RayColumns,
@@ -191,21 +180,8 @@ impl MeshBvh {
     /// [`Self::closest_hits`] for coherent rays (camera rays: 8 consecutive rays are
     /// neighbouring pixels, or samples of them), traced in packets of 8 (`packet.rs`).
     /// Brute force's answers, as [`Self::closest_hits`] gives, but for the grazing exception
-    /// (module docs).
-    pub fn closest_hits_coherent(
-        &self,
-        scene: &Scene,
-        rays: &RayColumns,
-        two_sided: bool,
-        t_out: &mut [f32],
-        prim_out: &mut [u32],
-    ) {
-        self.closest_hits_coherent_counted(scene, rays, two_sided, t_out, prim_out, &mut NoCount);
-    }
-
-    /// [`Self::closest_hits_coherent`], each ray's nodes, leaves and primitive tests added to
-    /// `costs`: a ray of a packet visits the nodes and leaves it is active in.
-    pub fn closest_hits_coherent_counted<S: Costs>(
+    /// (module docs). A ray of a packet is counted for the nodes and leaves it is active in.
+    pub fn closest_hits_coherent<S: Costs>(
         &self,
         scene: &Scene,
         rays: &RayColumns,
@@ -216,7 +192,7 @@ impl MeshBvh {
     ) {
         if self.root & LEAF != 0 {
             // A tree of one leaf (or none) has nothing to share.
-            return self.closest_hits_counted(scene, rays, two_sided, t_out, prim_out, costs);
+            return self.closest_hits(scene, rays, two_sided, t_out, prim_out, costs);
         }
         let mut walk = packet::Walk::new(self, two_sided);
         let rays = cut(rays);
@@ -237,17 +213,13 @@ impl MeshBvh {
 
     /// Whether anything (spheres, then triangles through the tree) blocks every ray in
     /// (T_MIN, tmax), as `Accel::occluded`. Rays with tmax ≤ T_MIN cannot be blocked and are
-    /// not traced (the shadow queue's dead lanes have tmax = 0).
+    /// not traced (the shadow queue's dead lanes have tmax = 0). Each traced ray's spheres
+    /// tested, nodes, leaves and triangle tests are added to `costs` (rays not traced add
+    /// nothing).
     ///
     /// (An occluder cache, a ray after a blocked one testing the leaf that blocked that one
     /// first, cost 6.6% more instructions on the gate's mesh tile: docs/TRIED.md, "The mesh BVH".)
-    pub fn occluded(&self, scene: &Scene, rays: &RayColumns, two_sided: bool, out: &mut [bool]) {
-        self.occluded_counted(scene, rays, two_sided, out, &mut NoCount);
-    }
-
-    /// [`Self::occluded`], each traced ray's spheres tested, nodes, leaves and triangle tests
-    /// added to `costs` (rays not traced, tmax ≤ T_MIN, add nothing).
-    pub fn occluded_counted<S: Costs>(
+    pub fn occluded<S: Costs>(
         &self,
         scene: &Scene,
         rays: &RayColumns,

@@ -6,8 +6,8 @@ use super::{RayColumns, Rays};
 use crate::render::geometry::{EDGE_EPSILON, MISS_MARGIN, T_MIN};
 use crate::render::scene::{NO_HIT, Sphere, Triangle};
 use crate::render::wavefront::batch::{HitRays, ShadowBlock};
-use crate::render::wavefront::cost::{Costs, Counter, NoCount};
-use crate::render::wavefront::lanes::{LaneWidth, Lanes, f32x8, f32x16, live_lanes, store_mask};
+use crate::render::wavefront::cost::{Costs, Counter};
+use crate::render::wavefront::lanes::{Lanes, f32x8, live_lanes, store_mask};
 use glam::Vec3;
 
 /// Möller–Trumbore's operands on N lanes (8 by default), as columns: ray origin o and
@@ -235,46 +235,16 @@ impl<V: Lanes> SphereLanes<V> {
     }
 }
 
-/// Closest hit of every ray against every primitive, in the reference's order (triangles by
-/// index, then spheres; a later primitive wins only when strictly closer). Writes `t`
-/// (`f32::INFINITY` on a miss) and the global primitive id (`NO_HIT` on a miss).
-pub fn closest_hits(
-    triangles: &[Triangle],
-    spheres: &[Sphere],
-    rays: &RayColumns,
-    two_sided: bool,
-    t_out: &mut [f32],
-    prim_out: &mut [u32],
-) {
-    closest_hits_lanes::<f32x8>(triangles, spheres, rays, two_sided, t_out, prim_out);
-}
-
-/// [`closest_hits`] at lane width `width` (`Auto` as the build's native width).
+/// Closest hit of every ray against every primitive, N rays at a time (`V`: 8 or 16 lanes,
+/// the same answers), in the reference's order (triangles by index, then spheres; a later
+/// primitive wins only when strictly closer). Writes `t` (`f32::INFINITY` on a miss) and the
+/// global primitive id (`NO_HIT` on a miss).
 ///
-/// The width is dispatched here, in a function of its own, not in `intersect::closest`: with
-/// the 16-lane loop inlined there, that stage's own per-hit loop took 1.1–1.75% more
+/// Never inlined, and its callers choose the width with `lanes::at_width!`: with the 16-lane
+/// loop inlined into `intersect::closest`, that stage's own per-hit loop took 1.1–1.75% more
 /// instructions at 8 lanes (tests/gates/icount.rs).
 #[inline(never)]
-pub fn closest_hits_at(
-    width: LaneWidth,
-    triangles: &[Triangle],
-    spheres: &[Sphere],
-    rays: &RayColumns,
-    two_sided: bool,
-    t_out: &mut [f32],
-    prim_out: &mut [u32],
-) {
-    match width.resolve() {
-        LaneWidth::Sixteen => {
-            closest_hits_lanes::<f32x16>(triangles, spheres, rays, two_sided, t_out, prim_out);
-        }
-        _ => closest_hits_lanes::<f32x8>(triangles, spheres, rays, two_sided, t_out, prim_out),
-    }
-}
-
-/// [`closest_hits`] at the lane width of `V` (8 or 16): the same answers.
-#[inline(never)]
-pub fn closest_hits_lanes<V: Lanes>(
+pub fn closest_hits<V: Lanes>(
     triangles: &[Triangle],
     spheres: &[Sphere],
     rays: &RayColumns,
@@ -317,62 +287,13 @@ pub fn closest_hits_lanes<V: Lanes>(
     }
 }
 
-/// For every ray, whether anything blocks it in (T_MIN, tmax). Spheres first, then triangles;
-/// a chunk of N lanes stops as soon as all its live lanes are blocked.
-pub fn occluded(
-    triangles: &[Triangle],
-    spheres: &[Sphere],
-    rays: &RayColumns,
-    two_sided: bool,
-    out: &mut [bool],
-) {
-    occluded_lanes::<f32x8>(triangles, spheres, rays, two_sided, out);
-}
-
-/// [`occluded`], each ray charged the primitives its block of 8 tested (a block stops when all
-/// its live lanes are blocked), added to `costs`.
-pub fn occluded_counted<S: Costs>(
-    triangles: &[Triangle],
-    spheres: &[Sphere],
-    rays: &RayColumns,
-    two_sided: bool,
-    out: &mut [bool],
-    costs: &mut S,
-) {
-    occluded_lanes_counted::<f32x8, S>(triangles, spheres, rays, two_sided, out, costs);
-}
-
-/// [`occluded`] at lane width `width` (`Auto` as the build's native width), dispatched in a
-/// function of its own as [`closest_hits_at`] is.
+/// For every ray, whether anything blocks it in (T_MIN, tmax), N rays at a time (`V`: 8 or 16
+/// lanes, the same answers). Spheres first, then triangles; a block of N lanes stops as soon as
+/// all its live lanes are blocked, and each of its live rays is charged the primitives the
+/// block tested, added to `costs` (`NoCount`: nothing is counted). Never inlined, so that the
+/// queued shadow stage calls it as a function of its own at either width.
 #[inline(never)]
-pub fn occluded_at(
-    width: LaneWidth,
-    triangles: &[Triangle],
-    spheres: &[Sphere],
-    rays: &RayColumns,
-    two_sided: bool,
-    out: &mut [bool],
-) {
-    match width.resolve() {
-        LaneWidth::Sixteen => occluded_lanes::<f32x16>(triangles, spheres, rays, two_sided, out),
-        _ => occluded_lanes::<f32x8>(triangles, spheres, rays, two_sided, out),
-    }
-}
-
-/// [`occluded`] at the lane width of `V` (8 or 16): the same answers.
-pub fn occluded_lanes<V: Lanes>(
-    triangles: &[Triangle],
-    spheres: &[Sphere],
-    rays: &RayColumns,
-    two_sided: bool,
-    out: &mut [bool],
-) {
-    occluded_lanes_counted::<V, NoCount>(triangles, spheres, rays, two_sided, out, &mut NoCount);
-}
-
-/// [`occluded_lanes`], each live ray charged the primitives its block tested.
-#[inline(always)]
-pub fn occluded_lanes_counted<V: Lanes, S: Costs>(
+pub fn occluded<V: Lanes, S: Costs>(
     triangles: &[Triangle],
     spheres: &[Sphere],
     rays: &RayColumns,
@@ -410,22 +331,11 @@ pub fn occluded_lanes_counted<V: Lanes, S: Costs>(
 
 /// The lanes of one block of shadow rays (`simd::shadow_rays`: N rays from one origin, dead
 /// lanes with tmax = 0) that something blocks, as a bit mask: for every live lane, the answer
-/// [`occluded_lanes`] gives for the same ray in a queue (the same rays, loaded from registers
-/// instead of the queue's columns); dead lanes' bits mean nothing.
+/// [`occluded`] gives for the same ray in a queue (the same rays, loaded from registers
+/// instead of the queue's columns); dead lanes' bits mean nothing. The primitives the block
+/// tested are counted in `c` once for the block (each of its live rays did those tests).
 #[inline(always)]
-pub fn block_occluded<V: Lanes>(
-    triangles: &[Triangle],
-    spheres: &[Sphere],
-    block: &ShadowBlock<V::Array>,
-    two_sided: bool,
-) -> u32 {
-    block_occluded_counted::<V, NoCount>(triangles, spheres, block, two_sided, &mut NoCount)
-}
-
-/// [`block_occluded`], the primitives the block tested counted in `c` (once for the block:
-/// each of its live rays did those tests).
-#[inline(always)]
-pub fn block_occluded_counted<V: Lanes, C: Counter>(
+pub fn block_occluded<V: Lanes, C: Counter>(
     triangles: &[Triangle],
     spheres: &[Sphere],
     block: &ShadowBlock<V::Array>,
@@ -447,23 +357,11 @@ pub fn block_occluded_counted<V: Lanes, C: Counter>(
 }
 
 /// The `live` lanes of one ray per hit (`simd::hit_shadow_rays`) that something blocks, as a
-/// bit mask: for every live lane, the answer [`occluded_lanes`] gives for the same ray in a
-/// queue; the other lanes' bits mean nothing.
+/// bit mask: for every live lane, the answer [`occluded`] gives for the same ray in a queue;
+/// the other lanes' bits mean nothing. The primitives tested are counted in `c` once for the
+/// block (each live lane did those tests).
 #[inline(always)]
-pub fn hit_rays_occluded<V: Lanes>(
-    triangles: &[Triangle],
-    spheres: &[Sphere],
-    rays: &HitRays<V::Array>,
-    live: u32,
-    two_sided: bool,
-) -> u32 {
-    hit_rays_occluded_counted::<V, NoCount>(triangles, spheres, rays, live, two_sided, &mut NoCount)
-}
-
-/// [`hit_rays_occluded`], the primitives the block tested counted in `c` (once for the block:
-/// each live lane did those tests).
-#[inline(always)]
-pub fn hit_rays_occluded_counted<V: Lanes, C: Counter>(
+pub fn hit_rays_occluded<V: Lanes, C: Counter>(
     triangles: &[Triangle],
     spheres: &[Sphere],
     rays: &HitRays<V::Array>,

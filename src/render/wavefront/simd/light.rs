@@ -7,7 +7,7 @@ use super::point_sets;
 use crate::render::sampling::Stream;
 use crate::render::spawn::{LightEnd, SurfaceHit};
 use crate::render::wavefront::batch::ShadowBlock;
-use crate::render::wavefront::lanes::{LANES, Lanes, LanesU, f32x8};
+use crate::render::wavefront::lanes::{Lanes, LanesU};
 use glam::Vec3;
 
 /// Chris Wellons' `lowbias32`, N lanes; twin of `sampling::mix32`.
@@ -97,12 +97,6 @@ fn divide<V: Lanes>(x: V, n: f32) -> V {
     } else {
         x / V::splat(n)
     }
-}
-
-/// Light points x, y, z of samples `j0..j0 + 8`: [`light_points`] at 8 lanes.
-#[inline]
-pub fn light_points8(b: &LightBlock) -> [[f32; LANES]; 3] {
-    light_points::<f32x8>(b)
 }
 
 /// Light points x, y, z of samples `j0..j0 + N`: lane k equals
@@ -248,17 +242,6 @@ fn parallelogram_points8<V: Lanes>(
         axis(origin.y, edge_u.y, edge_v.y),
         axis(origin.z, edge_u.z, edge_v.z),
     ]
-}
-
-/// Shadow rays from `hit` to 8 light points: [`shadow_rays`] at 8 lanes.
-#[inline]
-pub fn shadow_rays8(
-    hit: &SurfaceHit,
-    target: &[[f32; LANES]; 3],
-    end: &LightEnd,
-    lanes: usize,
-) -> ShadowBlock {
-    shadow_rays::<f32x8>(hit, target, end, lanes)
 }
 
 /// Shadow rays from `hit` to N light points, the first `lanes` of them real: lane k equals

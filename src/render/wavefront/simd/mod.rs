@@ -5,12 +5,13 @@
 //! loads and masks come from `wavefront/lanes.rs`.
 //!
 //! The brute-force, light and shading kernels are written once, generic over the lane type
-//! (`lanes::Lanes`), and run 8 or 16 lanes wide (`lanes::LaneWidth`). `closest_hits`,
-//! `occluded`, `light_points8`, `shadow_rays8` and `shade8` are their 8-lane entry points,
-//! `closest_hits_lanes`, `occluded_lanes`, `light_points`, `shadow_rays` and
-//! `shade::shade_lanes` take the width as a type parameter, and `triangle8`, `sphere8` and
-//! `moller_trumbore8` (names from the 8-wide days) take it from their operands. The mesh BVH's
-//! kernels stay 8-wide.
+//! (`lanes::Lanes`), and run 8 or 16 lanes wide (`lanes::LaneWidth`). Each has one entry
+//! point, which takes the width as a type parameter (`closest_hits::<V>`, `occluded::<V, _>`,
+//! `light_points::<V>`, `shadow_rays::<V>`, `shade::shade_lanes::<V>`; a width chosen at run
+//! time becomes that type in `lanes::at_width!`), or from its operands (`triangle8`,
+//! `sphere8` and `moller_trumbore8`, names from the 8-wide days). The kernels that count their
+//! work (`occluded`, `block_occluded`, `hit_rays_occluded`) take the count's sink too, and
+//! `cost::NoCount` compiles it away. The mesh BVH's kernels stay 8-wide.
 //!
 //! Every kernel is a lane-by-lane copy of a scalar twin, with the same operations in the
 //! same order, so that with IEEE arithmetic (no FMA contraction: Rust never fuses `a * b + c`,
@@ -22,10 +23,10 @@
 //! | [`sphere8`]          | `geometry::intersect_sphere`                             |
 //! | [`closest_hits`]     | `Accel::closest` without a BVH                           |
 //! | [`occluded`]         | `Accel::occluded` without a BVH                          |
-//! | [`light_points8`]    | `sampling::PointSet::point` then `Light::point`          |
+//! | [`light_points`]     | `sampling::PointSet::point` then `Light::point`          |
 //! | `point_sets::{halton, zsobol, pmj02}` | `sampling::Stream::point` of those samplers |
-//! | [`shadow_rays8`]     | the start of `Reference::direct` (l, dist, n·l)          |
-//! | `shade::shade8`      | `shade::shade_terms`, twin of `shading::shade`           |
+//! | [`shadow_rays`]      | the start of `Reference::direct` (l, dist, n·l)          |
+//! | `shade::shade_lanes` | `shade::shade_terms`, twin of `shading::shade`           |
 //!
 //! Branches become masks: a lane that misses gets `f32::INFINITY`, exactly like the twins'
 //! sentinel. Batches whose length is not a multiple of the width are padded with lanes that
@@ -37,13 +38,9 @@ mod light;
 mod point_sets;
 
 pub(crate) use geometry::{TriangleLanes, moller_trumbore8, moller_trumbore8_blocks};
-pub use geometry::{
-    block_occluded, block_occluded_counted, closest_hits, closest_hits_at, closest_hits_lanes,
-    hit_rays_occluded, hit_rays_occluded_counted, occluded, occluded_at, occluded_counted,
-    occluded_lanes, occluded_lanes_counted, sphere8, triangle8,
-};
+pub use geometry::{block_occluded, closest_hits, hit_rays_occluded, occluded, sphere8, triangle8};
 pub use hit_rays::{HitLanes, hit_shadow_rays};
-pub use light::{BlockSampler, LightBlock, light_points, light_points8, shadow_rays, shadow_rays8};
+pub use light::{BlockSampler, LightBlock, light_points, shadow_rays};
 
 use super::lanes::{LANES, Lanes, f32x8};
 use crate::render::geometry::Ray;
