@@ -23,7 +23,7 @@
 //!     undecided otherwise (the interval straddles a boundary: more rounds narrow it)
 //! ```
 //!
-//! The interval is distribution-free (`statistics::median_interval_rank`): for n paired ratios
+//! The interval is distribution-free (`stats::median_interval_rank_at`): for n paired ratios
 //! sorted, the median lies between the k-th and the (n − k + 1)-th with probability ≥ 95%, k the
 //! largest with P(Binomial(n, ½) < k) ≤ 2.5%. It needs n ≥ 6.
 //!

@@ -8,7 +8,7 @@ use crate::render::settings::RenderSettings;
 /// The settings fields each image flag sets (as named in the record's JSON). `--defaults`
 /// sets them all: given explicitly, nothing is adopted. Fields no flag names (the seed) are
 /// always adopted.
-pub(crate) const FLAG_FIELDS: [(&str, &[&str]); 10] = [
+const FLAG_FIELDS: [(&str, &[&str]); 10] = [
     ("size", &["width", "height"]),
     ("bounces", &["bounces"]),
     ("shadows", &["shadows"]),

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 /// Where `compare`'s argument lives: a path when it ends in `.json`, else a record name in
 /// `dir` (`record::record_path`).
-pub(crate) fn locate(dir: &Path, name: &str) -> Result<PathBuf> {
+fn locate(dir: &Path, name: &str) -> Result<PathBuf> {
     if name.ends_with(".json") {
         Ok(PathBuf::from(name))
     } else {

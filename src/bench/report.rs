@@ -7,7 +7,7 @@ use crate::render::settings::{RenderSettings, ShadowMode};
 use std::fmt::Write as _;
 
 /// A median whose 95% interval is wider than this share of it, in percent, is called noisy.
-pub(crate) const NOISY_WIDTH_PCT: f64 = 10.0;
+const NOISY_WIDTH_PCT: f64 = 10.0;
 
 /// The printed report of one record: header, then per engine its kinds and stages, then the
 /// headline figures.

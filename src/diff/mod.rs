@@ -32,7 +32,7 @@ use glam::Vec3;
 use serde::Serialize;
 
 /// relMSE's denominator is (b + RELATIVE_EPSILON)², as in pbrt-v4.
-pub(crate) const RELATIVE_EPSILON: f64 = 0.01;
+const RELATIVE_EPSILON: f64 = 0.01;
 
 /// The peak value PSNR is taken against: 8- and 16-bit images are read as [0, 1].
 pub const PSNR_PEAK: f64 = 1.0;
@@ -414,7 +414,7 @@ pub fn pixel_errors(a: &Image, b: &Image, region: &Region, metric: Metric) -> Ve
 }
 
 /// The longest side of an error figure, in pixels.
-pub(crate) const MAX_FIGURE_SIDE: u64 = 16384;
+const MAX_FIGURE_SIDE: u64 = 16384;
 
 /// The false-colour figure of a per-pixel error map: a log scale for the squared errors, a
 /// linear one for |a − b| and FLIP; NaN (outside the region) is drawn darkest.

@@ -334,7 +334,7 @@ pub fn record_path(dir: &Path, name: &str) -> Result<std::path::PathBuf> {
 }
 
 /// The largest record file `load` reads (a record of 1000 runs is about 1 MiB).
-pub(crate) const MAX_RECORD_BYTES: u64 = 64 << 20;
+const MAX_RECORD_BYTES: u64 = 64 << 20;
 
 /// Reads a saved record; a missing file says how to make one.
 pub fn load(path: &Path, name: &str) -> Result<BenchRecord> {
@@ -400,7 +400,7 @@ pub fn save(path: &Path, record: &BenchRecord) -> Result<()> {
 
 /// Seconds since the Unix epoch as RFC 3339 UTC (`2026-11-22T20:13:01Z`), by `humantime`.
 #[cfg(test)]
-pub(crate) fn rfc3339_utc(unix_seconds: u64) -> String {
+fn rfc3339_utc(unix_seconds: u64) -> String {
     let t = std::time::UNIX_EPOCH + std::time::Duration::from_secs(unix_seconds);
     humantime::format_rfc3339_seconds(t).to_string()
 }

@@ -267,10 +267,7 @@ pub fn unused(features: &[Feature], has: impl Fn(&Feature) -> bool) -> Vec<&'sta
 
 /// The `-C target-cpu` to suggest for a CPU: the highest x86-64 level (`x86-64-v4` to
 /// `x86-64`) all of whose features `has` finds.
-pub(crate) fn suggested_target(
-    features: &[Feature],
-    has: impl Fn(&Feature) -> bool,
-) -> &'static str {
+fn suggested_target(features: &[Feature], has: impl Fn(&Feature) -> bool) -> &'static str {
     let level_ok = |level: u8| {
         features
             .iter()

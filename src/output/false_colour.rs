@@ -122,7 +122,7 @@ impl Scale {
 
     /// The value at position `t` in [0, 1] (the inverse of [`Scale::position`] inside the
     /// range).
-    pub(crate) fn value_at(&self, t: f64) -> f64 {
+    fn value_at(&self, t: f64) -> f64 {
         if self.log {
             10f64.powf(self.low.log10() + t * (self.high.log10() - self.low.log10()))
         } else {

@@ -11,22 +11,22 @@
 use anyhow::{Result, bail};
 
 /// Bytes per pixel of the linear film (three `f32`).
-pub(crate) const FILM_BYTES_PER_PIXEL: u64 = 12;
+const FILM_BYTES_PER_PIXEL: u64 = 12;
 /// Bytes per pixel of the tone-mapped 8-bit copy.
-pub(crate) const RGB8_BYTES_PER_PIXEL: u64 = 3;
+const RGB8_BYTES_PER_PIXEL: u64 = 3;
 /// The process before any image: code, the thread pool, stacks, the scene's small arrays
 /// (a 512² PFM render peaks at 10.9 MiB, of which 3 MiB is the film).
-pub(crate) const BASE_BYTES: u64 = 8 << 20;
+const BASE_BYTES: u64 = 8 << 20;
 /// Per pixel, for encoder buffers and the allocator's rounding: keeps the estimate above the
 /// measured peaks (PNG at 4096² was within 1 % of film + 8-bit copy + base).
-pub(crate) const SLACK_BYTES_PER_PIXEL: u64 = 1;
+const SLACK_BYTES_PER_PIXEL: u64 = 1;
 /// Per triangle or sphere, the scene arrays and both engines' BVH copies.
-pub(crate) const BYTES_PER_PRIMITIVE: u64 = 400;
+const BYTES_PER_PRIMITIVE: u64 = 400;
 /// Per camera sample of a wavefront tile (rays, hits, shadow queue, radiance, next rays).
-pub(crate) const WORKSPACE_BYTES_PER_SAMPLE: u64 = 512;
+const WORKSPACE_BYTES_PER_SAMPLE: u64 = 512;
 /// Per pixel for `--cost-map`: its counts by kind (36 bytes), the map's values (4) and the
 /// figure's pixels, two panels of 3 bytes.
-pub(crate) const COST_MAP_BYTES_PER_PIXEL: u64 = 48;
+const COST_MAP_BYTES_PER_PIXEL: u64 = 48;
 
 /// What a render holds at its peak.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -49,7 +49,7 @@ pub struct RenderFootprint {
 
 impl RenderFootprint {
     /// The estimated peak in bytes: an upper bound of the measured peak.
-    pub(crate) fn peak_bytes(&self) -> u64 {
+    fn peak_bytes(&self) -> u64 {
         let per_pixel = FILM_BYTES_PER_PIXEL
             + SLACK_BYTES_PER_PIXEL
             + if self.rgb8 { RGB8_BYTES_PER_PIXEL } else { 0 }
@@ -154,7 +154,7 @@ pub fn parse_size(s: &str) -> Result<u64, String> {
 }
 
 /// Bytes for people: `1.5 GiB`, `300 MiB`.
-pub(crate) fn format_bytes(bytes: u64) -> String {
+fn format_bytes(bytes: u64) -> String {
     let mib = bytes as f64 / (1u64 << 20) as f64;
     if mib >= 1024.0 {
         format!("{:.1} GiB", mib / 1024.0)

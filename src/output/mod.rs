@@ -36,7 +36,7 @@ use std::os::unix::fs::MetadataExt;
 use std::path::{Path, PathBuf};
 
 /// The path that means standard output (and standard input for a scene).
-pub(crate) const STDIO: &str = "-";
+const STDIO: &str = "-";
 
 /// True when `path` is `-`.
 pub fn is_stdio(path: &Path) -> bool {

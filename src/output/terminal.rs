@@ -40,7 +40,7 @@ pub fn with_bar<T>(template: &str, quiet: bool, work: impl FnOnce(&Progress) -> 
 /// Writes `text` to standard output and flushes it. A closed pipe (`raywave ... | head`) or a
 /// full disk is an error, so that `main` exits 1 with a message instead of panicking as
 /// `println!` does.
-pub(crate) fn write_stdout(text: &str) -> std::io::Result<()> {
+fn write_stdout(text: &str) -> std::io::Result<()> {
     let mut out = std::io::stdout().lock();
     out.write_all(text.as_bytes())?;
     out.flush()

@@ -40,7 +40,7 @@ use std::time::{Duration, Instant};
 
 /// The variable naming the folder that holds `libembree4*.so.4` (read at run time, and at
 /// build time for the default).
-pub const DIR_ENV: &str = "RAYWAVE_EMBREE4_DIR";
+const DIR_ENV: &str = "RAYWAVE_EMBREE4_DIR";
 
 type Device = *mut c_void;
 type Geometry = *mut c_void;
@@ -706,7 +706,7 @@ impl BuildQuality {
         [BuildQuality::Low, BuildQuality::Medium, BuildQuality::High];
 
     /// The environment variable that chooses the build's quality.
-    pub const ENV: &'static str = "RAYWAVE_EMBREE_QUALITY";
+    const ENV: &'static str = "RAYWAVE_EMBREE_QUALITY";
 
     /// `low`, `medium` or `high`.
     pub fn name(self) -> &'static str {
@@ -718,7 +718,7 @@ impl BuildQuality {
     }
 
     /// The `RTCBuildQuality` value (0, 1, 2 in `rtcore_common.h`).
-    pub fn rtc(self) -> u32 {
+    fn rtc(self) -> u32 {
         match self {
             BuildQuality::Low => 0,
             BuildQuality::Medium => 1,

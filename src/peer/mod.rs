@@ -593,7 +593,7 @@ impl Agreement {
 
 /// Relative distance tolerance under which two hits on different triangles count as one hit
 /// on their shared edge.
-pub(crate) const EDGE_T_TOLERANCE: f32 = 1e-4;
+const EDGE_T_TOLERANCE: f32 = 1e-4;
 
 /// Under this distance a hit that one engine reports counts as agreeing with whatever the other
 /// reports (a miss, or a hit farther on): a ray that starts on the edge where two faces meet (a
@@ -603,7 +603,7 @@ pub(crate) const EDGE_T_TOLERANCE: f32 = 1e-4;
 /// intervals: tinybvh's plain BVH accepts t = 0 (it rejects only t < 0, and −0 passes), where
 /// raywave and Embree need t > 0 and go on to the next surface (15 of 43,264 incoherent rays
 /// of the mesh test scene at 256×256).
-pub const NEAR_ORIGIN_T: f32 = 1e-5;
+const NEAR_ORIGIN_T: f32 = 1e-5;
 
 /// Closest hits agree when both miss, both name the same triangle, both hit at distances
 /// within `EDGE_T_TOLERANCE · max(1, t)` (two triangles sharing the edge the ray crosses), or

@@ -377,7 +377,7 @@ pub fn largest_coordinate(m: f32, v: Vec3) -> f32 {
 /// thousand times smaller than the lab's, hits were lost (hundreds of pixels against the f64
 /// oracle). The reference builds and walks the tree in coordinates scaled by this factor,
 /// where 1e-4 is 1.5e-9 of the scene; a power of two changes no bits.
-pub(crate) fn bvh_scale(scene: &Scene) -> f32 {
+fn bvh_scale(scene: &Scene) -> f32 {
     let largest = scene
         .triangles
         .iter()
@@ -391,7 +391,7 @@ pub(crate) fn bvh_scale(scene: &Scene) -> f32 {
 }
 
 /// `build_cwbvh` over the triangles scaled by `scale` (a power of two).
-pub(crate) fn build_cwbvh_scaled(scene: &Scene, scale: f32) -> CwBvh {
+fn build_cwbvh_scaled(scene: &Scene, scale: f32) -> CwBvh {
     let tris: Vec<obvhs::triangle::Triangle> = scene
         .triangles
         .iter()
@@ -418,7 +418,7 @@ pub fn obvhs_ray(ray: &Ray, tmax: f32) -> obvhs::ray::Ray {
 
 /// `obvhs_ray` in coordinates scaled by `scale` (a power of two): the origin and distances
 /// scale, the direction does not.
-pub(crate) fn obvhs_ray_scaled(ray: &Ray, tmax: f32, scale: f32) -> obvhs::ray::Ray {
+fn obvhs_ray_scaled(ray: &Ray, tmax: f32, scale: f32) -> obvhs::ray::Ray {
     obvhs::ray::Ray::new(
         Vec3A::from(ray.origin * scale),
         Vec3A::from(ray.direction + Vec3::ZERO),

@@ -3,7 +3,7 @@
 //! is cut, so that a hostile file can neither drive the terminal nor flood it.
 
 /// The most characters of one quoted piece of input a message shows.
-pub(crate) const QUOTE_CHARS: usize = 60;
+const QUOTE_CHARS: usize = 60;
 
 /// `text` with every control or bidirectional-formatting character escaped (`\x1b`, `\n`,
 /// `\u{202e}`); everything else, non-ASCII letters included, as is.

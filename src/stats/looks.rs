@@ -33,7 +33,7 @@ use super::median::min_for_interval_at;
 pub const ALPHA: f64 = 0.05;
 
 /// Each planned look after the first comes at ⌈GROWTH × the previous look's rounds⌉.
-pub(crate) const GROWTH: f64 = 1.5;
+const GROWTH: f64 = 1.5;
 
 /// The planned looks and the level of each look's interval.
 #[derive(Clone, Debug, PartialEq)]

@@ -18,14 +18,8 @@ pub fn median(xs: &[f64]) -> f64 {
     }
 }
 
-/// The fewest values that give a 95% interval of the median (see [`median_interval_rank`]).
+/// The fewest values that give a 95% interval of the median (see [`median_interval_rank_at`]).
 pub const MIN_FOR_INTERVAL: usize = 6;
-
-/// The 1-based rank k of the lower end of a 95% interval of the median of n values
-/// ([`median_interval_rank_at`] with `alpha` 0.05). `None` below [`MIN_FOR_INTERVAL`].
-pub fn median_interval_rank(n: usize) -> Option<usize> {
-    median_interval_rank_at(n, 0.05)
-}
 
 /// The 1-based rank k of the lower end of a (1 − `alpha`) interval of the median of n values:
 /// for n values sorted, the median lies between the k-th and the (n − k + 1)-th with
@@ -60,7 +54,7 @@ pub fn min_for_interval_at(alpha: f64) -> usize {
         .unwrap_or(usize::MAX)
 }
 
-/// The median of `xs` and its 95% interval ([`median_interval_rank`]); the interval is
+/// The median of `xs` and its 95% interval ([`median_interval_rank_at`] at 0.05); the interval is
 /// (−∞, ∞) with fewer than [`MIN_FOR_INTERVAL`] values. NaN values are ignored.
 pub fn median_with_interval(xs: &[f64]) -> (f64, f64, f64) {
     median_with_interval_at(xs, 0.05)
@@ -87,7 +81,7 @@ pub const OUTLIER_Z: f64 = 14.0;
 /// median absolute deviation: robust, since neither the median nor the MAD moves much with one
 /// wild value. When the MAD is 0 (most values equal), a value equal to the median scores 0 and
 /// any other ±∞. NaN values score NaN.
-pub(crate) fn modified_z_scores(xs: &[f64]) -> Vec<f64> {
+fn modified_z_scores(xs: &[f64]) -> Vec<f64> {
     let m = median(xs);
     let deviations: Vec<f64> = xs.iter().map(|x| (x - m).abs()).collect();
     let mad = median(&deviations);
@@ -119,6 +113,11 @@ pub fn outliers(xs: &[f64]) -> Vec<usize> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The rank of the 95% interval, the one the tools use.
+    fn median_interval_rank(n: usize) -> Option<usize> {
+        median_interval_rank_at(n, 0.05)
+    }
 
     #[test]
     fn medians() {

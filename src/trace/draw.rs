@@ -30,12 +30,12 @@ use image::RgbImage;
 use rayon::prelude::*;
 
 /// How much of a segment's colour its see-through copy mixes into the image.
-pub(crate) const FAINT_ALPHA: f32 = 0.35;
+const FAINT_ALPHA: f32 = 0.35;
 /// Dash and gap length of blocked shadow rays, in pixels.
-pub(crate) const DASH_PIXELS: f32 = 6.0;
+const DASH_PIXELS: f32 = 6.0;
 /// The depth test lets a segment through this fraction of the scene's diagonal behind the first
 /// surface (segments end on surfaces).
-pub(crate) const DEPTH_TOLERANCE: f32 = 2e-3;
+const DEPTH_TOLERANCE: f32 = 2e-3;
 /// The render camera's marker is a frustum this fraction of the scene's diagonal deep.
 pub const MARKER_SIZE: f32 = 0.08;
 

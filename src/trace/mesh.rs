@@ -22,9 +22,9 @@ use glam::Vec3;
 use std::f32::consts::PI;
 
 /// Latitude bands of a tessellated sphere.
-pub(crate) const SPHERE_RINGS: u32 = 12;
+const SPHERE_RINGS: u32 = 12;
 /// Longitude steps of a tessellated sphere.
-pub(crate) const SPHERE_SEGMENTS: u32 = 24;
+const SPHERE_SEGMENTS: u32 = 24;
 
 /// One named group.
 #[derive(Clone, Debug, PartialEq)]

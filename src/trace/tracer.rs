@@ -70,7 +70,7 @@ pub enum TraceError {
 
 /// The most segments a tree may hold (about 400 MB of JSON): a bound on the count, from the
 /// settings, is checked before tracing, so a huge request is refused instead of filling memory.
-pub(crate) const MAX_SEGMENTS: u64 = 1_000_000;
+const MAX_SEGMENTS: u64 = 1_000_000;
 
 /// Traces pixel (x, y) (from the top-left) of `scene` rendered with `settings` and records its
 /// ray tree; errors when the pixel is outside the image.

@@ -168,7 +168,7 @@ pub fn nearest_budget(budgets: &[u32], n: u32) -> Option<u32> {
 }
 
 /// The largest total size of the K images a study holds at once.
-pub(crate) const MAX_STUDY_BYTES: u64 = 4 << 30;
+const MAX_STUDY_BYTES: u64 = 4 << 30;
 
 /// The cases of the study `options` describe: each scene at each size, in that order. Scene
 /// warnings go to `notice`.
@@ -246,7 +246,7 @@ pub fn load_cases(options: &VarianceOptions, notice: &dyn Fn(&str)) -> Result<Ve
 }
 
 /// The cache `options` ask for, if its directory can be made (else a warning, and none).
-pub(crate) fn open_cache(options: &VarianceOptions, notice: &dyn Fn(&str)) -> Option<Cache> {
+fn open_cache(options: &VarianceOptions, notice: &dyn Fn(&str)) -> Option<Cache> {
     let cache = (!options.no_cache).then(|| Cache::new(&options.cache, options.cache_limit_mib))?;
     match std::fs::create_dir_all(&cache.dir) {
         Ok(()) => Some(cache),

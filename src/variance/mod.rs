@@ -350,7 +350,7 @@ pub fn run_study(
 
 impl StudyResult {
     /// The smallest MSE measured in a region, to compare with the reference's own error.
-    pub(crate) fn smallest_mse(&self, region: Region) -> f64 {
+    fn smallest_mse(&self, region: Region) -> f64 {
         self.rows
             .iter()
             .filter(|r| r.region == region && r.stats.mse > 0.0)

@@ -23,13 +23,13 @@ use std::time::{Duration, Instant};
 pub(crate) const REQUEST_TIME: Duration = Duration::from_secs(5);
 
 /// The time a client has to take its reply.
-pub(crate) const WRITE_TIME: Duration = Duration::from_secs(30);
+const WRITE_TIME: Duration = Duration::from_secs(30);
 
 /// The largest request head (request line and headers).
-pub(crate) const MAX_HEAD_BYTES: usize = 16 * 1024;
+const MAX_HEAD_BYTES: usize = 16 * 1024;
 
 /// The most headers in one request.
-pub(crate) const MAX_HEADERS: usize = 64;
+const MAX_HEADERS: usize = 64;
 
 /// A request, read whole.
 #[derive(Debug)]

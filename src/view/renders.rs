@@ -44,7 +44,7 @@ pub(crate) const RENDER_BURST: u32 = 20;
 pub(crate) const RENDER_RATE: f64 = 20.0;
 
 /// The divisors of the levels, coarse to fine.
-pub(crate) const LEVEL_DIVISORS: [u32; 4] = [8, 4, 2, 1];
+const LEVEL_DIVISORS: [u32; 4] = [8, 4, 2, 1];
 
 /// Where a job is.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -193,7 +193,7 @@ impl RenderJob {
 
 /// The sizes of the levels of a `width` × `height` image: each divisor's, rounded up, without
 /// repeats (a 10-pixel image has fewer than four levels).
-pub(crate) fn level_sizes(width: u32, height: u32) -> Vec<[u32; 2]> {
+fn level_sizes(width: u32, height: u32) -> Vec<[u32; 2]> {
     let mut sizes: Vec<[u32; 2]> = Vec::new();
     for d in LEVEL_DIVISORS {
         let s = [width.div_ceil(d), height.div_ceil(d)];

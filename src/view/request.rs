@@ -18,9 +18,9 @@ pub const MAX_SIDE: u32 = 2048;
 /// The most camera samples (pixels × aa) one render may take.
 pub const MAX_CAMERA_SAMPLES: u64 = 4 << 20;
 /// The most shadow points per light.
-pub(crate) const MAX_SHADOW_SAMPLES: u32 = 4096;
+const MAX_SHADOW_SAMPLES: u32 = 4096;
 /// The most mirror bounces (the command line's bound).
-pub(crate) const MAX_BOUNCES: u32 = 64;
+const MAX_BOUNCES: u32 = 64;
 
 /// A pinhole camera as the page sends it (degrees, not radians).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -38,7 +38,7 @@ pub struct CameraJson {
 
 impl CameraJson {
     /// The scene camera as JSON.
-    pub(crate) fn from_camera(c: &Camera) -> Self {
+    fn from_camera(c: &Camera) -> Self {
         CameraJson {
             position: c.position.to_array(),
             look_at: c.point_of_interest.to_array(),
@@ -48,7 +48,7 @@ impl CameraJson {
     }
 
     /// The camera, or a 400 naming what is wrong with it.
-    pub(crate) fn to_camera(&self) -> Result<Camera, ApiError> {
+    fn to_camera(&self) -> Result<Camera, ApiError> {
         let all = [self.position, self.look_at, self.up];
         if all
             .iter()

@@ -9,7 +9,7 @@ use serde::Serialize;
 
 /// The most triangles sent to the page: beyond this the 3D view shows the first ones and says
 /// so (a 1M-triangle mesh would be 100 MB of JSON; the render itself is not limited).
-pub(crate) const MAX_DRAWN_TRIANGLES: usize = 200_000;
+const MAX_DRAWN_TRIANGLES: usize = 200_000;
 
 /// The scene for WebGL.
 #[derive(Serialize)]
@@ -45,7 +45,7 @@ pub(crate) struct SphereJson {
 
 /// The colour a surface is drawn with: its emission for lights, else its diffuse colour plus
 /// half its mirror colour (so mirrors read as light grey), clamped to [0, 1].
-pub(crate) fn display_colour(m: &Material) -> [f32; 3] {
+fn display_colour(m: &Material) -> [f32; 3] {
     let c = if m.emitted.max_element() > 0.0 {
         m.emitted / m.emitted.max_element()
     } else {

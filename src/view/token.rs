@@ -20,10 +20,10 @@ use subtle::ConstantTimeEq;
 const RANDOM_BYTES: usize = 24;
 
 /// The shortest token `--token` accepts.
-pub(crate) const MIN_LEN: usize = 16;
+const MIN_LEN: usize = 16;
 
 /// The longest token `--token` accepts.
-pub(crate) const MAX_LEN: usize = 256;
+const MAX_LEN: usize = 256;
 
 /// The secret every request must carry.
 #[derive(Clone, PartialEq, Eq)]
@@ -99,7 +99,7 @@ pub(crate) struct Presented<'a> {
 }
 
 /// The cookie's name: one per port, so that two viewers on one machine keep their own.
-pub(crate) fn cookie_name(port: u16) -> String {
+fn cookie_name(port: u16) -> String {
     format!("raywave_token_{port}")
 }
 

@@ -11,11 +11,11 @@ use serde::Serialize;
 
 /// The most segments a tree may have before it is traced (its JSON is about 1 KB a segment, and
 /// the page draws and lists each one).
-pub(crate) const MAX_TREE_SEGMENTS: u64 = 50_000;
+const MAX_TREE_SEGMENTS: u64 = 50_000;
 
 /// The most segments one pixel's tree can have: per camera sample, a camera or mirror ray at
 /// each depth, each followed by its shadow rays.
-pub(crate) fn max_segments(scene: &Scene, settings: &RenderSettings) -> u64 {
+fn max_segments(scene: &Scene, settings: &RenderSettings) -> u64 {
     let per_hit = 1 + scene.lights.len() as u64 * settings.points_per_light() as u64;
     settings.aa_samples.max(1) as u64 * (settings.bounces as u64 + 1) * per_hit
 }

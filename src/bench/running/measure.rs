@@ -103,7 +103,7 @@ fn timed(
 
 /// The order in which round `round` runs `n` engines: 0..n rotated by `round`, so each engine
 /// goes first in turn.
-pub(crate) fn round_order(n: usize, round: usize) -> Vec<usize> {
+fn round_order(n: usize, round: usize) -> Vec<usize> {
     (0..n).map(|i| (i + round) % n.max(1)).collect()
 }
 

@@ -61,7 +61,7 @@ fn permute(base: u32, h: u32, d: u32) -> u32 {
 /// digits permuted one by one and the rest drawn as one uniform number; `seed` picks the
 /// scramble. In [0, 1).
 #[inline]
-pub fn radical_inverse(base: u32, digits: u32, index: u32, seed: u32) -> f32 {
+fn radical_inverse(base: u32, digits: u32, index: u32, seed: u32) -> f32 {
     let mut h = mix32(seed ^ ROOT_SALT);
     let mut n = index;
     let mut kept = 0u32;

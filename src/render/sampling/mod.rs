@@ -88,7 +88,7 @@ impl LightSampler {
 
     /// The most points per light a stream of this sampler holds, and why; `None` for no limit
     /// below the command line's 65536.
-    pub(crate) fn max_points(self) -> Option<(u32, &'static str)> {
+    fn max_points(self) -> Option<(u32, &'static str)> {
         match self {
             LightSampler::Sobol => Some((65_536, "its Sobol indices are 16 bits")),
             LightSampler::Pmj02 => {
@@ -302,7 +302,7 @@ impl PointSet {
     /// inner loops cost those 3–8% more instructions (tests/gates/icount.rs). A loop over a
     /// stream's points should take its [`PointSet::stream`] once instead.
     #[inline(never)]
-    pub(crate) fn table_point(&self, key: &SampleKey, index: u32) -> (f32, f32) {
+    fn table_point(&self, key: &SampleKey, index: u32) -> (f32, f32) {
         match self.stream(key) {
             Some(stream) => stream.point(index),
             None => self.point(key, index),

@@ -34,7 +34,7 @@ use std::sync::OnceLock;
 pub const TABLE_POINTS: usize = 4096;
 
 /// Tables the streams choose among.
-pub(crate) const SETS: usize = 8;
+const SETS: usize = 8;
 
 /// The tables of each power-of-two size, generated on first use: a set of 4096 points takes
 /// about 25 ms, one of 16 points 5 µs, and a stream of N points reads the tables of the next
@@ -199,7 +199,7 @@ pub fn generate(n: usize, seed: u64) -> Vec<(u32, u32)> {
 }
 
 /// [`generate`] without the restart: `None` at a dead end.
-pub(crate) fn try_generate(n: usize, seed: u64) -> Option<Vec<(u32, u32)>> {
+fn try_generate(n: usize, seed: u64) -> Option<Vec<(u32, u32)>> {
     let mut rng = SplitMix64(seed);
     let mut points = Vec::with_capacity(n);
     if n == 0 {

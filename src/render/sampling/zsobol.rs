@@ -38,7 +38,7 @@ pub struct Layout {
 }
 
 /// The smallest b with 2^b ≥ n (0 for n ≤ 1).
-pub(crate) fn bits_for(n: u32) -> u32 {
+fn bits_for(n: u32) -> u32 {
     n.max(1).next_power_of_two().trailing_zeros()
 }
 
@@ -72,7 +72,7 @@ impl Layout {
 
 /// x's bits in the even positions, y's in the odd ones (each below 2^16).
 #[inline]
-pub(crate) fn morton(x: u32, y: u32) -> u32 {
+fn morton(x: u32, y: u32) -> u32 {
     let spread = |v: u32| {
         let mut v = v & 0xffff;
         v = (v | (v << 8)) & 0x00ff_00ff;
@@ -111,7 +111,7 @@ pub(crate) const PERMUTATIONS_4: [[u32; 4]; 24] = {
 /// lowest digit is one bit, flipped by a hashed bit.
 #[inline]
 #[cfg(test)]
-pub(crate) fn permute_digits(index: u32, bits: u32, seed: u32) -> u32 {
+fn permute_digits(index: u32, bits: u32, seed: u32) -> u32 {
     permute_part(index, bits, seed, |_| true)
 }
 
@@ -269,7 +269,7 @@ pub fn owen_scramble(x: u32, seed: u32) -> u32 {
 /// Corput sequence, dimension 1 the one of the primitive polynomial x + 1 (direction numbers
 /// v₀ = 2⁻¹, vₖ = vₖ₋₁ ⊕ vₖ₋₁/2).
 #[inline]
-pub fn sobol_2d(index: u32) -> (u32, u32) {
+fn sobol_2d(index: u32) -> (u32, u32) {
     let mut v = 1u32 << 31;
     let mut y = 0;
     let mut i = index;
@@ -285,7 +285,7 @@ pub fn sobol_2d(index: u32) -> (u32, u32) {
 
 /// The stream seed: the render's seed, the bounce and the light, not the pixel or sample.
 #[inline]
-pub(crate) fn stream_seed(key: &SampleKey) -> u32 {
+fn stream_seed(key: &SampleKey) -> u32 {
     let mut h = mix32(key.seed ^ 0x2f1e_5c3b);
     h = mix32(h ^ key.bounce);
     mix32(h ^ key.light)

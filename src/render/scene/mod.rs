@@ -249,7 +249,7 @@ impl Scene {
     }
 
     /// Reads and parses a scene file; errors name the file and line.
-    pub(crate) fn load_with(path: &Path, options: &ParseOptions) -> Result<Scene, SceneError> {
+    fn load_with(path: &Path, options: &ParseOptions) -> Result<Scene, SceneError> {
         Ok(load_scene(Some(path), options)?.scene)
     }
 

@@ -140,7 +140,7 @@ pub fn texel_pair(i: f32, n: u32) -> (u32, u32) {
 /// from the normal equations of the edges: ratios of lengths, so unchanged when the scene is
 /// scaled.
 #[inline]
-pub fn barycentrics(tri: &Triangle, p: Vec3) -> (f32, f32) {
+fn barycentrics(tri: &Triangle, p: Vec3) -> (f32, f32) {
     let q = p - tri.v0;
     let (e1, e2) = (tri.e1, tri.e2);
     let d00 = e1.x * e1.x + e1.y * e1.y + e1.z * e1.z;
@@ -157,7 +157,7 @@ pub fn barycentrics(tri: &Triangle, p: Vec3) -> (f32, f32) {
 
 /// (s, t) at `p` on a triangle whose corners (v0, v0 + e1, v0 + e2) have coordinates `st`.
 #[inline]
-pub fn interpolate(tri: &Triangle, st: &[[f32; 2]; 3], p: Vec3) -> [f32; 2] {
+fn interpolate(tri: &Triangle, st: &[[f32; 2]; 3], p: Vec3) -> [f32; 2] {
     let (b1, b2) = barycentrics(tri, p);
     let b0 = 1.0 - b1 - b2;
     [0, 1].map(|k| b0 * st[0][k] + b1 * st[1][k] + b2 * st[2][k])

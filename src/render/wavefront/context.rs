@@ -55,7 +55,7 @@ pub struct TriangleShading {
 /// half the queue slots reserved per hit) and soft shadows of 8 points or fewer (the lab
 /// benchmark's frame at 16 lanes: 0.72–0.79× of 8 at 4 points, 0.83–0.88× at 8;
 /// docs/PERFORMANCE.md).
-pub(crate) fn auto_width(settings: &RenderSettings, points_per_light: u32) -> LaneWidth {
+fn auto_width(settings: &RenderSettings, points_per_light: u32) -> LaneWidth {
     match settings.shadows {
         ShadowMode::Hard => LaneWidth::Eight,
         ShadowMode::Soft if points_per_light <= 8 => LaneWidth::Eight,

@@ -83,7 +83,7 @@ pub(crate) fn ids(v: [u32; LANES]) -> i32x8 {
 /// Lane k of an 8-lane bitmask as a bool, for all 256 masks: a chunk's results are stored with
 /// one 8-byte copy instead of a loop over lanes (that loop was 6% of the lab benchmark's
 /// instructions).
-pub(crate) const MASK_BOOLS: [[bool; LANES]; 256] = {
+const MASK_BOOLS: [[bool; LANES]; 256] = {
     let mut table = [[false; LANES]; 256];
     let mut mask = 0;
     while mask < 256 {

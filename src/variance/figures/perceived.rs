@@ -45,7 +45,7 @@ pub struct Perceived {
 }
 
 /// The error image of `image` against `reference`: the mean of the three channels' difference.
-pub(crate) fn error_image(image: &[Vec3], reference: &[Vec3]) -> Vec<f64> {
+fn error_image(image: &[Vec3], reference: &[Vec3]) -> Vec<f64> {
     image
         .iter()
         .zip(reference)

@@ -22,11 +22,11 @@ use std::path::Path;
 /// Tiles are enlarged by a whole factor until their shorter side reaches this many pixels.
 pub const MIN_TILE: u32 = 128;
 /// Width of the row labels on the left.
-pub(crate) const LABEL_WIDTH: u32 = 110;
+const LABEL_WIDTH: u32 = 110;
 /// Height of the title.
 pub const TITLE_HEIGHT: u32 = 34;
 /// Height of the column headers.
-pub(crate) const HEADER_HEIGHT: u32 = 24;
+const HEADER_HEIGHT: u32 = 24;
 /// Space between and around tiles.
 pub(crate) const GAP: u32 = 8;
 

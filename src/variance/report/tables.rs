@@ -13,7 +13,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 /// Version of `results.json`'s layout; raised whenever a key changes meaning or goes away.
-pub(crate) const SCHEMA_VERSION: u32 = 3;
+const SCHEMA_VERSION: u32 = 3;
 
 /// The keys of `results.json`, each with what it holds.
 pub const SCHEMA: [(&str, &str); 15] = [
@@ -435,7 +435,7 @@ impl StudyResult {
     }
 
     /// One row per sampler, N, region and seed.
-    pub(crate) fn seeds_csv(&self) -> String {
+    fn seeds_csv(&self) -> String {
         let mut s = String::from("sampler,n,region,seed,mse,bias,seconds\n");
         for r in self.seed_rows() {
             let _ = writeln!(

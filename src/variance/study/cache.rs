@@ -33,7 +33,7 @@ use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 
 /// Bumped when the entry layout or the meaning of its key changes.
-pub(crate) const CACHE_FORMAT: u32 = 1;
+const CACHE_FORMAT: u32 = 1;
 
 /// The first bytes of every entry.
 pub const MAGIC: &[u8; 8] = b"RWREF01\n";
@@ -135,7 +135,7 @@ impl Cache {
     }
 
     /// The lock file of `key`'s entry.
-    pub(crate) fn lock_path(&self, key: u64) -> PathBuf {
+    fn lock_path(&self, key: u64) -> PathBuf {
         self.dir.join(format!("reference-{key:016x}.lock"))
     }
 

@@ -223,7 +223,7 @@ pub fn parse_scene_in(
 /// colour 0.2·ke·area multiply up to four of them, which stays finite in f32 (1e36 < 3.4e38)
 /// below 1e9; larger values overflowed to infinity and came out as "degenerate" faces or
 /// infinite lights.
-pub(super) const MAX_NUMBER: f32 = 1e9;
+const MAX_NUMBER: f32 = 1e9;
 
 /// Whether `token`, which Rust's float parser read as an infinity or NaN, is a finite number
 /// past the type's range (`1e39` as an f32, `-1e309` as an f64: the parser rounds those to an
