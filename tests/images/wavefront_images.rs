@@ -233,9 +233,10 @@ fn sixteen_and_eight_lanes_give_the_same_bytes_on_every_scene() {
 }
 
 /// Every shadow path a render admits (`shadow::ShadowPath`: soft shadows fused block by block
-/// in registers, hard shadows (and the unshadowed centroid rays of `--shadows off`) fused or
-/// queued N hits at a time) gives the bytes and counts of `QueuedPerHit`, which sends every ray
-/// through the queue hit by hit, on every bundled scene: every sampler, point counts with dead
+/// in registers, hard shadows (and the unshadowed centroid rays of `--shadows off`) fused N hits
+/// at a time) gives the bytes and counts of `QueuedPerHit`, which sends every ray through the
+/// queue hit by hit, on every bundled scene (on the mesh scene, through the BVH, the same
+/// traversal counts per pixel too): every sampler, point counts with dead
 /// tail lanes at 8 and 16 lanes, both light models (the RPI model's fall-off is computed from
 /// each block's distances), bounces, antialiasing, two-sided faces and odd batch sizes (groups
 /// of hits that end mid-vector). Every path is taken somewhere, and the path a render chooses
@@ -307,6 +308,19 @@ fn every_shadow_path_gives_the_per_hit_path_s_bytes() {
                              {s:?}"
                         );
                         assert_eq!(cp, cf, "{name}: {path:?}'s ray counts differ with {s:?}");
+                        // Through a BVH every ray's walk is its own, so each pixel's counted
+                        // work is the same whichever path queued or fused its rays.
+                        if engine().context().accel.is_some() && batch == 64 {
+                            let costs = |path| {
+                                let e = engine().with_shadow_path(path);
+                                e.render_counted(&Progress::SILENT, true).2.pixels
+                            };
+                            assert!(
+                                costs(ShadowPath::QueuedPerHit) == costs(path),
+                                "{name}: {path:?} changed the traversal counts at {width:?}, \
+                                 {s:?}"
+                            );
+                        }
                     }
                 }
             }

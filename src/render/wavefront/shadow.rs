@@ -12,7 +12,7 @@
 //!     shade:   in queue order, direct[hit] += Shade(l) / N for the rays not blocked
 //! ```
 //!
-//! Which of four paths a render takes is [`ShadowPath`], chosen once when the context is
+//! Which of three paths a render takes is [`ShadowPath`], chosen once when the context is
 //! built; its table below says when each is taken and what it costs. Every path gives the
 //! queue's sums bit for bit: the same (hit, light, point) order, the same kernels.
 //!
@@ -27,6 +27,7 @@
 //! the same bits.
 
 use super::batch::{HitBatch, RayBatch, ShadowQueue};
+use super::bvh::{MeshBvh, Stack};
 use super::context::Context;
 use super::cost::{Costs, Counter, Remap};
 use super::lanes::{Lanes, at_width, set_bits};
@@ -34,7 +35,7 @@ use super::shade::{
     HitLight, ShadowLanes, ShadowRegisters, shade_lanes, shade_registers, shade_terms,
 };
 use super::simd::{self, LightBlock, RayColumns};
-use crate::render::geometry::casters;
+use crate::render::geometry::{Ray, casters};
 use crate::render::sampling::{SampleKey, mix32};
 use crate::render::scene::NO_HIT;
 use crate::render::settings::LightModel;
@@ -46,43 +47,37 @@ use glam::Vec3;
 ///
 /// | path | taken when | spawn | occlusion | shade | what it costs and saves |
 /// | --- | --- | --- | --- | --- | --- |
-/// | `FusedSoft` | soft shadows, every light a parallelogram, a sampler with a lane formula (all but the lab's at N = 1), no BVH | N points of one (hit, light) at a time (`simd::light_points`, `simd::shadow_rays`) | `simd::block_occluded` against the shadow casters | in registers, added in point order | no queue: each block is spawned, tested and shaded while it is in registers (the lab benchmark's path) |
-/// | `FusedHard` | hard shadows (or none), no BVH | N hits at a time, one ray per light (`simd::hit_shadow_rays`) | `simd::hit_rays_occluded` against the casters | each lit ray, in light order | no queue; spawning across hits is what a hard-shadow ray costs most (56 instructions a ray against 161 hit by hit) |
-/// | `QueuedAcross` | hard shadows (or none) with a BVH | N hits at a time into the queue | the queue through `MeshBvh::occluded`, one ray at a time | in queue order | the BVH's walk is one ray at a time, so the rays wait in the queue |
-/// | `QueuedPerHit` | everything else: soft shadows with a BVH, fan lights, the lab's sampler at N = 1 | hit by hit, in (light, point) order, N points at a time where a lane formula exists, else the scalar `PointSet::point` | the queue, N rays at a time against the casters, or through the BVH | in queue order, aligned blocks N lanes at a time | the general path, and the one every other is held to |
+/// | `FusedSoft` | soft shadows, every light a parallelogram, a sampler with a lane formula (all but the lab's at N = 1) | N points of one (hit, light) at a time (`simd::light_points`, `simd::shadow_rays`) | `simd::block_occluded` against the shadow casters, or each live lane through `MeshBvh::lanes_occluded` | in registers, added in point order | no queue: each block is spawned, tested and shaded while it is in registers (the lab benchmark's path; on the 12k-triangle box 4.7% fewer instructions than the queue, the same wall-clock within 2%) |
+/// | `FusedHard` | hard shadows (or none) | N hits at a time, one ray per light (`simd::hit_shadow_rays`) | `simd::hit_rays_occluded` against the casters, or each live lane through `MeshBvh::lanes_occluded` | each lit ray, in light order | no queue; spawning across hits is what a hard-shadow ray costs most (56 instructions a ray against 161 hit by hit); on meshes the queue's push and reread were a third of the stage's instructions outside the walk (the 12k-triangle box: 20% fewer instructions, 1.19× the stage's rate) |
+/// | `QueuedPerHit` | everything else: fan lights, the lab's sampler at N = 1 | hit by hit, in (light, point) order, N points at a time where a lane formula exists, else the scalar `PointSet::point` | the queue, N rays at a time against the casters, or through the BVH one at a time | in queue order, aligned blocks N lanes at a time | the general path, and the one every other is held to |
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ShadowPath {
     /// Soft shadows spawned, tested and shaded block by block in registers.
     FusedSoft,
     /// One ray per (hit, light), N hits at a time, in registers.
     FusedHard,
-    /// One ray per (hit, light), spawned N hits at a time into the queue for the BVH.
-    QueuedAcross,
     /// Every ray spawned hit by hit into the queue.
     QueuedPerHit,
 }
 
 impl ShadowPath {
     /// Every path, fastest first: [`ShadowPath::choose`] takes the first the context admits.
-    pub const ALL: [ShadowPath; 4] = [
+    pub const ALL: [ShadowPath; 3] = [
         ShadowPath::FusedSoft,
         ShadowPath::FusedHard,
-        ShadowPath::QueuedAcross,
         ShadowPath::QueuedPerHit,
     ];
 
-    /// True when this path gives `ctx`'s shadow stage its image (the table's "taken when",
-    /// or wider: `QueuedAcross` also runs without a BVH, `QueuedPerHit` everywhere).
+    /// True when this path gives `ctx`'s shadow stage its image (the table's "taken when";
+    /// `QueuedPerHit` everywhere).
     pub fn admits(self, ctx: &Context) -> bool {
         match self {
             ShadowPath::FusedSoft => {
-                ctx.accel.is_none()
-                    && ctx.samples_lights()
+                ctx.samples_lights()
                     && ctx.simd_light_sampling()
                     && ctx.lights.iter().all(|l| l.parallelogram.is_some())
             }
-            ShadowPath::FusedHard => ctx.accel.is_none() && !ctx.samples_lights(),
-            ShadowPath::QueuedAcross => !ctx.samples_lights(),
+            ShadowPath::FusedHard => !ctx.samples_lights(),
             ShadowPath::QueuedPerHit => true,
         }
     }
@@ -137,32 +132,33 @@ fn direct_light_lanes<V: Lanes, S: Remap>(
 ) -> u64 {
     let n = rays.len();
     hits.direct.fill(0..n, glam::Vec3::ZERO);
-    let across = match ctx.shadow_path {
-        ShadowPath::FusedSoft => return fused::<V, S>(ctx, rays, hits, costs),
-        ShadowPath::FusedHard => return fused_hard::<V, S>(ctx, rays, hits, costs),
-        ShadowPath::QueuedAcross => true,
-        ShadowPath::QueuedPerHit => false,
-    };
+    match ctx.shadow_path {
+        // Meshes get instances of their own, so that the lab's instance (no BVH) is compiled as
+        // if the tree did not exist: with the choice made inside the block loop, the lab's
+        // fused stage took 2.7% more instructions (tests/gates/icount.rs).
+        ShadowPath::FusedSoft if ctx.accel.is_some() => {
+            return fused::<V, S, true>(ctx, rays, hits, costs);
+        }
+        ShadowPath::FusedSoft => return fused::<V, S, false>(ctx, rays, hits, costs),
+        ShadowPath::FusedHard if ctx.accel.is_some() => {
+            return fused_hard::<V, S, true>(ctx, rays, hits, costs);
+        }
+        ShadowPath::FusedHard => return fused_hard::<V, S, false>(ctx, rays, hits, costs),
+        ShadowPath::QueuedPerHit => {}
+    }
     // Room for one hit's rays at least, each light's points padded to whole N-lane blocks.
     let per_hit = ctx.lights.len() * (ctx.points_per_light as usize).div_ceil(V::N) * V::N;
     queue.reset(
         capacity.max(per_hit),
         ctx.settings.light_model != LightModel::Lab,
     );
-    // Across hits, one ray per (hit, light) is spawned N hits at a time; a group of N hits
-    // needs at most lights × N entries, which is `per_hit` at one point per light.
     let mut cast = 0;
     let mut next = 0;
     while next < n {
         queue.len = 0;
         while next < n && queue.room() >= per_hit {
-            if across {
-                cast += spawn_across::<V>(ctx, rays, hits, next, queue);
-                next += V::N;
-            } else {
-                cast += spawn::<V>(ctx, rays, hits, next, queue);
-                next += 1;
-            }
+            cast += spawn::<V>(ctx, rays, hits, next, queue);
+            next += 1;
         }
         if ctx.casts_shadow_rays() {
             occlude::<V, S>(ctx, queue, costs); // writes every entry
@@ -209,7 +205,7 @@ fn first_block<'c>(
 /// [`shade`] adds a queued block. Returns the rays cast. Never inlined, so that profiles name
 /// it apart from the queued stage.
 #[inline(never)]
-fn fused<V: Lanes, S: Costs>(
+fn fused<V: Lanes, S: Costs, const MESH: bool>(
     ctx: &Context,
     rays: &RayBatch,
     hits: &mut HitBatch,
@@ -221,6 +217,9 @@ fn fused<V: Lanes, S: Costs>(
     let model = ctx.settings.light_model;
     let weight = 1.0 / ctx.points_per_light as f32;
     let count = ctx.points_per_light;
+    // Meshes: each live lane's ray walks the tree one at a time, from registers.
+    let bvh = if MESH { ctx.accel.as_ref() } else { None };
+    let mut stack = bvh.map_or_else(Stack::default, MeshBvh::stack);
     let mut cast = 0;
     for i in 0..rays.len() {
         if hits.prim[i] == NO_HIT {
@@ -255,15 +254,39 @@ fn fused<V: Lanes, S: Costs>(
                     continue;
                 }
                 cast += block.live.count_ones() as u64;
-                let mut c = S::Counter::default();
-                let blockers = simd::block_occluded::<V, S::Counter>(
-                    triangles,
-                    &scene.spheres,
-                    &block,
-                    two_sided,
-                    &mut c,
-                );
-                costs.add(i, c.times(block.live.count_ones()));
+                let blockers = match bvh {
+                    Some(bvh) => {
+                        let lane = |k: usize| {
+                            let l = block.l.map(|c| c.as_ref()[k]);
+                            let ray = Ray {
+                                origin: block.origin,
+                                direction: Vec3::from_array(l),
+                            };
+                            (ray, block.tmax.as_ref()[k])
+                        };
+                        bvh.lanes_occluded(
+                            scene,
+                            block.live,
+                            lane,
+                            two_sided,
+                            &mut stack,
+                            |_| i,
+                            costs,
+                        )
+                    }
+                    None => {
+                        let mut c = S::Counter::default();
+                        let blockers = simd::block_occluded::<V, S::Counter>(
+                            triangles,
+                            &scene.spheres,
+                            &block,
+                            two_sided,
+                            &mut c,
+                        );
+                        costs.add(i, c.times(block.live.count_ones()));
+                        blockers
+                    }
+                };
                 let lanes = ShadowRegisters {
                     l: block.l.map(V::from_array),
                     n_dot_l: V::from_array(block.n_dot_l),
@@ -285,7 +308,7 @@ fn fused<V: Lanes, S: Costs>(
 /// hit as [`shade`] adds a queued one. Each hit's rays come in light order, so its sum is the
 /// queue's, bit for bit. Returns the rays cast. Never inlined, as [`fused`] is not.
 #[inline(never)]
-fn fused_hard<V: Lanes, S: Costs>(
+fn fused_hard<V: Lanes, S: Costs, const MESH: bool>(
     ctx: &Context,
     rays: &RayBatch,
     hits: &mut HitBatch,
@@ -297,6 +320,9 @@ fn fused_hard<V: Lanes, S: Costs>(
     let model = ctx.settings.light_model;
     let weight = 1.0 / ctx.points_per_light as f32;
     let occludes = ctx.casts_shadow_rays();
+    // Meshes: each live lane's ray walks the tree one at a time, from registers.
+    let bvh = if MESH { ctx.accel.as_ref() } else { None };
+    let mut stack = bvh.map_or_else(Stack::default, MeshBvh::stack);
     let mut cast = 0;
     for i0 in (0..rays.len()).step_by(V::N) {
         let present = present_hits::<V>(hits, i0, rays.len());
@@ -309,20 +335,28 @@ fn fused_hard<V: Lanes, S: Costs>(
                 simd::hit_shadow_rays(&group, &scene.lights[li], light.end_offset, light.centroid);
             let live = block.live & present;
             cast += live.count_ones() as u64;
-            let blocked = if occludes {
-                let mut c = S::Counter::default();
-                let blocked = simd::hit_rays_occluded::<V, S::Counter>(
-                    triangles,
-                    &scene.spheres,
-                    &block,
-                    live,
-                    two_sided,
-                    &mut c,
-                );
-                costs.add_lanes(i0, live, c);
-                blocked
-            } else {
-                0
+            let blocked = match (occludes, bvh) {
+                (false, _) => 0,
+                (true, Some(bvh)) => {
+                    let lane = |k| {
+                        let s = block.lane(k);
+                        (s.ray, s.tmax)
+                    };
+                    bvh.lanes_occluded(scene, live, lane, two_sided, &mut stack, |k| i0 + k, costs)
+                }
+                (true, None) => {
+                    let mut c = S::Counter::default();
+                    let blocked = simd::hit_rays_occluded::<V, S::Counter>(
+                        triangles,
+                        &scene.spheres,
+                        &block,
+                        live,
+                        two_sided,
+                        &mut c,
+                    );
+                    costs.add_lanes(i0, live, c);
+                    blocked
+                }
             };
             // As the queue's Shade: unblocked rays with n·l > 0.
             let lit = set_bits(live & !blocked).filter(|&k| block.n_dot_l.as_ref()[k] > 0.0);
@@ -348,39 +382,6 @@ fn present_hits<V: Lanes>(hits: &HitBatch, i0: usize, len: usize) -> u32 {
     (0..(len - i0).min(V::N))
         .filter(|&k| hits.prim[i0 + k] != NO_HIT)
         .fold(0, |m, k| m | 1 << k)
-}
-
-/// Queues the one shadow ray per light (hard shadows, or none: the centroid) of hits
-/// `i0..i0 + N`, N hits at a time (`simd::hit_shadow_rays`), in (light, hit) order: each hit's
-/// rays still come in light order, so [`shade`] adds each hit's sum as [`spawn`]'s order
-/// would. Returns the number of live rays queued.
-fn spawn_across<V: Lanes>(
-    ctx: &Context,
-    rays: &RayBatch,
-    hits: &HitBatch,
-    i0: usize,
-    queue: &mut ShadowQueue,
-) -> u64 {
-    let present = present_hits::<V>(hits, i0, rays.len());
-    if present == 0 {
-        return 0;
-    }
-    let group = simd::HitLanes::<V>::load(hits, i0);
-    let mut cast = 0;
-    for (li, light) in ctx.lights.iter().enumerate() {
-        let block = simd::hit_shadow_rays(
-            &group,
-            &ctx.scene.lights[li],
-            light.end_offset,
-            light.centroid,
-        );
-        let live = block.live & present;
-        for k in set_bits(live) {
-            queue.push(&block.lane(k), (i0 + k) as u32, li as u32);
-        }
-        cast += live.count_ones() as u64;
-    }
-    cast
 }
 
 /// Queues the shadow rays of hit `i`, in (light, point) order.

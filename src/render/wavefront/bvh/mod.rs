@@ -58,9 +58,10 @@ use super::simd::{RayColumns, TriangleLanes};
 use crate::render::geometry::{Hit, Ray, T_MIN, intersect_sphere};
 use crate::render::scene::{NO_HIT, Scene, Triangle};
 use crate::render::wavefront::cost::{Costs, Counter};
-use crate::render::wavefront::lanes::{LANES, f32x8};
+use crate::render::wavefront::lanes::{LANES, f32x8, set_bits};
 use std::time::Duration;
-use traverse::{RayLanes, Stack, triangles8, triangles8_block};
+pub use traverse::Stack;
+use traverse::{RayLanes, triangles8, triangles8_block};
 
 /// Children per node and triangles per block: the lane count.
 pub const WIDTH: usize = LANES;
@@ -236,20 +237,69 @@ impl MeshBvh {
                 *blocked = false;
                 continue;
             }
-            let ray = rays.ray(i);
             let mut c = S::Counter::default();
-            if scene.spheres.iter().any(|s| {
-                c.tests(1);
-                crate::render::geometry::sphere_blocks(s, &ray, tmax)
-            }) {
-                *blocked = true;
-                costs.add(i, c);
-                continue;
-            }
-            *blocked =
-                self.blocker(&RayLanes::new(&ray), tmax, two_sided, &mut stack, &mut c) != EMPTY;
+            *blocked = self.ray_occluded(scene, &rays.ray(i), tmax, two_sided, &mut stack, &mut c);
             costs.add(i, c);
         }
+    }
+
+    /// The `live` lanes whose ray something blocks, as a bit mask: `lane(k)` is lane k's ray
+    /// and tmax, and its answer is what [`Self::occluded`] gives that ray in a queue (a lane
+    /// with tmax ≤ T_MIN is not traced). Each traced lane's work goes to `costs` at index
+    /// `index(k)`. The fused shadow stage walks a block's rays from registers with this, one at
+    /// a time, without queueing them.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    pub fn lanes_occluded<S: Costs>(
+        &self,
+        scene: &Scene,
+        live: u32,
+        lane: impl Fn(usize) -> (Ray, f32),
+        two_sided: bool,
+        stack: &mut Stack,
+        index: impl Fn(usize) -> usize,
+        costs: &mut S,
+    ) -> u32 {
+        let mut blocked = 0;
+        for k in set_bits(live) {
+            let (ray, tmax) = lane(k);
+            #[allow(clippy::neg_cmp_op_on_partial_ord)] // NaN must not be traced either
+            if !(tmax > T_MIN) {
+                continue;
+            }
+            let mut c = S::Counter::default();
+            if self.ray_occluded(scene, &ray, tmax, two_sided, stack, &mut c) {
+                blocked |= 1 << k;
+            }
+            costs.add(index(k), c);
+        }
+        blocked
+    }
+
+    /// A traversal stack for [`Self::lanes_occluded`], deep enough for any walk of this tree.
+    pub fn stack(&self) -> Stack {
+        Stack::new(self)
+    }
+
+    /// Whether anything blocks one ray in (T_MIN, tmax): the spheres first, then the triangles
+    /// through the tree; `c` counts the spheres tested and the walk.
+    #[inline(always)]
+    fn ray_occluded<C: Counter>(
+        &self,
+        scene: &Scene,
+        ray: &Ray,
+        tmax: f32,
+        two_sided: bool,
+        stack: &mut Stack,
+        c: &mut C,
+    ) -> bool {
+        if scene.spheres.iter().any(|s| {
+            c.tests(1);
+            crate::render::geometry::sphere_blocks(s, ray, tmax)
+        }) {
+            return true;
+        }
+        self.blocker(&RayLanes::new(ray), tmax, two_sided, stack, c) != EMPTY
     }
 }
 
