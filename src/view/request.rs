@@ -48,7 +48,7 @@ impl CameraJson {
     }
 
     /// The camera, or a 400 naming what is wrong with it.
-    fn to_camera(&self) -> Result<Camera, ApiError> {
+    fn to_camera(self) -> Result<Camera, ApiError> {
         let all = [self.position, self.look_at, self.up];
         if all
             .iter()
