@@ -35,7 +35,7 @@ use super::shade::{
     HitLight, ShadowLanes, ShadowRegisters, shade_lanes, shade_registers, shade_terms,
 };
 use super::simd::{self, LightBlock, RayColumns};
-use crate::render::geometry::{Ray, casters};
+use crate::render::geometry::casters;
 use crate::render::sampling::{SampleKey, mix32};
 use crate::render::scene::NO_HIT;
 use crate::render::settings::LightModel;
@@ -47,9 +47,9 @@ use glam::Vec3;
 ///
 /// | path | taken when | spawn | occlusion | shade | what it costs and saves |
 /// | --- | --- | --- | --- | --- | --- |
-/// | `FusedSoft` | soft shadows, every light a parallelogram, a sampler with a lane formula (all but the lab's at N = 1) | N points of one (hit, light) at a time (`simd::light_points`, `simd::shadow_rays`) | `simd::block_occluded` against the shadow casters, or each live lane through `MeshBvh::lanes_occluded` | in registers, added in point order | no queue: each block is spawned, tested and shaded while it is in registers (the lab benchmark's path; on the 12k-triangle box 4.7% fewer instructions than the queue, the same wall-clock within 2%) |
-/// | `FusedHard` | hard shadows (or none) | N hits at a time, one ray per light (`simd::hit_shadow_rays`) | `simd::hit_rays_occluded` against the casters, or each live lane through `MeshBvh::lanes_occluded` | each lit ray, in light order | no queue; spawning across hits is what a hard-shadow ray costs most (56 instructions a ray against 161 hit by hit); on meshes the queue's push and reread were a third of the stage's instructions outside the walk (the 12k-triangle box: 20% fewer instructions, 1.19× the stage's rate) |
-/// | `QueuedPerHit` | everything else: fan lights, the lab's sampler at N = 1 | hit by hit, in (light, point) order, N points at a time where a lane formula exists, else the scalar `PointSet::point` | the queue, N rays at a time against the casters, or through the BVH one at a time | in queue order, aligned blocks N lanes at a time | the general path, and the one every other is held to |
+/// | `FusedSoft` | soft shadows, every light a parallelogram, a sampler with a lane formula (all but the lab's at N = 1), no BVH | N points of one (hit, light) at a time (`simd::light_points`, `simd::shadow_rays`) | `simd::block_occluded` against the shadow casters | in registers, added in point order | no queue: each block is spawned, tested and shaded while it is in registers (the lab benchmark's path). Not for meshes: walking each block's rays from registers took 4.7% fewer instructions than the queue on the 12k-triangle box, and 2–4% more time (docs/TRIED.md) |
+/// | `FusedHard` | hard shadows (or none) | N hits at a time, one ray per light (`simd::hit_shadow_rays`) | `simd::hit_rays_occluded` against the casters, or each live lane through `MeshBvh::hit_rays_occluded` | each lit ray, in light order | no queue; spawning across hits is what a hard-shadow ray costs most (56 instructions a ray against 161 hit by hit); on meshes the queue's push and reread were a third of the stage's instructions outside the walk (the 12k-triangle box: 20% fewer instructions, 1.19× the stage's rate) |
+/// | `QueuedPerHit` | everything else: soft shadows with a BVH, fan lights, the lab's sampler at N = 1 | hit by hit, in (light, point) order, N points at a time where a lane formula exists, else the scalar `PointSet::point` | the queue, N rays at a time against the casters, or through the BVH one at a time | in queue order, aligned blocks N lanes at a time | the general path, and the one every other is held to |
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ShadowPath {
     /// Soft shadows spawned, tested and shaded block by block in registers.
@@ -73,7 +73,8 @@ impl ShadowPath {
     pub fn admits(self, ctx: &Context) -> bool {
         match self {
             ShadowPath::FusedSoft => {
-                ctx.samples_lights()
+                ctx.accel.is_none()
+                    && ctx.samples_lights()
                     && ctx.simd_light_sampling()
                     && ctx.lights.iter().all(|l| l.parallelogram.is_some())
             }
@@ -133,13 +134,10 @@ fn direct_light_lanes<V: Lanes, S: Remap>(
     let n = rays.len();
     hits.direct.fill(0..n, glam::Vec3::ZERO);
     match ctx.shadow_path {
-        // Meshes get instances of their own, so that the lab's instance (no BVH) is compiled as
-        // if the tree did not exist: with the choice made inside the block loop, the lab's
-        // fused stage took 2.7% more instructions (tests/gates/icount.rs).
-        ShadowPath::FusedSoft if ctx.accel.is_some() => {
-            return fused::<V, S, true>(ctx, rays, hits, costs);
-        }
-        ShadowPath::FusedSoft => return fused::<V, S, false>(ctx, rays, hits, costs),
+        // Meshes get an instance of their own, so that the lab's (no BVH) is compiled as if the
+        // tree did not exist: with the choice made inside the loop, the lab's fused soft stage
+        // took 2.7% more instructions when it walked meshes too (tests/gates/icount.rs).
+        ShadowPath::FusedSoft => return fused::<V, S>(ctx, rays, hits, costs),
         ShadowPath::FusedHard if ctx.accel.is_some() => {
             return fused_hard::<V, S, true>(ctx, rays, hits, costs);
         }
@@ -205,7 +203,7 @@ fn first_block<'c>(
 /// [`shade`] adds a queued block. Returns the rays cast. Never inlined, so that profiles name
 /// it apart from the queued stage.
 #[inline(never)]
-fn fused<V: Lanes, S: Costs, const MESH: bool>(
+fn fused<V: Lanes, S: Costs>(
     ctx: &Context,
     rays: &RayBatch,
     hits: &mut HitBatch,
@@ -217,9 +215,6 @@ fn fused<V: Lanes, S: Costs, const MESH: bool>(
     let model = ctx.settings.light_model;
     let weight = 1.0 / ctx.points_per_light as f32;
     let count = ctx.points_per_light;
-    // Meshes: each live lane's ray walks the tree one at a time, from registers.
-    let bvh = if MESH { ctx.accel.as_ref() } else { None };
-    let mut stack = bvh.map_or_else(Stack::default, MeshBvh::stack);
     let mut cast = 0;
     for i in 0..rays.len() {
         if hits.prim[i] == NO_HIT {
@@ -254,39 +249,15 @@ fn fused<V: Lanes, S: Costs, const MESH: bool>(
                     continue;
                 }
                 cast += block.live.count_ones() as u64;
-                let blockers = match bvh {
-                    Some(bvh) => {
-                        let lane = |k: usize| {
-                            let l = block.l.map(|c| c.as_ref()[k]);
-                            let ray = Ray {
-                                origin: block.origin,
-                                direction: Vec3::from_array(l),
-                            };
-                            (ray, block.tmax.as_ref()[k])
-                        };
-                        bvh.lanes_occluded(
-                            scene,
-                            block.live,
-                            lane,
-                            two_sided,
-                            &mut stack,
-                            |_| i,
-                            costs,
-                        )
-                    }
-                    None => {
-                        let mut c = S::Counter::default();
-                        let blockers = simd::block_occluded::<V, S::Counter>(
-                            triangles,
-                            &scene.spheres,
-                            &block,
-                            two_sided,
-                            &mut c,
-                        );
-                        costs.add(i, c.times(block.live.count_ones()));
-                        blockers
-                    }
-                };
+                let mut c = S::Counter::default();
+                let blockers = simd::block_occluded::<V, S::Counter>(
+                    triangles,
+                    &scene.spheres,
+                    &block,
+                    two_sided,
+                    &mut c,
+                );
+                costs.add(i, c.times(block.live.count_ones()));
                 let lanes = ShadowRegisters {
                     l: block.l.map(V::from_array),
                     n_dot_l: V::from_array(block.n_dot_l),
@@ -338,11 +309,7 @@ fn fused_hard<V: Lanes, S: Costs, const MESH: bool>(
             let blocked = match (occludes, bvh) {
                 (false, _) => 0,
                 (true, Some(bvh)) => {
-                    let lane = |k| {
-                        let s = block.lane(k);
-                        (s.ray, s.tmax)
-                    };
-                    bvh.lanes_occluded(scene, live, lane, two_sided, &mut stack, |k| i0 + k, costs)
+                    bvh.hit_rays_occluded(scene, &block, live, two_sided, &mut stack, i0, costs)
                 }
                 (true, None) => {
                     let mut c = S::Counter::default();

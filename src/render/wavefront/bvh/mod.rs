@@ -57,6 +57,7 @@ mod traverse;
 use super::simd::{RayColumns, TriangleLanes};
 use crate::render::geometry::{Hit, Ray, T_MIN, intersect_sphere};
 use crate::render::scene::{NO_HIT, Scene, Triangle};
+use crate::render::wavefront::batch::HitRays;
 use crate::render::wavefront::cost::{Costs, Counter};
 use crate::render::wavefront::lanes::{LANES, f32x8, set_bits};
 use std::time::Duration;
@@ -243,40 +244,40 @@ impl MeshBvh {
         }
     }
 
-    /// The `live` lanes whose ray something blocks, as a bit mask: `lane(k)` is lane k's ray
-    /// and tmax, and its answer is what [`Self::occluded`] gives that ray in a queue (a lane
+    /// The `live` lanes of one ray per hit (`simd::hit_shadow_rays`) that something blocks, as
+    /// a bit mask: lane k is what [`Self::occluded`] answers for that ray in a queue (a lane
     /// with tmax ≤ T_MIN is not traced). Each traced lane's work goes to `costs` at index
-    /// `index(k)`. The fused shadow stage walks a block's rays from registers with this, one at
-    /// a time, without queueing them.
+    /// `i0 + k`. The hard-shadow stage walks its rays from registers with this, one at a time,
+    /// without queueing them.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
-    pub fn lanes_occluded<S: Costs>(
+    pub fn hit_rays_occluded<A: AsRef<[f32]>, S: Costs>(
         &self,
         scene: &Scene,
+        rays: &HitRays<A>,
         live: u32,
-        lane: impl Fn(usize) -> (Ray, f32),
         two_sided: bool,
         stack: &mut Stack,
-        index: impl Fn(usize) -> usize,
+        i0: usize,
         costs: &mut S,
     ) -> u32 {
         let mut blocked = 0;
         for k in set_bits(live) {
-            let (ray, tmax) = lane(k);
+            let s = rays.lane(k);
             #[allow(clippy::neg_cmp_op_on_partial_ord)] // NaN must not be traced either
-            if !(tmax > T_MIN) {
+            if !(s.tmax > T_MIN) {
                 continue;
             }
             let mut c = S::Counter::default();
-            if self.ray_occluded(scene, &ray, tmax, two_sided, stack, &mut c) {
+            if self.ray_occluded(scene, &s.ray, s.tmax, two_sided, stack, &mut c) {
                 blocked |= 1 << k;
             }
-            costs.add(index(k), c);
+            costs.add(i0 + k, c);
         }
         blocked
     }
 
-    /// A traversal stack for [`Self::lanes_occluded`], deep enough for any walk of this tree.
+    /// A traversal stack for [`Self::hit_rays_occluded`], deep enough for any walk of this tree.
     pub fn stack(&self) -> Stack {
         Stack::new(self)
     }
