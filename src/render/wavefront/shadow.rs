@@ -48,7 +48,7 @@ use glam::Vec3;
 /// | path | taken when | spawn | occlusion | shade | what it costs and saves |
 /// | --- | --- | --- | --- | --- | --- |
 /// | `FusedSoft` | soft shadows, every light a parallelogram, a sampler with a lane formula (all but the lab's at N = 1), no BVH | N points of one (hit, light) at a time (`simd::light_points`, `simd::shadow_rays`) | `simd::block_occluded` against the shadow casters | in registers, added in point order | no queue: each block is spawned, tested and shaded while it is in registers (the lab benchmark's path). Not for meshes: walking each block's rays from registers took 4.7% fewer instructions than the queue on the 12k-triangle box, and 2–4% more time (docs/TRIED.md) |
-/// | `FusedHard` | hard shadows (or none) | N hits at a time, one ray per light (`simd::hit_shadow_rays`) | `simd::hit_rays_occluded` against the casters, or each live lane through `MeshBvh::hit_rays_occluded` | each lit ray, in light order | no queue; spawning across hits is what a hard-shadow ray costs most (56 instructions a ray against 161 hit by hit); on meshes the queue's push and reread were a third of the stage's instructions outside the walk (the 12k-triangle box: 20% fewer instructions, 1.19× the stage's rate) |
+/// | `FusedHard` | hard shadows (or none) | N hits at a time, one ray per light (`simd::hit_shadow_rays`) | `simd::hit_rays_occluded` against the casters, or each live lane through `MeshBvh::hit_rays_occluded` | each lit ray, in light order | no queue; spawning across hits is what a hard-shadow ray costs most (56 instructions a ray against 161 hit by hit); on meshes the queue's push and reread were a third of the stage's instructions outside the walk (the 12k-triangle box: 20% fewer instructions, 1.19–1.26× the stage's rate) |
 /// | `QueuedPerHit` | everything else: soft shadows with a BVH, fan lights, the lab's sampler at N = 1 | hit by hit, in (light, point) order, N points at a time where a lane formula exists, else the scalar `PointSet::point` | the queue, N rays at a time against the casters, or through the BVH one at a time | in queue order, aligned blocks N lanes at a time | the general path, and the one every other is held to |
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ShadowPath {
@@ -134,9 +134,9 @@ fn direct_light_lanes<V: Lanes, S: Remap>(
     let n = rays.len();
     hits.direct.fill(0..n, glam::Vec3::ZERO);
     match ctx.shadow_path {
-        // Meshes get an instance of their own, so that the lab's (no BVH) is compiled as if the
-        // tree did not exist: with the choice made inside the loop, the lab's fused soft stage
-        // took 2.7% more instructions when it walked meshes too (tests/gates/icount.rs).
+        // Meshes get an instance of the hard path of their own, so that the lab's (no BVH) is
+        // compiled as if the tree did not exist: the same choice made inside the fused soft
+        // stage's loop cost the lab's stage 2.7% more instructions (tests/gates/icount.rs).
         ShadowPath::FusedSoft => return fused::<V, S>(ctx, rays, hits, costs),
         ShadowPath::FusedHard if ctx.accel.is_some() => {
             return fused_hard::<V, S, true>(ctx, rays, hits, costs);
