@@ -4,17 +4,20 @@
 //! at ±0, behind it, grazing the tangent plane, at the light point itself, NaN and infinite
 //! coordinates, zero offsets) and on random hits at every scale, for groups that end
 //! mid-vector. And `simd::hit_rays_occluded` (the blockers of those rays, in registers) ==
-//! `simd::occluded` on the same rays in columns.
+//! `simd::occluded` on the same rays in columns; on a mesh, `MeshBvh::hit_rays_occluded` (the
+//! hard-shadow stage's walk from registers) == `MeshBvh::occluded` on them in columns, answers
+//! and per-ray traversal counts, lanes with a NaN, zero, negative or T_MIN tmax included.
 
 use crate::common;
 
 use common::{Draw, TestRng, seeded};
 use glam::Vec3;
-use raywave::render::geometry::{self, shadow_casters};
+use raywave::render::geometry::{self, T_MIN, shadow_casters};
 use raywave::render::scene::{Light, Scene};
 use raywave::render::spawn::{SurfaceHit, light_end, light_offset, shadow_ray};
 use raywave::render::wavefront::batch::HitBatch;
-use raywave::render::wavefront::cost::NoCount;
+use raywave::render::wavefront::bvh::MeshBvh;
+use raywave::render::wavefront::cost::{Cost, NoCount, PerRay};
 use raywave::render::wavefront::lanes::{Lanes, f32x8, f32x16};
 use raywave::render::wavefront::simd::{
     self, HitLanes, RayColumns, hit_rays_occluded, hit_shadow_rays,
@@ -228,6 +231,99 @@ fn occlusion_in_registers_equals_occlusion_in_columns() {
         for two_sided in [false, true] {
             check_occlusion::<f32x8>(&mut rng, len, two_sided);
             check_occlusion::<f32x16>(&mut rng, len, two_sided);
+        }
+    }
+}
+
+/// The rays `hit_shadow_rays` makes from random hits inside the mesh box (its tessellated
+/// spheres block some), through the BVH from registers and from columns. Every other group has
+/// its first lanes' tmax set to NaN, −1, 0, T_MIN and just above it: the walk skips the same
+/// lanes the queue's does, and charges each traced lane what the queue charges its ray.
+fn check_mesh_occlusion<V: Lanes>(rng: &mut TestRng, scene: &Scene, len: usize, two_sided: bool) {
+    let bvh = MeshBvh::new(scene);
+    let light = &scene.lights[0];
+    let hits: Vec<SurfaceHit> = (0..len)
+        .map(|_| hit(rng.point(0.95), rng.direction().normalize(), 1e-4))
+        .collect();
+    let b = batch(&hits);
+    let mut stack = bvh.stack();
+    let mut some_blocked = false;
+    for i0 in (0..len).step_by(V::N) {
+        let mut rays = hit_shadow_rays(
+            &HitLanes::<V>::load(&b, i0),
+            light,
+            light_offset(light),
+            light.centroid,
+        );
+        let lanes = (len - i0).min(V::N);
+        if (i0 / V::N) % 2 == 1 {
+            let edges = [f32::NAN, -1.0, 0.0, T_MIN, T_MIN.next_up()];
+            for (t, edge) in rays.tmax.as_mut().iter_mut().zip(edges) {
+                *t = edge;
+            }
+        }
+        let live = rays.live & (((1u64 << lanes) - 1) as u32);
+        let mut got_costs = vec![Cost::default(); lanes];
+        let got = bvh.hit_rays_occluded(
+            scene,
+            &rays,
+            live,
+            two_sided,
+            &mut stack,
+            0,
+            &mut PerRay(&mut got_costs),
+        );
+        let col = |c: &V::Array| -> Vec<f32> { c.as_ref()[..lanes].to_vec() };
+        let tmax: Vec<f32> = (0..lanes)
+            .map(|k| {
+                if live >> k & 1 == 1 {
+                    rays.tmax.as_ref()[k]
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        let (o, l) = (rays.origin.each_ref().map(col), rays.l.each_ref().map(col));
+        let cols = RayColumns {
+            origin: [&o[0], &o[1], &o[2]],
+            direction: [&l[0], &l[1], &l[2]],
+            tmax: &tmax,
+        };
+        let (mut want, mut want_costs) = (vec![false; lanes], vec![Cost::default(); lanes]);
+        bvh.occluded(
+            scene,
+            &cols,
+            two_sided,
+            &mut want,
+            &mut PerRay(&mut want_costs),
+        );
+        for k in (0..lanes).filter(|k| live >> k & 1 == 1) {
+            assert_eq!(
+                got >> k & 1 == 1,
+                want[k],
+                "{}-lane group at {i0}, lane {k}, tmax {}",
+                V::N,
+                tmax[k]
+            );
+            some_blocked |= want[k];
+        }
+        assert_eq!(got_costs, want_costs, "{}-lane group at {i0}", V::N);
+    }
+    assert!(
+        len < 64 || some_blocked,
+        "no ray was blocked: the test has no power"
+    );
+}
+
+#[test]
+fn mesh_occlusion_in_registers_equals_the_queue_s() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/mesh_spheres_small.obj");
+    let scene = Scene::load(std::path::Path::new(path)).expect("scenes/mesh_spheres_small.obj");
+    let mut rng: TestRng = seeded(0x3e5b);
+    for len in [0, 1, 7, 8, 9, 17, 300] {
+        for two_sided in [false, true] {
+            check_mesh_occlusion::<f32x8>(&mut rng, &scene, len, two_sided);
+            check_mesh_occlusion::<f32x16>(&mut rng, &scene, len, two_sided);
         }
     }
 }
