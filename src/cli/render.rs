@@ -143,7 +143,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         ))?;
     }
     if args.stats {
-        say(&stats_table(&outcome.report))?;
+        say(&stats_table(&outcome.run, &outcome.report))?;
         say(&phases.table("tables, BVH, progress bar"))?;
     }
     if let Some(text) = &outcome.reference_error {

@@ -268,6 +268,7 @@ pub fn run(
         simd: engine.simd_path(),
         threads,
         batch_size: options.batch_size,
+        shadow_path: engine.shadow_path(),
     };
     drop(engine);
     if let Some(path) = &options.stats_json {

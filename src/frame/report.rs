@@ -13,6 +13,7 @@ use crate::render::quote::escape;
 use crate::render::scene::Scene;
 use crate::render::settings::options::{BackgroundSource, Effective};
 use crate::render::settings::{LightModel, ShadowMode};
+use crate::render::wavefront::shadow::ShadowPath;
 use crate::render::wavefront::stats::RenderStats;
 use anyhow::Result;
 use image::RgbImage;
@@ -141,6 +142,8 @@ pub struct RunInfo {
     pub threads: usize,
     /// Camera samples per wavefront tile.
     pub batch_size: u32,
+    /// How the wavefront engine's shadow stage ran; `None` for the reference.
+    pub shadow_path: Option<ShadowPath>,
 }
 
 /// What a render measured.
@@ -177,7 +180,7 @@ impl Report {
 
 /// The `--stats` tables: rays by kind (each kind over the thread-time of its own work, the
 /// total over the wall clock), then (wavefront) the BVH build and each stage.
-pub fn stats_table(report: &Report) -> String {
+pub fn stats_table(run: &RunInfo, report: &Report) -> String {
     let mut out = String::new();
     let kinds = report.kinds();
     let _ = writeln!(
@@ -232,6 +235,9 @@ pub fn stats_table(report: &Report) -> String {
     }
     if let Some((_, Some(build))) = &report.stages {
         let _ = writeln!(out, "bvh build {build:.3} s");
+    }
+    if let Some(path) = run.shadow_path {
+        let _ = writeln!(out, "shadow path {path:?}: {}", path.describe());
     }
     if let Some(t) = &report.traversal {
         let _ = writeln!(

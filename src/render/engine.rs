@@ -18,6 +18,7 @@ use crate::render::scene::Scene;
 use crate::render::settings::RenderSettings;
 use crate::render::wavefront::Wavefront;
 use crate::render::wavefront::lanes::LaneWidth;
+use crate::render::wavefront::shadow::ShadowPath;
 use crate::render::wavefront::stats::RenderStats;
 use serde::{Deserialize, Serialize};
 use std::sync::atomic::AtomicBool;
@@ -120,6 +121,15 @@ impl Prepared<'_> {
         match self {
             Prepared::Wavefront(w) => crate::simd_path_for(w.lane_width()),
             Prepared::Reference(_) => crate::simd_path(),
+        }
+    }
+
+    /// How the wavefront engine's shadow stage runs (`shadow::ShadowPath`, chosen once per
+    /// render); `None` for the reference.
+    pub fn shadow_path(&self) -> Option<ShadowPath> {
+        match self {
+            Prepared::Wavefront(w) => Some(w.shadow_path()),
+            Prepared::Reference(_) => None,
         }
     }
 

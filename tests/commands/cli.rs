@@ -576,6 +576,44 @@ fn stats_tables_give_each_kind_over_its_own_thread_time_the_total_over_the_wall_
                 "{text}"
             );
         }
+        // The wavefront engine names its shadow stage's path (soft shadows on the lab box:
+        // fused block by block); the reference has none.
+        let path = text.lines().find(|l| l.starts_with("shadow path "));
+        match engine {
+            "wavefront" => assert!(
+                path.is_some_and(|l| l.starts_with("shadow path FusedSoft: ")),
+                "{text}"
+            ),
+            _ => assert_eq!(path, None, "{text}"),
+        }
+    }
+}
+
+/// `--stats` names the shadow path each kind of render takes: hard shadows fused N hits at a
+/// time (on a mesh too, through the BVH), soft shadows on a mesh through the queue.
+#[test]
+fn stats_name_the_shadow_path_that_ran() {
+    let dir = dir_with(&[
+        "cornell_box_reflective_spheres.obj",
+        "mesh_spheres_small.obj",
+    ]);
+    for (line, path) in [
+        (
+            "cornell_box_reflective_spheres.obj --shadows hard",
+            "FusedHard",
+        ),
+        ("mesh_spheres_small.obj --shadows hard", "FusedHard"),
+        ("mesh_spheres_small.obj --shadows soft", "QueuedPerHit"),
+    ] {
+        let line = format!("{line} --size 16 12 --stats -q");
+        let out = raywave(dir.path(), &words(&line));
+        assert!(out.status.success(), "{line}: {}", stderr(&out));
+        let text = stdout(&out);
+        assert!(
+            text.lines()
+                .any(|l| l.starts_with(&format!("shadow path {path}: "))),
+            "{line}: expected the {path} path in:\n{text}"
+        );
     }
 }
 

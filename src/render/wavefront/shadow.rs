@@ -83,6 +83,21 @@ impl ShadowPath {
         }
     }
 
+    /// What the path does, in a few words, for `render --stats`.
+    pub fn describe(self) -> &'static str {
+        match self {
+            ShadowPath::FusedSoft => {
+                "each block of N light points spawned, tested against the shadow casters and shaded in registers"
+            }
+            ShadowPath::FusedHard => {
+                "one ray per light for N hits at a time, tested (against the casters, or each through the BVH) and shaded in registers"
+            }
+            ShadowPath::QueuedPerHit => {
+                "every hit's rays queued in (light, point) order, then tested and shaded from the queue"
+            }
+        }
+    }
+
     /// The fastest path `ctx` admits.
     pub fn choose(ctx: &Context) -> ShadowPath {
         ShadowPath::ALL
