@@ -237,7 +237,7 @@ pub fn stats_table(run: &RunInfo, report: &Report) -> String {
         let _ = writeln!(out, "bvh build {build:.3} s");
     }
     if let Some(path) = run.shadow_path {
-        let _ = writeln!(out, "shadow path {path:?}: {}", path.describe());
+        let _ = writeln!(out, "shadow path {}: {}", path.name(), path.describe());
     }
     if let Some(t) = &report.traversal {
         let _ = writeln!(
@@ -306,6 +306,7 @@ pub fn record(
         threads: run.threads,
         engine: run.engine,
         batch_size: run.batch_size,
+        shadow_path: run.shadow_path.map(ShadowPath::name),
         scene: SceneFigures {
             source: scene.source.clone(),
             triangles: scene.triangles.len(),

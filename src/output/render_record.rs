@@ -34,6 +34,10 @@ pub struct RenderRecord {
     pub engine: Engine,
     /// Wavefront camera samples per tile (as given, whichever the engine).
     pub batch_size: u32,
+    /// How the wavefront engine's shadow stage ran (`FusedSoft`, `FusedHard` or
+    /// `QueuedPerHit`: `raywave::render::wavefront::shadow::ShadowPath`); null for the
+    /// reference.
+    pub shadow_path: Option<&'static str>,
     /// The scene.
     pub scene: SceneFigures,
     /// The settings the image was rendered with.
@@ -244,6 +248,7 @@ mod tests {
             threads: 1,
             engine: Engine::Reference,
             batch_size: 8,
+            shadow_path: None,
             scene: SceneFigures {
                 source: "s".into(),
                 triangles: 1,

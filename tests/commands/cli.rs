@@ -589,8 +589,9 @@ fn stats_tables_give_each_kind_over_its_own_thread_time_the_total_over_the_wall_
     }
 }
 
-/// `--stats` names the shadow path each kind of render takes: hard shadows fused N hits at a
-/// time (on a mesh too, through the BVH), soft shadows on a mesh through the queue.
+/// `--stats` and `--stats-json` name the shadow path each kind of render takes: hard shadows
+/// fused N hits at a time (on a mesh too, through the BVH), soft shadows on a mesh through the
+/// queue.
 #[test]
 fn stats_name_the_shadow_path_that_ran() {
     let dir = dir_with(&[
@@ -605,7 +606,7 @@ fn stats_name_the_shadow_path_that_ran() {
         ("mesh_spheres_small.obj --shadows hard", "FusedHard"),
         ("mesh_spheres_small.obj --shadows soft", "QueuedPerHit"),
     ] {
-        let line = format!("{line} --size 16 12 --stats -q");
+        let line = format!("{line} --size 16 12 --stats --stats-json stats.json -q");
         let out = raywave(dir.path(), &words(&line));
         assert!(out.status.success(), "{line}: {}", stderr(&out));
         let text = stdout(&out);
@@ -614,6 +615,9 @@ fn stats_name_the_shadow_path_that_ran() {
                 .any(|l| l.starts_with(&format!("shadow path {path}: "))),
             "{line}: expected the {path} path in:\n{text}"
         );
+        let json = std::fs::read_to_string(dir.path().join("stats.json")).unwrap();
+        let record: serde_json::Value = serde_json::from_str(&json).unwrap();
+        assert_eq!(record["shadow_path"], path, "{line}: {json}");
     }
 }
 

@@ -83,6 +83,15 @@ impl ShadowPath {
         }
     }
 
+    /// The path's name, as `render --stats` and `--stats-json` give it.
+    pub fn name(self) -> &'static str {
+        match self {
+            ShadowPath::FusedSoft => "FusedSoft",
+            ShadowPath::FusedHard => "FusedHard",
+            ShadowPath::QueuedPerHit => "QueuedPerHit",
+        }
+    }
+
     /// What the path does, in a few words, for `render --stats`.
     pub fn describe(self) -> &'static str {
         match self {
