@@ -15,7 +15,7 @@ use glam::Vec3;
 use raywave::render::geometry::{self, T_MIN, shadow_casters};
 use raywave::render::scene::{Light, Scene};
 use raywave::render::spawn::{SurfaceHit, light_end, light_offset, shadow_ray};
-use raywave::render::wavefront::batch::HitBatch;
+use raywave::render::wavefront::batch::{HitBatch, HitRays};
 use raywave::render::wavefront::bvh::MeshBvh;
 use raywave::render::wavefront::cost::{Cost, NoCount, PerRay};
 use raywave::render::wavefront::lanes::{Lanes, f32x8, f32x16};
@@ -152,6 +152,42 @@ fn random_hits_at_every_scale_equal_the_scalar_spawn() {
     }
 }
 
+/// The first `lanes` rays of a group as the queue holds them: the `live` ones, and dead ones
+/// with tmax 0 (the queue holds no dead rays; a tmax of 0 cannot be blocked).
+struct Queued {
+    origin: [Vec<f32>; 3],
+    direction: [Vec<f32>; 3],
+    tmax: Vec<f32>,
+}
+
+impl Queued {
+    fn of<V: Lanes>(rays: &HitRays<V::Array>, live: u32, lanes: usize) -> Queued {
+        let col = |c: &V::Array| -> Vec<f32> { c.as_ref()[..lanes].to_vec() };
+        let tmax = (0..lanes)
+            .map(|k| {
+                if live >> k & 1 == 1 {
+                    rays.tmax.as_ref()[k]
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        Queued {
+            origin: rays.origin.each_ref().map(col),
+            direction: rays.l.each_ref().map(col),
+            tmax,
+        }
+    }
+
+    fn columns(&self) -> RayColumns<'_> {
+        RayColumns {
+            origin: self.origin.each_ref().map(Vec::as_slice),
+            direction: self.direction.each_ref().map(Vec::as_slice),
+            tmax: &self.tmax,
+        }
+    }
+}
+
 /// The rays `hit_shadow_rays` makes from random hits inside the lab box (its three spheres and,
 /// two-sided, its walls block some of them), tested in registers and in columns.
 fn check_occlusion<V: Lanes>(rng: &mut TestRng, len: usize, two_sided: bool) {
@@ -181,24 +217,8 @@ fn check_occlusion<V: Lanes>(rng: &mut TestRng, len: usize, two_sided: bool) {
             two_sided,
             &mut NoCount,
         );
-        // The live rays as columns, dead ones with tmax 0 (the queue holds no dead rays; a
-        // tmax of 0 cannot be blocked).
-        let col = |c: &V::Array| -> Vec<f32> { c.as_ref()[..lanes].to_vec() };
-        let tmax: Vec<f32> = (0..lanes)
-            .map(|k| {
-                if live >> k & 1 == 1 {
-                    rays.tmax.as_ref()[k]
-                } else {
-                    0.0
-                }
-            })
-            .collect();
-        let (o, l) = (rays.origin.each_ref().map(col), rays.l.each_ref().map(col));
-        let cols = RayColumns {
-            origin: [&o[0], &o[1], &o[2]],
-            direction: [&l[0], &l[1], &l[2]],
-            tmax: &tmax,
-        };
+        let queued = Queued::of::<V>(&rays, live, lanes);
+        let cols = queued.columns();
         let mut want = vec![false; lanes];
         simd::occluded::<f32x8, _>(
             triangles,
@@ -273,22 +293,8 @@ fn check_mesh_occlusion<V: Lanes>(rng: &mut TestRng, scene: &Scene, len: usize, 
             0,
             &mut PerRay(&mut got_costs),
         );
-        let col = |c: &V::Array| -> Vec<f32> { c.as_ref()[..lanes].to_vec() };
-        let tmax: Vec<f32> = (0..lanes)
-            .map(|k| {
-                if live >> k & 1 == 1 {
-                    rays.tmax.as_ref()[k]
-                } else {
-                    0.0
-                }
-            })
-            .collect();
-        let (o, l) = (rays.origin.each_ref().map(col), rays.l.each_ref().map(col));
-        let cols = RayColumns {
-            origin: [&o[0], &o[1], &o[2]],
-            direction: [&l[0], &l[1], &l[2]],
-            tmax: &tmax,
-        };
+        let queued = Queued::of::<V>(&rays, live, lanes);
+        let cols = queued.columns();
         let (mut want, mut want_costs) = (vec![false; lanes], vec![Cost::default(); lanes]);
         bvh.occluded(
             scene,
@@ -303,7 +309,7 @@ fn check_mesh_occlusion<V: Lanes>(rng: &mut TestRng, scene: &Scene, len: usize, 
                 want[k],
                 "{}-lane group at {i0}, lane {k}, tmax {}",
                 V::N,
-                tmax[k]
+                queued.tmax[k]
             );
             some_blocked |= want[k];
         }
