@@ -516,7 +516,8 @@ pub fn raywave_closest(ctx: &Context, set: &RaySet, out: &mut Hits) {
 /// The wavefront engine's occlusion path, over the set's batches.
 ///
 /// `wavefront::shadow`'s occlusion pass hands the shadow queue's columns to
-/// `MeshBvh::occluded` for meshes, and to the brute-force `simd::occluded` (the build's
+/// `MeshBvh::occluded` for meshes (the fused hard-shadow path walks the same per-ray code from
+/// registers, `MeshBvh::hit_rays_occluded`), and to the brute-force `simd::occluded` (the build's
 /// native lane width, as the stage runs it) over the shadow
 /// casters (`geometry::casters`: every triangle when two-sided) and spheres for smaller scenes;
 /// this hands the same function each batch's columns.
