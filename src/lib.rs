@@ -12,7 +12,7 @@
 //!
 //! Callers choose one through [`render::engine::Engine`]. The modules are in layers: the
 //! renderer ([`render`]), outputs and records (`output`), the tools built on both (`diff`,
-//! `trace`, `view`, `variance`, `bench`, `peer`), and the binary's `cli/`. What every module
+//! `trace`, `view`, `variance`, `bench`), and the binary's `cli/`. What every module
 //! holds is in the module map of docs/ARCHITECTURE.md.
 //!
 //! A tiny render of a scene given as text, by both engines:
@@ -76,8 +76,6 @@ pub mod bench;
 pub mod diff;
 #[cfg(feature = "tools")]
 pub mod frame;
-#[cfg(feature = "tools")]
-pub mod peer;
 #[cfg(feature = "tools")]
 pub mod trace;
 #[cfg(feature = "tools")]

@@ -25,7 +25,7 @@
 //! three spheres are removed too (`peer::without_spheres`), since the peers trace triangles.
 //!
 //! Every engine traces on one thread, two-sided, on the scene without its emissive wall
-//! (`peer::without_emitters`; see `src/peer/mod.rs`). `cargo bench --bench mesh_rays` runs it;
+//! (`peer::without_emitters`; see `peer/mod.rs`). `cargo bench --bench mesh_rays` runs it;
 //! `-- --test` traces each set once on a 32×32 image of the lab box and the 12k box (CI; the
 //! 1M box is left out there, its build alone takes seconds), `-- --quick` shortens the timing.
 //!
@@ -46,16 +46,19 @@
 
 #[path = "../common/mod.rs"]
 mod common;
+// Shared with the kernel tests (tests/kernels/peer_agreement.rs), which use other parts of it.
+#[allow(dead_code)]
+mod peer;
 mod peer_table;
 
 use criterion::{BenchmarkId, Criterion, Throughput};
-use peer_table::{Tables, peer_rows, print_peer_table};
-use raywave::peer::stage::ShadowStage;
-use raywave::peer::{
+use peer::stage::ShadowStage;
+use peer::{
     Hits, ObvhsMesh, RaySet, RaySetKind, RaySets, hit_agreement, mesh_bvh_bytes,
     occlusion_agreement, raywave_closest, wavefront_bvh_closest, wavefront_bvh_closest_one_ray,
     wavefront_closest, wavefront_occluded, without_emitters, without_spheres,
 };
+use peer_table::{Tables, peer_rows, print_peer_table};
 use raywave::render::scene::meshgen::{bands_for, cornell_box_mesh_spheres, triangle_count};
 use raywave::render::scene::{NO_HIT, Scene, parse_scene_str};
 use raywave::render::settings::RenderSettings;
@@ -73,9 +76,9 @@ const TEST_SIZE: u32 = 32;
 const SEED: u64 = 2026;
 
 #[cfg(feature = "embree4")]
-use raywave::peer::embree4::{BuildQuality, Embree4Mesh};
+use peer::embree4::{BuildQuality, Embree4Mesh};
 #[cfg(feature = "tinybvh")]
-use raywave::peer::tinybvh::{TinybvhLayout, TinybvhMesh};
+use peer::tinybvh::{TinybvhLayout, TinybvhMesh};
 
 /// Embree's build quality (`RAYWAVE_EMBREE_QUALITY`); nothing without the `embree4` feature.
 #[cfg(feature = "embree4")]
@@ -244,7 +247,7 @@ fn agreement(
     set: &RaySet,
     reference: &Answer,
     engine: &str,
-) -> raywave::peer::Agreement {
+) -> peer::Agreement {
     #[cfg(feature = "tinybvh")]
     if let (Some(&layout), Answer::Blocked(ours)) = (
         TinybvhLayout::ALL.iter().find(|l| l.name() == engine),
@@ -252,7 +255,7 @@ fn agreement(
     ) {
         let mut blockers = Hits::default();
         s.tinybvh.blockers(layout, set, &mut blockers);
-        return raywave::peer::blocker_agreement(ours, &blockers);
+        return peer::blocker_agreement(ours, &blockers);
     }
     match (reference, answer(s, ctx, set, engine)) {
         (Answer::Hits(a), Answer::Hits(b)) => hit_agreement(a, &b),

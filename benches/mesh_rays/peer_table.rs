@@ -5,7 +5,7 @@
 use super::{
     Outputs, Setup, agreement, answer, builds, peers, ratio, stage_engine, time_rounds, trace,
 };
-use raywave::peer::stage::ShadowStage;
+use crate::peer::stage::ShadowStage;
 use raywave::render::wavefront::context::Context;
 use raywave::stats::median;
 /// Agreement of a peer with raywave below which the peer table flags a cell.

@@ -69,9 +69,7 @@ fn uses_of(dir: &Path, modules: &[&str]) -> Vec<String> {
     found
 }
 
-const TOOLS: [&str; 7] = [
-    "bench", "diff", "frame", "peer", "trace", "variance", "view",
-];
+const TOOLS: [&str; 6] = ["bench", "diff", "frame", "trace", "variance", "view"];
 
 /// The layers of docs/ARCHITECTURE.md, each depending only on those above it: the renderer
 /// names neither the outputs nor a tool (its `--no-default-features` build would fail

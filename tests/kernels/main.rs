@@ -12,6 +12,10 @@ mod film;
 mod hit_rays;
 mod intersection;
 mod mesh_bvh;
+// The peer engines live with their benchmark; these tests check them and use part of them.
+#[allow(dead_code)]
+#[path = "../../benches/mesh_rays/peer/mod.rs"]
+mod peer;
 mod peer_agreement;
 mod point_set_lanes;
 mod shading_pixels;

@@ -467,7 +467,7 @@ fn packets_of_camera_rays_equal_brute_force() {
 #[test]
 #[ignore]
 fn probe() {
-    use raywave::peer::{Hits, ObvhsMesh, RaySets, without_emitters};
+    use crate::peer::{Hits, ObvhsMesh, RaySets, without_emitters};
     let scene = without_emitters(&mesh_scene(raywave::render::scene::meshgen::bands_for(
         12_000,
     )));
@@ -497,9 +497,9 @@ fn probe() {
     probe_trace(&mut || match (engine.as_str(), set.kind.is_occlusion()) {
         ("obvhs", false) => obvhs.closest(&scene, set, &mut hits),
         ("obvhs", true) => obvhs.occluded(&scene, set, &mut blocked),
-        ("one_ray", false) => raywave::peer::wavefront_bvh_closest_one_ray(&ctx, set, &mut hits),
-        (_, false) => raywave::peer::wavefront_closest(&ctx, set, &mut scratch, &mut hits),
-        (_, true) => raywave::peer::wavefront_occluded(&ctx, set, &mut blocked),
+        ("one_ray", false) => crate::peer::wavefront_bvh_closest_one_ray(&ctx, set, &mut hits),
+        (_, false) => crate::peer::wavefront_closest(&ctx, set, &mut scratch, &mut hits),
+        (_, true) => crate::peer::wavefront_occluded(&ctx, set, &mut blocked),
     });
     std::hint::black_box((&hits, &blocked));
 }

@@ -7,9 +7,9 @@
 //! records of `peer::embree4` are checked against what the library writes.
 
 #[cfg(feature = "embree4")]
-use raywave::peer::embree4::{BuildQuality, Embree4Mesh};
-use raywave::peer::stage::ShadowStage;
-use raywave::peer::{
+use crate::peer::embree4::{BuildQuality, Embree4Mesh};
+use crate::peer::stage::ShadowStage;
+use crate::peer::{
     Agreement, FAN_SIZES, Hits, ObvhsMesh, RaySet, RaySets, blocker_agreement, brute_force_closest,
     hit_agreement, occlusion_agreement, raywave_closest, wavefront_closest, wavefront_occluded,
     without_emitters, without_spheres,
@@ -396,9 +396,7 @@ struct Guarded<T> {
 #[cfg(feature = "embree4")]
 #[test]
 fn embree4_writes_the_hit_records_the_bindings_declare() {
-    use raywave::peer::embree4::{
-        Hit1, Hit8, QueryArguments, Ray1, Ray8, RayHit1, RayHit8, Valid8,
-    };
+    use crate::peer::embree4::{Hit1, Hit8, QueryArguments, Ray1, Ray8, RayHit1, RayHit8, Valid8};
     /// Neither a valid id nor `RTC_INVALID_GEOMETRY_ID`: a field still holding it was not written.
     const UNWRITTEN: u32 = 0x5eed_0000;
     const GUARD: u32 = 0xdead_beef;
@@ -567,7 +565,7 @@ fn embree4_memory_counts_buffers_and_bvh() {
 #[cfg(feature = "tinybvh")]
 #[test]
 fn tinybvh_layouts_equal_raywave() {
-    use raywave::peer::tinybvh::{TinybvhLayout, TinybvhMesh};
+    use crate::peer::tinybvh::{TinybvhLayout, TinybvhMesh};
     // BVH8_CPU is there wherever the build has AVX2 (the crate's condition for it).
     #[cfg(target_feature = "avx2")]
     assert!(TinybvhLayout::ALL.contains(&TinybvhLayout::Bvh8Cpu));

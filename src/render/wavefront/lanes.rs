@@ -158,8 +158,10 @@ impl LaneWidth {
 /// Evaluates `$body` with the type `$V` standing for the lane type of `$width` (`Auto` resolved
 /// for this build): `at_width!(ctx.lane_width, V => simd::closest_hits::<V>(..))`. The one
 /// place a lane width chosen at run time becomes a type; only the arm of each width is
-/// compiled for it.
-macro_rules! at_width {
+/// compiled for it. Exported (as `lanes::at_width`) for the peer benchmark's engines.
+#[doc(hidden)]
+#[macro_export]
+macro_rules! __at_width {
     ($width:expr, $V:ident => $body:expr) => {
         match $width.resolve() {
             $crate::render::wavefront::lanes::LaneWidth::Sixteen => {
@@ -173,7 +175,7 @@ macro_rules! at_width {
         }
     };
 }
-pub(crate) use at_width;
+pub use crate::__at_width as at_width;
 
 /// A float lane vector, as the width-generic kernels use it: lane k of every operation is the
 /// scalar operation on lane k (no fused multiply-add, no reordering), so a kernel written once

@@ -31,19 +31,19 @@ pub mod stage;
 #[cfg(feature = "tinybvh")]
 pub mod tinybvh;
 
-use crate::render::camera::CameraRays;
-use crate::render::geometry::{Ray, casters, intersect_triangle, obvhs_ray};
-use crate::render::sampling::SplitMix64;
-use crate::render::scene::{NO_HIT, Scene};
-use crate::render::spawn::surface_hit;
-use crate::render::wavefront::batch::{HitBatch, PathId, RayBatch};
-use crate::render::wavefront::bvh::MeshBvh;
-use crate::render::wavefront::context::Context;
-use crate::render::wavefront::cost::NoCount;
-use crate::render::wavefront::lanes::{LaneWidth, at_width};
-use crate::render::wavefront::{DEFAULT_BATCH_SIZE, intersect, simd};
 use glam::Vec3;
 use obvhs::{cwbvh::CwBvh, ray::RayHit};
+use raywave::render::camera::CameraRays;
+use raywave::render::geometry::{Ray, casters, intersect_triangle, obvhs_ray};
+use raywave::render::sampling::SplitMix64;
+use raywave::render::scene::{NO_HIT, Scene};
+use raywave::render::spawn::surface_hit;
+use raywave::render::wavefront::batch::{HitBatch, PathId, RayBatch};
+use raywave::render::wavefront::bvh::MeshBvh;
+use raywave::render::wavefront::context::Context;
+use raywave::render::wavefront::cost::NoCount;
+use raywave::render::wavefront::lanes::{LaneWidth, at_width};
+use raywave::render::wavefront::{DEFAULT_BATCH_SIZE, intersect, simd};
 use std::time::{Duration, Instant};
 
 /// The scene as the peers see it: every triangle except the emissive ones (the lights).
@@ -143,11 +143,6 @@ impl RaySet {
     /// Number of rays.
     pub fn len(&self) -> usize {
         self.batches.iter().map(RayBatch::len).sum()
-    }
-
-    /// True without rays.
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
     }
 
     fn push(&mut self, origin: Vec3, direction: Vec3, tmax: f32) {
@@ -361,7 +356,7 @@ impl ObvhsMesh {
     /// Builds the CWBVH with the same preset as raywave's `Accel` (`medium_build`).
     pub fn new(scene: &Scene) -> Self {
         let start = Instant::now();
-        let bvh = crate::render::geometry::build_cwbvh(scene);
+        let bvh = raywave::render::geometry::build_cwbvh(scene);
         ObvhsMesh {
             bvh,
             build_time: start.elapsed(),

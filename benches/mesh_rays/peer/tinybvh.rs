@@ -35,8 +35,8 @@
 //! checked in `tests/kernels/peer_agreement.rs` and printed with every peer table.
 
 use super::{Hits, RaySet};
-use crate::render::scene::{NO_HIT, Scene};
-use crate::render::wavefront::batch::RayBatch;
+use raywave::render::scene::{NO_HIT, Scene};
+use raywave::render::wavefront::batch::RayBatch;
 use std::cell::RefCell;
 use std::time::{Duration, Instant};
 use tinybvh_rs::{Intersection, Intersector, Ray, bvh};

@@ -27,10 +27,10 @@
 compile_error!("the embree4 feature loads libembree4 with dlopen and RTLD_DEEPBIND: Linux only");
 
 use super::{Hits, RaySet};
-use crate::render::geometry::T_MIN;
-use crate::render::scene::{NO_HIT, Scene};
-use crate::render::wavefront::batch::RayBatch;
 use anyhow::{Context as _, bail};
+use raywave::render::geometry::T_MIN;
+use raywave::render::scene::{NO_HIT, Scene};
+use raywave::render::wavefront::batch::RayBatch;
 use std::ffi::{CStr, CString, c_char, c_void};
 use std::mem::offset_of;
 use std::path::{Path, PathBuf};

@@ -16,12 +16,12 @@
 //! one origin in n hits.
 
 use super::{BATCH, RaySet, RaySetKind};
-use crate::render::scene::Scene;
-use crate::render::settings::{RenderSettings, ShadowMode};
-use crate::render::wavefront::batch::{HitBatch, ShadowQueue};
-use crate::render::wavefront::context::Context;
-use crate::render::wavefront::cost::NoCount;
-use crate::render::wavefront::{intersect, shadow};
+use raywave::render::scene::Scene;
+use raywave::render::settings::{RenderSettings, ShadowMode};
+use raywave::render::wavefront::batch::{HitBatch, ShadowQueue};
+use raywave::render::wavefront::context::Context;
+use raywave::render::wavefront::cost::NoCount;
+use raywave::render::wavefront::{intersect, shadow};
 
 /// The shadow stage of one ray kind, ready to run over the camera hits it was built with.
 pub struct ShadowStage<'s> {
@@ -66,11 +66,6 @@ impl<'s> ShadowStage<'s> {
             hits,
             queue: ShadowQueue::default(),
         }
-    }
-
-    /// The stage's context: its lane width and the light sampler it runs.
-    pub fn context(&self) -> &Context<'s> {
-        &self.ctx
     }
 
     /// One pass of the stage over every camera hit of `primary` (the set the stage was built
