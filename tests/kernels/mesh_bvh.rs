@@ -168,9 +168,13 @@ fn packet_hits(
 /// edges, go to the lowest id in both), for one- and two-sided faces; occlusion equal. The same
 /// rays as packets of 8 (which part at once on random rays, so this tests the split) too.
 fn check_against_brute_force(scene: &Scene, rays: &[(Ray, f32)]) {
-    let bvh = MeshBvh::new(scene);
+    check_tree_against_brute_force(&MeshBvh::new(scene), scene, rays);
+}
+
+/// [`check_against_brute_force`] for a given tree over `scene`.
+fn check_tree_against_brute_force(bvh: &MeshBvh, scene: &Scene, rays: &[(Ray, f32)]) {
     for two_sided in [false, true] {
-        let packets = packet_hits(&bvh, scene, rays, two_sided);
+        let packets = packet_hits(bvh, scene, rays, two_sided);
         for (i, (r, tmax)) in rays.iter().enumerate() {
             let (t, prim) = brute_force(scene, r, *tmax, two_sided);
             assert_eq!(
@@ -196,6 +200,100 @@ fn check_against_brute_force(scene: &Scene, rays: &[(Ray, f32)]) {
             );
         }
     }
+}
+
+/// A binary tree over `scene`'s triangles made without obvhs's builder: median splits of the
+/// centroids along the widest axis, leaves of at most 3 triangles, and every 7th triangle also
+/// referenced in a second leaf, whose box grows to hold it (a spatial-split build leaves a
+/// triangle in several leaves).
+fn median_split_tree(scene: &Scene) -> obvhs::bvh2::Bvh2 {
+    use obvhs::aabb::Aabb;
+    use obvhs::bvh2::{Bvh2, node::Bvh2Node};
+    let tris = &scene.triangles;
+    let box_of = |ids: &[u32]| {
+        let mut b = Aabb::INVALID;
+        for &i in ids {
+            let t = &tris[i as usize];
+            for v in [t.v0, t.v0 + t.e1, t.v0 + t.e2] {
+                b.extend(v.into());
+            }
+        }
+        b
+    };
+    let mut out = Bvh2::default();
+    out.nodes.push(Bvh2Node::default());
+    let mut todo = vec![(0usize, (0..tris.len() as u32).collect::<Vec<u32>>())];
+    let mut leaves = 0;
+    while let Some((slot, mut ids)) = todo.pop() {
+        if ids.len() <= 3 {
+            leaves += 1;
+            if leaves % 7 == 0 && slot > 1 {
+                ids.push(ids[0].saturating_sub(1)); // a neighbour's triangle, again
+            }
+            out.nodes[slot] = Bvh2Node {
+                aabb: box_of(&ids),
+                prim_count: ids.len() as u32,
+                first_index: out.primitive_indices.len() as u32,
+                ..Default::default()
+            };
+            out.primitive_indices.extend(ids);
+            continue;
+        }
+        let b = box_of(&ids);
+        let axis = b.largest_axis();
+        let centre = |i: &u32| {
+            let t = &tris[*i as usize];
+            (t.v0 + (t.e1 + t.e2) / 3.0)[axis]
+        };
+        ids.sort_by(|a, b| centre(a).total_cmp(&centre(b)));
+        let right = ids.split_off(ids.len() / 2);
+        let first = out.nodes.len();
+        out.nodes.extend([Bvh2Node::default(); 2]);
+        out.nodes[slot] = Bvh2Node {
+            aabb: b,
+            prim_count: 0,
+            first_index: first as u32,
+            ..Default::default()
+        };
+        todo.push((first, ids));
+        todo.push((first + 1, right));
+    }
+    // Leaf boxes hold their triangles; inner boxes were made before the duplicates were added,
+    // so grow them bottom up (children after parents: reverse order).
+    for i in (0..out.nodes.len()).rev() {
+        let n = out.nodes[i];
+        if n.prim_count == 0 {
+            let c = n.first_index as usize;
+            out.nodes[i].aabb = out.nodes[c].aabb.union(&out.nodes[c + 1].aabb);
+        }
+    }
+    out
+}
+
+/// The collapse takes any binary tree, not only obvhs's: another builder's tree, with a
+/// triangle in two leaves, traces as brute force too.
+#[test]
+fn a_tree_collapsed_from_another_builder_s_binary_tree_equals_brute_force() {
+    for scene in [mesh_scene(8), chain_scene()] {
+        let bvh2 = median_split_tree(&scene);
+        assert!(bvh2.primitive_indices.len() > scene.triangles.len());
+        let bvh = MeshBvh::from_bvh2(&scene, &bvh2);
+        check_tree_against_brute_force(&bvh, &scene, &random_rays(&scene, 2000, 17));
+    }
+}
+
+/// A leaf of more triangles than one block holds is refused, not cut short.
+#[test]
+#[should_panic(expected = "a leaf of more than 8 triangles")]
+fn a_binary_tree_with_a_leaf_of_nine_triangles_is_refused() {
+    let scene = mesh_scene(4);
+    let mut bvh2 = obvhs::bvh2::Bvh2::default();
+    bvh2.nodes.push(obvhs::bvh2::node::Bvh2Node {
+        prim_count: 9,
+        ..Default::default()
+    });
+    bvh2.primitive_indices = (0..9).collect();
+    MeshBvh::from_bvh2(&scene, &bvh2);
 }
 
 fn mesh_scene(bands: u32) -> Scene {

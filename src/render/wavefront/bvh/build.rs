@@ -50,23 +50,18 @@ impl MeshBvh {
     pub fn new(scene: &Scene) -> MeshBvh {
         let start = Instant::now();
         let tris = &scene.triangles;
-        let aabbs: Vec<Aabb> = tris
-            .iter()
-            .map(|t| {
-                let mut b = Aabb::from_point(t.v0.into());
-                b.extend((t.v0 + t.e1).into());
-                b.extend((t.v0 + t.e2).into());
-                b
-            })
-            .collect();
-        let mut bvh = MeshBvh {
-            nodes: Vec::new(),
-            blocks: Vec::new(),
-            root: EMPTY,
-            depth: 0,
-            build_time: Duration::ZERO,
-        };
-        if !tris.is_empty() {
+        let mut bvh = if tris.is_empty() {
+            MeshBvh::from_bvh2(scene, &Bvh2::default())
+        } else {
+            let aabbs: Vec<Aabb> = tris
+                .iter()
+                .map(|t| {
+                    let mut b = Aabb::from_point(t.v0.into());
+                    b.extend((t.v0 + t.e1).into());
+                    b.extend((t.v0 + t.e2).into());
+                    b
+                })
+                .collect();
             let p = BvhBuildParams::medium_build();
             let mut bvh2 = obvhs::ploc::PlocBuilder::with_capacity(aabbs.len()).build(
                 p.ploc_search_distance,
@@ -76,7 +71,35 @@ impl MeshBvh {
                 p.search_depth_threshold,
             );
             ReinsertionOptimizer::default().run(&mut bvh2, p.reinsertion_batch_ratio, None);
-            bvh.collapse(&bvh2, tris);
+            MeshBvh::from_bvh2(scene, &bvh2)
+        };
+        bvh.build_time = start.elapsed();
+        bvh
+    }
+
+    /// The 8-wide tree collapsed from any binary tree over `scene.triangles` whose leaves name
+    /// triangles by index (`primitive_indices`; a triangle may sit in several leaves, as
+    /// spatial splits leave it). An empty `bvh2` gives the empty tree. `new` collapses obvhs's
+    /// build with it; the peer benchmark collapses other builders' trees, to compare trees
+    /// under one traversal. `build_time` is the collapse's.
+    ///
+    /// # Panics
+    /// On a leaf of more than 8 triangles (a block's worth), which the collapse cannot hold.
+    pub fn from_bvh2(scene: &Scene, bvh2: &Bvh2) -> MeshBvh {
+        let start = Instant::now();
+        assert!(
+            bvh2.nodes.iter().all(|n| n.prim_count <= LEAF_MAX),
+            "MeshBvh::from_bvh2: a leaf of more than {LEAF_MAX} triangles"
+        );
+        let mut bvh = MeshBvh {
+            nodes: Vec::new(),
+            blocks: Vec::new(),
+            root: EMPTY,
+            depth: 0,
+            build_time: Duration::ZERO,
+        };
+        if !bvh2.nodes.is_empty() {
+            bvh.collapse(bvh2, &scene.triangles);
             bvh.nodes = huge_pages(std::mem::take(&mut bvh.nodes));
             bvh.blocks = huge_pages(std::mem::take(&mut bvh.blocks));
         }
