@@ -40,9 +40,13 @@
 //! takes for that scene), Embree single and packet8, each tinybvh layout, and raywave's ratio
 //! to each, checked for agreement with raywave before any timing.
 //!
+//! `RAYWAVE_TREE_TABLE=ROUNDS cargo bench --bench mesh_rays --features embree4` prints the
+//! tree table instead (`tree_table.rs`): raywave's mesh tree beside the trees Embree 4's
+//! builder makes of the same triangles, each traced by raywave's walk.
+//!
 //! `RAYWAVE_MESH=lab` (or `12k`, `1M`) limits any mode but the test mode to one scene;
 //! `RAYWAVE_EMBREE_QUALITY=low|medium|high` (default high) sets Embree's build quality.
-//! The test mode ignores all four switches.
+//! The test mode ignores all five switches.
 
 #[path = "../common/mod.rs"]
 mod common;
@@ -50,6 +54,8 @@ mod common;
 #[allow(dead_code)]
 mod peer;
 mod peer_table;
+#[cfg(feature = "embree4")]
+mod tree_table;
 
 use criterion::{BenchmarkId, Criterion, Throughput};
 use peer::stage::ShadowStage;
@@ -520,9 +526,18 @@ fn main() {
     }
     let interleave = rounds_switch("RAYWAVE_INTERLEAVE", test_mode);
     let table = rounds_switch("RAYWAVE_PEER_TABLE", test_mode);
-    if interleave.is_some() && table.is_some() {
-        exit_with("RAYWAVE_INTERLEAVE and RAYWAVE_PEER_TABLE: one mode at a time");
+    let trees = rounds_switch("RAYWAVE_TREE_TABLE", test_mode);
+    if [interleave, table, trees].iter().flatten().count() > 1 {
+        exit_with(
+            "RAYWAVE_INTERLEAVE, RAYWAVE_PEER_TABLE and RAYWAVE_TREE_TABLE: one mode at a time",
+        );
     }
+    #[cfg(not(feature = "embree4"))]
+    if trees.is_some() {
+        exit_with("RAYWAVE_TREE_TABLE compares raywave's tree with Embree's: --features embree4");
+    }
+    #[cfg(feature = "embree4")]
+    let mut tree_table = tree_table::TreeTable::default();
     let size = if test_mode { TEST_SIZE } else { SIZE };
     let quality = embree_quality(test_mode);
     let mut c = common::criterion_for_frames(Duration::from_millis(300));
@@ -542,6 +557,11 @@ fn main() {
         let ctx = Context::new(&s.scene, &s.settings);
         if let Some(rounds) = table {
             peer_rows(&s, &ctx, rounds, &mut tables);
+            continue;
+        }
+        #[cfg(feature = "embree4")]
+        if let Some(rounds) = trees {
+            tree_table::tree_rows(&s, &ctx, rounds, &mut tree_table);
             continue;
         }
         if let Some(rounds) = interleave {
@@ -564,7 +584,11 @@ fn main() {
     } else if test_mode {
         print_peer_table(1, size, &tables);
     }
-    if interleave.is_none() && table.is_none() {
+    #[cfg(feature = "embree4")]
+    if let Some(rounds) = trees {
+        tree_table::print_tree_table(rounds, size, &tree_table);
+    }
+    if interleave.is_none() && table.is_none() && trees.is_none() {
         c.final_summary();
     }
 }

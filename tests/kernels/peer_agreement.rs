@@ -380,6 +380,59 @@ fn embree4_single_and_packet8_equal_raywave() {
     }
 }
 
+/// Embree 4's builder's trees (`peer::embree4_tree`, binned SAH and spatial splits), collapsed
+/// by raywave, trace as raywave's own tree: the tree table compares builds, not answers.
+#[cfg(feature = "embree4")]
+#[test]
+fn embree4_builder_trees_trace_as_raywave_s_own() {
+    use crate::peer::embree4_tree::embree_bvh2;
+    use raywave::render::wavefront::bvh::MeshBvh;
+    let (scene, settings) = (mesh_scene(), settings());
+    for quality in [BuildQuality::Medium, BuildQuality::High] {
+        let (bvh2, _) = embree_bvh2(&scene, quality).unwrap_or_else(|e| panic!("{e:#}"));
+        assert!(bvh2.primitive_indices.len() >= scene.triangles.len());
+        let mut ctx = Context::new(&scene, &settings);
+        ctx.accel = Some(MeshBvh::from_bvh2(&scene, &bvh2));
+        check_peer_against_raywave(
+            &format!("Embree 4's {} tree under raywave's walk", quality.name()),
+            &scene,
+            256,
+            &|set, out| raywave_closest(&ctx, set, out),
+            &|set, ours| {
+                let mut theirs = Vec::new();
+                wavefront_occluded(&ctx, set, &mut theirs);
+                occlusion_agreement(ours, &theirs)
+            },
+        );
+    }
+}
+
+/// A spatial split's two boxes: each on its side of the plane, together the triangle's box.
+#[cfg(feature = "embree4")]
+#[test]
+fn a_triangle_split_at_a_plane_gives_the_boxes_of_its_two_parts() {
+    use crate::peer::embree4_tree::split_triangle;
+    let t = crate::common::triangle(
+        glam::Vec3::new(0.0, 0.0, 0.0),
+        glam::Vec3::new(4.0, 0.0, 0.0),
+        glam::Vec3::new(0.0, 2.0, 1.0),
+    );
+    let (left, right) = split_triangle(&t, 0, 1.0);
+    assert_eq!(
+        (left.min.to_array(), left.max.to_array()),
+        ([0.0; 3], [1.0, 2.0, 1.0])
+    );
+    // Right of x = 1: the corner (4, 0, 0) and the two edges' crossings (1, 0, 0) and
+    // (1, 1.5, 0.75).
+    assert_eq!(
+        (right.min.to_array(), right.max.to_array()),
+        ([1.0, 0.0, 0.0], [4.0, 1.5, 0.75])
+    );
+    // A plane past the triangle leaves one side empty.
+    let (_, none) = split_triangle(&t, 1, 3.0);
+    assert!(!none.valid());
+}
+
 /// One Embree call's hit record and what lies after it: a guard that the library must leave
 /// as it was.
 #[cfg(feature = "embree4")]

@@ -42,7 +42,7 @@ use std::time::{Duration, Instant};
 /// build time for the default).
 const DIR_ENV: &str = "RAYWAVE_EMBREE4_DIR";
 
-type Device = *mut c_void;
+pub(super) type Device = *mut c_void;
 type Geometry = *mut c_void;
 type RtcScene = *mut c_void;
 type MemoryMonitor = unsafe extern "C" fn(*mut c_void, isize, bool) -> bool;
@@ -225,11 +225,11 @@ const _: () = {
     assert!(align_of::<Ray8>() == 32 && align_of::<Valid8>() == 32);
 };
 
-/// The library's entry points this module calls, resolved once by `dlsym`.
-struct Api {
+/// The library's entry points this module (and `embree4_tree`) calls, resolved once by `dlsym`.
+pub(super) struct Api {
     path: PathBuf,
-    new_device: unsafe extern "C" fn(*const c_char) -> Device,
-    release_device: unsafe extern "C" fn(Device),
+    pub(super) new_device: unsafe extern "C" fn(*const c_char) -> Device,
+    pub(super) release_device: unsafe extern "C" fn(Device),
     device_property: unsafe extern "C" fn(Device, u32) -> isize,
     device_error: unsafe extern "C" fn(Device) -> u32,
     last_error_message: unsafe extern "C" fn(Device) -> *const c_char,
@@ -248,6 +248,7 @@ struct Api {
     occluded1: unsafe extern "C" fn(RtcScene, *mut Ray1, *mut QueryArguments),
     intersect8: unsafe extern "C" fn(*const i32, RtcScene, *mut RayHit8, *mut QueryArguments),
     occluded8: unsafe extern "C" fn(*const i32, RtcScene, *mut Ray8, *mut QueryArguments),
+    pub(super) builder: super::embree4_tree::BuilderApi,
 }
 
 /// The library file: `libembree4*.so*` in `RAYWAVE_EMBREE4_DIR` (the run's, else the
@@ -369,12 +370,18 @@ impl Api {
             occluded1: resolve!("rtcOccluded1"),
             intersect8: resolve!("rtcIntersect8"),
             occluded8: resolve!("rtcOccluded8"),
+            builder: super::embree4_tree::BuilderApi {
+                new_bvh: resolve!("rtcNewBVH"),
+                build_bvh: resolve!("rtcBuildBVH"),
+                thread_local_alloc: resolve!("rtcThreadLocalAlloc"),
+                release_bvh: resolve!("rtcReleaseBVH"),
+            },
             path,
         })
     }
 
     /// The library, loaded on first use; the same error on every later call if it failed.
-    fn get() -> anyhow::Result<&'static Api> {
+    pub(super) fn get() -> anyhow::Result<&'static Api> {
         static API: OnceLock<Result<Api, String>> = OnceLock::new();
         API.get_or_init(|| Api::load().map_err(|e| format!("{e:#}")))
             .as_ref()
@@ -382,7 +389,7 @@ impl Api {
     }
 
     /// The device's error code and last message, e.g. `error 4: out of memory`.
-    fn error(&self, device: Device) -> String {
+    pub(super) fn error(&self, device: Device) -> String {
         // SAFETY: a device handle (or null, for the thread's device-creation error).
         unsafe {
             let code = (self.device_error)(device);
@@ -718,7 +725,7 @@ impl BuildQuality {
     }
 
     /// The `RTCBuildQuality` value (0, 1, 2 in `rtcore_common.h`).
-    fn rtc(self) -> u32 {
+    pub(super) fn rtc(self) -> u32 {
         match self {
             BuildQuality::Low => 0,
             BuildQuality::Medium => 1,

@@ -27,6 +27,8 @@
 
 #[cfg(feature = "embree4")]
 pub mod embree4;
+#[cfg(feature = "embree4")]
+pub mod embree4_tree;
 pub mod stage;
 #[cfg(feature = "tinybvh")]
 pub mod tinybvh;
