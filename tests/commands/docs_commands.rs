@@ -74,6 +74,10 @@ const BENCHMARKING: Page = Page {
             "RAYWAVE_PEER_TABLE=9 cargo bench --bench mesh_rays --features embree4,tinybvh",
             "needs libembree4 and builds tinybvh's C++; .ci/run builds without either feature",
         ),
+        (
+            "RAYWAVE_TREE_TABLE=15 cargo bench --bench mesh_rays --features embree4",
+            "needs libembree4 (the embreex wheel); .ci/run builds without the embree4 feature",
+        ),
     ],
     after: nothing,
 };
