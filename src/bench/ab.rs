@@ -37,13 +37,13 @@
 //! looks with narrower levels (`sequential`), within `--max-rounds` and `--max-time`.
 
 use super::running::sequential::{self, Budget};
-pub use super::verdict::{Rule, Verdict, VerdictForm};
+use super::verdict::{RatioSummary, Rule, Verdict, summarize};
 use super::{EXIT_REGRESSION, EXIT_UNDECIDED};
 use crate::render::engine::Engine;
 use crate::render::error::UsageError;
 use crate::render::progress::{Progress, Steps};
 use crate::stats::looks::LookPlan;
-use crate::stats::{MIN_FOR_INTERVAL, median, median_with_interval_at};
+use crate::stats::{MIN_FOR_INTERVAL, median};
 use anyhow::{Context, Result, bail};
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
@@ -96,19 +96,6 @@ pub struct EngineAb {
     pub sequential: Option<sequential::Outcome>,
 }
 
-/// A ratio's summary: median, interval, verdict.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RatioSummary {
-    /// Median of the per-round ratios this / other.
-    pub median: f64,
-    /// The low end of that median's interval (95%; with `--until-decided`, the look's level).
-    pub low: f64,
-    /// The high end of that median's interval.
-    pub high: f64,
-    /// Against the threshold.
-    pub verdict: Verdict,
-}
-
 impl EngineAb {
     /// Per-round ratios this / other.
     pub fn ratios(&self) -> Vec<f64> {
@@ -135,22 +122,6 @@ impl EngineAb {
                 |look| look.summary,
             ),
         }
-    }
-}
-
-/// Median, 95% interval and verdict of per-round ratios.
-pub fn summarize(ratios: &[f64], rule: Rule) -> RatioSummary {
-    summarize_at(ratios, rule, 0.05)
-}
-
-/// Median, (1 − `alpha`) interval and verdict of per-round ratios.
-pub fn summarize_at(ratios: &[f64], rule: Rule, alpha: f64) -> RatioSummary {
-    let (median, low, high) = median_with_interval_at(ratios, alpha);
-    RatioSummary {
-        median,
-        low,
-        high,
-        verdict: rule.judge(low, high),
     }
 }
 

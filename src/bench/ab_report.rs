@@ -1,8 +1,9 @@
 //! The text of `raywave bench --against`: the verdict table, and with `--until-decided` the
 //! plan of looks and each engine's rounds and looks.
 
-use super::ab::{AbOptions, EngineAb, Verdict, VerdictForm};
+use super::ab::{AbOptions, EngineAb};
 use super::running::sequential::{self, Budget, Stop};
+use super::verdict::{Verdict, VerdictForm};
 use crate::stats::looks::{self, LookPlan};
 use crate::stats::median;
 use std::time::Duration;

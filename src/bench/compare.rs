@@ -3,7 +3,7 @@
 //!
 //! The rule is in `verdict.rs` (docs/BENCHMARKING.md, "The verdict").
 
-use super::verdict::{Verdict, of_records};
+use super::verdict::{Verdict, change_pct, of_records};
 use crate::output::bench_record::{BenchRecord, FigureSummary, Setup};
 use std::fmt::Write;
 
@@ -175,15 +175,6 @@ impl Comparison {
             );
         }
         s
-    }
-}
-
-/// Percent change from `before` to `after`; 0 when `before` is 0 (nothing to compare).
-pub fn change_pct(before: f64, after: f64) -> f64 {
-    if before > 0.0 {
-        (after - before) / before * 100.0
-    } else {
-        0.0
     }
 }
 

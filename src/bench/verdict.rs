@@ -18,8 +18,8 @@
 //! are this build's time over the other's (lower is better). Slower is a regression (exit 3)
 //! in both.
 
-use super::compare::change_pct;
 use crate::output::bench_record::FigureSummary;
+use crate::stats::median_with_interval_at;
 
 /// What a rule says of one figure: the same five words for `bench --compare` and `--against`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -142,5 +142,43 @@ pub fn of_records(before: &FigureSummary, after: &FigureSummary, threshold_pct: 
     } else {
         // Apart or not, the change is within what the threshold says matters.
         Verdict::Within
+    }
+}
+
+/// A ratio's summary: median, interval, verdict.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RatioSummary {
+    /// Median of the per-round ratios this / other.
+    pub median: f64,
+    /// The low end of that median's interval (95%; with `--until-decided`, the look's level).
+    pub low: f64,
+    /// The high end of that median's interval.
+    pub high: f64,
+    /// Against the threshold.
+    pub verdict: Verdict,
+}
+
+/// Median, 95% interval and verdict of per-round ratios.
+pub fn summarize(ratios: &[f64], rule: Rule) -> RatioSummary {
+    summarize_at(ratios, rule, 0.05)
+}
+
+/// Median, (1 − `alpha`) interval and verdict of per-round ratios.
+pub fn summarize_at(ratios: &[f64], rule: Rule, alpha: f64) -> RatioSummary {
+    let (median, low, high) = median_with_interval_at(ratios, alpha);
+    RatioSummary {
+        median,
+        low,
+        high,
+        verdict: rule.judge(low, high),
+    }
+}
+
+/// Percent change from `before` to `after`; 0 when `before` is 0 (nothing to compare).
+pub fn change_pct(before: f64, after: f64) -> f64 {
+    if before > 0.0 {
+        (after - before) / before * 100.0
+    } else {
+        0.0
     }
 }

@@ -471,7 +471,7 @@ pub fn run(args: &BenchArgs, matches: Option<&ArgMatches>) -> Result<u8> {
             max_time: args.max_time,
         }),
         warmup: args.warmup,
-        rule: ab::Rule {
+        rule: raywave::bench::verdict::Rule {
             threshold_pct: args.threshold.unwrap_or(AB_THRESHOLD_PCT),
             form: args.verdict.into(),
         },

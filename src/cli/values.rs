@@ -7,7 +7,7 @@
 //! none for floats, so [`float`] is clap's string parser mapped through a check.
 
 use clap::builder::{StringValueParser, TypedValueParser};
-use raywave::bench::ab::VerdictForm;
+use raywave::bench::verdict::VerdictForm;
 use raywave::output::cost_map::{CostKind, CostMeasure};
 use raywave::render::engine::Engine;
 use raywave::render::film::ToneMap;

@@ -225,9 +225,12 @@ const _: () = {
     assert!(align_of::<Ray8>() == 32 && align_of::<Valid8>() == 32);
 };
 
-/// The library's entry points this module (and `embree4_tree`) calls, resolved once by `dlsym`.
+/// The library's entry points this module calls, resolved once by `dlsym`; other modules
+/// resolve theirs with [`Api::function`].
 pub(super) struct Api {
     path: PathBuf,
+    /// The `dlopen` handle, never closed.
+    handle: usize,
     pub(super) new_device: unsafe extern "C" fn(*const c_char) -> Device,
     pub(super) release_device: unsafe extern "C" fn(Device),
     device_property: unsafe extern "C" fn(Device, u32) -> isize,
@@ -248,7 +251,6 @@ pub(super) struct Api {
     occluded1: unsafe extern "C" fn(RtcScene, *mut Ray1, *mut QueryArguments),
     intersect8: unsafe extern "C" fn(*const i32, RtcScene, *mut RayHit8, *mut QueryArguments),
     occluded8: unsafe extern "C" fn(*const i32, RtcScene, *mut Ray8, *mut QueryArguments),
-    pub(super) builder: super::embree4_tree::BuilderApi,
 }
 
 /// The library file: `libembree4*.so*` in `RAYWAVE_EMBREE4_DIR` (the run's, else the
@@ -370,14 +372,28 @@ impl Api {
             occluded1: resolve!("rtcOccluded1"),
             intersect8: resolve!("rtcIntersect8"),
             occluded8: resolve!("rtcOccluded8"),
-            builder: super::embree4_tree::BuilderApi {
-                new_bvh: resolve!("rtcNewBVH"),
-                build_bvh: resolve!("rtcBuildBVH"),
-                thread_local_alloc: resolve!("rtcThreadLocalAlloc"),
-                release_bvh: resolve!("rtcReleaseBVH"),
-            },
+            handle: handle as usize,
             path,
         })
+    }
+
+    /// The entry point `name` as the function pointer type `F`.
+    ///
+    /// # Safety
+    /// `F` is the C signature of Embree 4.4's function of that name (include/embree4/*.h).
+    pub(super) unsafe fn function<F: Copy>(&self, name: &str) -> anyhow::Result<F> {
+        let c_name = CString::new(name).expect("symbol names have no NUL");
+        // SAFETY: the live handle `load` opened, and a valid C string.
+        let p = unsafe { libc::dlsym(self.handle as *mut c_void, c_name.as_ptr()) };
+        if p.is_null() {
+            bail!(
+                "{}: no symbol {name}: {}",
+                self.path.display(),
+                dl_error("not found")
+            );
+        }
+        // SAFETY: the caller's.
+        Ok(unsafe { as_fn(p) })
     }
 
     /// The library, loaded on first use; the same error on every later call if it failed.

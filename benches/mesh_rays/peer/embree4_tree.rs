@@ -26,14 +26,38 @@ use obvhs::aabb::Aabb;
 use obvhs::bvh2::{Bvh2, node::Bvh2Node};
 use raywave::render::scene::{Scene, Triangle};
 use std::ffi::c_void;
+use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
-/// The builder's entry points (`rtcore_builder.h`), resolved with the rest of the API.
-pub struct BuilderApi {
-    pub new_bvh: unsafe extern "C" fn(Device) -> *mut c_void,
-    pub build_bvh: unsafe extern "C" fn(*const BuildArguments) -> *mut c_void,
-    pub thread_local_alloc: unsafe extern "C" fn(*mut c_void, usize, usize) -> *mut c_void,
-    pub release_bvh: unsafe extern "C" fn(*mut c_void),
+/// The builder's entry points (`rtcore_builder.h`), resolved once.
+struct BuilderApi {
+    new_bvh: unsafe extern "C" fn(Device) -> *mut c_void,
+    build_bvh: unsafe extern "C" fn(*const BuildArguments) -> *mut c_void,
+    thread_local_alloc: unsafe extern "C" fn(*mut c_void, usize, usize) -> *mut c_void,
+    release_bvh: unsafe extern "C" fn(*mut c_void),
+}
+
+impl BuilderApi {
+    /// The entry points, from the library `api` loaded; the same error on every later call if
+    /// one is missing.
+    fn get(api: &Api) -> anyhow::Result<&'static BuilderApi> {
+        static BUILDER: OnceLock<Result<BuilderApi, String>> = OnceLock::new();
+        let load = || -> anyhow::Result<BuilderApi> {
+            // SAFETY: each field's type is the C signature of the function of that name.
+            unsafe {
+                Ok(BuilderApi {
+                    new_bvh: api.function("rtcNewBVH")?,
+                    build_bvh: api.function("rtcBuildBVH")?,
+                    thread_local_alloc: api.function("rtcThreadLocalAlloc")?,
+                    release_bvh: api.function("rtcReleaseBVH")?,
+                })
+            }
+        };
+        BUILDER
+            .get_or_init(|| load().map_err(|e| format!("{e:#}")))
+            .as_ref()
+            .map_err(|e| anyhow::anyhow!("{e}"))
+    }
 }
 
 /// Most triangles in one leaf of the binary tree: one block of raywave's.
@@ -69,7 +93,7 @@ type SplitPrimitive =
 
 /// `RTCBuildArguments` (Embree 4.4's `include/embree4/rtcore_builder.h`).
 #[repr(C)]
-pub struct BuildArguments {
+struct BuildArguments {
     byte_size: usize,
     build_quality: u32,
     build_flags: u32,
@@ -249,6 +273,7 @@ pub fn split_triangle(t: &Triangle, axis: usize, pos: f32) -> (Aabb, Aabb) {
 /// spatial splits), as obvhs's `Bvh2`, and the build's wall time (Embree's threads).
 pub fn embree_bvh2(scene: &Scene, quality: BuildQuality) -> anyhow::Result<(Bvh2, Duration)> {
     let api = Api::get()?;
+    let builder = BuilderApi::get(api)?;
     let tris = &scene.triangles;
     if tris.is_empty() {
         return Ok((Bvh2::default(), Duration::ZERO));
@@ -271,7 +296,7 @@ pub fn embree_bvh2(scene: &Scene, quality: BuildQuality) -> anyhow::Result<(Bvh2
     let count = prims.len();
     prims.resize(2 * count, prims[0]);
     let shared = Shared {
-        alloc: api.builder.thread_local_alloc,
+        alloc: builder.thread_local_alloc,
         triangles: tris,
     };
     let start = Instant::now();
@@ -283,7 +308,7 @@ pub fn embree_bvh2(scene: &Scene, quality: BuildQuality) -> anyhow::Result<(Bvh2
         if device.is_null() {
             bail!("rtcNewDevice failed: {}", api.error(device));
         }
-        let bvh = (api.builder.new_bvh)(device);
+        let bvh = (builder.new_bvh)(device);
         let args = BuildArguments {
             byte_size: size_of::<BuildArguments>(),
             build_quality: quality.rtc(),
@@ -307,14 +332,14 @@ pub fn embree_bvh2(scene: &Scene, quality: BuildQuality) -> anyhow::Result<(Bvh2
             build_progress: None,
             user_ptr: &shared as *const Shared as *mut c_void,
         };
-        let root = (api.builder.build_bvh)(&args);
+        let root = (builder.build_bvh)(&args);
         let time = start.elapsed();
         let tree = if root.is_null() {
             Err(anyhow::anyhow!("rtcBuildBVH failed: {}", api.error(device)))
         } else {
             to_bvh2(root as *const u32)
         };
-        (api.builder.release_bvh)(bvh);
+        (builder.release_bvh)(bvh);
         (api.release_device)(device);
         Ok((tree?, time))
     }

@@ -14,7 +14,7 @@
 //!        (K is the smallest split whose plan has at most K looks)
 //! for each planned look n:
 //!     rounds up to n, unless the caller's budget says the look cannot be reached: stop there
-//!     the n ratios' median and its (1 − 5%/K) interval → verdict (`ab::Rule::judge`)
+//!     the n ratios' median and its (1 − 5%/K) interval → verdict (`verdict::Rule::judge`)
 //!     decided (one-sided: slower, or not slower; three-way: slower, faster or within): stop
 //! after the last look: undecided at max-rounds
 //! ```
@@ -47,7 +47,7 @@
 //! `ab`); a ratio of two measured times equal to 1 + t to the bit is rare enough that the
 //! choice matters for the statement, not for a run.
 
-use crate::bench::ab::{RatioSummary, Rule, Verdict, summarize_at};
+use crate::bench::verdict::{RatioSummary, Rule, Verdict, summarize_at};
 use crate::stats::looks::LookPlan;
 use anyhow::Result;
 use std::time::Duration;

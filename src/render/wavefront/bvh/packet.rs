@@ -23,8 +23,8 @@ use crate::render::geometry::{T_MIN, closer};
 use crate::render::scene::NO_HIT;
 use crate::render::wavefront::cost::Counter;
 use crate::render::wavefront::lanes::{
-    MASK_LANES, f32_bits, f32_bits_signed, f32_from_bits, f32_from_signed, f32x8, i32x8, ids,
-    load_live, set_bits, u32x8, view,
+    MASK_LANES, f32_bits, f32_bits_signed, f32_from_bits, f32_from_signed, f32x8, i32x8, load_live,
+    set_bits, u32x8, view,
 };
 use crate::render::wavefront::simd::{self, RayColumns, TriangleLanes};
 
@@ -260,7 +260,7 @@ impl<'b> Walk<'b> {
                 }
             } else if cur != EMPTY {
                 let block = &bvh.blocks[(cur & !LEAF) as usize];
-                C::leaf_lanes(counts, active, block_len(block));
+                C::leaf_lanes(counts, active, block.len());
                 leaf_against_packet(block, active, p, &mut best, alone.two_sided);
             }
             // Pop the next entry that some lane may still find a closer hit in.
@@ -312,7 +312,7 @@ fn splits(bvh: &MeshBvh, cur: u32, active: u32) -> bool {
     active.count_ones() < PACKET_MIN_LANES
         || cur & LEAF != 0 && cur != EMPTY && {
             let block = &bvh.blocks[(cur & !LEAF) as usize];
-            block_len(block) > active.count_ones()
+            block.len() > active.count_ones()
         }
 }
 
@@ -361,7 +361,7 @@ fn leaf_against_packet(
     two_sided: bool,
 ) {
     let bits = &MASK_LANES[active as usize];
-    for j in 0..block_len(block) as usize {
+    for j in 0..block.len() as usize {
         let limit = bits.select(best.limit, f32x8::splat(f32::NEG_INFINITY));
         let t = simd::moller_trumbore8(&p.against(block, j), limit, two_sided);
         let hit = t.simd_lt(limit);
@@ -369,14 +369,4 @@ fn leaf_against_packet(
             best.take(hit, t, block.prim[j]);
         }
     }
-}
-
-/// Number of triangles in a block: its lanes before the first unused one (id `NO_HIT`). From
-/// the ids, not the vertices: a triangle built in code may have a NaN vertex.
-#[inline(always)]
-pub(super) fn block_len(block: &Block) -> u32 {
-    let unused = ids(block.prim)
-        .simd_eq(i32x8::splat(NO_HIT as i32))
-        .to_bitmask();
-    (unused | 1 << WIDTH).trailing_zeros()
 }

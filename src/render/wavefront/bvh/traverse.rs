@@ -10,7 +10,6 @@
 //!           blocker
 //! ```
 
-use super::packet::block_len;
 use super::{Block, EMPTY, LEAF, MeshBvh, Node, WIDTH, hit};
 use crate::render::geometry::{Hit, Ray, closer};
 use crate::render::scene::NO_HIT;
@@ -179,7 +178,7 @@ impl MeshBvh {
                 }
             } else if cur != EMPTY {
                 let block = &self.blocks[(cur & !LEAF) as usize];
-                c.leaf(block_len(block));
+                c.leaf(block.len());
                 (best_t, best_prim) = block_closest(block, r, (best_t, best_prim), two_sided);
             }
             // Pop the next entry that may still hold a closer hit.
@@ -239,7 +238,7 @@ impl MeshBvh {
                 }
             } else if cur != EMPTY {
                 let block = &self.blocks[(cur & !LEAF) as usize];
-                c.leaf(block_len(block));
+                c.leaf(block.len());
                 if triangles8_block(block, r, tmax8, two_sided) {
                     return cur;
                 }

@@ -3,36 +3,18 @@
 //! light) stream on a parallelogram light (the per-stream point sets in `point_sets.rs`), and
 //! the shadow rays from a hit to them.
 
-use super::point_sets;
+use super::point_sets::{self, mix32x8, owen_scramble_rev8, reverse_bits8, unit};
 use crate::render::sampling::Stream;
 use crate::render::spawn::{LightEnd, SurfaceHit};
 use crate::render::wavefront::batch::ShadowBlock;
 use crate::render::wavefront::lanes::{Lanes, LanesU};
 use glam::Vec3;
 
-/// Chris Wellons' `lowbias32`, N lanes; twin of `sampling::mix32`.
-#[inline(always)]
-pub(super) fn mix32x8<U: LanesU>(mut x: U) -> U {
-    x = x ^ (x >> 16);
-    x = x * U::splat(0x7feb_352d);
-    x = x ^ (x >> 15);
-    x = x * U::splat(0x846c_a68b);
-    x = x ^ (x >> 16);
-    x
-}
-
 /// Uniform numbers in [0, 1) for dimensions `dims` of the stream whose hash prefix is `prefix`
 /// (see `shadow::key_prefix`): twin of `sampling::uniform`.
 #[inline(always)]
 fn uniform8<U: LanesU>(prefix: u32, dims: U) -> U::F {
     unit(mix32x8(U::splat(prefix) ^ dims))
-}
-
-/// The 24-bit unit float of the top bits of `bits`: `(bits >> 8) as f32 · 2⁻²⁴`.
-#[inline(always)]
-pub(super) fn unit<U: LanesU>(bits: U) -> U::F {
-    // bits >> 8 < 2^24, so the signed conversion is exact.
-    (bits >> 8).to_f32_signed() * U::F::splat(1.0 / 16_777_216.0)
 }
 
 /// How a block's (u, v) are drawn: the samplers with a SIMD twin.
@@ -167,32 +149,6 @@ static SOBOL_VECTORS: std::sync::LazyLock<[[u32; 16]; 2]> = std::sync::LazyLock:
     let vectors = |d| std::array::from_fn(|k| sobol_burley::parts::sobol_rev(1 << (31 - k), d));
     [vectors(0), vectors(1)]
 });
-
-/// `sobol_burley::parts::owen_scramble_rev`, N lanes.
-#[inline(always)]
-pub(super) fn owen_scramble_rev8<U: LanesU>(mut n: U, scramble: u32) -> U {
-    n = n ^ (n * U::splat(0x3d20_adea));
-    n = n + U::splat(scramble);
-    n = n * U::splat((scramble >> 16) | 1);
-    n = n ^ (n * U::splat(0x0552_6c56));
-    n = n ^ (n * U::splat(0x53a2_2864));
-    n
-}
-
-/// `u32::reverse_bits`, N lanes.
-#[inline(always)]
-pub(super) fn reverse_bits8<U: LanesU>(mut x: U) -> U {
-    for (shift, mask) in [
-        (1, 0x5555_5555u32),
-        (2, 0x3333_3333),
-        (4, 0x0f0f_0f0f),
-        (8, 0x00ff_00ff),
-    ] {
-        let m = U::splat(mask);
-        x = ((x >> shift) & m) | ((x & m) << shift);
-    }
-    (x >> 16) | (x << 16)
-}
 
 /// `sobol_burley::parts::u32_to_f32_norm`, N lanes.
 #[inline(always)]

@@ -15,9 +15,52 @@
 //! The blue-noise sampler stays one lane at a time (`light::per_lane`): its points are three
 //! table reads at addresses that differ per lane, which lanes cannot gather any faster.
 
-use super::light::{mix32x8, reverse_bits8, unit};
 use crate::render::sampling::{ONE_MINUS_EPS, halton, mix32, zsobol};
 use crate::render::wavefront::lanes::{Lanes, LanesU};
+
+/// Chris Wellons' `lowbias32`, N lanes; twin of `sampling::mix32`.
+#[inline(always)]
+pub(super) fn mix32x8<U: LanesU>(mut x: U) -> U {
+    x = x ^ (x >> 16);
+    x = x * U::splat(0x7feb_352d);
+    x = x ^ (x >> 15);
+    x = x * U::splat(0x846c_a68b);
+    x = x ^ (x >> 16);
+    x
+}
+
+/// The 24-bit unit float of the top bits of `bits`: `(bits >> 8) as f32 · 2⁻²⁴`.
+#[inline(always)]
+pub(super) fn unit<U: LanesU>(bits: U) -> U::F {
+    // bits >> 8 < 2^24, so the signed conversion is exact.
+    (bits >> 8).to_f32_signed() * U::F::splat(1.0 / 16_777_216.0)
+}
+
+/// `sobol_burley::parts::owen_scramble_rev`, N lanes.
+#[inline(always)]
+pub(super) fn owen_scramble_rev8<U: LanesU>(mut n: U, scramble: u32) -> U {
+    n = n ^ (n * U::splat(0x3d20_adea));
+    n = n + U::splat(scramble);
+    n = n * U::splat((scramble >> 16) | 1);
+    n = n ^ (n * U::splat(0x0552_6c56));
+    n = n ^ (n * U::splat(0x53a2_2864));
+    n
+}
+
+/// `u32::reverse_bits`, N lanes.
+#[inline(always)]
+pub(super) fn reverse_bits8<U: LanesU>(mut x: U) -> U {
+    for (shift, mask) in [
+        (1, 0x5555_5555u32),
+        (2, 0x3333_3333),
+        (4, 0x0f0f_0f0f),
+        (8, 0x00ff_00ff),
+    ] {
+        let m = U::splat(mask);
+        x = ((x >> shift) & m) | ((x & m) << shift);
+    }
+    (x >> 16) | (x << 16)
+}
 
 /// x / 3 for every u32 x: 0xaaaa_aaab = ⌈2³³ / 3⌉.
 #[inline(always)]
@@ -191,7 +234,7 @@ pub(super) fn zsobol<U: LanesU>(j: U, stream: &zsobol::StreamIndex) -> (U::F, U:
 /// `zsobol::owen_scramble` on lanes.
 #[inline(always)]
 fn owen_scramble<U: LanesU>(x: U, seed: u32) -> U {
-    reverse_bits8(super::light::owen_scramble_rev8(reverse_bits8(x), seed))
+    reverse_bits8(owen_scramble_rev8(reverse_bits8(x), seed))
 }
 
 /// PMJ02 points `j0..j0 + N` of the stream reading `table` with the digital shift `masks`:
