@@ -47,14 +47,54 @@ impl CameraRays {
     /// with sub-pixel offset (ox, oy).
     #[inline]
     pub fn screen(&self, pixel: u32, ox: f32, oy: f32) -> (f32, f32) {
+        let (column, row) = (pixel % self.width, self.height - 1 - pixel / self.width);
+        self.screen_at(column, row, ox, oy, self.scale())
+    }
+
+    /// 1 / max(width, height): pixels to screen units.
+    #[inline]
+    fn scale(&self) -> f32 {
+        1.0 / (self.width as f32).max(self.height as f32)
+    }
+
+    /// [`Self::screen`] of the pixel in `column`, `row` (counted from the bottom), given
+    /// [`Self::scale`]: the one formula both it and [`Self::rays_of`] use.
+    #[inline]
+    fn screen_at(&self, column: u32, row: u32, ox: f32, oy: f32, scale: f32) -> (f32, f32) {
         let (w, h) = (self.width as f32, self.height as f32);
-        let i = (pixel % self.width) as f32;
-        let j = (self.height - 1 - pixel / self.width) as f32;
-        let scale = 1.0 / w.max(h);
         (
-            (i + ox - 0.5 * w) * scale + 0.5,
-            (j + oy - 0.5 * h) * scale + 0.5,
+            (column as f32 + ox - 0.5 * w) * scale + 0.5,
+            (row as f32 + oy - 0.5 * h) * scale + 0.5,
         )
+    }
+
+    /// Every camera ray of pixels `first..first + count`, `samples` each, in (pixel, sample)
+    /// order: `f(pixel, sample, direction)`, each direction [`Self::sample_ray`]'s to the bit
+    /// (the origin is always `origin`). Walks the rows instead of dividing each pixel index
+    /// by the width.
+    #[inline]
+    pub fn rays_of(
+        &self,
+        first: u32,
+        count: u32,
+        samples: u32,
+        seed: u32,
+        mut f: impl FnMut(u32, u32, Vec3),
+    ) {
+        let scale = self.scale();
+        let (mut column, mut from_top) = (first % self.width, first / self.width);
+        for pixel in first..first + count {
+            let row = self.height - 1 - from_top;
+            for sample in 0..samples {
+                let (ox, oy) = pixel_offset(&camera_key(pixel, sample, seed), sample, samples);
+                let (x, y) = self.screen_at(column, row, ox, oy, scale);
+                f(pixel, sample, self.ray(x, y).direction);
+            }
+            column += 1;
+            if column == self.width {
+                (column, from_top) = (0, from_top + 1);
+            }
+        }
     }
 
     /// The ray of antialiasing sample `sample` of `samples` in `pixel`: through the pixel centre
@@ -62,14 +102,7 @@ impl CameraRays {
     /// engines generate their camera rays here, so they start from identical rays.
     #[inline]
     pub fn sample_ray(&self, pixel: u32, sample: u32, samples: u32, seed: u32) -> Ray {
-        let key = SampleKey {
-            pixel,
-            sample,
-            bounce: 0,
-            light: CAMERA_LIGHT,
-            seed,
-        };
-        let (ox, oy) = pixel_offset(&key, sample, samples);
+        let (ox, oy) = pixel_offset(&camera_key(pixel, sample, seed), sample, samples);
         let (x, y) = self.screen(pixel, ox, oy);
         self.ray(x, y)
     }
@@ -82,5 +115,17 @@ impl CameraRays {
             origin: self.origin,
             direction: d.normalize(),
         }
+    }
+}
+
+/// The sample stream of a pixel's antialiasing sample.
+#[inline]
+fn camera_key(pixel: u32, sample: u32, seed: u32) -> SampleKey {
+    SampleKey {
+        pixel,
+        sample,
+        bounce: 0,
+        light: CAMERA_LIGHT,
+        seed,
     }
 }

@@ -375,6 +375,33 @@ fn camera_rays_follow_the_lab_pixel_mapping() {
     }
 }
 
+/// The row walk the wavefront engine generates camera rays with (`CameraRays::rays_of`) gives
+/// `sample_ray`'s rays to the bit, in (pixel, sample) order, for ranges that start and end
+/// mid-row, on square, wide and tall images, with one and several antialiasing samples.
+#[test]
+fn the_row_walk_gives_sample_ray_s_rays() {
+    let camera = Camera::default();
+    for (w, h) in [(1u32, 1u32), (5, 3), (3, 7), (64, 48)] {
+        let rays = CameraRays::new(&camera, w, h);
+        for samples in [1, 4] {
+            for (first, count) in [(0, w * h), (w / 2, w + 1), (w * h - 1, 1), (1, 0)] {
+                let mut walked = Vec::new();
+                rays.rays_of(first, count, samples, 9, |pixel, sample, d| {
+                    walked.push((pixel, sample, d.to_array().map(f32::to_bits)))
+                });
+                let expected: Vec<_> = (first..first + count)
+                    .flat_map(|p| (0..samples).map(move |s| (p, s)))
+                    .map(|(p, s)| {
+                        let d = rays.sample_ray(p, s, samples, 9).direction;
+                        (p, s, d.to_array().map(f32::to_bits))
+                    })
+                    .collect();
+                assert_eq!(walked, expected, "{w}x{h}, {samples} samples, from {first}");
+            }
+        }
+    }
+}
+
 #[test]
 fn off_centre_pixel_of_a_larger_image() {
     // A 7 × 5 image; pixel (i = 5, row 1) is computed by the mapping above and intersected with

@@ -1,31 +1,35 @@
 //! Stage 1, generate: the camera rays of a tile, every antialiasing sample of every pixel, in
-//! (pixel, sample) order. Scalar on purpose: one camera ray per path is a few percent of the
-//! rays of a render with shadows, and the scalar `CameraRays` code keeps the rays bit-identical
-//! to the reference's.
+//! (pixel, sample) order. Scalar on purpose: the scalar `CameraRays` code (`rays_of`, which
+//! walks the rows instead of dividing each pixel index) keeps the rays bit-identical to the
+//! reference's, and with the columns written by index the stage is about a twentieth of a
+//! frame at 16 points, not a sixth.
 
-use super::batch::{PathId, RayBatch};
+use super::batch::RayBatch;
 use super::context::Context;
-use glam::Vec3;
 
 /// Fills `rays` (depth 0) with the camera rays of pixels `first..first + count`; ray
-/// `p · n + s` is sample `s` of pixel `first + p`, and that is also its radiance slot.
+/// `p · n + s` is sample `s` of pixel `first + p`, and that is also its radiance slot. The
+/// columns every camera ray shares (origin, tmax, throughput) are filled whole, and the rest
+/// written by index: pushing ray by ray, 13 columns each, cost more than the rays' arithmetic.
 pub fn camera_rays(ctx: &Context, first: u32, count: u32, rays: &mut RayBatch) {
     rays.clear(0);
     let n = ctx.settings.aa_samples.max(1);
-    for pixel in first..first + count {
-        for sample in 0..n {
-            let ray = ctx.camera.sample_ray(pixel, sample, n, ctx.settings.seed);
-            let slot = (pixel - first) * n + sample;
-            rays.push(
-                ray.origin,
-                ray.direction,
-                Vec3::ONE,
-                PathId {
-                    pixel,
-                    sample,
-                    slot,
-                },
-            );
-        }
-    }
+    let total = (count * n) as usize;
+    let camera = &ctx.camera;
+    rays.origin.resize(total, 0.0);
+    rays.origin.fill(0..total, camera.origin);
+    rays.tmax.resize(total, f32::INFINITY);
+    rays.throughput.resize(total, 1.0);
+    rays.slot.extend(0..total as u32);
+    rays.pixel.resize(total, 0);
+    rays.sample.resize(total, 0);
+    rays.direction.resize(total, 0.0);
+    let [dx, dy, dz] = rays.direction.slices_mut(0..total);
+    let (pixels, samples) = (&mut rays.pixel[..total], &mut rays.sample[..total]);
+    let mut k = 0;
+    camera.rays_of(first, count, n, ctx.settings.seed, |pixel, sample, d| {
+        (dx[k], dy[k], dz[k]) = (d.x, d.y, d.z);
+        (pixels[k], samples[k]) = (pixel, sample);
+        k += 1;
+    });
 }
