@@ -204,7 +204,8 @@ pub fn run(args: &BenchOptions, progress: &Progress) -> Result<Outcome> {
                 }
             }
         }
-        crate::render::sampling::check(&settings)
+        settings
+            .check_sampler()
             .map_err(|e| crate::render::error::UsageError(e.to_string()))?;
         let pool = thread_pool(threads)?;
         let setup = Setup {

@@ -94,7 +94,10 @@ pub fn scene_and_settings(
     }
     plan.check_scene_files("SCENE", &scene)?;
     let effective = image.resolve(scene.background.map(|c| c.to_array()));
-    crate::render::sampling::check(&effective.settings).map_err(|e| UsageError(e.to_string()))?;
+    effective
+        .settings
+        .check_sampler()
+        .map_err(|e| UsageError(e.to_string()))?;
     Ok((scene, effective))
 }
 

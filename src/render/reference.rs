@@ -105,7 +105,7 @@ impl<'a> Reference<'a> {
             accel: Accel::new(scene),
             camera: CameraRays::new(&scene.camera, settings.width, settings.height),
             light_offsets: scene.lights.iter().map(light_offset).collect(),
-            points: PointSet::new(settings),
+            points: settings.point_set(),
         }
     }
 

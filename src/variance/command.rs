@@ -139,7 +139,7 @@ impl VarianceOptions {
                     aa_samples: 1,
                     ..RenderSettings::default()
                 };
-                crate::render::sampling::check(&settings).map_err(|e| {
+                settings.check_sampler().map_err(|e| {
                     UsageError(format!(
                         "{e}; the study's --budgets include {n}: leave {} out of --samplers, or that budget out",
                         sampler.name()

@@ -245,7 +245,8 @@ impl ViewSettings {
                 "width × height × aa = {samples} camera samples: the viewer renders at most {MAX_CAMERA_SAMPLES}"
             )));
         }
-        crate::render::sampling::check(&s).map_err(|e| ApiError::bad(e.to_string()))?;
+        s.check_sampler()
+            .map_err(|e| ApiError::bad(e.to_string()))?;
         let camera = match &self.camera {
             Some(c) => c.to_camera()?,
             None => base.camera,

@@ -67,7 +67,7 @@
 
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
-use raywave::render::sampling::{CAMERA_LIGHT, PointSet, SampleKey, pixel_offset};
+use raywave::render::sampling::{CAMERA_LIGHT, SampleKey, pixel_offset};
 use raywave::render::scene::{Camera, LightShape, Scene};
 use raywave::render::settings::{LightModel, RenderSettings, ShadowMode};
 
@@ -648,7 +648,7 @@ impl<'a> Oracle<'a> {
         let s = self.settings;
         let count = s.points_per_light();
         let mut sum = DVec3::ZERO;
-        let points = PointSet::new(s);
+        let points = s.point_set();
         for (li, lamp) in self.lamps.iter().enumerate() {
             let light_key = SampleKey {
                 light: li as u32,

@@ -27,7 +27,7 @@
 
 mod promises;
 
-use raywave::render::sampling::{LightSampler, PointSet, SampleKey, check, strata_grid};
+use raywave::render::sampling::{LightSampler, PointSet, SampleKey, strata_grid};
 use raywave::render::settings::{RenderSettings, ShadowMode};
 use statrs::distribution::{ChiSquared, ContinuousCDF, Normal};
 
@@ -40,7 +40,7 @@ const COUNTS: [u32; 3] = [16, 64, 256];
 /// The image the screen-space samplers (zsobol, bluenoise) lay their streams on.
 const IMAGE: (u32, u32) = (64, 64);
 
-/// The point set of `sampler` with N = `n` on [`IMAGE`], after `sampling::check` accepts it.
+/// The point set of `sampler` with N = `n` on [`IMAGE`], after `RenderSettings::check_sampler` accepts it.
 fn point_set(sampler: LightSampler, n: u32) -> PointSet {
     let settings = RenderSettings {
         width: IMAGE.0,
@@ -51,8 +51,10 @@ fn point_set(sampler: LightSampler, n: u32) -> PointSet {
         aa_samples: 1,
         ..RenderSettings::default()
     };
-    check(&settings).expect("N = 16, 64 and 256 on a 64 × 64 image are within every limit");
-    PointSet::new(&settings)
+    settings
+        .check_sampler()
+        .expect("N = 16, 64 and 256 on a 64 × 64 image are within every limit");
+    settings.point_set()
 }
 
 /// The N points of `key`'s stream, as the reference draws them: through the stream for the

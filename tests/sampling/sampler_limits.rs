@@ -1,8 +1,8 @@
-//! Each sampler's limits (`sampling::check`): the points per light and the image a render may
+//! Each sampler's limits (`RenderSettings::check_sampler`, `sampling::check`): the points per light and the image a render may
 //! ask of it, and a message that names the sampler, its limit and why past them. What the
 //! points themselves promise is in `point_statistics/promises.rs`.
 
-use raywave::render::sampling::{LightSampler, check};
+use raywave::render::sampling::LightSampler;
 use raywave::render::settings::{RenderSettings, ShadowMode};
 
 fn soft(sampler: LightSampler, n: u32, size: (u32, u32), aa: u32) -> RenderSettings {
@@ -19,8 +19,8 @@ fn soft(sampler: LightSampler, n: u32, size: (u32, u32), aa: u32) -> RenderSetti
 
 #[test]
 fn every_sampler_s_limits_are_checked_and_named() {
-    let ok = |s: RenderSettings| check(&s).expect("within the limits");
-    let err = |s: RenderSettings| check(&s).expect_err("past a limit").to_string();
+    let ok = |s: RenderSettings| s.check_sampler().expect("within the limits");
+    let err = |s: RenderSettings| s.check_sampler().expect_err("past a limit").to_string();
     for sampler in LightSampler::ALL {
         ok(soft(sampler, 1, (512, 512), 1));
         ok(soft(sampler, 256, (512, 512), 1));
@@ -34,7 +34,7 @@ fn every_sampler_s_limits_are_checked_and_named() {
             shadows: ShadowMode::Hard,
             ..soft(sampler, 0, (64, 64), 1)
         };
-        assert!(check(&hard).is_err());
+        assert!(hard.check_sampler().is_err());
     }
     for sampler in [
         LightSampler::Random,

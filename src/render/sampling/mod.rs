@@ -20,8 +20,6 @@ pub mod zsobol;
 
 pub use stream::Stream;
 
-use crate::render::settings::RenderSettings;
-
 use serde::{Deserialize, Serialize};
 
 /// The `light` value used for the camera's own dimensions.
@@ -163,16 +161,11 @@ impl std::fmt::Display for SamplerLimit {
 
 impl std::error::Error for SamplerLimit {}
 
-/// Whether `settings` ask their sampler for no more than it holds, and for at least one point
-/// (whatever the shadows: 0 points per light is never a setting). Only soft shadows sample
-/// points; hard shadows count as one point per light.
-pub fn check(settings: &RenderSettings) -> Result<(), SamplerLimit> {
-    let sampler = settings.sampler;
-    let n = settings.points_per_light();
-    if settings.shadow_samples == 0 {
-        return Err(SamplerLimit::NoPoints(sampler));
-    }
-    let aa = settings.aa_samples.max(1);
+/// Whether `n` points per light of `sampler`, with `aa` samples per pixel of a `size` image,
+/// ask the sampler for no more than it holds (`RenderSettings::check_sampler` adds that a
+/// render asks for at least one point).
+pub fn check(sampler: LightSampler, n: u32, aa: u32, size: (u32, u32)) -> Result<(), SamplerLimit> {
+    let aa = aa.max(1);
     match sampler {
         LightSampler::Bluenoise
             if u64::from(n) * u64::from(aa) > u64::from(bluenoise::MAX_SAMPLES) =>
@@ -190,12 +183,12 @@ pub fn check(settings: &RenderSettings) -> Result<(), SamplerLimit> {
             })
         }
         LightSampler::Zsobol => {
-            let layout = zsobol::Layout::new(settings.width, settings.height, aa, n);
+            let layout = zsobol::Layout::new(size.0, size.1, aa, n);
             let bits = layout.index_bits();
             if bits > 32 {
                 Err(SamplerLimit::IndexBits {
                     bits,
-                    image: format!("{}×{}", settings.width, settings.height),
+                    image: format!("{}×{}", size.0, size.1),
                     samples: 1u64 << (layout.aa_bits + layout.point_bits),
                 })
             } else {
@@ -230,16 +223,6 @@ pub struct PointSet {
 }
 
 impl PointSet {
-    /// The point set of a render with `settings`.
-    pub fn new(settings: &RenderSettings) -> Self {
-        Self::with(
-            settings.sampler,
-            settings.points_per_light(),
-            (settings.width, settings.height),
-            settings.aa_samples,
-        )
-    }
-
     /// `count` points per light of `sampler` on an image of `size` pixels with `aa` samples
     /// per pixel (the image and aa matter to zsobol and bluenoise only).
     pub fn with(sampler: LightSampler, count: u32, size: (u32, u32), aa: u32) -> Self {

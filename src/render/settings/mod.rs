@@ -2,7 +2,7 @@
 
 pub mod options;
 
-use crate::render::sampling::LightSampler;
+use crate::render::sampling::{self, LightSampler, PointSet, SamplerLimit};
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
@@ -147,6 +147,27 @@ impl RenderSettings {
     /// The background as a vector.
     pub fn background(&self) -> Vec3 {
         Vec3::from_array(self.background)
+    }
+
+    /// Whether these settings ask their sampler for no more than it holds, and for at least one
+    /// point (whatever the shadows: 0 points per light is never a setting). Only soft shadows
+    /// sample points; hard shadows count as one point per light.
+    pub fn check_sampler(&self) -> Result<(), SamplerLimit> {
+        if self.shadow_samples == 0 {
+            return Err(SamplerLimit::NoPoints(self.sampler));
+        }
+        let size = (self.width, self.height);
+        sampling::check(self.sampler, self.points_per_light(), self.aa_samples, size)
+    }
+
+    /// The point set of a render with these settings.
+    pub fn point_set(&self) -> PointSet {
+        PointSet::with(
+            self.sampler,
+            self.points_per_light(),
+            (self.width, self.height),
+            self.aa_samples,
+        )
     }
 
     /// Shadow rays (points) per light per shading point: 1 unless soft.

@@ -165,7 +165,7 @@ impl<'a> Context<'a> {
             points_per_light,
             lane_width: auto_width(settings, points_per_light),
             shadow_path: ShadowPath::QueuedPerHit,
-            points: PointSet::new(settings),
+            points: settings.point_set(),
             cell_x,
             cell_y,
             grid: (nx as f32, ny as f32),
