@@ -1,8 +1,8 @@
 //! Stage 1, generate: the camera rays of a tile, every antialiasing sample of every pixel, in
 //! (pixel, sample) order. Scalar on purpose: the scalar `CameraRays` code (`rays_of`, which
 //! walks the rows instead of dividing each pixel index) keeps the rays bit-identical to the
-//! reference's, and with the columns written by index the stage is about a twentieth of a
-//! frame at 16 points, not a sixth.
+//! reference's, and with the columns written by index the stage is about a fourteenth of the
+//! lab frame at 16 points and zero bounces, where pushing ray by ray made it a sixth.
 
 use super::batch::RayBatch;
 use super::context::Context;
