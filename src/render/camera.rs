@@ -53,14 +53,21 @@ impl CameraRays {
 
     /// 1 / max(width, height): pixels to screen units.
     #[inline]
-    fn scale(&self) -> f32 {
+    pub(crate) fn scale(&self) -> f32 {
         1.0 / (self.width as f32).max(self.height as f32)
     }
 
     /// [`Self::screen`] of the pixel in `column`, `row` (counted from the bottom), given
     /// [`Self::scale`]: the one formula both it and [`Self::rays_of`] use.
     #[inline]
-    fn screen_at(&self, column: u32, row: u32, ox: f32, oy: f32, scale: f32) -> (f32, f32) {
+    pub(crate) fn screen_at(
+        &self,
+        column: u32,
+        row: u32,
+        ox: f32,
+        oy: f32,
+        scale: f32,
+    ) -> (f32, f32) {
         let (w, h) = (self.width as f32, self.height as f32);
         (
             (column as f32 + ox - 0.5 * w) * scale + 0.5,

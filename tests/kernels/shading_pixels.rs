@@ -402,6 +402,57 @@ fn the_row_walk_gives_sample_ray_s_rays() {
     }
 }
 
+/// The wavefront engine's camera kernel (`simd::camera_directions`, 8 and 16 lanes) gives the
+/// row walk's directions to the bit at one sample per pixel: rows shorter and longer than a
+/// block, ranges that start and end mid-row, and a camera off the axes.
+#[test]
+fn the_camera_kernel_equals_the_row_walk_at_8_and_16_lanes() {
+    use raywave::render::wavefront::lanes::{f32x8, f32x16};
+    use raywave::render::wavefront::simd::camera_directions;
+    let cameras = [
+        Camera::default(),
+        Camera {
+            position: Vec3::new(3.0, -2.0, 7.5),
+            point_of_interest: Vec3::new(0.1, 0.3, -0.2),
+            up: Vec3::new(0.2, 1.0, 0.1),
+            fov: 55f32.to_radians(),
+        },
+    ];
+    for camera in cameras {
+        for (w, h) in [(1u32, 1u32), (5, 3), (7, 9), (8, 2), (17, 5), (64, 48)] {
+            let rays = CameraRays::new(&camera, w, h);
+            for (first, count) in [
+                (0, w * h),
+                (w / 2, w + 3),
+                (w * h - 1, 1),
+                (3.min(w * h), 0),
+            ] {
+                let count = count.min(w * h - first);
+                let mut walked = Vec::new();
+                rays.rays_of(first, count, 1, 0, |_, _, d| {
+                    walked.push(d.to_array().map(f32::to_bits))
+                });
+                for lanes in [8, 16] {
+                    let n = count as usize;
+                    let mut cols = [vec![0.0f32; n], vec![0.0; n], vec![0.0; n]];
+                    let [x, y, z] = &mut cols;
+                    match lanes {
+                        8 => camera_directions::<f32x8>(&rays, first, count, [x, y, z]),
+                        _ => camera_directions::<f32x16>(&rays, first, count, [x, y, z]),
+                    }
+                    let got: Vec<_> = (0..n)
+                        .map(|k| [cols[0][k], cols[1][k], cols[2][k]].map(f32::to_bits))
+                        .collect();
+                    assert_eq!(
+                        got, walked,
+                        "{w}x{h} from {first}, {count} pixels, {lanes} lanes"
+                    );
+                }
+            }
+        }
+    }
+}
+
 #[test]
 fn off_centre_pixel_of_a_larger_image() {
     // A 7 × 5 image; pixel (i = 5, row 1) is computed by the mapping above and intersected with

@@ -1,11 +1,13 @@
 //! Stage 1, generate: the camera rays of a tile, every antialiasing sample of every pixel, in
-//! (pixel, sample) order. Scalar on purpose: the scalar `CameraRays` code (`rays_of`, which
-//! walks the rows instead of dividing each pixel index) keeps the rays bit-identical to the
-//! reference's, and with the columns written by index the stage is about a fourteenth of the
-//! lab frame at 16 points and zero bounces, where pushing ray by ray made it a sixth.
+//! (pixel, sample) order. At one sample per pixel (the lab's), the directions come N pixels
+//! at a time from `simd::camera_directions`; with antialiasing, from the scalar
+//! `CameraRays::rays_of` (each sample's offset is drawn from its own stream). Both give the
+//! reference's rays to the bit. The columns every camera ray shares are filled whole.
 
 use super::batch::RayBatch;
 use super::context::Context;
+use super::lanes::at_width;
+use super::simd;
 
 /// Fills `rays` (depth 0) with the camera rays of pixels `first..first + count`; ray
 /// `p · n + s` is sample `s` of pixel `first + p`, and that is also its radiance slot. The
@@ -24,8 +26,17 @@ pub fn camera_rays(ctx: &Context, first: u32, count: u32, rays: &mut RayBatch) {
     rays.pixel.resize(total, 0);
     rays.sample.resize(total, 0);
     rays.direction.resize(total, 0.0);
-    let [dx, dy, dz] = rays.direction.slices_mut(0..total);
     let (pixels, samples) = (&mut rays.pixel[..total], &mut rays.sample[..total]);
+    if n == 1 {
+        // Pixel centres: N rays at a time (`simd::camera_directions`, `rays_of`'s twin).
+        for (k, pixel) in (first..first + count).enumerate() {
+            pixels[k] = pixel;
+        }
+        let out = rays.direction.slices_mut(0..total);
+        at_width!(ctx.lane_width, V => simd::camera_directions::<V>(camera, first, count, out));
+        return;
+    }
+    let [dx, dy, dz] = rays.direction.slices_mut(0..total);
     let mut k = 0;
     camera.rays_of(first, count, n, ctx.settings.seed, |pixel, sample, d| {
         (dx[k], dy[k], dz[k]) = (d.x, d.y, d.z);

@@ -27,16 +27,19 @@
 //! | `point_sets::{halton, zsobol, pmj02}` | `sampling::Stream::point` of those samplers |
 //! | [`shadow_rays`]      | the start of `Reference::direct` (l, dist, n·l)          |
 //! | `shade::shade_lanes` | `shade::shade_terms`, twin of `shading::shade`           |
+//! | [`camera_directions`] | `CameraRays::rays_of` at one sample per pixel           |
 //!
 //! Branches become masks: a lane that misses gets `f32::INFINITY`, exactly like the twins'
 //! sentinel. Batches whose length is not a multiple of the width are padded with lanes that
 //! cannot hit (tmax = 0, NaN directions), and the padding is never stored back.
 
+mod camera;
 mod geometry;
 mod hit_rays;
 mod light;
 mod point_sets;
 
+pub use camera::camera_directions;
 pub(crate) use geometry::{TriangleLanes, moller_trumbore8, moller_trumbore8_blocks};
 pub use geometry::{block_occluded, closest_hits, hit_rays_occluded, occluded, sphere8, triangle8};
 pub use hit_rays::{HitLanes, hit_shadow_rays};
