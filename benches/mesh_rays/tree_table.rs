@@ -12,10 +12,10 @@
 //!              the per-round ratios to raywave's tree; answers checked against it first
 //! ```
 
-use super::{Outputs, Setup, exit_with, ratio, trace};
+use super::{Outputs, Setup, agreement, answer, exit_with, ratio, trace};
 use crate::peer::embree4::BuildQuality;
 use crate::peer::embree4_tree::embree_bvh2;
-use crate::peer::{RaySet, hit_agreement, mesh_bvh_bytes, occlusion_agreement};
+use crate::peer::{RaySet, mesh_bvh_bytes};
 use raywave::render::wavefront::bvh::MeshBvh;
 use raywave::render::wavefront::context::Context;
 use raywave::render::wavefront::cost::{Cost, PerRay};
@@ -54,19 +54,6 @@ fn per_ray(ctx: &Context, bvh: &MeshBvh, set: &RaySet) -> [f64; 3] {
     }
     let n = set.len().max(1) as f64;
     [sum.nodes, sum.leaves, sum.tests].map(|x| x as f64 / n)
-}
-
-/// How many of `set`'s answers through `ctx` equal raywave's tree's (`reference`).
-fn agreement(s: &Setup, reference: &Context, ctx: &Context, set: &RaySet) -> (usize, usize) {
-    let (mut a, mut b) = (Outputs::default(), Outputs::default());
-    trace(s, reference, set, "raywave", &mut a);
-    trace(s, ctx, set, "raywave", &mut b);
-    let agreement = if set.kind.is_occlusion() {
-        occlusion_agreement(&a.blocked, &b.blocked)
-    } else {
-        hit_agreement(&a.hits, &b.hits)
-    };
-    (agreement.agree, agreement.rays)
 }
 
 /// The rows and notes of one mesh scene (`ctx` holds raywave's own tree).
@@ -112,8 +99,10 @@ pub fn tree_rows(s: &Setup, ctx: &Context, rounds: usize, table: &mut TreeTable)
         .notes
         .push(format!("{title}, builds: {}.", builds.join("; ")));
     for set in s.sets.all() {
+        let reference = answer(s, ctx, set, "raywave");
         for (&c, (name, _)) in contexts.iter().zip(&trees).skip(1) {
-            let (agree, rays) = agreement(s, ctx, c, set);
+            let a = agreement(s, c, set, &reference, "raywave");
+            let (agree, rays) = (a.agree, a.rays);
             if agree < rays {
                 table.notes.push(format!(
                     "{title}, {}, {name}: {agree} of {rays} answers equal raywave's tree's \

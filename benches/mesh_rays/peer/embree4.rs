@@ -310,6 +310,21 @@ fn dl_error(what: &str) -> String {
     }
 }
 
+/// The address of `name` in the library `handle` (opened from `path`), or an error naming both.
+fn symbol(handle: *mut c_void, path: &Path, name: &str) -> anyhow::Result<*mut c_void> {
+    let c_name = CString::new(name).expect("symbol names have no NUL");
+    // SAFETY: a live `dlopen` handle (never closed) and a valid C string.
+    let p = unsafe { libc::dlsym(handle, c_name.as_ptr()) };
+    if p.is_null() {
+        bail!(
+            "{}: no symbol {name}: {}",
+            path.display(),
+            dl_error("not found")
+        );
+    }
+    Ok(p)
+}
+
 impl Api {
     /// Opens the library and resolves every entry point.
     fn load() -> anyhow::Result<Api> {
@@ -332,19 +347,7 @@ impl Api {
                 dl_error("dlopen failed")
             );
         }
-        let symbol = |name: &str| -> anyhow::Result<*mut c_void> {
-            let c_name = CString::new(name).expect("symbol names have no NUL");
-            // SAFETY: a live handle and a valid C string.
-            let p = unsafe { libc::dlsym(handle, c_name.as_ptr()) };
-            if p.is_null() {
-                bail!(
-                    "{}: no symbol {name}: {}",
-                    path.display(),
-                    dl_error("not found")
-                );
-            }
-            Ok(p)
-        };
+        let symbol = |name: &str| symbol(handle, &path, name);
         macro_rules! resolve {
             ($name:literal) => {
                 // SAFETY: the symbol is the Embree 4.4 function of that name, whose C
@@ -382,16 +385,7 @@ impl Api {
     /// # Safety
     /// `F` is the C signature of Embree 4.4's function of that name (include/embree4/*.h).
     pub(super) unsafe fn function<F: Copy>(&self, name: &str) -> anyhow::Result<F> {
-        let c_name = CString::new(name).expect("symbol names have no NUL");
-        // SAFETY: the live handle `load` opened, and a valid C string.
-        let p = unsafe { libc::dlsym(self.handle as *mut c_void, c_name.as_ptr()) };
-        if p.is_null() {
-            bail!(
-                "{}: no symbol {name}: {}",
-                self.path.display(),
-                dl_error("not found")
-            );
-        }
+        let p = symbol(self.handle as *mut c_void, &self.path, name)?;
         // SAFETY: the caller's.
         Ok(unsafe { as_fn(p) })
     }
