@@ -135,7 +135,7 @@ const FIXED_TARGET: &str = "x86-64-v3";
 /// Where the child is built: its own target directory, so that building it does not wait on
 /// the lock of the `cargo test` that runs this, and its flags do not rebuild the test build.
 const FIXED_TARGET_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/target/icount-x86-64-v3");
-/// The child's example target (Cargo.toml) and the crate name its symbols carry.
+/// The child's binary target (Cargo.toml) and the crate name its symbols carry.
 const CHILD_BIN: &str = "raywave-icount-child";
 const CHILD_CRATE: &str = "raywave_icount_child";
 /// The line by which the child tells the runner its key.
@@ -153,7 +153,7 @@ fn fixed_target_child() -> Result<PathBuf, String> {
             "--no-default-features",
             "--features",
             "icount-child",
-            "--example",
+            "--bin",
             CHILD_BIN,
             "--message-format=json",
         ])

@@ -1,6 +1,6 @@
 //! Gates: checks on the code itself rather than on what it renders. The instruction-count gate
 //! (`icount`: callgrind's counts of the hot kernels against committed baselines; its child
-//! workloads are the `raywave-icount-child` example, `icount_child.rs`), the layering rule
+//! workloads are the `raywave-icount-child` binary, `icount_child.rs`), the layering rule
 //! (`layering`: only the lane layer names `wide`), the module map (`module_map`:
 //! docs/ARCHITECTURE.md's tree is `src/`) and the docs' budgets (`doc_budgets`: README.md,
 //! docs/PERFORMANCE.md and docs/BENCHMARKING.md within their line counts, docs/TESTING.md
