@@ -275,11 +275,10 @@ pub fn run(
     };
     drop(engine);
     if let Some(path) = &options.stats_json {
-        let record = report::record(&scene, &effective, &run, &report);
-        match &reference_error {
-            Some((_, json)) => record.write_with(path, "mse_reference", json.clone())?,
-            None => record.write(path)?,
-        }
+        let extra = reference_error
+            .as_ref()
+            .map(|(_, json)| ("mse_reference", json.clone()));
+        report::record(&scene, &effective, &run, &report).write(path, extra)?;
     }
     // Every output in place before the summary says it was written.
     crate::output::commit_outputs()?;

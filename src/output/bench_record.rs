@@ -9,7 +9,6 @@ use crate::stats::median;
 use anyhow::{Context, Result, bail};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
-use std::io::Write;
 use std::path::Path;
 
 /// The layout version of bench records and `--stats-json` files (both carry it as `format`),
@@ -392,10 +391,7 @@ pub fn save(path: &Path, record: &BenchRecord) -> Result<()> {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("cannot create directory {}", dir.display()))?;
     }
-    crate::output::image_file::write_atomically(path, |w| {
-        serde_json::to_writer_pretty(&mut *w, record)?;
-        Ok(writeln!(w)?)
-    })
+    crate::output::image_file::write_json(path, record)
 }
 
 /// Seconds since the Unix epoch as RFC 3339 UTC (`2026-11-22T20:13:01Z`), by `humantime`.

@@ -13,7 +13,6 @@ use crate::render::wavefront::cost::CostSum;
 use crate::render::wavefront::stats::StageFigure;
 use schemars::JsonSchema;
 use serde::Serialize;
-use std::io::Write;
 use std::path::Path;
 
 /// Everything `--stats-json` writes.
@@ -188,31 +187,20 @@ pub fn schemas() -> [(&'static str, String); 2] {
 }
 
 impl RenderRecord {
-    /// Writes the record as pretty JSON, whole or not at all. It goes through
-    /// `serde_json::Value`, whose objects sort their keys: the files have always listed
-    /// every object's keys alphabetically.
-    pub fn write(&self, path: &Path) -> anyhow::Result<()> {
-        let json = serde_json::to_value(self)?;
-        crate::output::image_file::write_atomically(path, |w| {
-            serde_json::to_writer_pretty(&mut *w, &json)?;
-            Ok(writeln!(w)?)
-        })
-    }
-
-    /// [`RenderRecord::write`] with one more top-level entry, `key` (e.g. `mse_reference`,
-    /// the render's error against `render --mse-reference`).
-    pub fn write_with(
+    /// Writes the record as pretty JSON, whole or not at all, with `extra` as one more
+    /// top-level entry (e.g. `mse_reference`, the render's error against `render
+    /// --mse-reference`). It goes through `serde_json::Value`, whose objects sort their keys:
+    /// the files have always listed every object's keys alphabetically.
+    pub fn write(
         &self,
         path: &Path,
-        key: &str,
-        value: serde_json::Value,
+        extra: Option<(&str, serde_json::Value)>,
     ) -> anyhow::Result<()> {
         let mut json = serde_json::to_value(self)?;
-        json[key] = value;
-        crate::output::image_file::write_atomically(path, |w| {
-            serde_json::to_writer_pretty(&mut *w, &json)?;
-            Ok(writeln!(w)?)
-        })
+        if let Some((key, value)) = extra {
+            json[key] = value;
+        }
+        crate::output::image_file::write_json(path, &json)
     }
 }
 
@@ -271,7 +259,7 @@ mod tests {
         };
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("s.json");
-        record.write(&path).unwrap();
+        record.write(&path, None).unwrap();
         let text = std::fs::read_to_string(&path).unwrap();
         let top: Vec<&str> = text
             .lines()
