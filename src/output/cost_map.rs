@@ -219,12 +219,8 @@ fn side_by_side(a: &RgbImage, b: &RgbImage) -> RgbImage {
         a.height().max(b.height()),
         image::Rgb([255, 255, 255]),
     );
-    for (x, y, p) in a.enumerate_pixels() {
-        out.put_pixel(x, y, *p);
-    }
-    for (x, y, p) in b.enumerate_pixels() {
-        out.put_pixel(a.width() + x, y, *p);
-    }
+    image::imageops::replace(&mut out, a, 0, 0);
+    image::imageops::replace(&mut out, b, i64::from(a.width()), 0);
     out
 }
 
