@@ -203,16 +203,12 @@ pub fn run(
         film.write_hdr(hdr)?;
     }
     phases.mark("tone map, encode, write");
-    let reference_error = match &reference {
-        Some((path, image)) => Some(report::reference_error(
-            path,
-            image,
-            &film,
-            img.as_ref(),
-            options.tonemap,
-        )?),
-        None => None,
-    };
+    let reference_error = reference
+        .as_ref()
+        .map(|(path, image)| {
+            report::reference_error(path, image, &film, img.as_ref(), options.tonemap)
+        })
+        .transpose()?;
     // The second passes below render again: the memory check counted one film.
     drop((img, film));
     // The reference's render carries no timer; its kinds are timed by a second pass with
