@@ -27,7 +27,7 @@ const SPHERE_RINGS: u32 = 12;
 const SPHERE_SEGMENTS: u32 = 24;
 
 /// One named group.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Group {
     /// Object / group name.
     pub name: String,
@@ -43,9 +43,7 @@ impl Group {
     fn new(name: &str) -> Group {
         Group {
             name: name.to_string(),
-            vertices: Vec::new(),
-            triangles: Vec::new(),
-            lines: Vec::new(),
+            ..Group::default()
         }
     }
 
