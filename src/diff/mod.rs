@@ -264,10 +264,6 @@ pub fn check_same_size(a: &Image, a_name: &str, b: &Image, b_name: &str) -> Resu
     Ok(())
 }
 
-fn finite(p: &Vec3) -> bool {
-    p.is_finite()
-}
-
 /// PSNR in dB of an MSE against [`PSNR_PEAK`]: infinite for 0.
 pub fn psnr(mse: f64) -> f64 {
     10.0 * (PSNR_PEAK * PSNR_PEAK / mse).log10()
@@ -298,7 +294,7 @@ pub fn compare(a: &Image, b: &Image, region: &Region) -> Result<Comparison> {
         if !inside {
             continue;
         }
-        if !finite(pa) || !finite(pb) {
+        if !pa.is_finite() || !pb.is_finite() {
             non_finite += 1;
             continue;
         }
@@ -391,7 +387,7 @@ pub fn pixel_errors(a: &Image, b: &Image, region: &Region, metric: Metric) -> Ve
         .zip(&b.film.pixels)
         .zip(&region.inside)
         .map(|((pa, pb), &inside)| {
-            if !inside || !finite(pa) || !finite(pb) {
+            if !inside || !pa.is_finite() || !pb.is_finite() {
                 return f32::NAN;
             }
             let d = |c: usize| pa[c] as f64 - pb[c] as f64;

@@ -183,38 +183,25 @@ impl Report {
 pub fn stats_table(run: &RunInfo, report: &Report) -> String {
     let mut out = String::new();
     let kinds = report.kinds();
-    let _ = writeln!(
-        out,
-        "{:<12} {:>14} {:>14} {:>20}",
-        "kind", "rays", "thread-s", "Mrays/thread-s"
-    );
+    // A row of the kind and stage tables: name, rays, seconds, rate.
+    let row = |out: &mut String, cells: [&dyn std::fmt::Display; 4]| {
+        let [name, rays, seconds, rate] = cells;
+        let _ = writeln!(out, "{name:<12} {rays:>14} {seconds:>14} {rate:>20}");
+    };
     let or_dash = |x: Option<f64>, scale: f64, digits: usize| {
         x.map_or("-".to_string(), |x| format!("{:.digits$}", x * scale))
     };
+    row(&mut out, [&"kind", &"rays", &"thread-s", &"Mrays/thread-s"]);
     for (kind, figure) in kinds.kinds.iter() {
-        let _ = writeln!(
-            out,
-            "{:<12} {:>14} {:>14} {:>20}",
-            kind.name(),
-            figure.rays,
-            or_dash(figure.thread_seconds, 1.0, 4),
-            or_dash(figure.rays_per_thread_second, 1e-6, 2)
-        );
+        let seconds = or_dash(figure.thread_seconds, 1.0, 4);
+        let rate = or_dash(figure.rays_per_thread_second, 1e-6, 2);
+        row(&mut out, [&kind.name(), &figure.rays, &seconds, &rate]);
     }
     let total = kinds.total;
-    let _ = writeln!(
-        out,
-        "{:<12} {:>14} {:>14} {:>20}",
-        "", "", "wall s", "Mrays/s"
-    );
-    let _ = writeln!(
-        out,
-        "{:<12} {:>14} {:>14.3} {:>20.2}",
-        "total",
-        total.rays,
-        total.seconds,
-        total.rays_per_second / 1e6
-    );
+    row(&mut out, [&"", &"", &"wall s", &"Mrays/s"]);
+    let seconds = format!("{:.3}", total.seconds);
+    let rate = format!("{:.2}", total.rays_per_second / 1e6);
+    row(&mut out, [&"total", &total.rays, &seconds, &rate]);
     match report.instrumented_seconds {
         Some(pass) => {
             let _ = writeln!(
@@ -264,20 +251,14 @@ pub fn stats_table(run: &RunInfo, report: &Report) -> String {
         );
     }
     if let Some((stats, _)) = &report.stages {
-        let _ = writeln!(
-            out,
-            "{:<12} {:>14} {:>14} {:>20}",
-            "stage", "rays", "thread-s", "Mrays/thread-s"
+        row(
+            &mut out,
+            [&"stage", &"rays", &"thread-s", &"Mrays/thread-s"],
         );
-        for row in stats.stage_figures() {
-            let _ = writeln!(
-                out,
-                "{:<12} {:>14} {:>14.4} {:>20.2}",
-                row.stage,
-                row.rays,
-                row.thread_seconds,
-                row.rays_per_thread_second / 1e6
-            );
+        for stage in stats.stage_figures() {
+            let seconds = format!("{:.4}", stage.thread_seconds);
+            let rate = format!("{:.2}", stage.rays_per_thread_second / 1e6);
+            row(&mut out, [&stage.stage, &stage.rays, &seconds, &rate]);
         }
     }
     out
