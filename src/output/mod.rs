@@ -263,55 +263,35 @@ pub(crate) fn is_stdout(path: &Path) -> bool {
 /// that the command creates) and that this process may write in.
 fn check_writable(out: &Named) -> Result<()> {
     let path = &out.path;
-    match target(path) {
-        Target::Stdout | Target::Special(_) => return Ok(()),
-        Target::Regular(real) => {
-            if let Err(e) = std::fs::metadata(path)
-                && e.raw_os_error() == Some(libc::ELOOP)
-            {
-                bail!(
-                    "cannot write {}: its symlinks form a loop, expected a file or a symlink to one",
-                    path.display()
-                );
-            }
-            if real.is_dir() {
-                bail!(
-                    "cannot write {}: it is a directory, expected a file",
-                    path.display()
-                );
-            }
-            let mut dir = write::parent_dir(&real).to_path_buf();
-            if out.creates_dir {
-                // The nearest existing ancestor is where the new directories will be made.
-                while !dir.exists() {
-                    match dir.parent() {
-                        Some(p) if !p.as_os_str().is_empty() => dir = p.to_path_buf(),
-                        _ => dir = PathBuf::from("."),
-                    }
+    let Target::Regular(real) = target(path) else {
+        return Ok(());
+    };
+    let problem = if let Err(e) = std::fs::metadata(path)
+        && e.raw_os_error() == Some(libc::ELOOP)
+    {
+        "its symlinks form a loop, expected a file or a symlink to one".to_string()
+    } else if real.is_dir() {
+        "it is a directory, expected a file".to_string()
+    } else {
+        let mut dir = write::parent_dir(&real).to_path_buf();
+        if out.creates_dir {
+            // The nearest existing ancestor is where the new directories will be made.
+            while !dir.exists() {
+                match dir.parent() {
+                    Some(p) if !p.as_os_str().is_empty() => dir = p.to_path_buf(),
+                    _ => dir = PathBuf::from("."),
                 }
             }
-            if !dir.exists() {
-                bail!(
-                    "cannot write {}: directory {} does not exist",
-                    path.display(),
-                    dir.display()
-                );
-            }
-            if !dir.is_dir() {
-                bail!(
-                    "cannot write {}: {} is not a directory",
-                    path.display(),
-                    dir.display()
-                );
-            }
-            if !write::may_write_in(&dir) {
-                bail!(
-                    "cannot write {}: no permission to create files in {}",
-                    path.display(),
-                    dir.display()
-                );
-            }
         }
-    }
-    Ok(())
+        if !dir.exists() {
+            format!("directory {} does not exist", dir.display())
+        } else if !dir.is_dir() {
+            format!("{} is not a directory", dir.display())
+        } else if !write::may_write_in(&dir) {
+            format!("no permission to create files in {}", dir.display())
+        } else {
+            return Ok(());
+        }
+    };
+    bail!("cannot write {}: {problem}", path.display())
 }
