@@ -168,14 +168,6 @@ impl Report {
     pub fn kinds(&self) -> KindFigures {
         KindFigures::new(&self.stats, self.seconds)
     }
-
-    /// How the kinds' thread-time was measured, as the JSON names it.
-    fn kinds_timed_by(&self) -> KindTiming {
-        match self.instrumented_seconds {
-            Some(_) => KindTiming::InstrumentedPass,
-            None => KindTiming::StageTimers,
-        }
-    }
 }
 
 /// The `--stats` tables: rays by kind (each kind over the thread-time of its own work, the
@@ -303,7 +295,10 @@ pub fn record(
         },
         seconds: report.seconds,
         rays: report.kinds(),
-        kinds_timed_by: report.kinds_timed_by(),
+        kinds_timed_by: match report.instrumented_seconds {
+            Some(_) => KindTiming::InstrumentedPass,
+            None => KindTiming::StageTimers,
+        },
         instrumented_seconds: report.instrumented_seconds,
         stages,
         traversal: report.traversal,

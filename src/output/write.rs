@@ -405,14 +405,13 @@ pub fn install_signal_cleanup() -> Result<()> {
         .spawn(move || {
             if let Some(signal) = signals.forever().next() {
                 let state = outputs();
-                let temps = &state.temporaries;
-                for p in temps.iter() {
+                for p in &state.temporaries {
                     let _ = std::fs::remove_file(p);
                 }
                 let name = if signal == SIGINT { "SIGINT" } else { "SIGTERM" };
                 eprintln!(
                     "\nerror: stopped by {name}; {} unfinished temporary file(s) removed, the file being written left as it was",
-                    temps.len()
+                    state.temporaries.len()
                 );
                 // _exit: no destructors, no flushing of locks another thread may hold.
                 // SAFETY: _exit ends the process; nothing runs after it.

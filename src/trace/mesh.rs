@@ -65,7 +65,7 @@ fn rgb8(c: Vec3) -> Rgb {
     [c.x.round() as u8, c.y.round() as u8, c.z.round() as u8]
 }
 
-/// The groups of a scene and a tree; `main_aspect` is the render's width / height.
+/// The groups of a scene and a tree.
 pub fn groups(scene: &Scene, tree: &RayTree) -> Vec<Group> {
     let mut out = Vec::new();
     let mut faces = Group::new("scene");
