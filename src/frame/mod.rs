@@ -258,7 +258,7 @@ pub fn run(
     let report = Report {
         stats,
         seconds,
-        stages: engine.bvh_build_seconds().map(|bvh| (stats, bvh)),
+        bvh: engine.bvh_build_seconds(),
         instrumented_seconds,
         traversal,
     };

@@ -152,8 +152,8 @@ pub struct Report {
     pub stats: RenderStats,
     /// Wall-clock seconds of the render (for the reference, its set-up included).
     pub seconds: f64,
-    /// Wavefront only: per-stage figures, and the BVH build time if a BVH was used.
-    pub stages: Option<(RenderStats, Option<f64>)>,
+    /// Wavefront only (its stages are in `stats`): the BVH build time if a BVH was used.
+    pub bvh: Option<Option<f64>>,
     /// Reference only, with --stats or --stats-json: the wall-clock seconds of the second,
     /// instrumented pass that timed the kinds.
     pub instrumented_seconds: Option<f64>,
@@ -212,7 +212,7 @@ pub fn stats_table(run: &RunInfo, report: &Report) -> String {
             );
         }
     }
-    if let Some((_, Some(build))) = &report.stages {
+    if let Some(Some(build)) = report.bvh {
         let _ = writeln!(out, "bvh build {build:.3} s");
     }
     if let Some(path) = run.shadow_path {
@@ -242,12 +242,12 @@ pub fn stats_table(run: &RunInfo, report: &Report) -> String {
             t.counted_seconds
         );
     }
-    if let Some((stats, _)) = &report.stages {
+    if report.bvh.is_some() {
         row(
             &mut out,
             [&"stage", &"rays", &"thread-s", &"Mrays/thread-s"],
         );
-        for stage in stats.stage_figures() {
+        for stage in report.stats.stage_figures() {
             let seconds = format!("{:.4}", stage.thread_seconds);
             let rate = format!("{:.2}", stage.rays_per_thread_second / 1e6);
             row(&mut out, [&stage.stage, &stage.rays, &seconds, &rate]);
@@ -263,10 +263,6 @@ pub fn record(
     run: &RunInfo,
     report: &Report,
 ) -> RenderRecord {
-    let (stages, bvh) = match &report.stages {
-        Some((stats, bvh)) => (Some(stats.stage_figures()), Some(*bvh)),
-        None => (None, None),
-    };
     RenderRecord {
         format: crate::output::bench_record::FORMAT,
         raywave: env!("CARGO_PKG_VERSION"),
@@ -285,8 +281,8 @@ pub fn record(
             triangles: scene.triangles.len(),
             spheres: scene.spheres.len(),
             lights: scene.lights.len(),
-            bvh: bvh.map(|b| b.is_some()),
-            bvh_build_seconds: bvh.flatten(),
+            bvh: report.bvh.map(|b| b.is_some()),
+            bvh_build_seconds: report.bvh.flatten(),
         },
         settings: effective.settings.clone(),
         defaults: DefaultsUsed {
@@ -300,7 +296,7 @@ pub fn record(
             None => KindTiming::StageTimers,
         },
         instrumented_seconds: report.instrumented_seconds,
-        stages,
+        stages: report.bvh.map(|_| report.stats.stage_figures()),
         traversal: report.traversal,
     }
 }
