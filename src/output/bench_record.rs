@@ -13,8 +13,7 @@ use std::path::Path;
 
 /// The layout version of bench records and `--stats-json` files (both carry it as `format`),
 /// bumped when either layout changes; records of another version are refused with a message.
-/// 3: a bench measurement's `seconds`, `rays` and `rates` became one `rays`, the
-/// [`KindFigures`] of `--stats-json`. docs/SCHEMA.md has the rule and the history.
+/// docs/SCHEMA.md has the rule and the history of each version.
 pub const FORMAT: u32 = 3;
 
 /// One `raywave bench` invocation.
