@@ -23,6 +23,7 @@ pub mod text;
 #[cfg(feature = "flip")]
 mod flip;
 
+pub use crate::output::image_file::to_byte;
 pub use read::read_image;
 
 use crate::output::false_colour::{self, Scale};
@@ -369,12 +370,6 @@ pub fn add_flip(
             "FLIP needs raywave built with the `flip` feature (on by default; it needs a C++ compiler)"
         )
     }
-}
-
-/// The 8-bit value a channel is shown as: clamped to [0, 1], ×255, rounded (raywave's clamp
-/// tone map; an 8-bit file's own bytes come back unchanged).
-pub fn to_byte(v: f32) -> u8 {
-    (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8
 }
 
 /// The per-pixel error `metric` maps: the mean over channels of (a − b)² (MSE and PSNR) or of

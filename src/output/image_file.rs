@@ -18,7 +18,7 @@ impl Film {
                 ToneMap::Clamp => *c,
                 ToneMap::Exp => Vec3::ONE - (-3.0 * *c).exp(),
             };
-            *px = image::Rgb(c.to_array().map(crate::diff::to_byte));
+            *px = image::Rgb(c.to_array().map(to_byte));
         }
         img
     }
@@ -126,6 +126,12 @@ impl Film {
         .to_buffered(w)
         .map_err(|e| anyhow::anyhow!("{e}"))
     }
+}
+
+/// The 8-bit value a channel is shown as: clamped to [0, 1], ×255, rounded (raywave's clamp
+/// tone map; an 8-bit file's own bytes come back unchanged).
+pub fn to_byte(v: f32) -> u8 {
+    (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8
 }
 
 /// An 8-bit image format raywave writes.
