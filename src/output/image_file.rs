@@ -23,11 +23,6 @@ impl Film {
         img
     }
 
-    /// Writes an 8-bit image; the format follows the extension (png, ppm).
-    pub fn write_ldr(&self, path: &Path, tone: ToneMap) -> Result<()> {
-        write_rgb8(&self.to_rgb8(tone), path)
-    }
-
     /// Reads a colour PFM as written by `write_hdr` (little-endian, rows bottom to top).
     pub fn read_pfm(path: &Path) -> Result<Film> {
         let bytes =
