@@ -160,28 +160,16 @@ pub fn schemas() -> [(&'static str, String); 2] {
     // The files as written: every field required (an absent value is written as null),
     // except the few left out when empty (a bench record's host name in `--stats-json`).
     let settings = schemars::generate::SchemaSettings::draft2020_12().for_serialize();
-    let pretty = |schema: schemars::Schema| {
-        let mut text = serde_json::to_string_pretty(&schema).unwrap_or_default();
-        text.push('\n');
-        text
-    };
+    let generator = || settings.clone().into_generator();
+    let pretty = |schema| serde_json::to_string_pretty(&schema).unwrap_or_default() + "\n";
     [
         (
             "render-record.schema.json",
-            pretty(
-                settings
-                    .clone()
-                    .into_generator()
-                    .into_root_schema_for::<RenderRecord>(),
-            ),
+            pretty(generator().into_root_schema_for::<RenderRecord>()),
         ),
         (
             "bench-record.schema.json",
-            pretty(
-                settings
-                    .into_generator()
-                    .into_root_schema_for::<BenchRecord>(),
-            ),
+            pretty(generator().into_root_schema_for::<BenchRecord>()),
         ),
     ]
 }
