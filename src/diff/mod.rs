@@ -23,6 +23,7 @@ pub mod text;
 #[cfg(feature = "flip")]
 mod flip;
 
+pub use crate::output::image_file::to_byte;
 pub use read::read_image;
 
 use crate::output::false_colour::{self, Scale};
@@ -264,10 +265,6 @@ pub fn check_same_size(a: &Image, a_name: &str, b: &Image, b_name: &str) -> Resu
     Ok(())
 }
 
-fn finite(p: &Vec3) -> bool {
-    p.is_finite()
-}
-
 /// PSNR in dB of an MSE against [`PSNR_PEAK`]: infinite for 0.
 pub fn psnr(mse: f64) -> f64 {
     10.0 * (PSNR_PEAK * PSNR_PEAK / mse).log10()
@@ -298,7 +295,7 @@ pub fn compare(a: &Image, b: &Image, region: &Region) -> Result<Comparison> {
         if !inside {
             continue;
         }
-        if !finite(pa) || !finite(pb) {
+        if !pa.is_finite() || !pb.is_finite() {
             non_finite += 1;
             continue;
         }
@@ -375,12 +372,6 @@ pub fn add_flip(
     }
 }
 
-/// The 8-bit value a channel is shown as: clamped to [0, 1], ×255, rounded (raywave's clamp
-/// tone map; an 8-bit file's own bytes come back unchanged).
-pub fn to_byte(v: f32) -> u8 {
-    (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8
-}
-
 /// The per-pixel error `metric` maps: the mean over channels of (a − b)² (MSE and PSNR) or of
 /// the relative squared error, or the largest |a − b| over channels; NaN outside the region
 /// and where a value is not finite. FLIP's map comes from [`add_flip`].
@@ -391,7 +382,7 @@ pub fn pixel_errors(a: &Image, b: &Image, region: &Region, metric: Metric) -> Ve
         .zip(&b.film.pixels)
         .zip(&region.inside)
         .map(|((pa, pb), &inside)| {
-            if !inside || !finite(pa) || !finite(pb) {
+            if !inside || !pa.is_finite() || !pb.is_finite() {
                 return f32::NAN;
             }
             let d = |c: usize| pa[c] as f64 - pb[c] as f64;

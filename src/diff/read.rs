@@ -40,8 +40,10 @@ pub fn read_image(path: &Path) -> Result<Image> {
     let reader = ImageReader::open(path)
         .and_then(|r| r.with_guessed_format())
         .with_context(|| format!("cannot read {}", path.display()))?;
-    let format = match reader.format() {
-        Some(f @ (ImageFormat::Png | ImageFormat::Pnm | ImageFormat::OpenExr)) => f,
+    let name = match reader.format() {
+        Some(ImageFormat::Png) => "PNG",
+        Some(ImageFormat::Pnm) => "PPM",
+        Some(ImageFormat::OpenExr) => "EXR",
         Some(other) => bail!(
             "{}: a {other:?} image, which raywave does not read: expected PNG, PPM, PFM or EXR",
             path.display()
@@ -50,11 +52,6 @@ pub fn read_image(path: &Path) -> Result<Image> {
             "{}: not an image raywave reads: expected PNG, PPM, PFM or EXR",
             path.display()
         ),
-    };
-    let name = match format {
-        ImageFormat::Png => "PNG",
-        ImageFormat::Pnm => "PPM",
-        _ => "EXR",
     };
     let decoded = reader
         .decode()

@@ -203,16 +203,12 @@ pub fn run(
         film.write_hdr(hdr)?;
     }
     phases.mark("tone map, encode, write");
-    let reference_error = match &reference {
-        Some((path, image)) => Some(report::reference_error(
-            path,
-            image,
-            &film,
-            img.as_ref(),
-            options.tonemap,
-        )?),
-        None => None,
-    };
+    let reference_error = reference
+        .as_ref()
+        .map(|(path, image)| {
+            report::reference_error(path, image, &film, img.as_ref(), options.tonemap)
+        })
+        .transpose()?;
     // The second passes below render again: the memory check counted one film.
     drop((img, film));
     // The reference's render carries no timer; its kinds are timed by a second pass with
@@ -262,7 +258,7 @@ pub fn run(
     let report = Report {
         stats,
         seconds,
-        stages: engine.bvh_build_seconds().map(|bvh| (stats, bvh)),
+        bvh: engine.bvh_build_seconds(),
         instrumented_seconds,
         traversal,
     };
@@ -275,11 +271,10 @@ pub fn run(
     };
     drop(engine);
     if let Some(path) = &options.stats_json {
-        let record = report::record(&scene, &effective, &run, &report);
-        match &reference_error {
-            Some((_, json)) => record.write_with(path, "mse_reference", json.clone())?,
-            None => record.write(path)?,
-        }
+        let extra = reference_error
+            .as_ref()
+            .map(|(_, json)| ("mse_reference", json.clone()));
+        report::record(&scene, &effective, &run, &report).write(path, extra)?;
     }
     // Every output in place before the summary says it was written.
     crate::output::commit_outputs()?;

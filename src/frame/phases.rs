@@ -39,13 +39,10 @@ impl Phases {
     /// Seconds from the start of `main` to the end of phase `name` (the sum up to it).
     pub fn until(&self, name: &str) -> Option<f64> {
         let mut sum = 0.0;
-        for &(n, s) in &self.done {
+        self.done.iter().find_map(|&(n, s)| {
             sum += s;
-            if n == name {
-                return Some(sum);
-            }
-        }
-        None
+            (n == name).then_some(sum)
+        })
     }
 
     /// The phases as a table in milliseconds, with the time from `main` to the first ray.

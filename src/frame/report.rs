@@ -152,8 +152,8 @@ pub struct Report {
     pub stats: RenderStats,
     /// Wall-clock seconds of the render (for the reference, its set-up included).
     pub seconds: f64,
-    /// Wavefront only: per-stage figures, and the BVH build time if a BVH was used.
-    pub stages: Option<(RenderStats, Option<f64>)>,
+    /// Wavefront only (its stages are in `stats`): the BVH build time if a BVH was used.
+    pub bvh: Option<Option<f64>>,
     /// Reference only, with --stats or --stats-json: the wall-clock seconds of the second,
     /// instrumented pass that timed the kinds.
     pub instrumented_seconds: Option<f64>,
@@ -168,14 +168,6 @@ impl Report {
     pub fn kinds(&self) -> KindFigures {
         KindFigures::new(&self.stats, self.seconds)
     }
-
-    /// How the kinds' thread-time was measured, as the JSON names it.
-    fn kinds_timed_by(&self) -> KindTiming {
-        match self.instrumented_seconds {
-            Some(_) => KindTiming::InstrumentedPass,
-            None => KindTiming::StageTimers,
-        }
-    }
 }
 
 /// The `--stats` tables: rays by kind (each kind over the thread-time of its own work, the
@@ -183,38 +175,25 @@ impl Report {
 pub fn stats_table(run: &RunInfo, report: &Report) -> String {
     let mut out = String::new();
     let kinds = report.kinds();
-    let _ = writeln!(
-        out,
-        "{:<12} {:>14} {:>14} {:>20}",
-        "kind", "rays", "thread-s", "Mrays/thread-s"
-    );
+    // A row of the kind and stage tables: name, rays, seconds, rate.
+    let row = |out: &mut String, cells: [&dyn std::fmt::Display; 4]| {
+        let [name, rays, seconds, rate] = cells;
+        let _ = writeln!(out, "{name:<12} {rays:>14} {seconds:>14} {rate:>20}");
+    };
     let or_dash = |x: Option<f64>, scale: f64, digits: usize| {
         x.map_or("-".to_string(), |x| format!("{:.digits$}", x * scale))
     };
+    row(&mut out, [&"kind", &"rays", &"thread-s", &"Mrays/thread-s"]);
     for (kind, figure) in kinds.kinds.iter() {
-        let _ = writeln!(
-            out,
-            "{:<12} {:>14} {:>14} {:>20}",
-            kind.name(),
-            figure.rays,
-            or_dash(figure.thread_seconds, 1.0, 4),
-            or_dash(figure.rays_per_thread_second, 1e-6, 2)
-        );
+        let seconds = or_dash(figure.thread_seconds, 1.0, 4);
+        let rate = or_dash(figure.rays_per_thread_second, 1e-6, 2);
+        row(&mut out, [&kind.name(), &figure.rays, &seconds, &rate]);
     }
     let total = kinds.total;
-    let _ = writeln!(
-        out,
-        "{:<12} {:>14} {:>14} {:>20}",
-        "", "", "wall s", "Mrays/s"
-    );
-    let _ = writeln!(
-        out,
-        "{:<12} {:>14} {:>14.3} {:>20.2}",
-        "total",
-        total.rays,
-        total.seconds,
-        total.rays_per_second / 1e6
-    );
+    row(&mut out, [&"", &"", &"wall s", &"Mrays/s"]);
+    let seconds = format!("{:.3}", total.seconds);
+    let rate = format!("{:.2}", total.rays_per_second / 1e6);
+    row(&mut out, [&"total", &total.rays, &seconds, &rate]);
     match report.instrumented_seconds {
         Some(pass) => {
             let _ = writeln!(
@@ -233,7 +212,7 @@ pub fn stats_table(run: &RunInfo, report: &Report) -> String {
             );
         }
     }
-    if let Some((_, Some(build))) = &report.stages {
+    if let Some(Some(build)) = report.bvh {
         let _ = writeln!(out, "bvh build {build:.3} s");
     }
     if let Some(path) = run.shadow_path {
@@ -263,21 +242,15 @@ pub fn stats_table(run: &RunInfo, report: &Report) -> String {
             t.counted_seconds
         );
     }
-    if let Some((stats, _)) = &report.stages {
-        let _ = writeln!(
-            out,
-            "{:<12} {:>14} {:>14} {:>20}",
-            "stage", "rays", "thread-s", "Mrays/thread-s"
+    if report.bvh.is_some() {
+        row(
+            &mut out,
+            [&"stage", &"rays", &"thread-s", &"Mrays/thread-s"],
         );
-        for row in stats.stage_figures() {
-            let _ = writeln!(
-                out,
-                "{:<12} {:>14} {:>14.4} {:>20.2}",
-                row.stage,
-                row.rays,
-                row.thread_seconds,
-                row.rays_per_thread_second / 1e6
-            );
+        for stage in report.stats.stage_figures() {
+            let seconds = format!("{:.4}", stage.thread_seconds);
+            let rate = format!("{:.2}", stage.rays_per_thread_second / 1e6);
+            row(&mut out, [&stage.stage, &stage.rays, &seconds, &rate]);
         }
     }
     out
@@ -290,10 +263,6 @@ pub fn record(
     run: &RunInfo,
     report: &Report,
 ) -> RenderRecord {
-    let (stages, bvh) = match &report.stages {
-        Some((stats, bvh)) => (Some(stats.stage_figures()), Some(*bvh)),
-        None => (None, None),
-    };
     RenderRecord {
         format: crate::output::bench_record::FORMAT,
         raywave: env!("CARGO_PKG_VERSION"),
@@ -312,8 +281,8 @@ pub fn record(
             triangles: scene.triangles.len(),
             spheres: scene.spheres.len(),
             lights: scene.lights.len(),
-            bvh: bvh.map(|b| b.is_some()),
-            bvh_build_seconds: bvh.flatten(),
+            bvh: report.bvh.map(|b| b.is_some()),
+            bvh_build_seconds: report.bvh.flatten(),
         },
         settings: effective.settings.clone(),
         defaults: DefaultsUsed {
@@ -322,9 +291,12 @@ pub fn record(
         },
         seconds: report.seconds,
         rays: report.kinds(),
-        kinds_timed_by: report.kinds_timed_by(),
+        kinds_timed_by: match report.instrumented_seconds {
+            Some(_) => KindTiming::InstrumentedPass,
+            None => KindTiming::StageTimers,
+        },
         instrumented_seconds: report.instrumented_seconds,
-        stages,
+        stages: report.bvh.map(|_| report.stats.stage_figures()),
         traversal: report.traversal,
     }
 }

@@ -9,13 +9,11 @@ use crate::stats::median;
 use anyhow::{Context, Result, bail};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
-use std::io::Write;
 use std::path::Path;
 
 /// The layout version of bench records and `--stats-json` files (both carry it as `format`),
 /// bumped when either layout changes; records of another version are refused with a message.
-/// 3: a bench measurement's `seconds`, `rays` and `rates` became one `rays`, the
-/// [`KindFigures`] of `--stats-json`. docs/SCHEMA.md has the rule and the history.
+/// docs/SCHEMA.md has the rule and the history of each version.
 pub const FORMAT: u32 = 3;
 
 /// One `raywave bench` invocation.
@@ -392,10 +390,7 @@ pub fn save(path: &Path, record: &BenchRecord) -> Result<()> {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("cannot create directory {}", dir.display()))?;
     }
-    crate::output::image_file::write_atomically(path, |w| {
-        serde_json::to_writer_pretty(&mut *w, record)?;
-        Ok(writeln!(w)?)
-    })
+    crate::output::image_file::write_json(path, record)
 }
 
 /// Seconds since the Unix epoch as RFC 3339 UTC (`2026-11-22T20:13:01Z`), by `humantime`.

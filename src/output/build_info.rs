@@ -27,11 +27,8 @@ pub struct BuildInfo {
 pub fn current() -> BuildInfo {
     BuildInfo {
         commit: env!("RAYWAVE_GIT_COMMIT").to_string(),
-        dirty: match env!("RAYWAVE_GIT_DIRTY") {
-            "true" => Some(true),
-            "false" => Some(false),
-            _ => None,
-        },
+        // "true", "false", or "unknown" (None).
+        dirty: env!("RAYWAVE_GIT_DIRTY").parse().ok(),
         profile: env!("RAYWAVE_BUILD_PROFILE").to_string(),
         target: env!("RAYWAVE_BUILD_TARGET").to_string(),
         target_features: env!("RAYWAVE_TARGET_FEATURES").to_string(),

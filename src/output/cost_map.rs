@@ -96,7 +96,7 @@ impl Count {
 pub struct CostInput<'a> {
     /// Each pixel's work by kind, row-major (`CostReport::pixels`).
     pub pixels: &'a [PerKind<Cost>],
-    /// Image width and height.
+    /// Image width.
     pub width: u32,
     /// Image height.
     pub height: u32,
@@ -110,23 +110,20 @@ pub struct CostInput<'a> {
 
 /// The cost map of `input`: `kind`'s rays, `measure` (two panels for `Both`).
 pub fn figure(input: &CostInput, kind: CostKind, measure: CostMeasure) -> Result<RgbImage> {
+    let panel = |one| panel(input, kind, one);
     match measure {
-        CostMeasure::Nodes => panel(input, kind, Count::Nodes),
-        CostMeasure::Tests => panel(input, kind, Count::Tests),
-        CostMeasure::Both => Ok(side_by_side(
-            &panel(input, kind, Count::Nodes)?,
-            &panel(input, kind, Count::Tests)?,
-        )),
+        CostMeasure::Nodes => panel(Count::Nodes),
+        CostMeasure::Tests => panel(Count::Tests),
+        CostMeasure::Both => Ok(side_by_side(&panel(Count::Nodes)?, &panel(Count::Tests)?)),
     }
 }
 
 /// One count's figure.
 fn panel(input: &CostInput, kind: CostKind, one: Count) -> Result<RgbImage> {
     let map = overlay(input, kind, one);
-    let mean = match map.per_ray {
-        Some(m) => format!("{m:.2} per ray"),
-        None => "no rays".to_string(),
-    };
+    let mean = map
+        .per_ray
+        .map_or("no rays".to_string(), |m| format!("{m:.2} per ray"));
     let title = format!("{}: {}", kind.title(), one.name());
     let label = format!(
         "per pixel and camera sample; {mean}, largest {}",
@@ -219,12 +216,8 @@ fn side_by_side(a: &RgbImage, b: &RgbImage) -> RgbImage {
         a.height().max(b.height()),
         image::Rgb([255, 255, 255]),
     );
-    for (x, y, p) in a.enumerate_pixels() {
-        out.put_pixel(x, y, *p);
-    }
-    for (x, y, p) in b.enumerate_pixels() {
-        out.put_pixel(a.width() + x, y, *p);
-    }
+    image::imageops::replace(&mut out, a, 0, 0);
+    image::imageops::replace(&mut out, b, i64::from(a.width()), 0);
     out
 }
 

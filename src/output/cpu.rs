@@ -247,13 +247,11 @@ impl Cpuid {
 /// The features of `features` this binary was compiled with that `has` says the CPU lacks, in
 /// table order: the check itself, over any table and any detector.
 pub fn missing(features: &[Feature], has: impl Fn(&Feature) -> bool) -> Vec<&'static str> {
-    let mut out = Vec::new();
-    for f in features {
-        if f.compiled && !has(f) {
-            out.push(f.name);
-        }
-    }
-    out
+    features
+        .iter()
+        .filter(|f| f.compiled && !has(f))
+        .map(|f| f.name)
+        .collect()
 }
 
 /// The features `has` says the CPU has that this binary was not compiled with.

@@ -134,11 +134,11 @@ impl Scale {
 /// The map alone, one pixel per value: `values` is row-major, `width × height`.
 pub fn map_image(values: &[f32], width: u32, height: u32, scale: &Scale) -> RgbImage {
     assert_eq!(values.len(), (width as usize) * (height as usize));
-    let mut img = RgbImage::new(width, height);
-    for (px, v) in img.pixels_mut().zip(values) {
-        *px = image::Rgb(inferno(scale.position(*v)));
-    }
-    img
+    RgbImage::from_fn(width, height, |x, y| {
+        image::Rgb(inferno(
+            scale.position(values[y as usize * width as usize + x as usize]),
+        ))
+    })
 }
 
 /// A figure of `values` (row-major, `width × height`): `title` above the map, a colour bar on

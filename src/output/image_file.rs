@@ -1,10 +1,8 @@
 //! A film's files: PNG and PPM after tone mapping, PFM and EXR linear, the one table of image
-//! formats by extension, and the atomic writer every command's files go through.
-//!
-//! Every file is written whole or not at all: the bytes go to a temporary file in the same
-//! directory, which is renamed over the target only once it is complete (devices, FIFOs and
-//! standard output are written directly: `output::write`).
+//! formats by extension, and the atomic writer every command's files go through
+//! (`output::write`: each file whole or not at all).
 
+use crate::output::{Target, target};
 use crate::render::film::{Film, ToneMap};
 use anyhow::{Context, Result, bail};
 use glam::Vec3;
@@ -20,15 +18,9 @@ impl Film {
                 ToneMap::Clamp => *c,
                 ToneMap::Exp => Vec3::ONE - (-3.0 * *c).exp(),
             };
-            let q = |x: f32| (x.clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
-            *px = image::Rgb([q(c.x), q(c.y), q(c.z)]);
+            *px = image::Rgb(c.to_array().map(to_byte));
         }
         img
-    }
-
-    /// Writes an 8-bit image; the format follows the extension (png, ppm).
-    pub fn write_ldr(&self, path: &Path, tone: ToneMap) -> Result<()> {
-        write_rgb8(&self.to_rgb8(tone), path)
     }
 
     /// Reads a colour PFM as written by `write_hdr` (little-endian, rows bottom to top).
@@ -69,20 +61,14 @@ impl Film {
         if width == 0 || height == 0 || floats.len() as u64 != expected {
             return Err(bad());
         }
-        let mut pixels: Vec<Vec3> = floats
-            .chunks_exact(12)
+        // Rows were stored bottom to top.
+        let pixels = (floats.chunks_exact(12 * width as usize).rev())
+            .flat_map(|row| row.chunks_exact(12))
             .map(|c| {
                 let f = |i: usize| f32::from_le_bytes([c[i], c[i + 1], c[i + 2], c[i + 3]]);
                 Vec3::new(f(0), f(4), f(8))
             })
             .collect();
-        // Rows were stored bottom to top.
-        let rows: Vec<Vec<Vec3>> = pixels
-            .chunks(width as usize)
-            .rev()
-            .map(|r| r.to_vec())
-            .collect();
-        pixels = rows.concat();
         Ok(Film {
             width,
             height,
@@ -107,7 +93,7 @@ impl Film {
                 Ok(())
             }),
             HdrFormat::Exr => {
-                if crate::output::target(path).is_stream() {
+                if target(path).is_stream() {
                     // EXR seeks back to its offset table: a pipe needs the file in memory.
                     let mut bytes = std::io::Cursor::new(Vec::new());
                     self.write_exr(&mut bytes)?;
@@ -135,6 +121,12 @@ impl Film {
         .to_buffered(w)
         .map_err(|e| anyhow::anyhow!("{e}"))
     }
+}
+
+/// The 8-bit value a channel is shown as: clamped to [0, 1], ×255, rounded (raywave's clamp
+/// tone map; an 8-bit file's own bytes come back unchanged).
+pub fn to_byte(v: f32) -> u8 {
+    (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8
 }
 
 /// An 8-bit image format raywave writes.
@@ -171,22 +163,34 @@ const FORMATS: [(&str, Format); 4] = [
     ("exr", Format::Hdr(HdrFormat::Exr)),
 ];
 
-/// The format `path`'s extension names, if any.
-fn format_of(path: &Path) -> Option<Format> {
-    let ext = extension(path)?;
-    FORMATS.iter().find(|(e, _)| *e == ext).map(|&(_, f)| f)
+/// What `pick` makes of the format `path`'s extension names; for a path without one to go by
+/// (standard output, an existing device or FIFO), `stream`, a format that streams; else an
+/// error saying what was `expected`.
+fn format_for<T>(
+    path: &Path,
+    pick: impl Fn(Format) -> Option<T>,
+    stream: T,
+    expected: &str,
+) -> Result<T> {
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase());
+    let format = FORMATS.iter().find(|(e, _)| Some(*e) == ext.as_deref());
+    match format.and_then(|&(_, f)| pick(f)) {
+        Some(f) => Ok(f),
+        None if !matches!(target(path), Target::Regular(_)) => Ok(stream),
+        None => bail!("cannot write {}: expected {expected}", path.display()),
+    }
 }
 
 /// The 8-bit format for an output path, or an error naming what is accepted.
 pub fn ldr_format(path: &Path) -> Result<LdrFormat> {
-    match format_of(path) {
-        Some(Format::Ldr(f)) => Ok(f),
-        _ if is_stream_or_device(path) => Ok(LdrFormat::Png),
-        _ => bail!(
-            "cannot write {}: expected an output file ending in .png or .ppm (use --hdr for .pfm or .exr)",
-            path.display()
-        ),
-    }
+    let pick = |f| match f {
+        Format::Ldr(f) => Some(f),
+        Format::Hdr(_) => None,
+    };
+    let expected = "an output file ending in .png or .ppm (use --hdr for .pfm or .exr)";
+    format_for(path, pick, LdrFormat::Png, expected)
 }
 
 /// What `-o FILE` writes: an 8-bit image, or (for `.pfm` and `.exr`) only the linear floats.
@@ -200,15 +204,13 @@ pub enum OutputFormat {
 
 /// The format of an `-o` path, or an error naming the extensions accepted.
 pub fn output_format(path: &Path) -> Result<OutputFormat> {
-    match format_of(path) {
-        Some(Format::Ldr(f)) => Ok(OutputFormat::Ldr(f)),
-        Some(Format::Hdr(_)) => Ok(OutputFormat::Linear),
-        _ if is_stream_or_device(path) => Ok(OutputFormat::Ldr(LdrFormat::Png)),
-        _ => bail!(
-            "cannot write {}: expected an output file ending in .png or .ppm (8-bit), or .pfm or .exr (linear floats only)",
-            path.display()
-        ),
-    }
+    let pick = |f| match f {
+        Format::Ldr(f) => Some(OutputFormat::Ldr(f)),
+        Format::Hdr(_) => Some(OutputFormat::Linear),
+    };
+    let expected =
+        "an output file ending in .png or .ppm (8-bit), or .pfm or .exr (linear floats only)";
+    format_for(path, pick, OutputFormat::Ldr(LdrFormat::Png), expected)
 }
 
 /// Encodes an 8-bit image as PNG into `w`: the one PNG encoder of every output (files, figures
@@ -245,34 +247,18 @@ pub fn check_hdr_path(path: &Path) -> Result<()> {
 }
 
 fn hdr_extension(path: &Path) -> Result<HdrFormat> {
-    match format_of(path) {
-        Some(Format::Hdr(f)) => Ok(f),
-        _ if is_stream_or_device(path) => Ok(HdrFormat::Pfm),
-        _ => bail!(
-            "cannot write {}: expected an --hdr file ending in .pfm or .exr",
-            path.display()
-        ),
-    }
-}
-
-/// Standard output (`-`), or an existing device or FIFO: a name without an extension to go by,
-/// so PNG (8-bit) or PFM (floats), the formats that stream, are written.
-fn is_stream_or_device(path: &Path) -> bool {
-    !matches!(
-        crate::output::target(path),
-        crate::output::Target::Regular(_)
-    )
-}
-
-fn extension(path: &Path) -> Option<String> {
-    path.extension()
-        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+    let pick = |f| match f {
+        Format::Hdr(f) => Some(f),
+        Format::Ldr(_) => None,
+    };
+    let expected = "an --hdr file ending in .pfm or .exr";
+    format_for(path, pick, HdrFormat::Pfm, expected)
 }
 
 /// Checks, before a long render, that the directory of `path` exists and `path` is not a
 /// directory itself.
 pub fn check_output_dir(path: &Path) -> Result<()> {
-    let dir = parent_dir(path);
+    let dir = crate::output::write::parent_dir(path);
     if !dir.is_dir() {
         bail!(
             "cannot write {}: directory {} does not exist",
@@ -288,13 +274,6 @@ pub fn check_output_dir(path: &Path) -> Result<()> {
     Ok(())
 }
 
-fn parent_dir(path: &Path) -> &Path {
-    match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    }
-}
-
 /// Writes through `fill` into a temporary file beside `path` (beside the file a symlink points
 /// to), then renames it into place; standard output (`-`), devices and FIFOs are written
 /// directly (see `output::write`).
@@ -303,4 +282,12 @@ pub fn write_atomically(
     fill: impl FnOnce(&mut BufWriter<&mut std::fs::File>) -> Result<()>,
 ) -> Result<()> {
     crate::output::write_output(path, fill)
+}
+
+/// Writes `value` as pretty JSON with a final newline, through [`write_atomically`].
+pub fn write_json(path: &Path, value: &impl serde::Serialize) -> Result<()> {
+    write_atomically(path, |w| {
+        serde_json::to_writer_pretty(&mut *w, value)?;
+        Ok(writeln!(w)?)
+    })
 }

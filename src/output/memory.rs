@@ -52,13 +52,9 @@ impl RenderFootprint {
     fn peak_bytes(&self) -> u64 {
         let per_pixel = FILM_BYTES_PER_PIXEL
             + SLACK_BYTES_PER_PIXEL
-            + if self.rgb8 { RGB8_BYTES_PER_PIXEL } else { 0 }
-            + if self.exr_in_memory { 12 } else { 0 }
-            + if self.cost_map {
-                COST_MAP_BYTES_PER_PIXEL
-            } else {
-                0
-            };
+            + u64::from(self.rgb8) * RGB8_BYTES_PER_PIXEL
+            + u64::from(self.exr_in_memory) * 12
+            + u64::from(self.cost_map) * COST_MAP_BYTES_PER_PIXEL;
         BASE_BYTES
             + self.primitives * BYTES_PER_PRIMITIVE
             + self.threads * self.batch_size * WORKSPACE_BYTES_PER_SAMPLE
@@ -99,11 +95,11 @@ pub fn available() -> Option<(u64, &'static str)> {
             .and_then(|v| v.trim().trim_end_matches("kB").trim().parse::<u64>().ok())
             .map(|kb| (kb * 1024, "MemAvailable in /proc/meminfo"))
     });
-    let cgroup = cgroup_limit();
-    match (meminfo, cgroup) {
-        (Some(m), Some(c)) => Some(if c.0 < m.0 { c } else { m }),
-        (m, c) => m.or(c),
-    }
+    // The smaller; MemAvailable's on a tie.
+    [meminfo, cgroup_limit()]
+        .into_iter()
+        .flatten()
+        .min_by_key(|&(bytes, _)| bytes)
 }
 
 /// The cgroup's memory limit less its usage (v2 `memory.max`, v1 `memory.limit_in_bytes`).

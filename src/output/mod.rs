@@ -54,20 +54,20 @@ struct Identity {
 
 impl Identity {
     fn of(path: &Path) -> Identity {
-        if is_stdio(path) || is_dev_stdout(path) {
-            let dev_ino = stdout_dev_ino();
+        if is_stdout(path) {
+            // Whatever standard output is (a file, a pipe, a terminal).
             return Identity {
-                dev_ino,
+                dev_ino: dev_ino("/proc/self/fd/1"),
                 canonical: PathBuf::from("<stdout>"),
             };
         }
-        match std::fs::metadata(path) {
-            Ok(meta) => Identity {
-                dev_ino: Some((meta.dev(), meta.ino())),
+        match dev_ino(path) {
+            Some(dev_ino) => Identity {
+                dev_ino: Some(dev_ino),
                 canonical: std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf()),
             },
             // A new file, or one a dangling symlink would create.
-            Err(_) => Identity {
+            None => Identity {
                 dev_ino: None,
                 canonical: canonical_new(&write::resolve_symlinks(path)),
             },
@@ -76,10 +76,8 @@ impl Identity {
 
     /// True for `/dev/null` under any name (also standard output sent there).
     fn is_null(&self) -> bool {
-        let null = std::fs::metadata("/dev/null")
-            .ok()
-            .map(|m| (m.dev(), m.ino()));
-        self.canonical == Path::new("/dev/null") || (self.dev_ino.is_some() && self.dev_ino == null)
+        self.canonical == Path::new("/dev/null")
+            || (self.dev_ino.is_some() && self.dev_ino == dev_ino("/dev/null"))
     }
 
     fn same(&self, other: &Identity) -> bool {
@@ -88,11 +86,10 @@ impl Identity {
     }
 }
 
-/// Device and inode of whatever standard output is (a file, a pipe, a terminal).
-fn stdout_dev_ino() -> Option<(u64, u64)> {
-    std::fs::metadata("/proc/self/fd/1")
-        .ok()
-        .map(|m| (m.dev(), m.ino()))
+/// Device and inode of the file at `path` (symlinks followed), if it exists.
+fn dev_ino(path: impl AsRef<Path>) -> Option<(u64, u64)> {
+    let meta = std::fs::metadata(path).ok()?;
+    Some((meta.dev(), meta.ino()))
 }
 
 /// The canonical form of a path that does not exist yet: its parent canonicalised (when it
@@ -116,6 +113,14 @@ struct Named {
 }
 
 impl Named {
+    fn new(flag: &str, path: &Path, creates_dir: bool) -> Named {
+        Named {
+            flag: flag.to_string(),
+            path: path.to_path_buf(),
+            creates_dir,
+        }
+    }
+
     fn describe(&self) -> String {
         if is_stdio(&self.path) {
             format!("{} - (standard output)", self.flag)
@@ -142,50 +147,38 @@ impl OutputPlan {
     /// Standard input (`-`) is not a file and is skipped.
     pub fn input(mut self, flag: &str, path: &Path) -> OutputPlan {
         if !is_stdio(path) {
-            self.inputs.push(Named {
-                flag: flag.to_string(),
-                path: path.to_path_buf(),
-                creates_dir: false,
-            });
+            self.inputs.push(Named::new(flag, path, false));
         }
         self
     }
 
     /// An output file whose directory must already exist.
     pub fn output(mut self, flag: &str, path: &Path) -> OutputPlan {
-        self.outputs.push(Named {
-            flag: flag.to_string(),
-            path: path.to_path_buf(),
-            creates_dir: false,
-        });
+        self.outputs.push(Named::new(flag, path, false));
         self
     }
 
     /// An output file in a directory the command creates if it is missing.
     pub fn output_in_new_dir(mut self, flag: &str, path: &Path) -> OutputPlan {
-        self.outputs.push(Named {
-            flag: flag.to_string(),
-            path: path.to_path_buf(),
-            creates_dir: true,
-        });
+        self.outputs.push(Named::new(flag, path, true));
         self
     }
 
     /// True when some output is standard output (text meant for the terminal must then go to
     /// standard error).
     pub fn uses_stdout(&self) -> bool {
-        self.outputs
-            .iter()
-            .any(|o| is_stdio(&o.path) || is_dev_stdout(&o.path))
+        self.outputs.iter().any(|o| is_stdout(&o.path))
     }
 
     /// Refuses binary output (`flag -`) to standard output when that is a terminal: the
     /// bytes would only garble it.
     pub fn refuse_binary_on_terminal(&self, flags: &[&str]) -> Result<()> {
         use std::io::IsTerminal;
-        if let Some(o) = self.outputs.iter().find(|o| {
-            (is_stdio(&o.path) || is_dev_stdout(&o.path)) && flags.contains(&o.flag.as_str())
-        }) && std::io::stdout().is_terminal()
+        if let Some(o) = self
+            .outputs
+            .iter()
+            .find(|o| is_stdout(&o.path) && flags.contains(&o.flag.as_str()))
+            && std::io::stdout().is_terminal()
         {
             return Err(UsageError(format!(
                 "{} would write an image to the terminal: expected standard output redirected to a file or a pipe",
@@ -227,16 +220,10 @@ impl OutputPlan {
 
     /// The first half of [`OutputPlan::check`]: no output is an input or another output.
     fn check_against_inputs(&self) -> Result<()> {
-        let inputs: Vec<(&Named, Identity)> = self
-            .inputs
-            .iter()
-            .map(|n| (n, Identity::of(&n.path)))
-            .collect();
-        let outputs: Vec<(&Named, Identity)> = self
-            .outputs
-            .iter()
-            .map(|n| (n, Identity::of(&n.path)))
-            .collect();
+        fn identities(named: &[Named]) -> Vec<(&Named, Identity)> {
+            named.iter().map(|n| (n, Identity::of(&n.path))).collect()
+        }
+        let (inputs, outputs) = (identities(&self.inputs), identities(&self.outputs));
         for (i, (out, id)) in outputs.iter().enumerate() {
             for (input, input_id) in &inputs {
                 if id.same(input_id) {
@@ -264,66 +251,47 @@ impl OutputPlan {
     }
 }
 
-/// `/dev/stdout`, `/dev/fd/1`, `/proc/self/fd/1`: standard output under another name.
-pub(crate) fn is_dev_stdout(path: &Path) -> bool {
-    ["/dev/stdout", "/dev/fd/1", "/proc/self/fd/1"]
-        .iter()
-        .any(|p| path == Path::new(p))
+/// `-`, or standard output under another name: `/dev/stdout`, `/dev/fd/1`, `/proc/self/fd/1`.
+pub(crate) fn is_stdout(path: &Path) -> bool {
+    is_stdio(path)
+        || ["/dev/stdout", "/dev/fd/1", "/proc/self/fd/1"]
+            .iter()
+            .any(|p| path == Path::new(p))
 }
 
 /// Checks that the output can be written: not a directory, in a directory that exists (or
 /// that the command creates) and that this process may write in.
 fn check_writable(out: &Named) -> Result<()> {
     let path = &out.path;
-    match target(path) {
-        Target::Stdout | Target::Special(_) => return Ok(()),
-        Target::Regular(real) => {
-            if let Err(e) = std::fs::metadata(path)
-                && e.raw_os_error() == Some(libc::ELOOP)
-            {
-                bail!(
-                    "cannot write {}: its symlinks form a loop, expected a file or a symlink to one",
-                    path.display()
-                );
-            }
-            if real.is_dir() {
-                bail!(
-                    "cannot write {}: it is a directory, expected a file",
-                    path.display()
-                );
-            }
-            let mut dir = write::parent_dir(&real).to_path_buf();
-            if out.creates_dir {
-                // The nearest existing ancestor is where the new directories will be made.
-                while !dir.exists() {
-                    match dir.parent() {
-                        Some(p) if !p.as_os_str().is_empty() => dir = p.to_path_buf(),
-                        _ => dir = PathBuf::from("."),
-                    }
+    let Target::Regular(real) = target(path) else {
+        return Ok(());
+    };
+    let problem = if let Err(e) = std::fs::metadata(path)
+        && e.raw_os_error() == Some(libc::ELOOP)
+    {
+        "its symlinks form a loop, expected a file or a symlink to one".to_string()
+    } else if real.is_dir() {
+        "it is a directory, expected a file".to_string()
+    } else {
+        let mut dir = write::parent_dir(&real).to_path_buf();
+        if out.creates_dir {
+            // The nearest existing ancestor is where the new directories will be made.
+            while !dir.exists() {
+                match dir.parent() {
+                    Some(p) if !p.as_os_str().is_empty() => dir = p.to_path_buf(),
+                    _ => dir = PathBuf::from("."),
                 }
             }
-            if !dir.exists() {
-                bail!(
-                    "cannot write {}: directory {} does not exist",
-                    path.display(),
-                    dir.display()
-                );
-            }
-            if !dir.is_dir() {
-                bail!(
-                    "cannot write {}: {} is not a directory",
-                    path.display(),
-                    dir.display()
-                );
-            }
-            if !write::may_write_in(&dir) {
-                bail!(
-                    "cannot write {}: no permission to create files in {}",
-                    path.display(),
-                    dir.display()
-                );
-            }
         }
-    }
-    Ok(())
+        if !dir.exists() {
+            format!("directory {} does not exist", dir.display())
+        } else if !dir.is_dir() {
+            format!("{} is not a directory", dir.display())
+        } else if !write::may_write_in(&dir) {
+            format!("no permission to create files in {}", dir.display())
+        } else {
+            return Ok(());
+        }
+    };
+    bail!("cannot write {}: {problem}", path.display())
 }

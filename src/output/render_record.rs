@@ -13,7 +13,6 @@ use crate::render::wavefront::cost::CostSum;
 use crate::render::wavefront::stats::StageFigure;
 use schemars::JsonSchema;
 use serde::Serialize;
-use std::io::Write;
 use std::path::Path;
 
 /// Everything `--stats-json` writes.
@@ -161,58 +160,35 @@ pub fn schemas() -> [(&'static str, String); 2] {
     // The files as written: every field required (an absent value is written as null),
     // except the few left out when empty (a bench record's host name in `--stats-json`).
     let settings = schemars::generate::SchemaSettings::draft2020_12().for_serialize();
-    let pretty = |schema: schemars::Schema| {
-        let mut text = serde_json::to_string_pretty(&schema).unwrap_or_default();
-        text.push('\n');
-        text
-    };
+    let generator = || settings.clone().into_generator();
+    let pretty = |schema| serde_json::to_string_pretty(&schema).unwrap_or_default() + "\n";
     [
         (
             "render-record.schema.json",
-            pretty(
-                settings
-                    .clone()
-                    .into_generator()
-                    .into_root_schema_for::<RenderRecord>(),
-            ),
+            pretty(generator().into_root_schema_for::<RenderRecord>()),
         ),
         (
             "bench-record.schema.json",
-            pretty(
-                settings
-                    .into_generator()
-                    .into_root_schema_for::<BenchRecord>(),
-            ),
+            pretty(generator().into_root_schema_for::<BenchRecord>()),
         ),
     ]
 }
 
 impl RenderRecord {
-    /// Writes the record as pretty JSON, whole or not at all. It goes through
-    /// `serde_json::Value`, whose objects sort their keys: the files have always listed
-    /// every object's keys alphabetically.
-    pub fn write(&self, path: &Path) -> anyhow::Result<()> {
-        let json = serde_json::to_value(self)?;
-        crate::output::image_file::write_atomically(path, |w| {
-            serde_json::to_writer_pretty(&mut *w, &json)?;
-            Ok(writeln!(w)?)
-        })
-    }
-
-    /// [`RenderRecord::write`] with one more top-level entry, `key` (e.g. `mse_reference`,
-    /// the render's error against `render --mse-reference`).
-    pub fn write_with(
+    /// Writes the record as pretty JSON, whole or not at all, with `extra` as one more
+    /// top-level entry (e.g. `mse_reference`, the render's error against `render
+    /// --mse-reference`). It goes through `serde_json::Value`, whose objects sort their keys:
+    /// the files have always listed every object's keys alphabetically.
+    pub fn write(
         &self,
         path: &Path,
-        key: &str,
-        value: serde_json::Value,
+        extra: Option<(&str, serde_json::Value)>,
     ) -> anyhow::Result<()> {
         let mut json = serde_json::to_value(self)?;
-        json[key] = value;
-        crate::output::image_file::write_atomically(path, |w| {
-            serde_json::to_writer_pretty(&mut *w, &json)?;
-            Ok(writeln!(w)?)
-        })
+        if let Some((key, value)) = extra {
+            json[key] = value;
+        }
+        crate::output::image_file::write_json(path, &json)
     }
 }
 
@@ -271,7 +247,7 @@ mod tests {
         };
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("s.json");
-        record.write(&path).unwrap();
+        record.write(&path, None).unwrap();
         let text = std::fs::read_to_string(&path).unwrap();
         let top: Vec<&str> = text
             .lines()

@@ -40,13 +40,9 @@ pub fn with_bar<T>(template: &str, quiet: bool, work: impl FnOnce(&Progress) -> 
 /// Writes `text` to standard output and flushes it. A closed pipe (`raywave ... | head`) or a
 /// full disk is an error, so that `main` exits 1 with a message instead of panicking as
 /// `println!` does.
-fn write_stdout(text: &str) -> std::io::Result<()> {
-    let mut out = std::io::stdout().lock();
-    out.write_all(text.as_bytes())?;
-    out.flush()
-}
-
-/// [`write_stdout`], with the message the commands give when it fails.
 pub fn print(text: &str) -> Result<()> {
-    write_stdout(text).context("cannot write to standard output")
+    let mut out = std::io::stdout().lock();
+    out.write_all(text.as_bytes())
+        .and_then(|()| out.flush())
+        .context("cannot write to standard output")
 }

@@ -74,6 +74,19 @@ impl Outputs {
         self.temporaries.retain(|p| p != tmp);
     }
 
+    /// Renames a finished temporary file over `real`, and forgets it (on failure it is removed
+    /// when the error is dropped).
+    fn persist(
+        &mut self,
+        tmp: tempfile::NamedTempFile,
+        real: &Path,
+    ) -> Result<(), tempfile::PersistError> {
+        let tmp_path = tmp.path().to_path_buf();
+        let persisted = tmp.persist(real);
+        self.unregister(&tmp_path);
+        persisted.map(drop)
+    }
+
     /// Drops the regular outputs in `renames` (their temporary files are removed) and returns
     /// the paths they would have replaced.
     fn drop_renames(&mut self, renames: impl IntoIterator<Item = HeldRename>) -> Vec<String> {
@@ -116,10 +129,7 @@ pub fn commit_outputs() -> Result<()> {
     let mut replaced = Vec::new();
     let mut renames = renames.into_iter();
     while let Some(HeldRename { tmp, real, shown }) = renames.next() {
-        let tmp_path = tmp.path().to_path_buf();
-        let persisted = tmp.persist(&real);
-        state.unregister(&tmp_path);
-        if let Err(e) = persisted {
+        if let Err(e) = state.persist(tmp, &real) {
             let kept = std::iter::once(shown.display().to_string())
                 .chain(state.drop_renames(renames))
                 .collect::<Vec<_>>()
@@ -187,7 +197,7 @@ impl Target {
 /// `/dev/stdout` and its aliases are standard output itself, so that its offset is shared and
 /// a pipe behind it (`/proc/self/fd/1 -> pipe:[N]`) is written, not looked up as a path.
 pub fn target(path: &Path) -> Target {
-    if super::is_stdio(path) || super::is_dev_stdout(path) {
+    if super::is_stdout(path) {
         return Target::Stdout;
     }
     // The kernel follows the links (also /proc's magic ones) to what is really there.
@@ -317,6 +327,7 @@ fn open_special(path: &Path) -> std::io::Result<File> {
     std::fs::OpenOptions::new().write(true).open(path)
 }
 
+/// Fills `file` through `fill` and flushes it; errors name the file as `name`.
 fn write_direct(
     file: &mut File,
     name: &str,
@@ -336,13 +347,10 @@ fn write_atomically(
     fill: impl FnOnce(&mut BufWriter<&mut File>) -> Result<()>,
 ) -> Result<()> {
     let tmp = write_temporary(path, real, fill)?;
-    let tmp_path = tmp.path().to_path_buf();
     // Renamed under the lock: a signal now waits for the rename, and finds nothing to remove.
-    let mut state = outputs();
-    let persisted = tmp.persist(real);
-    state.unregister(&tmp_path);
-    persisted.with_context(|| format!("cannot move the finished file to {}", path.display()))?;
-    Ok(())
+    outputs()
+        .persist(tmp, real)
+        .with_context(|| format!("cannot move the finished file to {}", path.display()))
 }
 
 /// The temporary file beside `real`, filled through `fill`, flushed, with the mode of the
@@ -364,24 +372,18 @@ fn write_temporary(
         state.temporaries.push(tmp.path().to_path_buf());
         tmp
     };
-    let result = (|| -> Result<()> {
-        {
-            let mut w = BufWriter::new(tmp.as_file_mut());
-            fill(&mut w).with_context(|| format!("cannot write {}", path.display()))?;
-            w.flush()
-                .with_context(|| format!("cannot write {}", path.display()))?;
-        }
-        // Temporary files are created private (0600); an image is not a secret. Keep the mode
-        // of the file being replaced, or use the usual 0644 for a new one.
-        use std::os::unix::fs::PermissionsExt;
-        let mode = std::fs::metadata(real)
-            .map(|m| m.permissions().mode())
-            .unwrap_or(0o644);
-        tmp.as_file()
-            .set_permissions(std::fs::Permissions::from_mode(mode))
-            .with_context(|| format!("cannot set the permissions of {}", path.display()))?;
-        Ok(())
-    })();
+    let result =
+        write_direct(tmp.as_file_mut(), &path.display().to_string(), fill).and_then(|()| {
+            // Temporary files are created private (0600); an image is not a secret. Keep the mode
+            // of the file being replaced, or use the usual 0644 for a new one.
+            use std::os::unix::fs::PermissionsExt;
+            let mode = std::fs::metadata(real)
+                .map(|m| m.permissions().mode())
+                .unwrap_or(0o644);
+            tmp.as_file()
+                .set_permissions(std::fs::Permissions::from_mode(mode))
+                .with_context(|| format!("cannot set the permissions of {}", path.display()))
+        });
     if let Err(e) = result {
         let tmp_path = tmp.path().to_path_buf();
         let mut state = outputs();
@@ -403,14 +405,13 @@ pub fn install_signal_cleanup() -> Result<()> {
         .spawn(move || {
             if let Some(signal) = signals.forever().next() {
                 let state = outputs();
-                let temps = &state.temporaries;
-                for p in temps.iter() {
+                for p in &state.temporaries {
                     let _ = std::fs::remove_file(p);
                 }
                 let name = if signal == SIGINT { "SIGINT" } else { "SIGTERM" };
                 eprintln!(
                     "\nerror: stopped by {name}; {} unfinished temporary file(s) removed, the file being written left as it was",
-                    temps.len()
+                    state.temporaries.len()
                 );
                 // _exit: no destructors, no flushing of locks another thread may hold.
                 // SAFETY: _exit ends the process; nothing runs after it.

@@ -63,13 +63,9 @@ pub fn tree_counts(tree: &RayTree) -> RayCounts {
 
 /// The sum of the segments' contributions, in f64, in tree order: the tree's `sum`.
 pub fn contribution_sum(segments: &[Segment]) -> [f64; 3] {
-    let mut sum = [0.0f64; 3];
-    for s in segments {
-        for (acc, c) in sum.iter_mut().zip(s.contribution) {
-            *acc += f64::from(c);
-        }
-    }
-    sum
+    segments.iter().fold([0.0f64; 3], |sum, s| {
+        [0, 1, 2].map(|c| sum[c] + f64::from(s.contribution[c]))
+    })
 }
 
 /// Renders the tree's pixel with both engines and compares them with the sum of the tree's

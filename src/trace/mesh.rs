@@ -27,7 +27,7 @@ const SPHERE_RINGS: u32 = 12;
 const SPHERE_SEGMENTS: u32 = 24;
 
 /// One named group.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Group {
     /// Object / group name.
     pub name: String,
@@ -43,9 +43,7 @@ impl Group {
     fn new(name: &str) -> Group {
         Group {
             name: name.to_string(),
-            vertices: Vec::new(),
-            triangles: Vec::new(),
-            lines: Vec::new(),
+            ..Group::default()
         }
     }
 
@@ -67,7 +65,7 @@ fn rgb8(c: Vec3) -> Rgb {
     [c.x.round() as u8, c.y.round() as u8, c.z.round() as u8]
 }
 
-/// The groups of a scene and a tree; `main_aspect` is the render's width / height.
+/// The groups of a scene and a tree.
 pub fn groups(scene: &Scene, tree: &RayTree) -> Vec<Group> {
     let mut out = Vec::new();
     let mut faces = Group::new("scene");

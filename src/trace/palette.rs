@@ -58,26 +58,23 @@ impl Style {
         }
     }
 
+    /// Each style's colour and group (OBJ object) name, in declaration order.
+    const LOOK: [(Rgb, &'static str); 5] = [
+        (CAMERA, "rays_camera"),
+        (REFLECTION, "rays_reflection"),
+        (SHADOW_VISIBLE, "rays_shadow_visible"),
+        (SHADOW_BLOCKED, "rays_shadow_blocked"),
+        (SHADOW_UNTESTED, "rays_shadow_untested"),
+    ];
+
     /// Its colour.
     pub fn colour(self) -> Rgb {
-        match self {
-            Style::Camera => CAMERA,
-            Style::Reflection => REFLECTION,
-            Style::ShadowVisible => SHADOW_VISIBLE,
-            Style::ShadowBlocked => SHADOW_BLOCKED,
-            Style::ShadowUntested => SHADOW_UNTESTED,
-        }
+        Style::LOOK[self as usize].0
     }
 
     /// The group (OBJ object) name.
     pub fn group(self) -> &'static str {
-        match self {
-            Style::Camera => "rays_camera",
-            Style::Reflection => "rays_reflection",
-            Style::ShadowVisible => "rays_shadow_visible",
-            Style::ShadowBlocked => "rays_shadow_blocked",
-            Style::ShadowUntested => "rays_shadow_untested",
-        }
+        Style::LOOK[self as usize].1
     }
 
     /// Drawn dashed in the PNG.

@@ -25,19 +25,15 @@ pub fn write_ply(out: &mut dyn Write, title: &str, groups: &[Group]) -> std::io:
         base += g.vertices.len();
     }
     writeln!(out, "element vertex {vertices}")?;
-    writeln!(out, "property float x\nproperty float y\nproperty float z")?;
+    const COLOUR: &str = "property uchar red\nproperty uchar green\nproperty uchar blue";
     writeln!(
         out,
-        "property uchar red\nproperty uchar green\nproperty uchar blue"
+        "property float x\nproperty float y\nproperty float z\n{COLOUR}"
     )?;
     writeln!(out, "element face {faces}")?;
     writeln!(out, "property list uchar int vertex_indices")?;
     writeln!(out, "element edge {edges}")?;
-    writeln!(out, "property int vertex1\nproperty int vertex2")?;
-    writeln!(
-        out,
-        "property uchar red\nproperty uchar green\nproperty uchar blue"
-    )?;
+    writeln!(out, "property int vertex1\nproperty int vertex2\n{COLOUR}")?;
     writeln!(out, "end_header")?;
     for g in groups {
         for (p, c) in &g.vertices {

@@ -5,7 +5,8 @@
 use super::tree::{PrimitiveRef, PrimitiveShape, RayTree, SegmentKind};
 use std::fmt::Write;
 
-fn v3(v: [f32; 3]) -> String {
+/// A point or vector with four decimals: `(x, y, z)`.
+pub(super) fn v3(v: [f32; 3]) -> String {
     format!("({:.4}, {:.4}, {:.4})", v[0], v[1], v[2])
 }
 
@@ -92,26 +93,24 @@ pub fn summary(tree: &RayTree) -> String {
                     seg.id,
                     v3(seg.origin)
                 );
-                if let Some(h) = &seg.hit
-                    && let Some(lookup) = &h.texture
-                {
-                    let _ = writeln!(
-                        s,
-                        "{indent}  (texture {} at s {:.4}, t {:.4}: kd {})",
-                        lookup.name,
-                        lookup.st[0],
-                        lookup.st[1],
-                        rgb(h.diffuse)
-                    );
-                }
-                if let Some(h) = &seg.hit
-                    && h.shadow_points_not_cast > 0
-                {
-                    let _ = writeln!(
-                        s,
-                        "{indent}  ({} light point(s) below the surface: no ray cast)",
-                        h.shadow_points_not_cast
-                    );
+                if let Some(h) = &seg.hit {
+                    if let Some(lookup) = &h.texture {
+                        let _ = writeln!(
+                            s,
+                            "{indent}  (texture {} at s {:.4}, t {:.4}: kd {})",
+                            lookup.name,
+                            lookup.st[0],
+                            lookup.st[1],
+                            rgb(h.diffuse)
+                        );
+                    }
+                    if h.shadow_points_not_cast > 0 {
+                        let _ = writeln!(
+                            s,
+                            "{indent}  ({} light point(s) below the surface: no ray cast)",
+                            h.shadow_points_not_cast
+                        );
+                    }
                 }
             }
             SegmentKind::Shadow => {

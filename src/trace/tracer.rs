@@ -31,7 +31,7 @@ use crate::render::per_kind::RayCounts;
 use crate::render::reference::{LightPoint, Reference, TraceLog};
 use crate::render::sampling::SampleKey;
 use crate::render::scene::{Material, Scene};
-use crate::render::settings::{LightModel, RenderSettings, ShadowMode};
+use crate::render::settings::RenderSettings;
 use crate::render::spawn::{ShadowRay, SurfaceHit};
 use glam::Vec3;
 
@@ -106,17 +106,15 @@ pub fn trace_pixel(
     let pixel = y * settings.width + x;
     let (lo, hi) = super::scene_view::scene_bounds(scene);
     let diagonal = (hi - lo).length();
-    let miss_length = if diagonal.is_finite() && diagonal > 0.0 {
-        diagonal
-    } else {
-        1.0
-    };
+    let miss_length = Some(diagonal)
+        .filter(|d| d.is_finite() && *d > 0.0)
+        .unwrap_or(1.0);
     let reference = Reference::new(scene, settings);
     let mut recorder = Recorder {
         scene,
         accel: reference.accel(),
         two_sided: settings.two_sided,
-        per_sample: 1.0 / settings.aa_samples.max(1) as f32,
+        per_sample: 1.0 / aa as f32,
         miss_length,
         chain: Vec::new(),
         segments: Vec::new(),
@@ -143,22 +141,13 @@ pub fn trace_settings(s: &RenderSettings) -> TraceSettings {
         width: s.width,
         height: s.height,
         bounces: s.bounces,
-        shadows: match s.shadows {
-            ShadowMode::Off => "off",
-            ShadowMode::Hard => "hard",
-            ShadowMode::Soft => "soft",
-        }
-        .to_string(),
+        shadows: s.shadows.name().to_string(),
         points_per_light: s.points_per_light(),
         sampler: s.sampler.name().to_string(),
         aa_samples: s.aa_samples.max(1),
         seed: s.seed,
         two_sided: s.two_sided,
-        light_model: match s.light_model {
-            LightModel::Lab => "lab",
-            LightModel::Rpi => "rpi",
-        }
-        .to_string(),
+        light_model: s.light_model.name().to_string(),
         background: s.background,
         ambient: s.ambient,
     }
@@ -166,27 +155,24 @@ pub fn trace_settings(s: &RenderSettings) -> TraceSettings {
 
 /// The primitive behind a global id.
 pub fn primitive_ref(scene: &Scene, prim: u32) -> PrimitiveRef {
-    let triangles = scene.triangles.len() as u32;
-    let material = scene
-        .triangles
-        .get(prim as usize)
-        .map(|t| t.material)
-        .unwrap_or_else(|| scene.spheres[(prim - triangles) as usize].material);
     match scene.triangles.get(prim as usize) {
         Some(t) => PrimitiveRef {
             id: prim,
             shape: PrimitiveShape::Triangle,
             index: prim,
             face: Some(t.face),
-            material,
+            material: t.material,
         },
-        None => PrimitiveRef {
-            id: prim,
-            shape: PrimitiveShape::Sphere,
-            index: prim - triangles,
-            face: None,
-            material,
-        },
+        None => {
+            let index = prim - scene.triangles.len() as u32;
+            PrimitiveRef {
+                id: prim,
+                shape: PrimitiveShape::Sphere,
+                index,
+                face: None,
+                material: scene.spheres[index as usize].material,
+            }
+        }
     }
 }
 

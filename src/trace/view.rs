@@ -7,6 +7,7 @@
 //! project(p): the inverse of CameraRays' pixel -> ray mapping (continuous pixel coordinates)
 //! ```
 
+use super::summary::v3;
 use crate::render::camera::CameraRays;
 use crate::render::scene::Camera;
 use glam::{Quat, Vec3};
@@ -43,13 +44,9 @@ impl ViewPlacement {
         let sideways = rotated.cross(up).length();
         if !(forward > 0.0 && sideways > 1e-6 * forward) {
             return Err(format!(
-                "the debug camera at ({:.4}, {:.4}, {:.4}) looks at ({:.4}, {:.4}, {:.4}) along the up axis or from that very point: expected an eye off the vertical through the point of interest",
-                position.x,
-                position.y,
-                position.z,
-                main.point_of_interest.x,
-                main.point_of_interest.y,
-                main.point_of_interest.z
+                "the debug camera at {} looks at {} along the up axis or from that very point: expected an eye off the vertical through the point of interest",
+                v3(position.to_array()),
+                v3(main.point_of_interest.to_array())
             ));
         }
         Ok(Camera {

@@ -2,7 +2,7 @@
 //! files written whole or not at all.
 
 use glam::Vec3;
-use raywave::output::image_file::{check_output_dir, ldr_format, write_atomically};
+use raywave::output::image_file::{check_output_dir, ldr_format, write_atomically, write_rgb8};
 use raywave::render::film::{Film, ToneMap};
 use std::io::Write;
 
@@ -98,7 +98,7 @@ fn png_round_trips() {
     let mut film = Film::new(3, 1);
     film.pixels = vec![Vec3::new(0.2, 0.1, 0.6), Vec3::ONE, Vec3::ZERO];
     let path = dir.path().join("x.png");
-    film.write_ldr(&path, ToneMap::Clamp).unwrap();
+    write_rgb8(&film.to_rgb8(ToneMap::Clamp), &path).unwrap();
     let img = image::open(&path).unwrap().to_rgb8();
     assert_eq!(img.get_pixel(0, 0).0, [51, 26, 153]);
     assert_eq!(img.get_pixel(1, 0).0, [255; 3]);
