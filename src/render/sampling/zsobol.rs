@@ -291,12 +291,6 @@ fn stream_seed(key: &SampleKey) -> u32 {
     mix32(h ^ key.light)
 }
 
-/// Point `j` of `key`'s stream.
-#[inline]
-pub fn point(layout: &Layout, key: &SampleKey, j: u32) -> (f32, f32) {
-    StreamIndex::new(layout, key).point(j)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
