@@ -1,7 +1,7 @@
 //! RPI's additions to the lab's format: cylinder rings (`r` lines), cut into quads as RPI's
 //! framework does, and the `PerspectiveCamera { ... }` block, the one construct that spans lines.
 
-use super::{CameraBlock, ParseError, Parser, number};
+use super::{CameraBlock, ParseError, Parser};
 use crate::render::quote::quote;
 use crate::render::scene::Camera;
 use glam::Vec3;
@@ -24,9 +24,9 @@ impl Parser<'_> {
             ));
         }
         let center = self.vec3(line, "r", &args[..3])?;
-        let height = number(self.file, line, "the height of `r`", Some(args[3]))?;
-        let inner = number(self.file, line, "the inner radius of `r`", Some(args[4]))?;
-        let outer = number(self.file, line, "the outer radius of `r`", Some(args[5]))?;
+        let height = self.number(line, "the height of `r`", Some(args[3]))?;
+        let inner = self.number(line, "the inner radius of `r`", Some(args[4]))?;
+        let outer = self.number(line, "the outer radius of `r`", Some(args[5]))?;
         if height <= 0.0 {
             return Err(self.error(
                 line,
@@ -111,7 +111,7 @@ impl Parser<'_> {
         Ok(())
     }
 
-    fn camera_from(&mut self, block: CameraBlock) -> Result<Camera, ParseError> {
+    fn camera_from(&self, block: CameraBlock) -> Result<Camera, ParseError> {
         let mut position = None;
         let mut poi = None;
         let mut direction = None;
@@ -139,12 +139,7 @@ impl Parser<'_> {
                     i += 4;
                 }
                 "angle" => {
-                    let a = number(
-                        self.file,
-                        line,
-                        "the camera `angle`",
-                        take(1).first().copied(),
-                    )?;
+                    let a = self.number(line, "the camera `angle`", take(1).first().copied())?;
                     // The older RPI dialect gives radians, the newer degrees. No field of view
                     // reaches π radians, and none in these scenes is as narrow as π degrees, so
                     // a value above π is degrees.
@@ -168,28 +163,19 @@ impl Parser<'_> {
             }
         }
         let start = block.start_line;
-        let position = position.ok_or_else(|| {
+        let missing = |key: &str| {
             self.error(
                 start,
-                "expected `camera_position` in the camera block, found none".into(),
+                format!("expected `{key}` in the camera block, found none"),
             )
-        })?;
+        };
+        let position = position.ok_or_else(|| missing("camera_position"))?;
         let point_of_interest = match (poi, direction) {
             (Some(p), _) => p,
             (None, Some(d)) => position + d,
-            (None, None) => {
-                return Err(self.error(
-                    start,
-                    "expected `point_of_interest` in the camera block, found none".into(),
-                ));
-            }
+            (None, None) => return Err(missing("point_of_interest")),
         };
-        let fov = angle.ok_or_else(|| {
-            self.error(
-                start,
-                "expected `angle` in the camera block, found none".into(),
-            )
-        })?;
+        let fov = angle.ok_or_else(|| missing("angle"))?;
         let forward = point_of_interest - position;
         if forward.length_squared() == 0.0 || forward.cross(up).length_squared() == 0.0 {
             return Err(self.error(

@@ -1,7 +1,7 @@
 //! RPI's textures: `vt s t`, which gives texture coordinates to the last vertex read, and a
 //! material's `texture_file NAME`, a PPM read from the scene file's folder (`scene::texture`).
 
-use super::{ParseError, Parser, number};
+use super::{ParseError, Parser};
 use crate::render::quote::quote;
 use crate::render::scene::texture_file::{read_texture, resolve};
 use glam::Vec3;
@@ -18,18 +18,13 @@ impl Parser<'_> {
                     .into(),
             ));
         }
-        let s = number(
-            self.file,
-            line,
-            "the s coordinate of `vt`",
-            args.first().copied(),
-        )?;
+        let s = self.number(line, "the s coordinate of `vt`", args.first().copied())?;
         let t = match args.get(1) {
-            Some(token) => number(self.file, line, "the t coordinate of `vt`", Some(token))?,
+            Some(token) => self.number(line, "the t coordinate of `vt`", Some(token))?,
             None => 0.0,
         };
         if let Some(w) = args.get(2) {
-            number(self.file, line, "the w coordinate of `vt`", Some(w))?;
+            self.number(line, "the w coordinate of `vt`", Some(w))?;
         }
         self.no_more(line, "vt", args, 3)?;
         *self.vertex_st.last_mut().expect("checked non-empty") = Some([s, t]);
