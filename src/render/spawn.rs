@@ -67,10 +67,7 @@ pub fn triangle_plane(tri: &Triangle) -> f32 {
 /// The offset of rays leaving a triangle: `OFFSET_SCALE` × its largest coordinate.
 pub fn triangle_offset(tri: &Triangle) -> f32 {
     let corners = [tri.v0, tri.v0 + tri.e1, tri.v0 + tri.e2];
-    OFFSET_SCALE
-        * corners
-            .iter()
-            .fold(0.0f32, |m, c| m.max(c.abs().max_element()))
+    OFFSET_SCALE * corners.into_iter().fold(0.0, largest_coordinate)
 }
 
 /// The offset of rays leaving a sphere: `OFFSET_SCALE` × (|centre|∞ + radius).

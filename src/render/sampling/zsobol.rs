@@ -107,18 +107,11 @@ pub(crate) const PERMUTATIONS_4: [[u32; 4]; 24] = {
 };
 
 /// `index` (of `bits` bits) with its base-4 digits permuted from the top, each by the
-/// permutation that hashing the digits above it with `seed` picks; when `bits` is odd the
-/// lowest digit is one bit, flipped by a hashed bit.
-#[inline]
-#[cfg(test)]
-fn permute_digits(index: u32, bits: u32, seed: u32) -> u32 {
-    permute_part(index, bits, seed, |_| true)
-}
-
-/// The digits of [`permute_digits`] whose lowest bit's position `keep` accepts, permuted; the
-/// others 0. A digit's permutation depends only on the digits above it, so the digits above
-/// the points' bits are the same for a whole stream and are permuted once
-/// ([`StreamIndex`]).
+/// permutation that hashing the digits above it with `seed` picks (when `bits` is odd the
+/// lowest digit is one bit, flipped by a hashed bit): only the digits whose lowest bit's
+/// position `keep` accepts, the others 0. A digit's permutation depends only on the digits
+/// above it, so the digits above the points' bits are the same for a whole stream and are
+/// permuted once ([`StreamIndex`]).
 #[inline(always)]
 fn permute_part(index: u32, bits: u32, seed: u32, keep: impl Fn(u32) -> bool) -> u32 {
     let odd = bits % 2;
@@ -294,6 +287,11 @@ fn stream_seed(key: &SampleKey) -> u32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Every digit of `index` permuted: what a stream's two parts make together.
+    fn permute_digits(index: u32, bits: u32, seed: u32) -> u32 {
+        permute_part(index, bits, seed, |_| true)
+    }
 
     #[test]
     fn the_first_sobol_points_are_the_textbook_ones() {

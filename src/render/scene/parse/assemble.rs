@@ -37,7 +37,8 @@ impl Parser<'_> {
         let mut warnings = self.warnings;
         // One entry per triangle once any face has texture coordinates; none before.
         let textured_faces = self.faces.iter().any(|f| !f.st.is_empty());
-        // Textured materials already warned about a primitive without coordinates.
+        // Textured materials already warned about a primitive (face or sphere) without
+        // coordinates: the warning comes once per material.
         let mut warned = vec![false; scene.materials.len()];
         let file = self.file;
         let mut untextured =
@@ -45,7 +46,15 @@ impl Parser<'_> {
                 let m = material as usize;
                 if scene.materials[m].texture.is_some() && !std::mem::replace(&mut warned[m], true)
                 {
-                    warnings.push(no_coordinates(file, line, m, what));
+                    warnings.push(Warning {
+                        file: file.to_string(),
+                        line,
+                        message: format!(
+                            "material {m} has a texture but this {what} has no texture \
+                             coordinates (`vt` after its vertices): it takes the texel at \
+                             (0, 0), as in RPI (reported once per material)"
+                        ),
+                    });
                 }
             };
         for (face_index, face) in self.faces.iter().enumerate() {
@@ -109,18 +118,6 @@ impl Parser<'_> {
         Ok(scene)
     }
 }
-/// The warning for the first primitive (`what`: a face or a sphere) of textured material `m`
-/// that has no texture coordinates.
-fn no_coordinates(file: &str, line: usize, m: usize, what: &str) -> Warning {
-    Warning {
-        file: file.to_string(),
-        line,
-        message: format!(
-            "material {m} has a texture but this {what} has no texture coordinates (`vt` after \
-             its vertices): it takes the texel at (0, 0), as in RPI (reported once per material)"
-        ),
-    }
-}
 
 /// The polygon's area-weighted normal (twice the area in length), robust for any planar polygon.
 pub(super) fn newell_normal(corners: &[Vec3]) -> Vec3 {
@@ -168,14 +165,13 @@ fn make_light(
         }
     } else {
         let mut running = 0.0;
-        let cdf = areas
+        let mut cdf: Vec<f32> = areas
             .iter()
             .map(|w| {
                 running += w / area;
                 running
             })
-            .collect::<Vec<f32>>();
-        let mut cdf = cdf;
+            .collect();
         if let Some(last) = cdf.last_mut() {
             *last = 1.0;
         }
