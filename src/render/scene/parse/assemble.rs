@@ -121,12 +121,8 @@ impl Parser<'_> {
 
 /// The polygon's area-weighted normal (twice the area in length), robust for any planar polygon.
 pub(super) fn newell_normal(corners: &[Vec3]) -> Vec3 {
-    let mut n = Vec3::ZERO;
-    for (i, &a) in corners.iter().enumerate() {
-        let b = corners[(i + 1) % corners.len()];
-        n += a.cross(b);
-    }
-    n
+    let next = corners.iter().cycle().skip(1);
+    corners.iter().zip(next).map(|(a, b)| a.cross(*b)).sum()
 }
 
 fn make_light(

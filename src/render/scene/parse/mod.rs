@@ -178,10 +178,7 @@ pub fn parse_scene_in(
     for (index, raw) in text.lines().enumerate() {
         let number = index + 1;
         last_line = number;
-        let content = match raw.find('#') {
-            Some(at) => &raw[..at],
-            None => raw,
-        };
+        let content = raw.split_once('#').map_or(raw, |(code, _)| code);
         if pending.is_empty() {
             pending_line = number;
         }
@@ -192,12 +189,10 @@ pub fn parse_scene_in(
             continue;
         }
         pending.push_str(trimmed);
-        let line = std::mem::take(&mut pending);
-        p.logical_line(&line, pending_line)?;
+        p.logical_line(&std::mem::take(&mut pending), pending_line)?;
     }
     if !pending.is_empty() {
-        let line = std::mem::take(&mut pending);
-        p.logical_line(&line, pending_line)?;
+        p.logical_line(&pending, pending_line)?;
     }
     if let Some(block) = &p.camera_block {
         return Err(p.error(
