@@ -21,7 +21,7 @@ impl Parser<'_> {
         if self.faces.is_empty() && self.spheres.is_empty() {
             return Err(self.error(
                 last_line,
-                "expected at least one face (`f`), sphere (`s`) or ring (`r`), found none".into(),
+                "expected at least one face (`f`), sphere (`s`) or ring (`r`), found none",
             ));
         }
         let mut scene = Scene {

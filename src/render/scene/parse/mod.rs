@@ -197,7 +197,7 @@ pub fn parse_scene_in(
     if let Some(block) = &p.camera_block {
         return Err(p.error(
             block.start_line,
-            "expected `}` to close the PerspectiveCamera block, found the end of the file".into(),
+            "expected `}` to close the PerspectiveCamera block, found the end of the file",
         ));
     }
     p.finish(last_line.max(1))
@@ -220,11 +220,11 @@ pub fn beyond_range(token: &str) -> bool {
 }
 
 impl Parser<'_> {
-    fn error(&self, line: usize, message: String) -> ParseError {
+    fn error(&self, line: usize, message: impl Into<String>) -> ParseError {
         ParseError {
             file: self.file.to_string(),
             line,
-            message,
+            message: message.into(),
         }
     }
 
@@ -251,11 +251,11 @@ impl Parser<'_> {
         }
     }
 
-    fn warn(&mut self, line: usize, message: String) {
+    fn warn(&mut self, line: usize, message: impl Into<String>) {
         self.warnings.push(Warning {
             file: self.file.to_string(),
             line,
-            message,
+            message: message.into(),
         });
     }
 
@@ -394,8 +394,7 @@ impl Parser<'_> {
                     self.warn(
                         line,
                         "`diffuse` ignored: the material's texture gives its diffuse colour \
-                         (RPI's materials have one or the other)"
-                            .into(),
+                         (RPI's materials have one or the other)",
                     );
                 } else {
                     material.diffuse = c;
@@ -431,28 +430,22 @@ impl Parser<'_> {
                 let c = self.colour(line, keyword, args)?;
                 self.current_material(line, keyword)?;
                 if c != Vec3::ZERO {
-                    self.warn(
-                        line,
-                        "transmission is not rendered: `transmitted` ignored".into(),
-                    );
+                    self.warn(line, "transmission is not rendered: `transmitted` ignored");
                 }
             }
-            "background_color" => {
-                self.background = Some(self.colour(line, keyword, args)?);
-            }
+            "background_color" => self.background = Some(self.colour(line, keyword, args)?),
             "PerspectiveCamera" => {
                 if self.camera.is_some() {
                     return Err(self.error(
                         line,
-                        "expected one camera block, found a second `PerspectiveCamera`".into(),
+                        "expected one camera block, found a second `PerspectiveCamera`",
                     ));
                 }
                 self.camera_block = Some(CameraBlock {
                     start_line: line,
                     tokens: Vec::new(),
                 });
-                let rest = args.join(" ");
-                self.camera_line(&rest, line)?;
+                self.camera_line(&args.join(" "), line)?;
             }
             "vn" | "vp" | "g" | "o" | "usemtl" | "mtllib" => {}
             other => self.warn(

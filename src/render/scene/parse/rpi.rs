@@ -180,7 +180,7 @@ impl Parser<'_> {
         if forward.length_squared() == 0.0 || forward.cross(up).length_squared() == 0.0 {
             return Err(self.error(
                 start,
-                "expected a camera whose point_of_interest differs from its position and whose up is not parallel to the view direction".into(),
+                "expected a camera whose point_of_interest differs from its position and whose up is not parallel to the view direction",
             ));
         }
         Ok(Camera {

@@ -14,8 +14,7 @@ impl Parser<'_> {
             return Err(self.error(
                 line,
                 "expected a `v` line before `vt` (its coordinates belong to the vertex just read), \
-                 found `vt` before any vertex"
-                    .into(),
+                 found `vt` before any vertex",
             ));
         }
         let s = self.number(line, "the s coordinate of `vt`", args.first().copied())?;
@@ -37,7 +36,7 @@ impl Parser<'_> {
         let Some(&name) = args.first() else {
             return Err(self.error(
                 line,
-                "expected a file name after `texture_file`, found the end of the line".into(),
+                "expected a file name after `texture_file`, found the end of the line",
             ));
         };
         self.no_more(line, "texture_file", args, 1)?;
@@ -62,8 +61,7 @@ impl Parser<'_> {
             self.warn(
                 line,
                 "the texture replaces the `diffuse` colour given above (RPI's materials have one \
-                 or the other)"
-                    .into(),
+                 or the other)",
             );
         }
         Ok(())
