@@ -154,13 +154,10 @@ impl<'a> Reference<'a> {
         (!skipped.into_inner()).then_some((film, counts))
     }
 
-    /// [`Reference::render`] with the thread-time of each kind's work measured: camera = the
-    /// camera ray and its closest hit, reflection = the mirror ray and its closest hit,
-    /// shadow = the whole light loop (spawn, occlusion, Shade). A separate copy of the loop
-    /// (the clock is a type parameter), so `render` carries no timer; this one reads the clock
-    /// two or three times per path segment (a reading that ends one interval starts the
-    /// next), which costs time: docs/SCHEMA.md gives the measured overhead. Same image, same
-    /// counts.
+    /// [`Reference::render`] with the thread-time of each kind's work measured (what each kind
+    /// covers: [`KindClock`]). A separate copy of the loop (the clock is a type parameter), so
+    /// `render` carries no timer; this one reads the clock two or three times per path segment,
+    /// which costs time: docs/SCHEMA.md gives the measured overhead. Same image, same counts.
     pub fn render_timed(&self, progress: &Progress) -> (Film, RayCounts, PerKind<Duration>) {
         let w = self.settings.width as usize;
         let rows = progress.steps(self.settings.height as u64, "rows");

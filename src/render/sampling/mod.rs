@@ -234,11 +234,9 @@ impl PointSet {
             LightSampler::Lab if count == 1 => (0.5, 0.5),
             LightSampler::Lab => (uniform(key, 2 * index), uniform(key, 2 * index + 1)),
             LightSampler::Sobol => {
-                // One scramble seed per stream; the Sobol index is the sample number (< 2^16,
-                // which `check` guarantees).
-                // `sample_4d` computes dimensions 0–3 together, with the index shuffle done once:
-                // the same values as `sample(index, 0 | 1, scramble)` (tests/sampling/sampling.rs), at
-                // about half the cost.
+                // One scramble seed per stream; the index is the sample number (< 2^16: `check`).
+                // `sample_4d` gives `sample(index, 0 | 1, scramble)`'s values at about half the
+                // cost, shuffling the index once for dimensions 0–3 (tests/sampling/sampling.rs).
                 let scramble = hash(key, SOBOL_SEED_DIM);
                 let [u, v, _, _] = sobol_burley::sample_4d(index, 0, scramble);
                 (u, v)

@@ -143,13 +143,10 @@ fn permute_part(index: u32, bits: u32, seed: u32, keep: impl Fn(u32) -> bool) ->
 /// `mix32((index >> 1) ^ mix32(seed ^ ODD_SALT))`.
 const ODD_SALT: u32 = 0x5bd1_e995;
 
-/// One stream's ZSobol state: its index without the point's bits, the part of the permuted
-/// index above them and that part's Sobol bits (Sobol points are linear over GF(2) in the
-/// index's bits, so the two parts' contributions XOR together), the hash state of each digit
-/// below (it depends on the seed and the digit's place only), and the Owen scramble seeds.
-///
-/// The wavefront engine computes [`StreamIndex::point`] on lanes from these fields
-/// (`wavefront/simd/point_sets.rs`).
+/// One stream's ZSobol state: the permuted digits above the point's bits are computed once, as
+/// Sobol bits (Sobol points are linear over GF(2) in the index's bits, so the two parts'
+/// contributions XOR together). The wavefront engine computes [`StreamIndex::point`] on lanes
+/// from these fields (`wavefront/simd/point_sets.rs`).
 #[derive(Clone, Copy, Debug)]
 pub struct StreamIndex {
     /// The stream's index with the point's bits 0.
