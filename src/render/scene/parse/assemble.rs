@@ -95,14 +95,10 @@ impl Parser<'_> {
                     face: face_id,
                 });
             }
-            if scene.materials[face.material as usize].emitted != Vec3::ZERO {
-                scene.lights.push(make_light(
-                    face_id,
-                    &face.corners,
-                    fan,
-                    polygon_normal,
-                    scene.materials[face.material as usize].emitted,
-                ));
+            let emitted = scene.materials[face.material as usize].emitted;
+            if emitted != Vec3::ZERO {
+                let light = make_light(face_id, &face.corners, fan, polygon_normal, emitted);
+                scene.lights.push(light);
             }
         }
         for (sphere, line) in &self.spheres {

@@ -5,6 +5,7 @@ use super::{CameraBlock, ParseError, Parser};
 use crate::render::quote::quote;
 use crate::render::scene::Camera;
 use glam::Vec3;
+use std::f32::consts::PI;
 
 impl Parser<'_> {
     /// An RPI cylinder ring, `r cx cy cz height inner_radius outer_radius`: a tube about the
@@ -117,16 +118,12 @@ impl Parser<'_> {
         let mut direction = None;
         let mut up = Vec3::Y;
         let mut angle = None;
-        let mut i = 0;
-        let tokens = &block.tokens;
-        while i < tokens.len() {
-            let (key, line) = (&tokens[i].0, tokens[i].1);
-            let take = |n: usize| -> Vec<&str> {
-                tokens[i + 1..(i + 1 + n).min(tokens.len())]
-                    .iter()
-                    .map(|t| t.0.as_str())
-                    .collect()
-            };
+        let mut tokens = block.tokens.iter();
+        while let Some((key, line)) = tokens.next() {
+            let line = *line;
+            // The next `n` tokens (fewer at the end of the block: the reading below says so).
+            let mut take =
+                |n: usize| -> Vec<&str> { tokens.by_ref().take(n).map(|t| t.0.as_str()).collect() };
             match key.as_str() {
                 "camera_position" | "center" | "point_of_interest" | "direction" | "up" => {
                     let v = self.vec3(line, key, &take(3))?;
@@ -136,23 +133,17 @@ impl Parser<'_> {
                         "direction" => direction = Some(v),
                         _ => up = v,
                     }
-                    i += 4;
                 }
                 "angle" => {
                     let a = self.number(line, "the camera `angle`", take(1).first().copied())?;
                     // The older RPI dialect gives radians, the newer degrees. No field of view
                     // reaches π radians, and none in these scenes is as narrow as π degrees, so
                     // a value above π is degrees.
-                    let radians = if a > std::f32::consts::PI {
-                        a.to_radians()
-                    } else {
-                        a
-                    };
-                    if radians <= 0.0 || radians >= std::f32::consts::PI {
+                    let radians = if a > PI { a.to_radians() } else { a };
+                    if radians <= 0.0 || radians >= PI {
                         return Err(self.error(line, format!("expected a field-of-view angle between 0 and 180 degrees, found {a}")));
                     }
                     angle = Some(radians);
-                    i += 2;
                 }
                 other => {
                     return Err(self.error(
