@@ -3,6 +3,7 @@
 //! and 1M triangles) and for tests of the BVH path; written out as the lab's `.obj` dialect so
 //! every tool reads it like a hand-written scene.
 
+use std::f64::consts::PI;
 use std::fmt::Write;
 
 /// The eight materials of the lab's `cornell_box_reflective_spheres.obj` as (diffuse,
@@ -98,15 +99,12 @@ pub fn cornell_box_mesh_spheres(bands: u32) -> String {
         };
         push(point(0.0, 0.0));
         for i in 1..lat {
-            let theta = std::f64::consts::PI * i as f64 / lat as f64;
+            let theta = PI * i as f64 / lat as f64;
             for k in 0..lon {
-                push(point(
-                    theta,
-                    2.0 * std::f64::consts::PI * k as f64 / lon as f64,
-                ));
+                push(point(theta, 2.0 * PI * k as f64 / lon as f64));
             }
         }
-        push(point(std::f64::consts::PI, 0.0));
+        push(point(PI, 0.0));
         let ring = |i: u32, k: u32| north + 1 + (i - 1) * lon + (k % lon);
         let south = north + 1 + (lat - 1) * lon;
         for k in 0..lon {
@@ -114,24 +112,14 @@ pub fn cornell_box_mesh_spheres(bands: u32) -> String {
         }
         for i in 1..lat - 1 {
             for k in 0..lon {
-                let _ = writeln!(
-                    s,
-                    "f {} {} {} {}",
-                    ring(i, k),
-                    ring(i + 1, k),
-                    ring(i + 1, k + 1),
-                    ring(i, k + 1)
-                );
+                let (a, b) = (ring(i, k), ring(i + 1, k));
+                let (c, d) = (ring(i + 1, k + 1), ring(i, k + 1));
+                let _ = writeln!(s, "f {a} {b} {c} {d}");
             }
         }
         for k in 0..lon {
-            let _ = writeln!(
-                s,
-                "f {} {} {}",
-                ring(lat - 1, k),
-                south,
-                ring(lat - 1, k + 1)
-            );
+            let (a, b) = (ring(lat - 1, k), ring(lat - 1, k + 1));
+            let _ = writeln!(s, "f {a} {south} {b}");
         }
         next_vertex = south + 1;
     }
