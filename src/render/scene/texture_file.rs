@@ -38,10 +38,7 @@ pub(crate) fn resolve(name: &str, base: Option<&Path>) -> (PathBuf, bool) {
         }
         escapes |= depth < 0;
     }
-    let path = match base {
-        Some(dir) => dir.join(named),
-        None => named.to_path_buf(),
-    };
+    let path = base.map_or_else(|| named.to_path_buf(), |dir| dir.join(named));
     // The resolved path is shown in the render's summary: canonical when it exists.
     (std::fs::canonicalize(&path).unwrap_or(path), escapes)
 }

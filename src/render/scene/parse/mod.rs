@@ -106,7 +106,6 @@ struct Face {
 }
 
 /// Camera keys gathered from a `PerspectiveCamera { ... }` block.
-#[derive(Default)]
 struct CameraBlock {
     start_line: usize,
     tokens: Vec<(String, usize)>,
