@@ -180,12 +180,11 @@ fn sphere_roots(sphere: &Sphere, ray: &Ray) -> Option<SphereRoots> {
     })
 }
 
-/// The order every closest-hit query over a BVH minimises: hit (t, prim) beats the best so far
-/// when it is closer, or as close with a lower primitive id, so that of two hits at the same t
-/// (a shared edge, a corner where two walls meet) the lowest id wins, as in a loop over the
-/// primitives in index order, whatever order a tree visits them in. A miss (t = ∞) never wins,
-/// not even against an infinite best. Used by `Accel::closest` and by both walks of the
-/// wavefront engine's mesh BVH (one ray, and lane by lane in packets).
+/// The order every closest-hit query over a BVH minimises: (t, prim) beats the best so far when
+/// closer, or as close with a lower id, so that ties (a shared edge, a corner where two walls
+/// meet) go to the lowest id whatever order a tree visits them in, as in a loop over the
+/// primitives. A miss (t = ∞) never wins, not even against an infinite best. Used by
+/// `Accel::closest` and both walks of the wavefront engine's mesh BVH.
 #[inline(always)]
 pub fn closer(t: f32, prim: u32, best_t: f32, best_prim: u32) -> bool {
     t < best_t || (t == best_t && t < f32::INFINITY && prim < best_prim)

@@ -121,10 +121,9 @@ impl<'a> Reference<'a> {
             .expect("a render whose cancel flag is never set renders every row")
     }
 
-    /// [`Reference::render`] that stops early once `cancel` is set: every worker reads the flag
-    /// before each row and skips the row when it is set, so the call returns within about one
-    /// row per thread. `None` when a row was skipped (the film is incomplete); an image that
-    /// got every row is the same, bit for bit, as `render`'s.
+    /// [`Reference::render`] that skips every row left once `cancel` is set, so it returns within
+    /// about one row per thread: `None` when a row was skipped; otherwise `render`'s image, bit
+    /// for bit.
     pub fn render_until(
         &self,
         progress: &Progress,

@@ -259,9 +259,8 @@ impl PointSet {
     }
 
     /// [`PointSet::point`] for the samplers of digit loops and table reads (through their
-    /// [`Stream`]), out of line: their code inlined beside the lab's four in the engines'
-    /// inner loops cost those 3–8% more instructions (tests/gates/icount.rs). A loop over a
-    /// stream's points should take its [`PointSet::stream`] once instead.
+    /// [`Stream`]), out of line: inlined beside the lab's four, their code cost those 3–8% more
+    /// instructions (tests/gates/icount.rs). A loop over a stream should take it once instead.
     #[inline(never)]
     fn table_point(&self, key: &SampleKey, index: u32) -> (f32, f32) {
         match self.stream(key) {

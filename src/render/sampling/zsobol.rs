@@ -107,11 +107,9 @@ pub(crate) const PERMUTATIONS_4: [[u32; 4]; 24] = {
 };
 
 /// `index` (of `bits` bits) with its base-4 digits permuted from the top, each by the
-/// permutation that hashing the digits above it with `seed` picks (when `bits` is odd the
-/// lowest digit is one bit, flipped by a hashed bit): only the digits whose lowest bit's
-/// position `keep` accepts, the others 0. A digit's permutation depends only on the digits
-/// above it, so the digits above the points' bits are the same for a whole stream and are
-/// permuted once ([`StreamIndex`]).
+/// permutation that hashing the digits above it with `seed` picks (an odd length's lowest digit
+/// is one bit, flipped by a hashed bit); only digits whose lowest bit's position `keep` accepts,
+/// the others 0, so that a stream permutes the digits above its points' once ([`StreamIndex`]).
 #[inline(always)]
 fn permute_part(index: u32, bits: u32, seed: u32, keep: impl Fn(u32) -> bool) -> u32 {
     let odd = bits % 2;

@@ -121,7 +121,7 @@ impl Parser<'_> {
         let mut tokens = block.tokens.iter();
         while let Some((key, line)) = tokens.next() {
             let line = *line;
-            // The next `n` tokens (fewer at the end of the block: the reading below says so).
+            // The next `n` tokens; fewer at the end of the block, which `vec3` and `number` report.
             let mut take =
                 |n: usize| -> Vec<&str> { tokens.by_ref().take(n).map(|t| t.0.as_str()).collect() };
             match key.as_str() {
