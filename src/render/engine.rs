@@ -16,10 +16,10 @@ use crate::render::progress::Progress;
 use crate::render::reference::Reference;
 use crate::render::scene::Scene;
 use crate::render::settings::RenderSettings;
-use crate::render::wavefront::Wavefront;
 use crate::render::wavefront::lanes::LaneWidth;
 use crate::render::wavefront::shadow::ShadowPath;
 use crate::render::wavefront::stats::RenderStats;
+use crate::render::wavefront::{DEFAULT_BATCH_SIZE, Wavefront};
 use serde::{Deserialize, Serialize};
 use std::sync::atomic::AtomicBool;
 
@@ -88,12 +88,7 @@ impl Engine {
     /// `RenderFn` takes it. Pixels it clamps are not reported: a caller that warns of them
     /// uses [`Engine::render`] and [`clamped_warning`].
     pub fn image(self, scene: &Scene, settings: &RenderSettings) -> (Film, RayCounts) {
-        let (film, stats) = self.render(
-            scene,
-            settings,
-            crate::render::wavefront::DEFAULT_BATCH_SIZE,
-            &Progress::SILENT,
-        );
+        let (film, stats) = self.render(scene, settings, DEFAULT_BATCH_SIZE, &Progress::SILENT);
         (film, stats.counts)
     }
 }

@@ -16,8 +16,7 @@ use glam::{Vec3, Vec3A};
 use obvhs::{BvhBuildParams, cwbvh::CwBvh, ray::RayHit};
 use std::time::Duration;
 
-/// Where a ray's interval starts: a hit needs t > 0. Secondary rays avoid the surface they leave
-/// by where they start (`crate::render::spawn`), not by a minimum distance.
+/// Where a ray's interval starts: a hit needs t > 0 (no epsilon: see the module doc).
 pub const T_MIN: f32 = 0.0;
 
 /// Slack on the barycentric edge tests (u ≥ −ε, v ≥ −ε, u + v ≤ 1 + ε), so that a ray crossing
@@ -181,12 +180,11 @@ fn sphere_roots(sphere: &Sphere, ray: &Ray) -> Option<SphereRoots> {
     })
 }
 
-/// The order every closest-hit query over a BVH minimises: hit (t, prim) beats the best so far
-/// when it is closer, or as close with a lower primitive id, so that of two hits at the same t
-/// (a shared edge, a corner where two walls meet) the lowest id wins, as in a loop over the
-/// primitives in index order, whatever order a tree visits them in. A miss (t = ∞) never wins,
-/// not even against an infinite best. Used by `Accel::closest` and by both walks of the
-/// wavefront engine's mesh BVH (one ray, and lane by lane in packets).
+/// The order every closest-hit query over a BVH minimises: (t, prim) beats the best so far when
+/// closer, or as close with a lower id, so that ties (a shared edge, a corner where two walls
+/// meet) go to the lowest id whatever order a tree visits them in, as in a loop over the
+/// primitives. A miss (t = ∞) never wins, not even against an infinite best. Used by
+/// `Accel::closest` and both walks of the wavefront engine's mesh BVH.
 #[inline(always)]
 pub fn closer(t: f32, prim: u32, best_t: f32, best_prim: u32) -> bool {
     t < best_t || (t == best_t && t < f32::INFINITY && prim < best_prim)
@@ -311,19 +309,17 @@ impl Accel {
 /// The triangles that can block a shadow ray toward one of the scene's lights when faces are
 /// one-sided: every triangle except those with every light wholly on their front side.
 ///
-/// A shadow ray runs from a point x towards a point p on a light (`spawn::shadow_ray`: from
-/// just off the surface, parallel to x → p, ending before the light's plane). A one-sided face
-/// is hit only from its front, by a ray going from its front half-space to its back one, so it
-/// meets the face's plane at or beyond p when p is on the front side or on the plane: such a
-/// face can never block it (exactly for faces at right angles to the light or coplanar with
-/// it; within the ray's offset, 2^-18 of the scene, for a face touching the light at another
-/// angle). The lab's box shows why this
-/// matters: its light is a wall of the box, so the light lies on or in front of every wall's
-/// plane and no wall can shadow it; only the spheres can. Signed distances are taken in f64
-/// with a tolerance of 1e-6 of the light corner's coordinates and distance from the face, so a
-/// light *touching* a face's plane (the lab's light shares an edge with four walls) counts as
-/// in front of it despite rounding in the face's edges. Both engines test this same list, so they still agree bit for bit; with
-/// `--two-sided` every triangle is tested.
+/// A shadow ray runs from just off a surface towards a point p on a light, ending before the
+/// light's plane (`spawn::shadow_ray`). A one-sided face is hit only by a ray going from its
+/// front half-space to its back one, so it meets the face's plane at or beyond p when p is on
+/// the front side or on the plane: it can never block (exactly for faces at right angles to the
+/// light or coplanar with it; within the ray's offset, 2^-18 of the scene, for a face touching
+/// the light at another angle). In the lab's box the light is a wall, so no wall can shadow it;
+/// only the spheres can. Signed distances are taken in f64 with a tolerance of 1e-6 of the light
+/// corner's coordinates and distance from the face, so a light *touching* a face's plane (the
+/// lab's light shares an edge with four walls) counts as in front of it despite rounding. Both
+/// engines test this same list, so they still agree bit for bit; with `--two-sided` every
+/// triangle is tested.
 pub fn shadow_casters(scene: &Scene) -> Vec<Triangle> {
     let corners: Vec<Vec3> = scene.lights.iter().flat_map(Light::corners).collect();
     scene

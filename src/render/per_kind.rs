@@ -101,22 +101,18 @@ impl<T> IndexMut<RayKind> for PerKind<T> {
     }
 }
 
-impl<T: Add<Output = T>> Add for PerKind<T> {
+impl<T: Add<Output = T> + Copy> Add for PerKind<T> {
     type Output = PerKind<T>;
     fn add(self, o: PerKind<T>) -> PerKind<T> {
-        PerKind {
-            camera: self.camera + o.camera,
-            shadow: self.shadow + o.shadow,
-            reflection: self.reflection + o.reflection,
-        }
+        PerKind::from_fn(|k| self[k] + o[k])
     }
 }
 
-impl<T: AddAssign> AddAssign for PerKind<T> {
+impl<T: AddAssign + Copy> AddAssign for PerKind<T> {
     fn add_assign(&mut self, o: PerKind<T>) {
-        self.camera += o.camera;
-        self.shadow += o.shadow;
-        self.reflection += o.reflection;
+        for k in RayKind::ALL {
+            self[k] += o[k];
+        }
     }
 }
 

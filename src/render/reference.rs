@@ -121,10 +121,9 @@ impl<'a> Reference<'a> {
             .expect("a render whose cancel flag is never set renders every row")
     }
 
-    /// [`Reference::render`] that stops early once `cancel` is set: every worker reads the flag
-    /// before each row and skips the row when it is set, so the call returns within about one
-    /// row per thread. `None` when a row was skipped (the film is incomplete); an image that
-    /// got every row is the same, bit for bit, as `render`'s.
+    /// [`Reference::render`] that skips every row left once `cancel` is set, so it returns within
+    /// about one row per thread: `None` when a row was skipped; otherwise `render`'s image, bit
+    /// for bit.
     pub fn render_until(
         &self,
         progress: &Progress,
@@ -154,13 +153,10 @@ impl<'a> Reference<'a> {
         (!skipped.into_inner()).then_some((film, counts))
     }
 
-    /// [`Reference::render`] with the thread-time of each kind's work measured: camera = the
-    /// camera ray and its closest hit, reflection = the mirror ray and its closest hit,
-    /// shadow = the whole light loop (spawn, occlusion, Shade). A separate copy of the loop
-    /// (the clock is a type parameter), so `render` carries no timer; this one reads the clock
-    /// two or three times per path segment (a reading that ends one interval starts the
-    /// next), which costs time: docs/SCHEMA.md gives the measured overhead. Same image, same
-    /// counts.
+    /// [`Reference::render`] with the thread-time of each kind's work measured (what each kind
+    /// covers: [`KindClock`]). A separate copy of the loop (the clock is a type parameter), so
+    /// `render` carries no timer; this one reads the clock two or three times per path segment,
+    /// which costs time: docs/SCHEMA.md gives the measured overhead. Same image, same counts.
     pub fn render_timed(&self, progress: &Progress) -> (Film, RayCounts, PerKind<Duration>) {
         let w = self.settings.width as usize;
         let rows = progress.steps(self.settings.height as u64, "rows");

@@ -67,10 +67,7 @@ pub fn triangle_plane(tri: &Triangle) -> f32 {
 /// The offset of rays leaving a triangle: `OFFSET_SCALE` × its largest coordinate.
 pub fn triangle_offset(tri: &Triangle) -> f32 {
     let corners = [tri.v0, tri.v0 + tri.e1, tri.v0 + tri.e2];
-    OFFSET_SCALE
-        * corners
-            .iter()
-            .fold(0.0f32, |m, c| m.max(c.abs().max_element()))
+    OFFSET_SCALE * corners.into_iter().fold(0.0, largest_coordinate)
 }
 
 /// The offset of rays leaving a sphere: `OFFSET_SCALE` × (|centre|∞ + radius).
@@ -204,12 +201,9 @@ pub struct ShadowRay {
 /// a speckle) or the ray's origin is not above the light's moved plane.
 ///
 /// l = normalize(target − point) is the Shade formula's, from the hit point itself; the ray runs
-/// along it from `hit.offset` off the surface, so it is l shifted by at most that offset, and
-/// ends where it meets the light's plane moved towards the hit by the two offsets. At a
-/// grazing angle the error of where a ray crosses the light's plane grows as 1/|l·n_L|, and so
-/// does the distance between that crossing and the ray's end: the light, and faces coplanar
-/// with it, never block their own points. Written once, for every engine: the lane twin is
-/// `wavefront::simd::shadow_rays`.
+/// along it from `hit.offset` off the surface and ends at the light's moved plane (the module
+/// doc says why the light and faces coplanar with it then never block their own points).
+/// Written once, for every engine: the lane twin is `wavefront::simd::shadow_rays`.
 #[inline]
 #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(x > y)` is on purpose: NaN casts no ray
 pub fn shadow_ray(hit: &SurfaceHit, target: Vec3, end: &LightEnd) -> Option<ShadowRay> {

@@ -39,58 +39,25 @@ impl Tables {
     /// The tables for `samples` per pixel (rounded up to a power of two; at most
     /// [`MAX_SAMPLES`], above which the 256-sample tables are returned).
     pub fn for_samples(samples: u32) -> Self {
-        use blue_noise_sampler as b;
-        let t = |sobol, scrambling, ranking| Tables {
-            sobol,
-            scrambling,
-            ranking,
-        };
+        macro_rules! tables {
+            ($spp:ident) => {
+                Tables {
+                    sobol: blue_noise_sampler::$spp::SOBOL,
+                    scrambling: blue_noise_sampler::$spp::SCRAMBLING_TILE,
+                    ranking: blue_noise_sampler::$spp::RANKING_TILE,
+                }
+            };
+        }
         match samples.max(1).next_power_of_two() {
-            1 => t(
-                b::spp1::SOBOL,
-                b::spp1::SCRAMBLING_TILE,
-                b::spp1::RANKING_TILE,
-            ),
-            2 => t(
-                b::spp2::SOBOL,
-                b::spp2::SCRAMBLING_TILE,
-                b::spp2::RANKING_TILE,
-            ),
-            4 => t(
-                b::spp4::SOBOL,
-                b::spp4::SCRAMBLING_TILE,
-                b::spp4::RANKING_TILE,
-            ),
-            8 => t(
-                b::spp8::SOBOL,
-                b::spp8::SCRAMBLING_TILE,
-                b::spp8::RANKING_TILE,
-            ),
-            16 => t(
-                b::spp16::SOBOL,
-                b::spp16::SCRAMBLING_TILE,
-                b::spp16::RANKING_TILE,
-            ),
-            32 => t(
-                b::spp32::SOBOL,
-                b::spp32::SCRAMBLING_TILE,
-                b::spp32::RANKING_TILE,
-            ),
-            64 => t(
-                b::spp64::SOBOL,
-                b::spp64::SCRAMBLING_TILE,
-                b::spp64::RANKING_TILE,
-            ),
-            128 => t(
-                b::spp128::SOBOL,
-                b::spp128::SCRAMBLING_TILE,
-                b::spp128::RANKING_TILE,
-            ),
-            _ => t(
-                b::spp256::SOBOL,
-                b::spp256::SCRAMBLING_TILE,
-                b::spp256::RANKING_TILE,
-            ),
+            1 => tables!(spp1),
+            2 => tables!(spp2),
+            4 => tables!(spp4),
+            8 => tables!(spp8),
+            16 => tables!(spp16),
+            32 => tables!(spp32),
+            64 => tables!(spp64),
+            128 => tables!(spp128),
+            _ => tables!(spp256),
         }
     }
 
@@ -111,13 +78,12 @@ impl Tables {
     }
 }
 
-/// Where a stream reads the tables: the tile offset and the rotation of its render's seed and
-/// its (bounce, light), and its pair of dimensions.
+/// Where a stream reads the tables (dimensions 0 and 1): the tile offset and the rotation of
+/// its render's seed and its (bounce, light).
 #[derive(Clone, Copy, Debug)]
 pub struct Stream {
     x: u32,
     y: u32,
-    dims: (u32, u32),
     rotation: (f32, f32),
     first: u32,
 }
@@ -135,7 +101,6 @@ impl Stream {
         Stream {
             x: key.pixel % width + (tile & 127),
             y: key.pixel / width + ((tile >> 7) & 127),
-            dims: (0, 1),
             rotation: (unit(mix32(h ^ 1)), unit(mix32(h ^ 2))),
             first: key.sample.wrapping_mul(points),
         }
@@ -151,8 +116,8 @@ impl Stream {
             (if r >= 1.0 { r - 1.0 } else { r }).min(ONE_MINUS_EPS)
         };
         (
-            coordinate(self.dims.0, self.rotation.0),
-            coordinate(self.dims.1, self.rotation.1),
+            coordinate(0, self.rotation.0),
+            coordinate(1, self.rotation.1),
         )
     }
 }

@@ -18,13 +18,8 @@ use super::{ONE_MINUS_EPS, mix32};
 /// The digits a stream of `count` points uses in each base: the smallest m with b^m ≥ count
 /// (at least 1), for bases 2 and 3.
 pub fn digits(count: u32) -> (u32, u32) {
-    let needed = |base: u64| {
-        let mut m = 1;
-        while base.pow(m) < u64::from(count) {
-            m += 1;
-        }
-        m
-    };
+    // b^m ≥ count ⇔ m > log_b(count − 1), for count ≥ 2.
+    let needed = |base: u32| (count.max(2) - 1).ilog(base) + 1;
     (needed(2), needed(3))
 }
 

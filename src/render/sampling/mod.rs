@@ -103,11 +103,13 @@ impl LightSampler {
 
 /// A render that asks a sampler for more than it holds: the message names the sampler, its
 /// limit and why.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum SamplerLimit {
     /// No points per light.
+    #[error("--shadow-samples 0 with --sampler {}: expected {}", .0.name(), range(*.0))]
     NoPoints(LightSampler),
     /// More points per stream than the sampler holds.
+    #[error("--sampler {} with {asked}: expected {}", sampler.name(), range(*sampler))]
     TooManyPoints {
         /// The sampler.
         sampler: LightSampler,
@@ -115,6 +117,12 @@ pub enum SamplerLimit {
         asked: String,
     },
     /// An image and sample count whose ZSobol indices pass 32 bits.
+    #[error(
+        "--sampler zsobol on a {image} image with {samples} samples per pixel needs {bits}-bit \
+         sample indices: expected at most 32 (2 bits per doubling of the image's larger \
+         side, plus those of the aa samples × points per light, each rounded up to a \
+         power of two); use a smaller image or fewer points"
+    )]
     IndexBits {
         /// The bits the render needs.
         bits: u32,
@@ -125,41 +133,13 @@ pub enum SamplerLimit {
     },
 }
 
-impl std::fmt::Display for SamplerLimit {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let range = |s: &LightSampler| match s.max_points() {
-            Some((n, why)) => format!("1 to {n} points per light ({why})"),
-            None => "1 to 65536 points per light".to_string(),
-        };
-        match self {
-            SamplerLimit::NoPoints(s) => write!(
-                f,
-                "--shadow-samples 0 with --sampler {}: expected {}",
-                s.name(),
-                range(s)
-            ),
-            SamplerLimit::TooManyPoints { sampler, asked } => write!(
-                f,
-                "--sampler {} with {asked}: expected {}",
-                sampler.name(),
-                range(sampler)
-            ),
-            SamplerLimit::IndexBits {
-                bits,
-                image,
-                samples,
-            } => write!(
-                f,
-                "--sampler zsobol on a {image} image with {samples} samples per pixel needs {bits}-bit \
-                 sample indices: expected at most 32 (2 bits per doubling of the image's larger \
-                 side, plus those of the aa samples × points per light, each rounded up to a \
-                 power of two); use a smaller image or fewer points"
-            ),
-        }
+/// The points per light `sampler` takes, in words.
+fn range(sampler: LightSampler) -> String {
+    match sampler.max_points() {
+        Some((n, why)) => format!("1 to {n} points per light ({why})"),
+        None => "1 to 65536 points per light".to_string(),
     }
 }
-
-impl std::error::Error for SamplerLimit {}
 
 /// Whether `n` points per light of `sampler`, with `aa` samples per pixel of a `size` image,
 /// ask the sampler for no more than it holds (`RenderSettings::check_sampler` adds that a
@@ -254,11 +234,9 @@ impl PointSet {
             LightSampler::Lab if count == 1 => (0.5, 0.5),
             LightSampler::Lab => (uniform(key, 2 * index), uniform(key, 2 * index + 1)),
             LightSampler::Sobol => {
-                // One scramble seed per stream; the Sobol index is the sample number (< 2^16,
-                // which `check` guarantees).
-                // `sample_4d` computes dimensions 0–3 together, with the index shuffle done once:
-                // the same values as `sample(index, 0 | 1, scramble)` (tests/sampling/sampling.rs), at
-                // about half the cost.
+                // One scramble seed per stream; the index is the sample number (< 2^16: `check`).
+                // `sample_4d` gives `sample(index, 0 | 1, scramble)`'s values at about half the
+                // cost, shuffling the index once for dimensions 0–3 (tests/sampling/sampling.rs).
                 let scramble = hash(key, SOBOL_SEED_DIM);
                 let [u, v, _, _] = sobol_burley::sample_4d(index, 0, scramble);
                 (u, v)
@@ -281,9 +259,8 @@ impl PointSet {
     }
 
     /// [`PointSet::point`] for the samplers of digit loops and table reads (through their
-    /// [`Stream`]), out of line: their code inlined beside the lab's four in the engines'
-    /// inner loops cost those 3–8% more instructions (tests/gates/icount.rs). A loop over a
-    /// stream's points should take its [`PointSet::stream`] once instead.
+    /// [`Stream`]), out of line: inlined beside the lab's four, their code cost those 3–8% more
+    /// instructions (tests/gates/icount.rs). A loop over a stream should take it once instead.
     #[inline(never)]
     fn table_point(&self, key: &SampleKey, index: u32) -> (f32, f32) {
         match self.stream(key) {

@@ -116,13 +116,10 @@ impl Occupancy {
     }
 
     /// A row Y for column X (both m-bit) in no occupied interval, its top `prefix.0` bits equal
-    /// to `prefix.1` when given; `None` when there is none. Y is built from its top bit down:
-    /// with d bits chosen, the shape whose rows have d bits is complete and is checked.
-    fn row(&self, x: u32, prefix: Option<(u32, u32)>, rng: &mut SplitMix64) -> Option<u32> {
-        self.row_from(x, 0, 0, prefix, rng)
-    }
-
-    fn row_from(
+    /// to `prefix.1` when given; `None` when there is none. Y is built from its top bit down
+    /// (`d` bits chosen so far, `y_top`; start at 0, 0): with d bits chosen, the shape whose rows
+    /// have d bits is complete and is checked.
+    fn row(
         &self,
         x: u32,
         d: u32,
@@ -144,7 +141,7 @@ impl Occupancy {
             {
                 continue;
             }
-            if let Some(y) = self.row_from(x, d + 1, (y_top << 1) | b, prefix, rng) {
+            if let Some(y) = self.row(x, d + 1, (y_top << 1) | b, prefix, rng) {
                 return Some(y);
             }
         }
@@ -177,7 +174,7 @@ fn choose(
             {
                 continue;
             }
-            if let Some(y) = grid.row(x, attempt.map(|(_, py)| py), rng) {
+            if let Some(y) = grid.row(x, 0, 0, attempt.map(|(_, py)| py), rng) {
                 return Some((x, y));
             }
         }

@@ -107,18 +107,9 @@ pub(crate) const PERMUTATIONS_4: [[u32; 4]; 24] = {
 };
 
 /// `index` (of `bits` bits) with its base-4 digits permuted from the top, each by the
-/// permutation that hashing the digits above it with `seed` picks; when `bits` is odd the
-/// lowest digit is one bit, flipped by a hashed bit.
-#[inline]
-#[cfg(test)]
-fn permute_digits(index: u32, bits: u32, seed: u32) -> u32 {
-    permute_part(index, bits, seed, |_| true)
-}
-
-/// The digits of [`permute_digits`] whose lowest bit's position `keep` accepts, permuted; the
-/// others 0. A digit's permutation depends only on the digits above it, so the digits above
-/// the points' bits are the same for a whole stream and are permuted once
-/// ([`StreamIndex`]).
+/// permutation that hashing the digits above it with `seed` picks (an odd length's lowest digit
+/// is one bit, flipped by a hashed bit); only digits whose lowest bit's position `keep` accepts,
+/// the others 0, so that a stream permutes the digits above its points' once ([`StreamIndex`]).
 #[inline(always)]
 fn permute_part(index: u32, bits: u32, seed: u32, keep: impl Fn(u32) -> bool) -> u32 {
     let odd = bits % 2;
@@ -150,13 +141,10 @@ fn permute_part(index: u32, bits: u32, seed: u32, keep: impl Fn(u32) -> bool) ->
 /// `mix32((index >> 1) ^ mix32(seed ^ ODD_SALT))`.
 const ODD_SALT: u32 = 0x5bd1_e995;
 
-/// One stream's ZSobol state: its index without the point's bits, the part of the permuted
-/// index above them and that part's Sobol bits (Sobol points are linear over GF(2) in the
-/// index's bits, so the two parts' contributions XOR together), the hash state of each digit
-/// below (it depends on the seed and the digit's place only), and the Owen scramble seeds.
-///
-/// The wavefront engine computes [`StreamIndex::point`] on lanes from these fields
-/// (`wavefront/simd/point_sets.rs`).
+/// One stream's ZSobol state: the permuted digits above the point's bits are computed once, as
+/// Sobol bits (Sobol points are linear over GF(2) in the index's bits, so the two parts'
+/// contributions XOR together). The wavefront engine computes [`StreamIndex::point`] on lanes
+/// from these fields (`wavefront/simd/point_sets.rs`).
 #[derive(Clone, Copy, Debug)]
 pub struct StreamIndex {
     /// The stream's index with the point's bits 0.
@@ -291,15 +279,14 @@ fn stream_seed(key: &SampleKey) -> u32 {
     mix32(h ^ key.light)
 }
 
-/// Point `j` of `key`'s stream.
-#[inline]
-pub fn point(layout: &Layout, key: &SampleKey, j: u32) -> (f32, f32) {
-    StreamIndex::new(layout, key).point(j)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Every digit of `index` permuted: what a stream's two parts make together.
+    fn permute_digits(index: u32, bits: u32, seed: u32) -> u32 {
+        permute_part(index, bits, seed, |_| true)
+    }
 
     #[test]
     fn the_first_sobol_points_are_the_textbook_ones() {

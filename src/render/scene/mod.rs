@@ -15,7 +15,7 @@ pub use parse::{
     ParseError, ParseOptions, RPI_RING_SEGMENTS, SceneError, Warning, beyond_range, parse_scene_in,
     parse_scene_str, parse_scene_str_with,
 };
-pub use read::{MAX_SCENE_BYTES, STDIN_NAME, read_capped, read_scene_bytes};
+pub use read::{MAX_SCENE_BYTES, STDIN_NAME, read_scene_bytes};
 pub use texture::Texture;
 pub use texture_file::MAX_TEXTURE_TEXELS;
 
@@ -28,7 +28,7 @@ pub const NO_HIT: u32 = u32::MAX;
 /// The lab's material: diffuse, reflective and emitted colours plus a glossiness that narrows
 /// (g = 0) or widens (g = 1) the highlight through the exponent 5 / (g + 0.01); RPI's may take
 /// its diffuse colour from a texture.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Material {
     /// Diffuse colour kd (also scales the fixed 0.2 ambient term). With a texture, the texture's
     /// average colour, which stands for it where one colour must (shading reads the texture:
@@ -43,18 +43,6 @@ pub struct Material {
     pub emitted: Vec3,
     /// The lab's glossiness g (an RPI file's `roughness` maps here too).
     pub glossiness: f32,
-}
-
-impl Default for Material {
-    fn default() -> Self {
-        Material {
-            diffuse: Vec3::ZERO,
-            texture: None,
-            reflective: Vec3::ZERO,
-            emitted: Vec3::ZERO,
-            glossiness: 0.0,
-        }
-    }
 }
 
 impl Material {
@@ -245,30 +233,7 @@ impl Scene {
     /// Reads and parses a scene file with the default [`ParseOptions`]; errors name the file
     /// and line.
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
-        Scene::load_with(path, &ParseOptions::default())
-    }
-
-    /// Reads and parses a scene file; errors name the file and line.
-    fn load_with(path: &Path, options: &ParseOptions) -> Result<Scene, SceneError> {
-        Ok(load_scene(Some(path), options)?.scene)
-    }
-
-    /// Parses a scene file's bytes; `file` names it in errors.
-    fn from_bytes(
-        bytes: &[u8],
-        file: &str,
-        options: &ParseOptions,
-        base: Option<&Path>,
-    ) -> Result<Scene, SceneError> {
-        let text = std::str::from_utf8(bytes).map_err(|e| {
-            let valid = &bytes[..e.valid_up_to()];
-            ParseError {
-                line: 1 + valid.iter().filter(|&&b| b == b'\n').count(),
-                message: "expected UTF-8 text, found a byte that is not UTF-8".into(),
-                file: file.to_string(),
-            }
-        })?;
-        Ok(parse_scene_in(text, file, options, base)?)
+        Ok(load_scene(Some(path), &ParseOptions::default())?.scene)
     }
 
     /// The built-in default: the lab's Cornell box with three mirror spheres.
@@ -309,8 +274,8 @@ pub struct SceneFile {
 
 /// Reads the scene file once (the built-in scene without a path; `-` is standard input) and
 /// parses it; errors name the file and line. Directories, devices and sockets are refused, and
-/// no more than [`MAX_SCENE_BYTES`] is read (see [`read_scene_bytes`]). The scene's warnings are kept in `Scene::warnings` for the caller to
-/// print.
+/// no more than [`MAX_SCENE_BYTES`] is read (see [`read_scene_bytes`]). The scene's warnings
+/// are kept in `Scene::warnings` for the caller to print.
 pub fn load_scene(path: Option<&Path>, options: &ParseOptions) -> Result<SceneFile, SceneError> {
     let Some(path) = path else {
         return Ok(SceneFile {
@@ -321,7 +286,15 @@ pub fn load_scene(path: Option<&Path>, options: &ParseOptions) -> Result<SceneFi
     let (mut bytes, file) = read_scene_bytes(path)?;
     // Texture names are relative to the scene file's folder (the current one for stdin).
     let base = (path.as_os_str() != "-").then(|| path.parent()).flatten();
-    let scene = Scene::from_bytes(&bytes, &file, options, base)?;
+    let text = std::str::from_utf8(&bytes).map_err(|e| ParseError {
+        line: 1 + bytes[..e.valid_up_to()]
+            .iter()
+            .filter(|&&b| b == b'\n')
+            .count(),
+        message: "expected UTF-8 text, found a byte that is not UTF-8".into(),
+        file: file.clone(),
+    })?;
+    let scene = parse_scene_in(text, &file, options, base)?;
     for texture in &scene.textures {
         bytes.extend_from_slice(b"\0texture\0");
         bytes.extend_from_slice(texture.name.as_bytes());

@@ -21,7 +21,7 @@ pub const STDIN_NAME: &str = "<stdin>";
 /// The bytes of the scene at `path` (`-` is standard input) and the name messages give it.
 pub fn read_scene_bytes(path: &Path) -> Result<(Vec<u8>, String), SceneError> {
     if path.as_os_str() == "-" {
-        let bytes = read_capped(std::io::stdin().lock(), STDIN_NAME)?;
+        let bytes = read_capped(std::io::stdin().lock(), STDIN_NAME, MAX_SCENE_BYTES)?;
         return Ok((bytes, STDIN_NAME.to_string()));
     }
     let name = escape(&path.display().to_string());
@@ -46,19 +46,15 @@ pub fn read_scene_bytes(path: &Path) -> Result<(Vec<u8>, String), SceneError> {
     } else if file_type.is_socket() {
         return Err(refuse("a socket"));
     } else if file_type.is_file() && kind.len() > MAX_SCENE_BYTES {
-        return Err(too_large(&name, Some(kind.len())));
+        return Err(too_large(&name, Some(kind.len()), MAX_SCENE_BYTES));
     }
     let file = std::fs::File::open(path).map_err(io)?;
-    let bytes = read_capped(file, &name)?;
+    let bytes = read_capped(file, &name, MAX_SCENE_BYTES)?;
     Ok((bytes, name))
 }
 
-/// Reads `reader` to its end, refusing more than [`MAX_SCENE_BYTES`].
-pub fn read_capped(reader: impl Read, name: &str) -> Result<Vec<u8>, SceneError> {
-    read_capped_at(reader, name, MAX_SCENE_BYTES)
-}
-
-fn read_capped_at(reader: impl Read, name: &str, cap: u64) -> Result<Vec<u8>, SceneError> {
+/// Reads `reader` to its end, refusing more than `cap` bytes ([`MAX_SCENE_BYTES`]).
+fn read_capped(reader: impl Read, name: &str, cap: u64) -> Result<Vec<u8>, SceneError> {
     let mut bytes = Vec::new();
     reader
         .take(cap + 1)
@@ -68,16 +64,12 @@ fn read_capped_at(reader: impl Read, name: &str, cap: u64) -> Result<Vec<u8>, Sc
             source,
         })?;
     if bytes.len() as u64 > cap {
-        return Err(too_large_at(name, None, cap));
+        return Err(too_large(name, None, cap));
     }
     Ok(bytes)
 }
 
-fn too_large(name: &str, size: Option<u64>) -> SceneError {
-    too_large_at(name, size, MAX_SCENE_BYTES)
-}
-
-fn too_large_at(name: &str, size: Option<u64>, cap: u64) -> SceneError {
+fn too_large(name: &str, size: Option<u64>, cap: u64) -> SceneError {
     let found = match size {
         Some(n) => format!("{n} bytes"),
         None => "more".to_string(),
@@ -97,12 +89,12 @@ mod tests {
 
     #[test]
     fn a_stream_longer_than_the_cap_is_refused_after_reading_one_byte_past_it() {
-        let ok = read_capped_at(&b"v 0 0 0\n"[..], "s", 8).unwrap();
+        let ok = read_capped(&b"v 0 0 0\n"[..], "s", 8).unwrap();
         assert_eq!(ok.len(), 8);
-        let e = read_capped_at(&b"v 0 0 0\n\n"[..], "s", 8).unwrap_err();
+        let e = read_capped(&b"v 0 0 0\n\n"[..], "s", 8).unwrap_err();
         assert!(e.to_string().contains("at most"), "{e}");
         // An endless stream stops at the cap.
-        let e = read_capped_at(std::io::repeat(b'x'), "<stdin>", 1 << 20).unwrap_err();
+        let e = read_capped(std::io::repeat(b'x'), "<stdin>", 1 << 20).unwrap_err();
         assert!(
             e.to_string()
                 .starts_with("<stdin>: expected a scene of at most 1 MiB")

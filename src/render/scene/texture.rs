@@ -18,7 +18,7 @@
 //! hit, and the wavefront engine's 8-lane kernel (`wavefront::texels`) is its twin.
 
 use super::{Scene, Triangle};
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 use std::path::PathBuf;
 
 /// A texture read from a PPM file: linear texels, rows from the bottom of the image up.
@@ -68,17 +68,15 @@ impl Texture {
     ) -> Texture {
         let (w, h) = (width as usize, height as usize);
         let mut texels = Vec::with_capacity(w * h);
-        let mut sum = [0.0f64; 3];
+        let mut sum = DVec3::ZERO;
         for j in 0..h {
             // Row j from the bottom is file row h − 1 − j.
             let row = (h - 1 - j) * w;
             for i in 0..w {
                 let at = 3 * (row + i);
                 let c = [0, 1, 2].map(|k| srgb_to_linear(samples(at + k) as f64 / max));
-                for k in 0..3 {
-                    sum[k] += c[k];
-                }
-                texels.push(Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32));
+                sum += DVec3::from_array(c);
+                texels.push(DVec3::from_array(c).as_vec3());
             }
         }
         let n = (w * h) as f64;
@@ -88,11 +86,7 @@ impl Texture {
             width,
             height,
             texels,
-            average: Vec3::new(
-                (sum[0] / n) as f32,
-                (sum[1] / n) as f32,
-                (sum[2] / n) as f32,
-            ),
+            average: (sum / n).as_vec3(),
             outside_folder: false,
             digest: 0,
         }

@@ -38,10 +38,7 @@ pub(crate) fn resolve(name: &str, base: Option<&Path>) -> (PathBuf, bool) {
         }
         escapes |= depth < 0;
     }
-    let path = match base {
-        Some(dir) => dir.join(named),
-        None => named.to_path_buf(),
-    };
+    let path = base.map_or_else(|| named.to_path_buf(), |dir| dir.join(named));
     // The resolved path is shown in the render's summary: canonical when it exists.
     (std::fs::canonicalize(&path).unwrap_or(path), escapes)
 }
@@ -62,7 +59,8 @@ pub(crate) fn read_texture(_name: &str, path: &Path) -> Result<Texture, String> 
 pub(crate) fn read_texture(name: &str, path: &Path) -> Result<Texture, String> {
     // The path comes from the scene file: its control characters are shown escaped.
     let shown = escape(&path.display().to_string());
-    let meta = std::fs::metadata(path).map_err(|e| format!("cannot read {shown}: {e}"))?;
+    let cannot = |e: std::io::Error| format!("cannot read {shown}: {e}");
+    let meta = std::fs::metadata(path).map_err(cannot)?;
     if !meta.is_file() {
         let kind = if meta.is_dir() {
             "a directory"
@@ -71,12 +69,10 @@ pub(crate) fn read_texture(name: &str, path: &Path) -> Result<Texture, String> {
         };
         return Err(format!("expected a PPM file at {shown}, found {kind}"));
     }
-    let file = File::open(path).map_err(|e| format!("cannot read {shown}: {e}"))?;
-    let mut reader = BufReader::new(file);
-    let mut magic = [0u8; 2];
-    let got =
-        read_up_to(&mut reader, &mut magic).map_err(|e| format!("cannot read {shown}: {e}"))?;
-    let found = match &magic[..got] {
+    let mut magic = Vec::new();
+    let file = File::open(path).map_err(cannot)?;
+    file.take(2).read_to_end(&mut magic).map_err(cannot)?;
+    let found = match &magic[..] {
         b"P3" | b"P6" => None,
         b"P1" | b"P4" => Some("a PBM (bitmap, `P1`/`P4`)".to_string()),
         b"P2" | b"P5" => Some("a PGM (grey, `P2`/`P5`)".to_string()),
@@ -93,7 +89,7 @@ pub(crate) fn read_texture(name: &str, path: &Path) -> Result<Texture, String> {
         ));
     }
     // The decoder reads the header again from the start.
-    let file = File::open(path).map_err(|e| format!("cannot read {shown}: {e}"))?;
+    let file = File::open(path).map_err(cannot)?;
     let decoder = PnmDecoder::new(BufReader::new(file))
         .map_err(|e| format!("expected a PPM header at {shown}: {e}"))?;
     debug_assert!(matches!(decoder.subtype(), PnmSubtype::Pixmap(_)));
@@ -132,19 +128,6 @@ pub(crate) fn read_texture(name: &str, path: &Path) -> Result<Texture, String> {
         Texture::from_srgb(name, path, width, height, |k| bytes[k] as u16, 255.0)
     };
     Ok(Texture { digest, ..texture })
-}
-
-/// Reads until `buf` is full or the input ends; the count read.
-#[cfg(feature = "textures")]
-fn read_up_to(reader: &mut impl Read, buf: &mut [u8]) -> std::io::Result<usize> {
-    let mut got = 0;
-    while got < buf.len() {
-        match reader.read(&mut buf[got..])? {
-            0 => break,
-            n => got += n,
-        }
-    }
-    Ok(got)
 }
 
 #[cfg(all(test, feature = "textures"))]

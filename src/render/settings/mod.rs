@@ -20,9 +20,6 @@ pub enum ShadowMode {
 }
 
 impl ShadowMode {
-    /// Every mode, in declaration order.
-    pub const ALL: [ShadowMode; 3] = [ShadowMode::Off, ShadowMode::Hard, ShadowMode::Soft];
-
     /// The mode's name, as flags, records and summaries spell it ("off", "hard", "soft").
     pub fn name(self) -> &'static str {
         match self {
@@ -186,7 +183,7 @@ mod tests {
     /// The names are the serialised spellings, so records and summaries say the same word.
     #[test]
     fn names_are_the_serialised_spellings() {
-        for m in ShadowMode::ALL {
+        for m in [ShadowMode::Off, ShadowMode::Hard, ShadowMode::Soft] {
             assert_eq!(serde_json::to_value(m).unwrap(), m.name());
         }
         for m in LightModel::ALL {

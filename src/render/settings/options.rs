@@ -79,36 +79,31 @@ impl Defaults {
     /// `-soft_shadow` is given, and RPI's casts none; soft shadows without a count use
     /// raywave's 16 points.
     pub const fn values(self) -> DefaultValues {
+        const RAYWAVE: DefaultValues = DefaultValues {
+            size: [512, 512],
+            bounces: 5,
+            shadows: ShadowMode::Soft,
+            shadow_samples: 16,
+            aa: 1,
+            background: [1.0; 3],
+            ambient: [0.2; 3],
+            light_model: LightModel::Lab,
+        };
         match self {
-            Defaults::Raywave => DefaultValues {
-                size: [512, 512],
-                bounces: 5,
-                shadows: ShadowMode::Soft,
-                shadow_samples: 16,
-                aa: 1,
-                background: [1.0; 3],
-                ambient: [0.2; 3],
-                light_model: LightModel::Lab,
-            },
+            Defaults::Raywave => RAYWAVE,
             Defaults::Lab => DefaultValues {
                 size: [100, 100],
                 bounces: 0,
                 shadows: ShadowMode::Hard,
-                shadow_samples: 16,
-                aa: 1,
-                background: [1.0; 3],
-                ambient: [0.2; 3],
-                light_model: LightModel::Lab,
+                ..RAYWAVE
             },
             Defaults::Rpi => DefaultValues {
                 size: [500, 500],
                 bounces: 0,
                 shadows: ShadowMode::Off,
-                shadow_samples: 16,
-                aa: 1,
-                background: [1.0; 3],
                 ambient: [0.1; 3],
                 light_model: LightModel::Rpi,
+                ..RAYWAVE
             },
         }
     }

@@ -21,7 +21,7 @@ impl Parser<'_> {
         if self.faces.is_empty() && self.spheres.is_empty() {
             return Err(self.error(
                 last_line,
-                "expected at least one face (`f`), sphere (`s`) or ring (`r`), found none".into(),
+                "expected at least one face (`f`), sphere (`s`) or ring (`r`), found none",
             ));
         }
         let mut scene = Scene {
@@ -37,7 +37,8 @@ impl Parser<'_> {
         let mut warnings = self.warnings;
         // One entry per triangle once any face has texture coordinates; none before.
         let textured_faces = self.faces.iter().any(|f| !f.st.is_empty());
-        // Textured materials already warned about a primitive without coordinates.
+        // Textured materials already warned about a primitive (face or sphere) without
+        // coordinates: the warning comes once per material.
         let mut warned = vec![false; scene.materials.len()];
         let file = self.file;
         let mut untextured =
@@ -45,7 +46,15 @@ impl Parser<'_> {
                 let m = material as usize;
                 if scene.materials[m].texture.is_some() && !std::mem::replace(&mut warned[m], true)
                 {
-                    warnings.push(no_coordinates(file, line, m, what));
+                    warnings.push(Warning {
+                        file: file.to_string(),
+                        line,
+                        message: format!(
+                            "material {m} has a texture but this {what} has no texture \
+                             coordinates (`vt` after its vertices): it takes the texel at \
+                             (0, 0), as in RPI (reported once per material)"
+                        ),
+                    });
                 }
             };
         for (face_index, face) in self.faces.iter().enumerate() {
@@ -86,14 +95,10 @@ impl Parser<'_> {
                     face: face_id,
                 });
             }
-            if scene.materials[face.material as usize].emitted != Vec3::ZERO {
-                scene.lights.push(make_light(
-                    face_id,
-                    &face.corners,
-                    fan,
-                    polygon_normal,
-                    scene.materials[face.material as usize].emitted,
-                ));
+            let emitted = scene.materials[face.material as usize].emitted;
+            if emitted != Vec3::ZERO {
+                let light = make_light(face_id, &face.corners, fan, polygon_normal, emitted);
+                scene.lights.push(light);
             }
         }
         for (sphere, line) in &self.spheres {
@@ -109,27 +114,11 @@ impl Parser<'_> {
         Ok(scene)
     }
 }
-/// The warning for the first primitive (`what`: a face or a sphere) of textured material `m`
-/// that has no texture coordinates.
-fn no_coordinates(file: &str, line: usize, m: usize, what: &str) -> Warning {
-    Warning {
-        file: file.to_string(),
-        line,
-        message: format!(
-            "material {m} has a texture but this {what} has no texture coordinates (`vt` after \
-             its vertices): it takes the texel at (0, 0), as in RPI (reported once per material)"
-        ),
-    }
-}
 
 /// The polygon's area-weighted normal (twice the area in length), robust for any planar polygon.
 pub(super) fn newell_normal(corners: &[Vec3]) -> Vec3 {
-    let mut n = Vec3::ZERO;
-    for (i, &a) in corners.iter().enumerate() {
-        let b = corners[(i + 1) % corners.len()];
-        n += a.cross(b);
-    }
-    n
+    let next = corners.iter().cycle().skip(1);
+    corners.iter().zip(next).map(|(a, b)| a.cross(*b)).sum()
 }
 
 fn make_light(
@@ -168,14 +157,13 @@ fn make_light(
         }
     } else {
         let mut running = 0.0;
-        let cdf = areas
+        let mut cdf: Vec<f32> = areas
             .iter()
             .map(|w| {
                 running += w / area;
                 running
             })
-            .collect::<Vec<f32>>();
-        let mut cdf = cdf;
+            .collect();
         if let Some(last) = cdf.last_mut() {
             *last = 1.0;
         }

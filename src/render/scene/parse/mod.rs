@@ -106,12 +106,12 @@ struct Face {
 }
 
 /// Camera keys gathered from a `PerspectiveCamera { ... }` block.
-#[derive(Default)]
 struct CameraBlock {
     start_line: usize,
     tokens: Vec<(String, usize)>,
 }
 
+#[derive(Default)]
 struct Parser<'a> {
     file: &'a str,
     options: ParseOptions,
@@ -123,8 +123,9 @@ struct Parser<'a> {
     /// Textures read so far, in `texture_file` order (a file named twice is read once).
     textures: Vec<Texture>,
     materials: Vec<Material>,
-    /// The `m i` selection and the line it was made on (checked against the materials at the end).
-    active_material: Option<(u32, usize)>,
+    /// The `m i` selection.
+    active_material: Option<u32>,
+    /// Every `m i` and its line, checked against the materials at the end.
     material_refs: Vec<(u32, usize)>,
     faces: Vec<Face>,
     spheres: Vec<(Sphere, usize)>,
@@ -168,20 +169,7 @@ pub fn parse_scene_in(
         file,
         options: *options,
         base,
-        vertices: Vec::new(),
-        vertex_st: Vec::new(),
-        textures: Vec::new(),
-        materials: Vec::new(),
-        active_material: None,
-        material_refs: Vec::new(),
-        faces: Vec::new(),
-        spheres: Vec::new(),
-        ring_points: Vec::new(),
-        rings: 0,
-        camera: None,
-        background: None,
-        warnings: Vec::new(),
-        camera_block: None,
+        ..Parser::default()
     };
     let mut pending = String::new();
     let mut pending_line = 0;
@@ -189,10 +177,7 @@ pub fn parse_scene_in(
     for (index, raw) in text.lines().enumerate() {
         let number = index + 1;
         last_line = number;
-        let content = match raw.find('#') {
-            Some(at) => &raw[..at],
-            None => raw,
-        };
+        let content = raw.split_once('#').map_or(raw, |(code, _)| code);
         if pending.is_empty() {
             pending_line = number;
         }
@@ -203,17 +188,15 @@ pub fn parse_scene_in(
             continue;
         }
         pending.push_str(trimmed);
-        let line = std::mem::take(&mut pending);
-        p.logical_line(&line, pending_line)?;
+        p.logical_line(&std::mem::take(&mut pending), pending_line)?;
     }
     if !pending.is_empty() {
-        let line = std::mem::take(&mut pending);
-        p.logical_line(&line, pending_line)?;
+        p.logical_line(&pending, pending_line)?;
     }
     if let Some(block) = &p.camera_block {
         return Err(p.error(
             block.start_line,
-            "expected `}` to close the PerspectiveCamera block, found the end of the file".into(),
+            "expected `}` to close the PerspectiveCamera block, found the end of the file",
         ));
     }
     p.finish(last_line.max(1))
@@ -235,56 +218,52 @@ pub fn beyond_range(token: &str) -> bool {
         .any(|s| unsigned.eq_ignore_ascii_case(s))
 }
 
-/// The one reading of a number in a scene file: an f32 of magnitude at most [`MAX_NUMBER`].
-fn number(file: &str, line: usize, what: &str, token: Option<&str>) -> Result<f32, ParseError> {
-    let error = |message: String| ParseError {
-        file: file.to_string(),
-        line,
-        message,
-    };
-    let token =
-        token.ok_or_else(|| error(format!("expected {what}, found the end of the line")))?;
-    let parsed = token.parse::<f32>();
-    let finite_beyond_f32 = beyond_range(token);
-    let token = quote(token);
-    match parsed {
-        Ok(x) if x.is_finite() && x.abs() <= MAX_NUMBER => Ok(x),
-        // Past 1e9, up to past f32's range: the same limit, the same message.
-        Ok(x) if x.is_finite() || finite_beyond_f32 => Err(error(format!(
-            "expected {what} of magnitude at most 1e9, found `{token}`"
-        ))),
-        Ok(_) => Err(error(format!(
-            "expected {what} (a finite number), found `{token}`"
-        ))),
-        Err(_) => Err(error(format!(
-            "expected {what} (a number), found `{token}`"
-        ))),
-    }
-}
-
 impl Parser<'_> {
-    fn error(&self, line: usize, message: String) -> ParseError {
+    fn error(&self, line: usize, message: impl Into<String>) -> ParseError {
         ParseError {
             file: self.file.to_string(),
             line,
-            message,
+            message: message.into(),
         }
     }
 
-    fn warn(&mut self, line: usize, message: String) {
+    /// The one reading of a number in a scene file: an f32 of magnitude at most [`MAX_NUMBER`].
+    fn number(&self, line: usize, what: &str, token: Option<&str>) -> Result<f32, ParseError> {
+        let error = |message: String| self.error(line, message);
+        let token =
+            token.ok_or_else(|| error(format!("expected {what}, found the end of the line")))?;
+        let parsed = token.parse::<f32>();
+        let finite_beyond_f32 = beyond_range(token);
+        let token = quote(token);
+        match parsed {
+            Ok(x) if x.is_finite() && x.abs() <= MAX_NUMBER => Ok(x),
+            // Past 1e9, up to past f32's range: the same limit, the same message.
+            Ok(x) if x.is_finite() || finite_beyond_f32 => Err(error(format!(
+                "expected {what} of magnitude at most 1e9, found `{token}`"
+            ))),
+            Ok(_) => Err(error(format!(
+                "expected {what} (a finite number), found `{token}`"
+            ))),
+            Err(_) => Err(error(format!(
+                "expected {what} (a number), found `{token}`"
+            ))),
+        }
+    }
+
+    fn warn(&mut self, line: usize, message: impl Into<String>) {
         self.warnings.push(Warning {
             file: self.file.to_string(),
             line,
-            message,
+            message: message.into(),
         });
     }
 
     /// Reads exactly three numbers after the keyword and nothing else.
     fn vec3(&self, line: usize, keyword: &str, args: &[&str]) -> Result<Vec3, ParseError> {
         let what = |axis: &str| format!("{axis} of `{keyword}`");
-        let x = number(self.file, line, &what("1st number"), args.first().copied())?;
-        let y = number(self.file, line, &what("2nd number"), args.get(1).copied())?;
-        let z = number(self.file, line, &what("3rd number"), args.get(2).copied())?;
+        let x = self.number(line, &what("1st number"), args.first().copied())?;
+        let y = self.number(line, &what("2nd number"), args.get(1).copied())?;
+        let z = self.number(line, &what("3rd number"), args.get(2).copied())?;
         self.no_more(line, keyword, args, 3)?;
         Ok(Vec3::new(x, y, z))
     }
@@ -337,13 +316,12 @@ impl Parser<'_> {
     }
 
     fn active_material(&self, line: usize, what: &str) -> Result<u32, ParseError> {
-        match self.active_material {
-            Some((m, _)) => Ok(m),
-            None => Err(self.error(
+        self.active_material.ok_or_else(|| {
+            self.error(
                 line,
                 format!("expected `m <material index>` before this {what}, found a {what} before any material was selected"),
-            )),
-        }
+            )
+        })
     }
 
     fn logical_line(&mut self, line_text: &str, line: usize) -> Result<(), ParseError> {
@@ -374,7 +352,7 @@ impl Parser<'_> {
                     ));
                 }
                 let center = self.vec3(line, "s", &args[..3])?;
-                let radius = number(self.file, line, "the radius of `s`", Some(args[3]))?;
+                let radius = self.number(line, "the radius of `s`", Some(args[3]))?;
                 if radius <= 0.0 {
                     return Err(self.error(
                         line,
@@ -404,7 +382,7 @@ impl Parser<'_> {
                     )
                 })?;
                 self.no_more(line, "m", args, 1)?;
-                self.active_material = Some((index, line));
+                self.active_material = Some(index);
                 self.material_refs.push((index, line));
             }
             "material" => self.materials.push(Material::default()),
@@ -415,8 +393,7 @@ impl Parser<'_> {
                     self.warn(
                         line,
                         "`diffuse` ignored: the material's texture gives its diffuse colour \
-                         (RPI's materials have one or the other)"
-                            .into(),
+                         (RPI's materials have one or the other)",
                     );
                 } else {
                     material.diffuse = c;
@@ -431,8 +408,7 @@ impl Parser<'_> {
                 self.current_material(line, keyword)?.emitted = c;
             }
             "glossiness" | "roughness" => {
-                let g = number(
-                    self.file,
+                let g = self.number(
                     line,
                     &format!("the value of `{keyword}`"),
                     args.first().copied(),
@@ -453,28 +429,22 @@ impl Parser<'_> {
                 let c = self.colour(line, keyword, args)?;
                 self.current_material(line, keyword)?;
                 if c != Vec3::ZERO {
-                    self.warn(
-                        line,
-                        "transmission is not rendered: `transmitted` ignored".into(),
-                    );
+                    self.warn(line, "transmission is not rendered: `transmitted` ignored");
                 }
             }
-            "background_color" => {
-                self.background = Some(self.colour(line, keyword, args)?);
-            }
+            "background_color" => self.background = Some(self.colour(line, keyword, args)?),
             "PerspectiveCamera" => {
                 if self.camera.is_some() {
                     return Err(self.error(
                         line,
-                        "expected one camera block, found a second `PerspectiveCamera`".into(),
+                        "expected one camera block, found a second `PerspectiveCamera`",
                     ));
                 }
                 self.camera_block = Some(CameraBlock {
                     start_line: line,
                     tokens: Vec::new(),
                 });
-                let rest = args.join(" ");
-                self.camera_line(&rest, line)?;
+                self.camera_line(&args.join(" "), line)?;
             }
             "vn" | "vp" | "g" | "o" | "usemtl" | "mtllib" => {}
             other => self.warn(

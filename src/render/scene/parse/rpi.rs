@@ -1,10 +1,11 @@
 //! RPI's additions to the lab's format: cylinder rings (`r` lines), cut into quads as RPI's
 //! framework does, and the `PerspectiveCamera { ... }` block, the one construct that spans lines.
 
-use super::{CameraBlock, ParseError, Parser, number};
+use super::{CameraBlock, ParseError, Parser};
 use crate::render::quote::quote;
 use crate::render::scene::Camera;
 use glam::Vec3;
+use std::f32::consts::PI;
 
 impl Parser<'_> {
     /// An RPI cylinder ring, `r cx cy cz height inner_radius outer_radius`: a tube about the
@@ -24,9 +25,9 @@ impl Parser<'_> {
             ));
         }
         let center = self.vec3(line, "r", &args[..3])?;
-        let height = number(self.file, line, "the height of `r`", Some(args[3]))?;
-        let inner = number(self.file, line, "the inner radius of `r`", Some(args[4]))?;
-        let outer = number(self.file, line, "the outer radius of `r`", Some(args[5]))?;
+        let height = self.number(line, "the height of `r`", Some(args[3]))?;
+        let inner = self.number(line, "the inner radius of `r`", Some(args[4]))?;
+        let outer = self.number(line, "the outer radius of `r`", Some(args[5]))?;
         if height <= 0.0 {
             return Err(self.error(
                 line,
@@ -111,22 +112,18 @@ impl Parser<'_> {
         Ok(())
     }
 
-    fn camera_from(&mut self, block: CameraBlock) -> Result<Camera, ParseError> {
+    fn camera_from(&self, block: CameraBlock) -> Result<Camera, ParseError> {
         let mut position = None;
         let mut poi = None;
         let mut direction = None;
         let mut up = Vec3::Y;
         let mut angle = None;
-        let mut i = 0;
-        let tokens = &block.tokens;
-        while i < tokens.len() {
-            let (key, line) = (&tokens[i].0, tokens[i].1);
-            let take = |n: usize| -> Vec<&str> {
-                tokens[i + 1..(i + 1 + n).min(tokens.len())]
-                    .iter()
-                    .map(|t| t.0.as_str())
-                    .collect()
-            };
+        let mut tokens = block.tokens.iter();
+        while let Some((key, line)) = tokens.next() {
+            let line = *line;
+            // The next `n` tokens; fewer at the end of the block, which `vec3` and `number` report.
+            let mut take =
+                |n: usize| -> Vec<&str> { tokens.by_ref().take(n).map(|t| t.0.as_str()).collect() };
             match key.as_str() {
                 "camera_position" | "center" | "point_of_interest" | "direction" | "up" => {
                     let v = self.vec3(line, key, &take(3))?;
@@ -136,28 +133,17 @@ impl Parser<'_> {
                         "direction" => direction = Some(v),
                         _ => up = v,
                     }
-                    i += 4;
                 }
                 "angle" => {
-                    let a = number(
-                        self.file,
-                        line,
-                        "the camera `angle`",
-                        take(1).first().copied(),
-                    )?;
+                    let a = self.number(line, "the camera `angle`", take(1).first().copied())?;
                     // The older RPI dialect gives radians, the newer degrees. No field of view
                     // reaches π radians, and none in these scenes is as narrow as π degrees, so
                     // a value above π is degrees.
-                    let radians = if a > std::f32::consts::PI {
-                        a.to_radians()
-                    } else {
-                        a
-                    };
-                    if radians <= 0.0 || radians >= std::f32::consts::PI {
+                    let radians = if a > PI { a.to_radians() } else { a };
+                    if radians <= 0.0 || radians >= PI {
                         return Err(self.error(line, format!("expected a field-of-view angle between 0 and 180 degrees, found {a}")));
                     }
                     angle = Some(radians);
-                    i += 2;
                 }
                 other => {
                     return Err(self.error(
@@ -168,33 +154,24 @@ impl Parser<'_> {
             }
         }
         let start = block.start_line;
-        let position = position.ok_or_else(|| {
+        let missing = |key: &str| {
             self.error(
                 start,
-                "expected `camera_position` in the camera block, found none".into(),
+                format!("expected `{key}` in the camera block, found none"),
             )
-        })?;
+        };
+        let position = position.ok_or_else(|| missing("camera_position"))?;
         let point_of_interest = match (poi, direction) {
             (Some(p), _) => p,
             (None, Some(d)) => position + d,
-            (None, None) => {
-                return Err(self.error(
-                    start,
-                    "expected `point_of_interest` in the camera block, found none".into(),
-                ));
-            }
+            (None, None) => return Err(missing("point_of_interest")),
         };
-        let fov = angle.ok_or_else(|| {
-            self.error(
-                start,
-                "expected `angle` in the camera block, found none".into(),
-            )
-        })?;
+        let fov = angle.ok_or_else(|| missing("angle"))?;
         let forward = point_of_interest - position;
         if forward.length_squared() == 0.0 || forward.cross(up).length_squared() == 0.0 {
             return Err(self.error(
                 start,
-                "expected a camera whose point_of_interest differs from its position and whose up is not parallel to the view direction".into(),
+                "expected a camera whose point_of_interest differs from its position and whose up is not parallel to the view direction",
             ));
         }
         Ok(Camera {

@@ -1,7 +1,7 @@
 //! RPI's textures: `vt s t`, which gives texture coordinates to the last vertex read, and a
 //! material's `texture_file NAME`, a PPM read from the scene file's folder (`scene::texture`).
 
-use super::{ParseError, Parser, number};
+use super::{ParseError, Parser};
 use crate::render::quote::quote;
 use crate::render::scene::texture_file::{read_texture, resolve};
 use glam::Vec3;
@@ -14,22 +14,16 @@ impl Parser<'_> {
             return Err(self.error(
                 line,
                 "expected a `v` line before `vt` (its coordinates belong to the vertex just read), \
-                 found `vt` before any vertex"
-                    .into(),
+                 found `vt` before any vertex",
             ));
         }
-        let s = number(
-            self.file,
-            line,
-            "the s coordinate of `vt`",
-            args.first().copied(),
-        )?;
+        let s = self.number(line, "the s coordinate of `vt`", args.first().copied())?;
         let t = match args.get(1) {
-            Some(token) => number(self.file, line, "the t coordinate of `vt`", Some(token))?,
+            Some(token) => self.number(line, "the t coordinate of `vt`", Some(token))?,
             None => 0.0,
         };
         if let Some(w) = args.get(2) {
-            number(self.file, line, "the w coordinate of `vt`", Some(w))?;
+            self.number(line, "the w coordinate of `vt`", Some(w))?;
         }
         self.no_more(line, "vt", args, 3)?;
         *self.vertex_st.last_mut().expect("checked non-empty") = Some([s, t]);
@@ -42,7 +36,7 @@ impl Parser<'_> {
         let Some(&name) = args.first() else {
             return Err(self.error(
                 line,
-                "expected a file name after `texture_file`, found the end of the line".into(),
+                "expected a file name after `texture_file`, found the end of the line",
             ));
         };
         self.no_more(line, "texture_file", args, 1)?;
@@ -67,8 +61,7 @@ impl Parser<'_> {
             self.warn(
                 line,
                 "the texture replaces the `diffuse` colour given above (RPI's materials have one \
-                 or the other)"
-                    .into(),
+                 or the other)",
             );
         }
         Ok(())
