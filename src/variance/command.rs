@@ -11,7 +11,7 @@ use crate::render::error::UsageError;
 use crate::render::progress::Progress;
 use crate::render::sampling::LightSampler;
 use crate::render::scene::{ParseOptions, SceneFile, load_scene};
-use crate::render::settings::{LightModel, RenderSettings, ShadowMode};
+use crate::render::settings::{LightModel, RenderSettings};
 use crate::shard::{Host, Identity, Part, Shard, Work};
 use anyhow::{Context, Result, bail};
 use std::path::{Path, PathBuf};
@@ -130,15 +130,13 @@ impl VarianceOptions {
         // Every sampler takes every budget, or the study stops before it starts.
         for &sampler in &self.samplers {
             for &n in &self.budgets {
-                let settings = RenderSettings {
-                    width: self.sizes[0][0],
-                    height: self.sizes[0][1],
-                    shadows: ShadowMode::Soft,
-                    shadow_samples: n,
-                    sampler,
-                    aa_samples: 1,
+                let [width, height] = self.sizes[0];
+                let base = RenderSettings {
+                    width,
+                    height,
                     ..RenderSettings::default()
                 };
+                let settings = StudyConfig::standard(base).run_settings(sampler, n, 0);
                 settings.check_sampler().map_err(|e| {
                     UsageError(format!(
                         "{e}; the study's --budgets include {n}: leave {} out of --samplers, or that budget out",
@@ -198,18 +196,8 @@ pub fn load_cases(options: &VarianceOptions, notice: &dyn Fn(&str)) -> Result<Ve
     }
     let stems: Vec<String> = loaded.iter().map(|l| l.0.clone()).collect();
     let names = case_names(&stems, &options.sizes);
-    let mut samplers = Vec::new();
-    for s in &options.samplers {
-        if !samplers.contains(s) {
-            samplers.push(*s);
-        }
-    }
-    let mut budgets = Vec::new();
-    for n in &options.budgets {
-        if !budgets.contains(n) {
-            budgets.push(*n);
-        }
-    }
+    let samplers = super::unique(options.samplers.iter().copied());
+    let budgets = super::unique(options.budgets.iter().copied());
     let mut cases = Vec::new();
     let mut names = names.into_iter();
     for (_, scene, bytes) in loaded {
@@ -404,8 +392,7 @@ pub(crate) fn write_report(
     for (name, result) in names.iter().zip(&results) {
         for region in [Region::Penumbra, Region::Lit] {
             let margin = result.reference_margin(region);
-            let i = Region::ALL.iter().position(|&r| r == region).unwrap_or(0);
-            if result.region_pixels[i] > 0 && margin < 10.0 {
+            if result.region_pixels[region as usize] > 0 && margin < 10.0 {
                 let case = if results.len() > 1 {
                     format!("{name}: ")
                 } else {

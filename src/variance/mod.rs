@@ -197,7 +197,8 @@ pub fn converged_reference(
     })
 }
 
-/// The three regions a study reports.
+/// The three regions a study reports, in `ALL` order: `region as usize` indexes the per-region
+/// arrays.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Region {
@@ -214,12 +215,19 @@ impl Region {
     pub const ALL: [Region; 3] = [Region::Whole, Region::Penumbra, Region::Lit];
     /// Lower-case name.
     pub fn name(self) -> &'static str {
-        match self {
-            Region::Whole => "whole",
-            Region::Penumbra => "penumbra",
-            Region::Lit => "lit",
+        ["whole", "penumbra", "lit"][self as usize]
+    }
+}
+
+/// `items` without repeats, in first-seen order.
+pub(crate) fn unique<T: PartialEq>(items: impl IntoIterator<Item = T>) -> Vec<T> {
+    let mut out = Vec::new();
+    for x in items {
+        if !out.contains(&x) {
+            out.push(x);
         }
     }
+    out
 }
 
 /// One line of the results: a (sampler, N, region).
@@ -349,18 +357,14 @@ pub fn run_study(
 }
 
 impl StudyResult {
-    /// The smallest MSE measured in a region, to compare with the reference's own error.
-    fn smallest_mse(&self, region: Region) -> f64 {
-        self.rows
+    /// How many times the reference's own MSE lies below the smallest MSE measured in `region`.
+    pub fn reference_margin(&self, region: Region) -> f64 {
+        let smallest = self
+            .rows
             .iter()
             .filter(|r| r.region == region && r.stats.mse > 0.0)
             .map(|r| r.stats.mse)
-            .fold(f64::INFINITY, f64::min)
-    }
-
-    /// How many times the reference's own MSE lies below the smallest measured MSE, per region.
-    pub fn reference_margin(&self, region: Region) -> f64 {
-        let i = Region::ALL.iter().position(|&r| r == region).unwrap_or(0);
-        self.smallest_mse(region) / self.reference_mse[i].max(1e-30)
+            .fold(f64::INFINITY, f64::min);
+        smallest / self.reference_mse[region as usize].max(1e-30)
     }
 }

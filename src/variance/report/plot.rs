@@ -93,14 +93,17 @@ fn panel(
         1.5,
         (0.5, 400.0),
     );
-    let i = Region::ALL.iter().position(|&r| r == region).unwrap_or(0);
     let what = match axis {
         Axis::Budget => "MSE against N",
         Axis::Time => "MSE against time",
     };
     let mut chart = ChartBuilder::on(area)
         .caption(
-            format!("{}: {what} ({} px)", region.name(), result.region_pixels[i]),
+            format!(
+                "{}: {what} ({} px)",
+                region.name(),
+                result.region_pixels[region as usize]
+            ),
             ("sans-serif", 20),
         )
         .margin(12)
@@ -148,23 +151,10 @@ fn panel(
             })
             .filter(|_| axis == Axis::Budget)
             .unwrap_or_default();
+        let label = format!("{}{slope}", sampler.name());
         // The lab's strategy draws random's points for N > 1: dash it so both show.
-        let series = if *sampler == LightSampler::Lab {
-            chart.draw_series(DashedLineSeries::new(
-                pts.clone(),
-                8,
-                6,
-                colour.stroke_width(2),
-            ))
-        } else {
-            chart.draw_series(LineSeries::new(pts.clone(), colour.stroke_width(2)))
-        };
-        series
-            .map_err(err)?
-            .label(format!("{}{slope}", sampler.name()))
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
-            });
+        let dashed = *sampler == LightSampler::Lab;
+        line(&mut chart, pts.clone(), colour, dashed, label)?;
         chart
             .draw_series(pts.iter().map(|&p| Circle::new(p, 4, colour.filled())))
             .map_err(err)?;
@@ -198,23 +188,58 @@ fn panel(
     Ok(())
 }
 
-/// Draws `mse.png`: MSE against N (top row) and against median time per image (bottom row),
-/// one log-log panel per region (whole, penumbra, lit), 95% intervals as bars.
-pub(crate) fn mse_plot(result: &StudyResult, path: &Path) -> Result<()> {
+/// Draws `pts` as a line of `colour`, solid or dashed, labelled `label` in the legend.
+pub(crate) fn line<X, Y>(
+    chart: &mut ChartContext<BitMapBackend, Cartesian2d<X, Y>>,
+    pts: Vec<(f64, f64)>,
+    colour: RGBColor,
+    dashed: bool,
+    label: String,
+) -> Result<()>
+where
+    X: Ranged<ValueType = f64>,
+    Y: Ranged<ValueType = f64>,
+{
+    let style = colour.stroke_width(2);
+    let series = if dashed {
+        chart.draw_series(DashedLineSeries::new(pts, 8, 6, style))
+    } else {
+        chart.draw_series(LineSeries::new(pts, style))
+    };
+    series
+        .map_err(|e| anyhow!("plot: {e}"))?
+        .label(label)
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+    Ok(())
+}
+
+/// A white `w` × `h` canvas with `draw` drawn on it, as an image.
+pub(crate) fn canvas(
+    (w, h): (u32, u32),
+    draw: impl FnOnce(&DrawingArea<BitMapBackend, Shift>) -> Result<()>,
+) -> Result<image::RgbImage> {
     register_font();
-    let (w, h) = (1500u32, 1040u32);
     let mut buffer = vec![0u8; (w * h * 3) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut buffer, (w, h)).into_drawing_area();
         root.fill(&WHITE).map_err(|e| anyhow!("plot: {e}"))?;
+        draw(&root)?;
+        root.present().map_err(|e| anyhow!("plot: {e}"))?;
+    }
+    image::RgbImage::from_raw(w, h, buffer).context("plot buffer")
+}
+
+/// Draws `mse.png`: MSE against N (top row) and against median time per image (bottom row),
+/// one log-log panel per region (whole, penumbra, lit), 95% intervals as bars.
+pub(crate) fn mse_plot(result: &StudyResult, path: &Path) -> Result<()> {
+    let img = canvas((1500, 1040), |root| {
         let panels = root.split_evenly((2, 3));
         for (j, region) in Region::ALL.iter().enumerate() {
             panel(&panels[j], result, *region, Axis::Budget)?;
             panel(&panels[3 + j], result, *region, Axis::Time)?;
         }
-        root.present().map_err(|e| anyhow!("plot: {e}"))?;
-    }
-    let img = image::RgbImage::from_raw(w, h, buffer).context("plot buffer")?;
+        Ok(())
+    })?;
     write_rgb8(&img, path)
 }
 

@@ -15,7 +15,8 @@
 use crate::render::sampling::LightSampler;
 use crate::stats::{BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, grouped_bootstrap_interval};
 use crate::variance::figures::fits::{fit_rows, fitted, mean_at};
-use crate::variance::{Region, Row, StudyResult};
+use crate::variance::report::tables::write_text;
+use crate::variance::{Region, Row, StudyResult, unique};
 use anyhow::{Context, Result};
 use serde::Serialize;
 use std::fmt::Write as _;
@@ -54,7 +55,7 @@ pub struct RatioAcross {
 }
 
 /// The summary across cases.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Default, Serialize)]
 pub struct Summary {
     /// The cases' names, in order.
     pub cases: Vec<String>,
@@ -77,11 +78,7 @@ fn interval(sizes: &[usize], stat: impl FnMut(&[Vec<usize>]) -> f64) -> Option<[
 /// The summary of `cases` (named `names`), which share samplers, budgets and seeds.
 pub fn summarize(names: &[String], cases: &[StudyResult]) -> Summary {
     let Some(first) = cases.first() else {
-        return Summary {
-            cases: Vec::new(),
-            slopes: Vec::new(),
-            ratios: Vec::new(),
-        };
+        return Summary::default();
     };
     let config = &first.config;
     let sizes: Vec<usize> = cases.iter().map(|c| c.config.seeds as usize).collect();
@@ -238,12 +235,8 @@ impl Summary {
             for x in self.slopes.iter().filter(|x| x.region == region) {
                 let _ = writeln!(s, "  {:<10} {}", x.sampler, figure(x.mean, x.interval));
             }
-            let mut samplers: Vec<&str> = Vec::new();
-            for x in self.ratios.iter().filter(|x| x.region == region) {
-                if !samplers.contains(&x.sampler) {
-                    samplers.push(x.sampler);
-                }
-            }
+            let ratios = self.ratios.iter().filter(|x| x.region == region);
+            let samplers = unique(ratios.map(|x| x.sampler));
             if samplers.is_empty() {
                 continue;
             }
@@ -272,47 +265,21 @@ impl Summary {
             let _ = write!(s, ",{c}");
         }
         s.push('\n');
-        let mut line = |kind: &str,
-                        sampler: &str,
-                        n: String,
-                        region: Region,
-                        v: Option<f64>,
-                        iv: Option<[f64; 2]>,
-                        per: &[Option<f64>]| {
-            let _ = write!(
-                s,
-                "{kind},{sampler},{n},{},{},{},{}",
-                region.name(),
-                opt(v),
-                opt(iv.map(|i| i[0])),
-                opt(iv.map(|i| i[1]))
-            );
+        let mut line = |head: String, v: Option<f64>, iv: Option<[f64; 2]>, per: &[Option<f64>]| {
+            let [low, high] = iv.map_or([None; 2], |[a, b]| [Some(a), Some(b)]);
+            let _ = write!(s, "{head},{},{},{}", opt(v), opt(low), opt(high));
             for p in per {
                 let _ = write!(s, ",{}", opt(*p));
             }
             s.push('\n');
         };
         for x in &self.slopes {
-            line(
-                "slope",
-                x.sampler,
-                String::new(),
-                x.region,
-                x.mean,
-                x.interval,
-                &x.per_case,
-            );
+            let head = format!("slope,{},,{}", x.sampler, x.region.name());
+            line(head, x.mean, x.interval, &x.per_case);
         }
         for x in &self.ratios {
-            line(
-                "error_reduction",
-                x.sampler,
-                x.n.to_string(),
-                x.region,
-                x.geometric_mean,
-                x.interval,
-                &x.per_case,
-            );
+            let head = format!("error_reduction,{},{},{}", x.sampler, x.n, x.region.name());
+            line(head, x.geometric_mean, x.interval, &x.per_case);
         }
         s
     }
@@ -326,10 +293,7 @@ impl Summary {
             ("summary.csv", self.csv()),
             ("summary.json", json),
         ] {
-            written.push(crate::variance::report::tables::write_text(
-                &dir.join(name),
-                &body,
-            )?);
+            written.push(write_text(&dir.join(name), &body)?);
         }
         Ok(written)
     }

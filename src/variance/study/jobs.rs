@@ -165,15 +165,15 @@ fn rows_of(m: &Measured, reference: &Converged, masks: &[Vec<bool>; 3], host: &s
     let (seconds, lo, hi) = crate::stats::median_with_interval(&m.times);
     let seconds_interval = (lo.is_finite() && hi.is_finite()).then_some([lo, hi]);
     let excluded_sampler = deterministic(m.sampler, m.n);
+    let (width, height) = (
+        reference.film.width as usize,
+        reference.film.height as usize,
+    );
     Region::ALL
         .iter()
         .zip(masks)
         .map(|(region, mask)| {
             let stats = error_stats(&m.images, &reference.film.pixels, &reference.noise, mask);
-            let (width, height) = (
-                reference.film.width as usize,
-                reference.film.height as usize,
-            );
             let perceived =
                 perceived::measure(&m.images, &reference.film.pixels, width, height, mask);
             let per = per_image_errors(&m.images, &reference.film.pixels, mask);
@@ -229,12 +229,8 @@ pub fn run_jobs(
 ) -> Vec<JobResult> {
     let lights = scene.lights.len();
     let mut out = Vec::new();
-    let mut start = 0;
-    while start < jobs.len() {
-        let n = jobs[start].n;
-        let end = start + jobs[start..].iter().take_while(|j| j.n == n).count();
-        let group = &jobs[start..end];
-        start = end;
+    for group in jobs.chunk_by(|a, b| a.n == b.n) {
+        let n = group[0].n;
         let per_render = |job: &Job| cost(config, lights, job) / (config.seeds as f64 + 1.0);
         // Warm-up: caches, page tables and the thread pool reach their working state before
         // the first timed render; the images (seed 0, used by no timed render) are kept.
