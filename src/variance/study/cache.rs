@@ -134,11 +134,6 @@ impl Cache {
         self.dir.join(format!("reference-{key:016x}.rwref"))
     }
 
-    /// The lock file of `key`'s entry.
-    fn lock_path(&self, key: u64) -> PathBuf {
-        self.dir.join(format!("reference-{key:016x}.lock"))
-    }
-
     /// Takes the exclusive lock on `key`'s entry, held until the returned guard is dropped;
     /// calls `waiting` first when another process holds it, then blocks until it is released.
     /// An error means the filesystem cannot lock (the caller goes on without the lock).
@@ -148,7 +143,7 @@ impl Cache {
     /// lock on a file that was removed meanwhile (its path now names a new file, or none) lets
     /// it go and locks the path again.
     pub fn lock(&self, key: u64, waiting: impl FnOnce(&Path)) -> Result<EntryLock> {
-        let path = self.lock_path(key);
+        let path = self.entry_path(key).with_extension("lock");
         std::fs::create_dir_all(&self.dir)
             .with_context(|| format!("cannot create {}", self.dir.display()))?;
         let mut waiting = Some(waiting);
