@@ -63,6 +63,12 @@ pub(crate) fn log_range(
     }
 }
 
+/// `v` and the ends of its interval (`v` again without one), for an axis's range.
+pub(crate) fn with_ends(v: f64, iv: Option<[f64; 2]>) -> [f64; 3] {
+    let [a, b] = iv.unwrap_or([v; 2]);
+    [v, a, b]
+}
+
 /// One panel: MSE of every sampler in `region` against `axis`, with 95% intervals.
 fn panel(
     area: &DrawingArea<BitMapBackend, Shift>,
@@ -76,36 +82,23 @@ fn panel(
         .iter()
         .filter(|r| r.region == region && r.stats.mse > 0.0)
         .collect();
-    let (y_lo, y_hi) = log_range(
-        rows.iter().flat_map(|r| {
-            let [a, b] = r.mse_interval.unwrap_or([r.stats.mse; 2]);
-            [r.stats.mse, a, b]
-        }),
-        1.6,
-        (1e-6, 1.0),
-    );
-    let (x_lo, x_hi) = log_range(
-        rows.iter().flat_map(|r| {
-            let (x, iv) = x_of(r, axis);
-            let [a, b] = iv.unwrap_or([x; 2]);
-            [x, a, b]
-        }),
-        1.5,
-        (0.5, 400.0),
-    );
-    let what = match axis {
-        Axis::Budget => "MSE against N",
-        Axis::Time => "MSE against time",
+    let y_values = rows
+        .iter()
+        .flat_map(|r| with_ends(r.stats.mse, r.mse_interval));
+    let (y_lo, y_hi) = log_range(y_values, 1.6, (1e-6, 1.0));
+    let x_values = rows.iter().flat_map(|r| {
+        let (x, iv) = x_of(r, axis);
+        with_ends(x, iv)
+    });
+    let (x_lo, x_hi) = log_range(x_values, 1.5, (0.5, 400.0));
+    let (what, x_desc) = match axis {
+        Axis::Budget => ("MSE against N", "light samples N"),
+        Axis::Time => ("MSE against time", "ms per image (median)"),
     };
+    let pixels = result.region_pixels[region as usize];
+    let title = format!("{}: {what} ({pixels} px)", region.name());
     let mut chart = ChartBuilder::on(area)
-        .caption(
-            format!(
-                "{}: {what} ({} px)",
-                region.name(),
-                result.region_pixels[region as usize]
-            ),
-            ("sans-serif", 20),
-        )
+        .caption(title, ("sans-serif", 20))
         .margin(12)
         .x_label_area_size(40)
         .y_label_area_size(70)
@@ -113,10 +106,7 @@ fn panel(
         .map_err(err)?;
     chart
         .configure_mesh()
-        .x_desc(match axis {
-            Axis::Budget => "light samples N",
-            Axis::Time => "ms per image (median)",
-        })
+        .x_desc(x_desc)
         .y_desc("MSE")
         .y_label_formatter(&|y| format!("{y:.0e}"))
         .x_label_formatter(&|x| {

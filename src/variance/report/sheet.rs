@@ -13,6 +13,7 @@
 
 use crate::output::false_colour::register_font;
 use crate::output::image_file::write_rgb8;
+use crate::render::sampling::LightSampler;
 use crate::variance::StudyResult;
 use anyhow::{Result, anyhow};
 use image::RgbImage;
@@ -101,26 +102,21 @@ pub fn contact_sheet(
 /// Writes the study's contact sheet (its warm-up renders, seed 0) to `path`; false when the
 /// study kept no renders.
 pub fn write(result: &StudyResult, path: &Path) -> Result<bool> {
-    let samplers = &result.config.samplers;
-    let budgets = &result.config.budgets;
-    let mut images = Vec::new();
-    for s in samplers {
-        let mut row = Vec::new();
-        for n in budgets {
-            match result
-                .thumbnails
-                .iter()
-                .find(|(ts, tn, _)| ts == s && tn == n)
-            {
-                Some((_, _, img)) => row.push(img),
-                None => return Ok(false),
-            }
-        }
-        images.push(row);
-    }
-    if images.is_empty() {
+    let (samplers, budgets) = (&result.config.samplers, &result.config.budgets);
+    let thumbnail = |s: &LightSampler, n: &u32| {
+        let found = result
+            .thumbnails
+            .iter()
+            .find(|(ts, tn, _)| ts == s && tn == n);
+        found.map(|(_, _, img)| img)
+    };
+    let images: Option<Vec<Vec<&RgbImage>>> = samplers
+        .iter()
+        .map(|s| budgets.iter().map(|n| thumbnail(s, n)).collect())
+        .collect();
+    let Some(images) = images.filter(|i| !i.is_empty()) else {
         return Ok(false);
-    }
+    };
     let title = format!(
         "seed 0, {}×{}: {}",
         result.config.base.width, result.config.base.height, result.scene

@@ -7,7 +7,7 @@ use crate::output::image_file::write_rgb8;
 use crate::render::sampling::LightSampler;
 use crate::variance::figures::perceived::Perceived;
 use crate::variance::figures::spectrum::{LOW_BAND, RINGS, ring_frequency};
-use crate::variance::report::plot::{PALETTE, canvas, line, log_range};
+use crate::variance::report::plot::{PALETTE, canvas, line, log_range, with_ends};
 use crate::variance::{Region, StudyResult};
 use anyhow::{Result, anyhow};
 use plotters::coord::Shift;
@@ -123,20 +123,15 @@ fn draw_curves(
     curves: &[Curve],
 ) -> Result<()> {
     let err = |e| anyhow!("plot: {e}");
-    let (y_lo, y_hi) = log_range(
-        curves.iter().flat_map(|c| {
-            let p = c.perceived;
-            p.spectrum_interval
-                .iter()
-                .zip(&p.spectrum)
-                .flat_map(|(iv, v)| {
-                    let [a, b] = iv.unwrap_or([*v; 2]);
-                    [*v, a, b]
-                })
-        }),
-        1.5,
-        (1e-8, 1.0),
-    );
+    let values = curves.iter().flat_map(|c| {
+        let p = c.perceived;
+        let ends = p.spectrum_interval.iter();
+        p.spectrum
+            .iter()
+            .zip(ends)
+            .flat_map(|(v, iv)| with_ends(*v, *iv))
+    });
+    let (y_lo, y_hi) = log_range(values, 1.5, (1e-8, 1.0));
     let mut chart = ChartBuilder::on(area)
         .caption(title, ("sans-serif", 20))
         .margin(12)

@@ -177,15 +177,9 @@ fn rows_of(m: &Measured, reference: &Converged, masks: &[Vec<bool>; 3], host: &s
             let perceived =
                 perceived::measure(&m.images, &reference.film.pixels, width, height, mask);
             let per = per_image_errors(&m.images, &reference.film.pixels, mask);
-            let seed_mse: Vec<f64> = per.iter().map(|e| e.0).collect();
-            let seed_bias: Vec<f64> = per.iter().map(|e| e.1).collect();
+            let (seed_mse, seed_bias): (Vec<f64>, Vec<f64>) = per.into_iter().unzip();
             let mse_interval = fits::interval(k, |idx| fits::mean_at(&seed_mse, Some(idx)));
-            let times = &m.times;
-            let efficiency_interval = fits::interval(k, |idx| {
-                let t: Vec<f64> = idx.iter().map(|&i| times[i]).collect();
-                1.0 / (fits::mean_at(&seed_mse, Some(idx)) * crate::stats::median(&t).max(1e-12))
-            });
-            Row {
+            let mut row = Row {
                 sampler: m.sampler.name(),
                 n: m.n,
                 region: *region,
@@ -201,7 +195,7 @@ fn rows_of(m: &Measured, reference: &Converged, masks: &[Vec<bool>; 3], host: &s
                 } else {
                     f64::INFINITY
                 },
-                efficiency_interval,
+                efficiency_interval: None,
                 error_reduction: None,
                 error_reduction_interval: None,
                 efficiency_vs_random: None,
@@ -211,7 +205,9 @@ fn rows_of(m: &Measured, reference: &Converged, masks: &[Vec<bool>; 3], host: &s
                 seed_mse,
                 seed_bias,
                 seed_seconds: m.times.clone(),
-            }
+            };
+            row.efficiency_interval = fits::interval(k, |idx| fits::efficiency_at(&row, idx));
+            row
         })
         .collect()
 }
