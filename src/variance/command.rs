@@ -90,7 +90,7 @@ impl VarianceOptions {
         // (the samplers are interleaved), and one 8-bit render per sampler and N for the
         // contact sheet.
         if self.sizes.is_empty() {
-            return Err(UsageError("no image size: expected at least one".into()).into());
+            bail!(UsageError("no image size: expected at least one".into()));
         }
         for &[w, h] in &self.sizes {
             let pixels = w as u64 * h as u64;
@@ -98,14 +98,13 @@ impl VarianceOptions {
             let bytes =
                 pixels * samplers * (self.seeds as u64 * 12 + self.budgets.len() as u64 * 3);
             if bytes > MAX_STUDY_BYTES {
-                return Err(UsageError(format!(
+                bail!(UsageError(format!(
                     "--seeds {} of {} samplers at --size {w} {h} would hold {:.1} GiB of images at once: expected at most {} GiB; use fewer seeds or samplers, or a smaller size",
                     self.seeds,
                     samplers,
                     bytes as f64 / (1u64 << 30) as f64,
                     MAX_STUDY_BYTES >> 30
-                ))
-                .into());
+                )));
             }
         }
         if self.out.exists() && !self.out.is_dir() {
@@ -115,17 +114,16 @@ impl VarianceOptions {
             );
         }
         if self.budgets.is_empty() {
-            return Err(
-                UsageError("--budgets is empty: expected at least one budget N".into()).into(),
-            );
+            bail!(UsageError(
+                "--budgets is empty: expected at least one budget N".into()
+            ));
         }
         if self.samplers.is_empty() {
             let names: Vec<&str> = LightSampler::ALL.iter().map(|s| s.name()).collect();
-            return Err(UsageError(format!(
+            bail!(UsageError(format!(
                 "--samplers is empty: expected at least one of {}",
                 names.join(", ")
-            ))
-            .into());
+            )));
         }
         // Every sampler takes every budget, or the study stops before it starts.
         for &sampler in &self.samplers {
@@ -457,10 +455,9 @@ pub fn prepare(
 ) -> Result<Vec<(String, bool)>> {
     options.validate()?;
     if options.no_cache {
-        return Err(UsageError(
-            "`raywave variance prepare` fills the cache: --no-cache leaves it nothing to do".into(),
-        )
-        .into());
+        bail!(UsageError(
+            "`raywave variance prepare` fills the cache: --no-cache leaves it nothing to do".into()
+        ));
     }
     let Some(cache) = open_cache(options, progress.notice) else {
         bail!(

@@ -343,11 +343,7 @@ impl StudyResult {
             "\nslope of log MSE against log N [95%] (points where the sampler ignores the seed, \
              such as lab at N = 1, are bias, not noise, and are left out):"
         );
-        let _ = writeln!(
-            s,
-            "  {:<10} {:<24} {:<24} {:<24}",
-            "sampler", "whole", "penumbra", "lit"
-        );
+        region_row(&mut s, "sampler", |region| region.name().into());
         for sampler in &self.config.samplers {
             let cell = |region: Region| {
                 self.slopes
