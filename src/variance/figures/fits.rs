@@ -136,13 +136,19 @@ pub(crate) fn slopes(rows: &[Row], samplers: &[LightSampler], k: usize) -> Vec<S
     out
 }
 
+/// The samplers compared with random: every other one, when random is studied; none otherwise.
+pub(crate) fn against_random(samplers: &[LightSampler]) -> impl Iterator<Item = LightSampler> {
+    let random = samplers.contains(&LightSampler::Random);
+    samplers
+        .iter()
+        .copied()
+        .filter(move |&s| random && s != LightSampler::Random)
+}
+
 /// One matching budget per (sampler other than random, region), when random was studied.
 pub(crate) fn matching(rows: &[Row], samplers: &[LightSampler], k: usize) -> Vec<Matching> {
     let mut out = Vec::new();
-    if !samplers.contains(&LightSampler::Random) {
-        return out;
-    }
-    for &sampler in samplers.iter().filter(|&&s| s != LightSampler::Random) {
+    for sampler in against_random(samplers) {
         for region in Region::ALL {
             let (random, other) = (
                 fitted(rows, LightSampler::Random, region),

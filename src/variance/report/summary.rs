@@ -14,7 +14,7 @@
 
 use crate::render::sampling::LightSampler;
 use crate::stats::{BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, grouped_bootstrap_interval};
-use crate::variance::figures::fits::{fit_rows, fitted, mean_at};
+use crate::variance::figures::fits::{against_random, fit_rows, fitted, mean_at};
 use crate::variance::report::tables::write_text;
 use crate::variance::{Region, Row, StudyResult, unique};
 use anyhow::{Context, Result};
@@ -75,6 +75,12 @@ fn interval(sizes: &[usize], stat: impl FnMut(&[Vec<usize>]) -> f64) -> Option<[
         .map(|(a, b)| [a, b])
 }
 
+/// The geometric mean of `values` (1 for none).
+fn geomean(values: impl Iterator<Item = f64>) -> f64 {
+    let (sum, count) = values.fold((0.0, 0usize), |(s, c), v| (s + v.ln(), c + 1));
+    (sum / count.max(1) as f64).exp()
+}
+
 /// The summary of `cases` (named `names`), which share samplers, budgets and seeds.
 pub fn summarize(names: &[String], cases: &[StudyResult]) -> Summary {
     let Some(first) = cases.first() else {
@@ -118,54 +124,43 @@ pub fn summarize(names: &[String], cases: &[StudyResult]) -> Summary {
     }
     let mut ratios = Vec::new();
     let random = LightSampler::Random.name();
-    if config.samplers.contains(&LightSampler::Random) {
-        for &sampler in config
-            .samplers
-            .iter()
-            .filter(|&&s| s != LightSampler::Random)
-        {
-            for &n in &config.budgets {
-                for region in Region::ALL {
-                    let pairs: Vec<Option<(&Row, &Row)>> = cases
-                        .iter()
-                        .map(|c| {
-                            row(&c.rows, random, n, region)
-                                .zip(row(&c.rows, sampler.name(), n, region))
-                                .filter(|(b, r)| b.stats.mse > 0.0 && r.stats.mse > 0.0)
-                        })
-                        .collect();
-                    let per_case: Vec<Option<f64>> = pairs
-                        .iter()
-                        .map(|p| p.map(|(b, r)| b.stats.mse / r.stats.mse))
-                        .collect();
-                    let geomean = |values: &mut dyn Iterator<Item = f64>| {
-                        let (sum, count) =
-                            values.fold((0.0, 0usize), |(s, c), v| (s + v.ln(), c + 1));
-                        (sum / count.max(1) as f64).exp()
-                    };
-                    let geometric_mean = per_case
-                        .iter()
-                        .copied()
-                        .collect::<Option<Vec<f64>>>()
-                        .map(|v| geomean(&mut v.into_iter()));
-                    let interval = geometric_mean.and_then(|_| {
-                        interval(&sizes, |idx| {
-                            geomean(&mut pairs.iter().zip(idx).map(|(p, i)| {
-                                p.map_or(f64::NAN, |(b, r)| {
-                                    mean_at(&b.seed_mse, Some(i)) / mean_at(&r.seed_mse, Some(i))
-                                })
-                            }))
-                        })
-                    });
-                    ratios.push(RatioAcross {
-                        sampler: sampler.name(),
-                        n,
-                        region,
-                        per_case,
-                        geometric_mean,
-                        interval,
-                    });
-                }
+    for sampler in against_random(&config.samplers) {
+        for &n in &config.budgets {
+            for region in Region::ALL {
+                let pairs: Vec<Option<(&Row, &Row)>> = cases
+                    .iter()
+                    .map(|c| {
+                        row(&c.rows, random, n, region)
+                            .zip(row(&c.rows, sampler.name(), n, region))
+                            .filter(|(b, r)| b.stats.mse > 0.0 && r.stats.mse > 0.0)
+                    })
+                    .collect();
+                let per_case: Vec<Option<f64>> = pairs
+                    .iter()
+                    .map(|p| p.map(|(b, r)| b.stats.mse / r.stats.mse))
+                    .collect();
+                let geometric_mean = per_case
+                    .iter()
+                    .copied()
+                    .collect::<Option<Vec<f64>>>()
+                    .map(|v| geomean(v.into_iter()));
+                let interval = geometric_mean.and_then(|_| {
+                    interval(&sizes, |idx| {
+                        geomean(pairs.iter().zip(idx).map(|(p, i)| {
+                            p.map_or(f64::NAN, |(b, r)| {
+                                mean_at(&b.seed_mse, Some(i)) / mean_at(&r.seed_mse, Some(i))
+                            })
+                        }))
+                    })
+                });
+                ratios.push(RatioAcross {
+                    sampler: sampler.name(),
+                    n,
+                    region,
+                    per_case,
+                    geometric_mean,
+                    interval,
+                });
             }
         }
     }

@@ -6,6 +6,7 @@
 use super::{plot, sheet, spectrum_plot};
 use crate::output::machine::Machine;
 use crate::render::sampling::LightSampler;
+use crate::variance::figures::fits::{LAB_RANDOM_POINTS, against_random};
 use crate::variance::{Region, Row, StudyConfig, StudyResult, unique};
 use anyhow::{Context, Result};
 use serde::Serialize;
@@ -359,14 +360,9 @@ impl StudyResult {
                 s,
                 "\nbudget matching the MSE of {} random points (the lab's choice), from the fits \
                  [95%]:",
-                crate::variance::figures::fits::LAB_RANDOM_POINTS
+                LAB_RANDOM_POINTS
             );
-            for sampler in self
-                .config
-                .samplers
-                .iter()
-                .filter(|&&x| x != LightSampler::Random)
-            {
+            for sampler in against_random(&self.config.samplers) {
                 let cell = |region: Region| {
                     self.matching
                         .iter()
