@@ -149,20 +149,15 @@ fn panel(
             .draw_series(pts.iter().map(|&p| Circle::new(p, 4, colour.filled())))
             .map_err(err)?;
         // 95% intervals: MSE vertically, time horizontally.
+        let bar = |ends: Vec<(f64, f64)>| PathElement::new(ends, colour);
         let mut bars = Vec::new();
         for r in &mine {
-            let (x, x_iv) = x_of(r, axis);
+            let ((x, x_iv), y) = (x_of(r, axis), r.stats.mse);
             if let Some([a, b]) = r.mse_interval {
-                bars.push(PathElement::new(
-                    vec![(x, a.max(y_lo)), (x, b.min(y_hi))],
-                    colour,
-                ));
+                bars.push(bar(vec![(x, a.max(y_lo)), (x, b.min(y_hi))]));
             }
             if let Some([a, b]) = x_iv {
-                bars.push(PathElement::new(
-                    vec![(a.max(x_lo), r.stats.mse), (b.min(x_hi), r.stats.mse)],
-                    colour,
-                ));
+                bars.push(bar(vec![(a.max(x_lo), y), (b.min(x_hi), y)]));
             }
         }
         chart.draw_series(bars).map_err(err)?;

@@ -297,10 +297,10 @@ impl Summary {
 /// The files a study of several cases writes: per case its report under `NAME/`, then the
 /// summary at the top.
 pub fn file_names(names: &[String], per_case: &[String]) -> Vec<String> {
-    let mut out = Vec::new();
-    for name in names {
-        out.extend(per_case.iter().map(|f| format!("{name}/{f}")));
-    }
+    let in_dirs = names
+        .iter()
+        .flat_map(|n| per_case.iter().map(move |f| format!("{n}/{f}")));
+    let mut out: Vec<String> = in_dirs.collect();
     out.extend(["summary.txt", "summary.csv", "summary.json"].map(String::from));
     out
 }

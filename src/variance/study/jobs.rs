@@ -239,10 +239,8 @@ pub fn run_jobs(
                 height: image.height(),
                 rgb: image.into_raw(),
             });
-            progress(
-                per_render(job),
-                &format!("{} N={n} warm-up", job.sampler.name()),
-            );
+            let label = format!("{} N={n} warm-up", job.sampler.name());
+            progress(per_render(job), &label);
         }
         let mut films: Vec<Vec<Film>> = vec![Vec::new(); group.len()];
         let mut times = vec![Vec::new(); group.len()];
