@@ -120,13 +120,9 @@ pub fn converged_reference(
     cache: Option<&Cache>,
     notice: &(dyn Fn(&str) + Sync),
 ) -> Result<Converged> {
-    let halves = [0xa11c_e000u32, 0xb0b0_0001];
-    let settings: Vec<RenderSettings> = halves
-        .iter()
-        .map(|&seed| config.run_settings(LightSampler::Stratified, config.reference_samples, seed))
-        .collect();
+    let half = |seed| config.run_settings(LightSampler::Stratified, config.reference_samples, seed);
+    let settings = [half(0xa11c_e000), half(0xb0b0_0001)];
     let key = cache::key(scene_id, &settings);
-    let (width, height) = (config.base.width, config.base.height);
     // Held until the entry is read, or rendered and written: concurrent shards render it once.
     let _lock = cache.and_then(|c| {
         let waiting = |path: &std::path::Path| {
@@ -143,6 +139,7 @@ pub fn converged_reference(
             })
             .ok()
     });
+    let (width, height) = (config.base.width, config.base.height);
     let lookup = cache.map_or(cache::Lookup::Miss, |c| c.read(key, width, height));
     let cached = matches!(lookup, cache::Lookup::Hit(_));
     let [a, b] = match lookup {
