@@ -174,7 +174,7 @@ pub fn load_cases(options: &VarianceOptions, notice: &dyn Fn(&str)) -> Result<Ve
     } else {
         options.scenes.clone()
     };
-    let mut loaded = Vec::new();
+    let (mut stems, mut loaded) = (Vec::new(), Vec::new());
     for path in &scenes {
         let SceneFile { scene, bytes } = load_scene(path.as_deref(), &ParseOptions::default())?;
         for w in &scene.warnings {
@@ -186,19 +186,15 @@ pub fn load_cases(options: &VarianceOptions, notice: &dyn Fn(&str)) -> Result<Ve
                 scene.source
             );
         }
-        let stem = path
-            .as_ref()
-            .and_then(|p| p.file_stem())
-            .map_or("builtin".to_string(), |s| s.to_string_lossy().into_owned());
-        loaded.push((stem, scene, bytes));
+        let stem = path.as_ref().and_then(|p| p.file_stem());
+        stems.push(stem.map_or("builtin".to_string(), |s| s.to_string_lossy().into_owned()));
+        loaded.push((scene, bytes));
     }
-    let stems: Vec<String> = loaded.iter().map(|l| l.0.clone()).collect();
-    let names = case_names(&stems, &options.sizes);
+    let mut names = case_names(&stems, &options.sizes).into_iter();
     let samplers = super::unique(options.samplers.iter().copied());
     let budgets = super::unique(options.budgets.iter().copied());
     let mut cases = Vec::new();
-    let mut names = names.into_iter();
-    for (_, scene, bytes) in loaded {
+    for (scene, bytes) in loaded {
         for &[width, height] in &options.sizes {
             let base = RenderSettings {
                 width,
@@ -207,8 +203,7 @@ pub fn load_cases(options: &VarianceOptions, notice: &dyn Fn(&str)) -> Result<Ve
                 light_model: options.light_model,
                 background: scene
                     .background
-                    .map(|c| c.to_array())
-                    .unwrap_or(RenderSettings::default().background),
+                    .map_or(RenderSettings::default().background, |c| c.to_array()),
                 ..RenderSettings::default()
             };
             let config = StudyConfig {
