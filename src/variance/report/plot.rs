@@ -228,9 +228,8 @@ pub(crate) fn mse_plot(result: &StudyResult, path: &Path) -> Result<()> {
     write_rgb8(&img, path)
 }
 
-/// Writes `heat_<sampler>_N<n>.png` for every sampler: per-pixel MSE over the seeds on one log
-/// scale shared by all samplers (dark = low error, bright = high), with a title and a
-/// labelled colour bar, so the maps compare directly and each reads on its own.
+/// Writes `heat_<sampler>_N<n>.png` for every sampler: per-pixel MSE over the seeds on the log
+/// scale all samplers share, with a title and a labelled colour bar, so each reads on its own.
 pub(crate) fn heatmaps(result: &StudyResult, dir: &Path) -> Result<Vec<PathBuf>> {
     let Some(scale) = Scale::from_values(result.heatmaps.iter().flat_map(|(_, m)| m), true) else {
         return Ok(Vec::new());
@@ -259,10 +258,9 @@ pub(crate) fn heatmaps(result: &StudyResult, dir: &Path) -> Result<Vec<PathBuf>>
     Ok(written)
 }
 
-/// Per-pixel MSE maps (each `w` × `h`) as images on one shared log scale
-/// ([`false_colour::Scale::from_values`]: the 1st to the 99.9th percentile of all maps' positive
-/// values; dark = low error, bright = high), so that the maps compare directly; also returns
-/// that scale as (lo, hi) in log10. `None` when no map has a positive value.
+/// Per-pixel MSE maps (each `w` × `h`) as images on one shared log scale (the 1st to the 99.9th
+/// percentile of all maps' positive values, [`false_colour::Scale::from_values`]), and that
+/// scale as (lo, hi) in log10. `None` when no map has a positive value.
 pub(crate) fn heat_images(
     maps: &[&[f32]],
     w: u32,

@@ -179,7 +179,7 @@ fn rows_of(
                 excluded_from_fit: excluded_sampler || (stats.pixels > 0 && stats.variance == 0.0),
                 seconds,
                 seconds_interval,
-                rays: rays,
+                rays,
                 rays_per_second: rays as f64 / seconds.max(1e-12),
                 efficiency: if stats.mse > 0.0 {
                     1.0 / (stats.mse * seconds.max(1e-12))
