@@ -11,7 +11,7 @@ use crate::render::error::UsageError;
 use crate::render::progress::Progress;
 use crate::render::sampling::LightSampler;
 use crate::render::scene::{ParseOptions, SceneFile, load_scene};
-use crate::render::settings::{LightModel, RenderSettings, ShadowMode};
+use crate::render::settings::{LightModel, RenderSettings};
 use crate::shard::{Host, Identity, Part, Shard, Work};
 use anyhow::{Context, Result, bail};
 use std::path::{Path, PathBuf};
@@ -90,7 +90,7 @@ impl VarianceOptions {
         // (the samplers are interleaved), and one 8-bit render per sampler and N for the
         // contact sheet.
         if self.sizes.is_empty() {
-            return Err(UsageError("no image size: expected at least one".into()).into());
+            bail!(UsageError("no image size: expected at least one".into()));
         }
         for &[w, h] in &self.sizes {
             let pixels = w as u64 * h as u64;
@@ -98,14 +98,13 @@ impl VarianceOptions {
             let bytes =
                 pixels * samplers * (self.seeds as u64 * 12 + self.budgets.len() as u64 * 3);
             if bytes > MAX_STUDY_BYTES {
-                return Err(UsageError(format!(
+                bail!(UsageError(format!(
                     "--seeds {} of {} samplers at --size {w} {h} would hold {:.1} GiB of images at once: expected at most {} GiB; use fewer seeds or samplers, or a smaller size",
                     self.seeds,
                     samplers,
                     bytes as f64 / (1u64 << 30) as f64,
                     MAX_STUDY_BYTES >> 30
-                ))
-                .into());
+                )));
             }
         }
         if self.out.exists() && !self.out.is_dir() {
@@ -115,30 +114,27 @@ impl VarianceOptions {
             );
         }
         if self.budgets.is_empty() {
-            return Err(
-                UsageError("--budgets is empty: expected at least one budget N".into()).into(),
-            );
+            bail!(UsageError(
+                "--budgets is empty: expected at least one budget N".into()
+            ));
         }
         if self.samplers.is_empty() {
             let names: Vec<&str> = LightSampler::ALL.iter().map(|s| s.name()).collect();
-            return Err(UsageError(format!(
+            bail!(UsageError(format!(
                 "--samplers is empty: expected at least one of {}",
                 names.join(", ")
-            ))
-            .into());
+            )));
         }
         // Every sampler takes every budget, or the study stops before it starts.
         for &sampler in &self.samplers {
             for &n in &self.budgets {
-                let settings = RenderSettings {
-                    width: self.sizes[0][0],
-                    height: self.sizes[0][1],
-                    shadows: ShadowMode::Soft,
-                    shadow_samples: n,
-                    sampler,
-                    aa_samples: 1,
+                let [width, height] = self.sizes[0];
+                let base = RenderSettings {
+                    width,
+                    height,
                     ..RenderSettings::default()
                 };
+                let settings = StudyConfig::standard(base).run_settings(sampler, n, 0);
                 settings.check_sampler().map_err(|e| {
                     UsageError(format!(
                         "{e}; the study's --budgets include {n}: leave {} out of --samplers, or that budget out",
@@ -178,7 +174,7 @@ pub fn load_cases(options: &VarianceOptions, notice: &dyn Fn(&str)) -> Result<Ve
     } else {
         options.scenes.clone()
     };
-    let mut loaded = Vec::new();
+    let (mut stems, mut loaded) = (Vec::new(), Vec::new());
     for path in &scenes {
         let SceneFile { scene, bytes } = load_scene(path.as_deref(), &ParseOptions::default())?;
         for w in &scene.warnings {
@@ -190,29 +186,15 @@ pub fn load_cases(options: &VarianceOptions, notice: &dyn Fn(&str)) -> Result<Ve
                 scene.source
             );
         }
-        let stem = path
-            .as_ref()
-            .and_then(|p| p.file_stem())
-            .map_or("builtin".to_string(), |s| s.to_string_lossy().into_owned());
-        loaded.push((stem, scene, bytes));
+        let stem = path.as_ref().and_then(|p| p.file_stem());
+        stems.push(stem.map_or("builtin".to_string(), |s| s.to_string_lossy().into_owned()));
+        loaded.push((scene, bytes));
     }
-    let stems: Vec<String> = loaded.iter().map(|l| l.0.clone()).collect();
-    let names = case_names(&stems, &options.sizes);
-    let mut samplers = Vec::new();
-    for s in &options.samplers {
-        if !samplers.contains(s) {
-            samplers.push(*s);
-        }
-    }
-    let mut budgets = Vec::new();
-    for n in &options.budgets {
-        if !budgets.contains(n) {
-            budgets.push(*n);
-        }
-    }
+    let mut names = case_names(&stems, &options.sizes).into_iter();
+    let samplers = super::unique(options.samplers.iter().copied());
+    let budgets = super::unique(options.budgets.iter().copied());
     let mut cases = Vec::new();
-    let mut names = names.into_iter();
-    for (_, scene, bytes) in loaded {
+    for (scene, bytes) in loaded {
         for &[width, height] in &options.sizes {
             let base = RenderSettings {
                 width,
@@ -221,8 +203,7 @@ pub fn load_cases(options: &VarianceOptions, notice: &dyn Fn(&str)) -> Result<Ve
                 light_model: options.light_model,
                 background: scene
                     .background
-                    .map(|c| c.to_array())
-                    .unwrap_or(RenderSettings::default().background),
+                    .map_or(RenderSettings::default().background, |c| c.to_array()),
                 ..RenderSettings::default()
             };
             let config = StudyConfig {
@@ -404,8 +385,7 @@ pub(crate) fn write_report(
     for (name, result) in names.iter().zip(&results) {
         for region in [Region::Penumbra, Region::Lit] {
             let margin = result.reference_margin(region);
-            let i = Region::ALL.iter().position(|&r| r == region).unwrap_or(0);
-            if result.region_pixels[i] > 0 && margin < 10.0 {
+            if result.region_pixels[region as usize] > 0 && margin < 10.0 {
                 let case = if results.len() > 1 {
                     format!("{name}: ")
                 } else {
@@ -470,10 +450,9 @@ pub fn prepare(
 ) -> Result<Vec<(String, bool)>> {
     options.validate()?;
     if options.no_cache {
-        return Err(UsageError(
-            "`raywave variance prepare` fills the cache: --no-cache leaves it nothing to do".into(),
-        )
-        .into());
+        bail!(UsageError(
+            "`raywave variance prepare` fills the cache: --no-cache leaves it nothing to do".into()
+        ));
     }
     let Some(cache) = open_cache(options, progress.notice) else {
         bail!(

@@ -11,7 +11,7 @@ use super::command::{Outcome, create_out, write_report};
 use super::study::jobs::{self, CaseFacts, JobResult};
 use super::study::plan::Study;
 use crate::render::error::UsageError;
-use crate::shard::{HostSummary, Machines, same_file};
+use crate::shard::{Machines, same_file};
 use anyhow::{Result, bail};
 use std::path::{Path, PathBuf};
 
@@ -19,31 +19,23 @@ use std::path::{Path, PathBuf};
 pub struct Merged {
     /// The report and the files written.
     pub outcome: Outcome,
-    /// The part files read.
-    pub parts: Vec<PathBuf>,
-    /// Shards in the study.
-    pub shards: usize,
+    /// The parts read, by shard index, and their machines (the results moved into the report).
+    shards: crate::shard::Merged<Study>,
     /// Jobs in the study.
-    pub jobs: usize,
-    /// The machines, with the shards and jobs each ran and their summed wall time.
-    pub hosts: Vec<HostSummary>,
-    /// Per shard, in index order: its part, host, jobs and wall time.
-    pub shard_times: Vec<(PathBuf, String, usize, f64)>,
-    /// Seconds from the first shard's start to the last one's end.
-    pub elapsed: f64,
+    jobs: usize,
     /// How many times a shard rendered a case's converged reference (not from the cache).
-    pub references_rendered: usize,
-    /// How many times a shard read a case's converged reference from the cache.
-    pub references_cached: usize,
+    references_rendered: usize,
 }
 
 impl Merged {
     /// What the merge prints after the report: shards, jobs, hosts, and the shards' wall time
     /// summed against the elapsed time.
     pub fn describe(&self) -> String {
-        let summed: f64 = self.hosts.iter().map(|h| h.seconds).sum();
-        let hosts: Vec<String> = self
-            .hosts
+        let (parts, hosts) = (&self.shards.parts, &self.shards.hosts);
+        let summed: f64 = hosts.iter().map(|h| h.seconds).sum();
+        let elapsed = self.shards.elapsed_seconds();
+        let touched: usize = parts.iter().map(|(_, p)| p.extra.len()).sum();
+        let host_list: Vec<String> = hosts
             .iter()
             .map(|h| {
                 format!(
@@ -52,29 +44,31 @@ impl Merged {
                 )
             })
             .collect();
-        let shards: String = self
-            .shard_times
+        let shards: String = parts
             .iter()
             .enumerate()
-            .map(|(i, (path, host, jobs, wall))| {
+            .map(|(i, (path, p))| {
                 format!(
-                    "  {i}/{} {}: {jobs} jobs on {host}, {wall:.1} s\n",
-                    self.shards,
-                    path.display()
+                    "  {i}/{} {}: {} jobs on {}, {:.1} s\n",
+                    parts.len(),
+                    path.display(),
+                    p.items.len(),
+                    p.host.hostname,
+                    p.host.seconds()
                 )
             })
             .collect();
         format!(
             "{shards}merged  {} shards, {} jobs, {} host{}: {}\nwall    {summed:.1} s summed over the shards, {:.1} s from the first start to the last end ({:.2} shards at once on average)\nreferences {} rendered by a shard, {} read from the cache\n",
-            self.shards,
+            parts.len(),
             self.jobs,
-            self.hosts.len(),
-            if self.hosts.len() == 1 { "" } else { "s" },
-            hosts.join(", "),
-            self.elapsed,
-            summed / self.elapsed.max(1e-9),
+            hosts.len(),
+            if hosts.len() == 1 { "" } else { "s" },
+            host_list.join(", "),
+            elapsed,
+            summed / elapsed.max(1e-9),
             self.references_rendered,
-            self.references_cached
+            touched - self.references_rendered
         )
     }
 }
@@ -155,28 +149,10 @@ pub fn merge(inputs: &[PathBuf], out: &Path, notice: &(dyn Fn(&str) + Sync)) -> 
     }
     let names: Vec<String> = study.cases.iter().map(|c| c.name.clone()).collect();
     let outcome = write_report(&names, studies, out, notice)?;
-    let shard_times = merged
-        .parts
-        .iter()
-        .map(|(path, p)| {
-            (
-                path.clone(),
-                p.host.hostname.clone(),
-                p.items.len(),
-                p.host.seconds(),
-            )
-        })
-        .collect();
-    let touched: usize = merged.parts.iter().map(|(_, p)| p.extra.len()).sum();
     Ok(Merged {
         outcome,
-        parts: merged.parts.iter().map(|(p, _)| p.clone()).collect(),
-        shards: merged.parts.len(),
+        shards: merged,
         jobs: study.jobs().len(),
-        hosts: merged.hosts.clone(),
-        shard_times,
-        elapsed: merged.elapsed_seconds(),
         references_rendered: rendered,
-        references_cached: touched - rendered,
     })
 }

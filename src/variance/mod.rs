@@ -120,13 +120,9 @@ pub fn converged_reference(
     cache: Option<&Cache>,
     notice: &(dyn Fn(&str) + Sync),
 ) -> Result<Converged> {
-    let halves = [0xa11c_e000u32, 0xb0b0_0001];
-    let settings: Vec<RenderSettings> = halves
-        .iter()
-        .map(|&seed| config.run_settings(LightSampler::Stratified, config.reference_samples, seed))
-        .collect();
+    let half = |seed| config.run_settings(LightSampler::Stratified, config.reference_samples, seed);
+    let settings = [half(0xa11c_e000), half(0xb0b0_0001)];
     let key = cache::key(scene_id, &settings);
-    let (width, height) = (config.base.width, config.base.height);
     // Held until the entry is read, or rendered and written: concurrent shards render it once.
     let _lock = cache.and_then(|c| {
         let waiting = |path: &std::path::Path| {
@@ -143,6 +139,7 @@ pub fn converged_reference(
             })
             .ok()
     });
+    let (width, height) = (config.base.width, config.base.height);
     let lookup = cache.map_or(cache::Lookup::Miss, |c| c.read(key, width, height));
     let cached = matches!(lookup, cache::Lookup::Hit(_));
     let [a, b] = match lookup {
@@ -197,7 +194,8 @@ pub fn converged_reference(
     })
 }
 
-/// The three regions a study reports.
+/// The three regions a study reports, in `ALL` order: `region as usize` indexes the per-region
+/// arrays.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Region {
@@ -214,12 +212,19 @@ impl Region {
     pub const ALL: [Region; 3] = [Region::Whole, Region::Penumbra, Region::Lit];
     /// Lower-case name.
     pub fn name(self) -> &'static str {
-        match self {
-            Region::Whole => "whole",
-            Region::Penumbra => "penumbra",
-            Region::Lit => "lit",
+        ["whole", "penumbra", "lit"][self as usize]
+    }
+}
+
+/// `items` without repeats, in first-seen order.
+pub(crate) fn unique<T: PartialEq>(items: impl IntoIterator<Item = T>) -> Vec<T> {
+    let mut out = Vec::new();
+    for x in items {
+        if !out.contains(&x) {
+            out.push(x);
         }
     }
+    out
 }
 
 /// One line of the results: a (sampler, N, region).
@@ -349,18 +354,14 @@ pub fn run_study(
 }
 
 impl StudyResult {
-    /// The smallest MSE measured in a region, to compare with the reference's own error.
-    fn smallest_mse(&self, region: Region) -> f64 {
-        self.rows
+    /// How many times the reference's own MSE lies below the smallest MSE measured in `region`.
+    pub fn reference_margin(&self, region: Region) -> f64 {
+        let smallest = self
+            .rows
             .iter()
             .filter(|r| r.region == region && r.stats.mse > 0.0)
             .map(|r| r.stats.mse)
-            .fold(f64::INFINITY, f64::min)
-    }
-
-    /// How many times the reference's own MSE lies below the smallest measured MSE, per region.
-    pub fn reference_margin(&self, region: Region) -> f64 {
-        let i = Region::ALL.iter().position(|&r| r == region).unwrap_or(0);
-        self.smallest_mse(region) / self.reference_mse[i].max(1e-30)
+            .fold(f64::INFINITY, f64::min);
+        smallest / self.reference_mse[region as usize].max(1e-30)
     }
 }

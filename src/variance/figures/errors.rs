@@ -1,5 +1,5 @@
 //! The numbers of a variance study, as pure functions of images: error against the converged
-//! reference over a region, and the log-log slope of MSE against N. Tested on synthetic data,
+//! reference over a region, per seed and pooled, and the bias bound. Tested on synthetic data,
 //! where the right answers are known in closed form.
 
 use crate::render::sampling::LightSampler;
@@ -13,11 +13,8 @@ pub struct ErrorStats {
     pub mse: f64,
     /// Mean signed error (image − reference).
     pub bias: f64,
-    /// The largest |bias| that no bias explains, at the false-alarm rate of four standard
-    /// errors of a normal mean (α = 6.3e-5, two-sided): Student's t quantile with K − 1
-    /// degrees of freedom times the standard error of the mean of the K images' mean errors
-    /// ([`bias_bound`]). A larger |bias| means the sampler (or the reference) is biased.
-    /// Infinite for fewer than 2 images.
+    /// The largest |bias| that no bias explains at [`BIAS_FALSE_ALARM`] ([`bias_bound`]): a
+    /// larger |bias| means the sampler (or the reference) is biased. Infinite below 2 images.
     pub bias_bound: f64,
     /// Per-pixel variance across the K images (K − 1 denominator), averaged over the region.
     pub variance: f64,

@@ -113,7 +113,10 @@ pub(crate) fn slopes(rows: &[Row], samplers: &[LightSampler], k: usize) -> Vec<S
     let mut out = Vec::new();
     for &sampler in samplers {
         for region in Region::ALL {
-            let pts = fitted(rows, sampler, region);
+            let (pts, excluded): (Vec<&Row>, Vec<&Row>) = rows
+                .iter()
+                .filter(|r| r.sampler == sampler.name() && r.region == region)
+                .partition(|r| !r.excluded_from_fit);
             let fit = fit_rows(&pts, None);
             let slope_interval = fit.and_then(|_| {
                 interval(k, |idx| {
@@ -126,26 +129,26 @@ pub(crate) fn slopes(rows: &[Row], samplers: &[LightSampler], k: usize) -> Vec<S
                 fit,
                 slope_interval,
                 fitted: pts.iter().map(|r| r.n).collect(),
-                excluded: rows
-                    .iter()
-                    .filter(|r| {
-                        r.sampler == sampler.name() && r.region == region && r.excluded_from_fit
-                    })
-                    .map(|r| r.n)
-                    .collect(),
+                excluded: excluded.iter().map(|r| r.n).collect(),
             });
         }
     }
     out
 }
 
+/// The samplers compared with random: every other one, when random is studied; none otherwise.
+pub(crate) fn against_random(samplers: &[LightSampler]) -> impl Iterator<Item = LightSampler> {
+    let random = samplers.contains(&LightSampler::Random);
+    samplers
+        .iter()
+        .copied()
+        .filter(move |&s| random && s != LightSampler::Random)
+}
+
 /// One matching budget per (sampler other than random, region), when random was studied.
 pub(crate) fn matching(rows: &[Row], samplers: &[LightSampler], k: usize) -> Vec<Matching> {
     let mut out = Vec::new();
-    if !samplers.contains(&LightSampler::Random) {
-        return out;
-    }
-    for &sampler in samplers.iter().filter(|&&s| s != LightSampler::Random) {
+    for sampler in against_random(samplers) {
         for region in Region::ALL {
             let (random, other) = (
                 fitted(rows, LightSampler::Random, region),
@@ -175,27 +178,34 @@ pub(crate) fn matching(rows: &[Row], samplers: &[LightSampler], k: usize) -> Vec
 }
 
 /// Efficiency 1/(mean MSE × median time) of `row` on the seeds `idx`.
-fn efficiency_at(row: &Row, idx: &[usize]) -> f64 {
+pub(crate) fn efficiency_at(row: &Row, idx: &[usize]) -> f64 {
     let t: Vec<f64> = idx.iter().map(|&i| row.seed_seconds[i]).collect();
     1.0 / (mean_at(&row.seed_mse, Some(idx)) * median(&t).max(1e-12))
 }
 
-/// Fills every row's error reduction (random's MSE over its own) and efficiency relative to
-/// random's, at the same N and region, with their intervals (the same seeds resampled for
-/// both: seed k of every sampler ran in round k, so a slow round slows both).
-pub(crate) fn ratios_to_random(rows: &mut [Row], k: usize) {
+/// Calls `f` with every row that random has a row beside (at the same N and region), and a
+/// copy of that row of random's taken before any row changed.
+pub(crate) fn with_random(rows: &mut [Row], mut f: impl FnMut(&mut Row, &Row)) {
     let random: Vec<Row> = rows
         .iter()
         .filter(|r| r.sampler == LightSampler::Random.name())
         .cloned()
         .collect();
     for row in rows.iter_mut() {
-        let Some(base) = random
+        if let Some(base) = random
             .iter()
             .find(|r| r.n == row.n && r.region == row.region)
-        else {
-            continue;
-        };
+        {
+            f(row, base);
+        }
+    }
+}
+
+/// Fills every row's error reduction (random's MSE over its own) and efficiency relative to
+/// random's, at the same N and region, with their intervals (the same seeds resampled for
+/// both: seed k of every sampler ran in round k, so a slow round slows both).
+pub(crate) fn ratios_to_random(rows: &mut [Row], k: usize) {
+    with_random(rows, |row, base| {
         row.efficiency_vs_random = Some(row.efficiency / base.efficiency);
         row.error_reduction = Some(base.stats.mse / row.stats.mse);
         let this: &Row = row;
@@ -205,5 +215,5 @@ pub(crate) fn ratios_to_random(rows: &mut [Row], k: usize) {
         });
         row.efficiency_vs_random_interval = efficiency;
         row.error_reduction_interval = error;
-    }
+    });
 }

@@ -39,81 +39,54 @@ pub fn penumbra_mask(scene: &Scene, settings: &RenderSettings, points: u32) -> R
     let end_offsets: Vec<f32> = scene.lights.iter().map(light_offset).collect();
     let camera = CameraRays::new(&scene.camera, settings.width, settings.height);
     let pixels = settings.width * settings.height;
-    let classes: Vec<(bool, bool)> = (0..pixels)
-        .into_par_iter()
-        .map(|pixel| {
-            classify(
-                scene,
-                settings,
-                &accel,
-                &camera,
-                &end_offsets,
-                pixel,
-                points,
-            )
-        })
-        .collect();
+    // Per pixel: (penumbra, lit).
+    let classify = |pixel: u32| {
+        let (x, y) = camera.screen(pixel, 0.5, 0.5);
+        let mut ray = camera.ray(x, y);
+        let mut penumbra = false;
+        let mut lit = true;
+        let mut any_hit = false;
+        for bounce in 0..=settings.bounces {
+            let hit = accel.closest(scene, &ray, f32::INFINITY, settings.two_sided);
+            if !hit.is_hit() {
+                break;
+            }
+            any_hit = true;
+            let surface = surface_hit(scene, hit.prim, &ray, hit.t, settings.two_sided);
+            for (li, light) in scene.lights.iter().enumerate() {
+                let key = SampleKey {
+                    pixel,
+                    sample: 0,
+                    bounce,
+                    light: li as u32,
+                    seed: 0x6d61_736b,
+                };
+                let end = light_end(light, end_offsets[li], &surface);
+                let set = PointSet::of(LightSampler::Stratified, points);
+                let visible = (0..points)
+                    .filter(|&j| {
+                        let (u, v) = set.point(&key, j);
+                        // Spawned as the renderers spawn it: no ray below the tangent plane.
+                        let shadow = shadow_ray(&surface, light.point(u, v), &end);
+                        shadow.is_some_and(|s| {
+                            !accel.occluded(scene, &s.ray, s.tmax, settings.two_sided)
+                        })
+                    })
+                    .count() as u32;
+                penumbra |= visible > 0 && visible < points;
+                lit &= visible == points;
+            }
+            if !scene.material_of(hit.prim).is_reflective() {
+                break;
+            }
+            ray = mirror_ray(&surface, ray.direction);
+        }
+        // Without lights nothing is lit (every light fully visible would be vacuously true).
+        (penumbra, lit && any_hit && !scene.lights.is_empty())
+    };
+    let classes: Vec<(bool, bool)> = (0..pixels).into_par_iter().map(classify).collect();
     Regions {
         penumbra: classes.iter().map(|c| c.0).collect(),
         lit: classes.iter().map(|c| c.1).collect(),
     }
-}
-
-fn classify(
-    scene: &Scene,
-    settings: &RenderSettings,
-    accel: &Accel,
-    camera: &CameraRays,
-    end_offsets: &[f32],
-    pixel: u32,
-    points: u32,
-) -> (bool, bool) {
-    let (x, y) = camera.screen(pixel, 0.5, 0.5);
-    let mut ray = camera.ray(x, y);
-    let mut penumbra = false;
-    let mut lit = true;
-    let mut any_hit = false;
-    for bounce in 0..=settings.bounces {
-        let hit = accel.closest(scene, &ray, f32::INFINITY, settings.two_sided);
-        if !hit.is_hit() {
-            break;
-        }
-        any_hit = true;
-        let surface = surface_hit(scene, hit.prim, &ray, hit.t, settings.two_sided);
-        for (li, light) in scene.lights.iter().enumerate() {
-            let key = SampleKey {
-                pixel,
-                sample: 0,
-                bounce,
-                light: li as u32,
-                seed: 0x6d61_736b,
-            };
-            let end = light_end(light, end_offsets[li], &surface);
-            let mut visible = 0;
-            let set = PointSet::of(LightSampler::Stratified, points);
-            for j in 0..points {
-                let (u, v) = set.point(&key, j);
-                // Spawned as the renderers spawn it: no ray below the tangent plane.
-                let shadow = shadow_ray(&surface, light.point(u, v), &end);
-                if shadow
-                    .is_some_and(|s| !accel.occluded(scene, &s.ray, s.tmax, settings.two_sided))
-                {
-                    visible += 1;
-                }
-            }
-            if visible > 0 && visible < points {
-                penumbra = true;
-            }
-            if visible < points {
-                lit = false;
-            }
-        }
-        let material = scene.material_of(hit.prim);
-        if !material.is_reflective() {
-            break;
-        }
-        ray = mirror_ray(&surface, ray.direction);
-    }
-    // Without lights nothing is lit (every light fully visible would be vacuously true).
-    (penumbra, lit && any_hit && !scene.lights.is_empty())
 }

@@ -3,9 +3,8 @@
 //! 95% interval (bootstrap over seeds, as every figure of the study), and the low band as a
 //! ratio to random's on the same seeds.
 
-use crate::render::sampling::LightSampler;
 use crate::variance::Row;
-use crate::variance::figures::fits::{interval, mean_at};
+use crate::variance::figures::fits::{interval, mean_at, with_random};
 use crate::variance::figures::spectrum::{LOWPASS_SIGMAS, RINGS, lowpass_mse, radial_power};
 use glam::Vec3;
 use serde::Serialize;
@@ -102,36 +101,18 @@ pub fn measure(
 
 /// Fills every row's low band relative to random's at the same N and region.
 pub(crate) fn low_band_vs_random(rows: &mut [Row], k: usize) {
-    let random: Vec<(u32, crate::variance::Region, Vec<f64>, f64)> = rows
-        .iter()
-        .filter(|r| r.sampler == LightSampler::Random.name())
-        .map(|r| {
-            (
-                r.n,
-                r.region,
-                r.perceived.seed_low_band.clone(),
-                r.perceived.low_band_power,
-            )
-        })
-        .collect();
-    for row in rows.iter_mut() {
-        let Some((_, _, base_seeds, base)) = random
-            .iter()
-            .find(|(n, region, _, _)| *n == row.n && *region == row.region)
-        else {
-            continue;
-        };
-        let p = &mut row.perceived;
+    with_random(rows, |row, random| {
+        let (p, base) = (&mut row.perceived, &random.perceived);
         // An empty region measured nothing: no seeds to resample.
-        if p.seed_low_band.len() != k || base_seeds.len() != k {
-            continue;
+        if p.seed_low_band.len() != k || base.seed_low_band.len() != k {
+            return;
         }
-        if *base > 0.0 {
-            p.low_band_vs_random = Some(p.low_band_power / base);
+        if base.low_band_power > 0.0 {
+            p.low_band_vs_random = Some(p.low_band_power / base.low_band_power);
         }
         let seeds = &p.seed_low_band;
         p.low_band_vs_random_interval = interval(k, |idx| {
-            mean_at(seeds, Some(idx)) / mean_at(base_seeds, Some(idx))
+            mean_at(seeds, Some(idx)) / mean_at(&base.seed_low_band, Some(idx))
         });
-    }
+    });
 }

@@ -102,22 +102,15 @@ pub fn radial_power(error: &[f64], width: usize, height: usize, region: &[bool])
             }
         }
     }
+    let mean = |s: f64, c: usize| if c == 0 { f64::NAN } else { s / c as f64 };
     Some(Radial {
         power: sums
             .iter()
             .zip(&counts)
-            .map(|(&s, &c)| if c == 0 { f64::NAN } else { s / c as f64 })
+            .map(|(&s, &c)| mean(s, c))
             .collect(),
-        low_band: if low_count == 0 {
-            f64::NAN
-        } else {
-            low_sum / low_count as f64
-        },
-        all_band: if all_count == 0 {
-            f64::NAN
-        } else {
-            all_sum / all_count as f64
-        },
+        low_band: mean(low_sum, low_count),
+        all_band: mean(all_sum, all_count),
     })
 }
 

@@ -1,9 +1,10 @@
 //! The perceived-error part of a study's report: a table of each sampler's low-pass error and
 //! low band against random's, per budget and region, and the CSV files behind the spectra.
 
+use crate::variance::StudyResult;
 use crate::variance::figures::spectrum::{LOWPASS_SIGMAS, RINGS, ring_frequency};
 use crate::variance::report::spectrum_plot::REGIONS;
-use crate::variance::{Region, StudyResult};
+use crate::variance::report::tables::{iv_cells, with_interval};
 use std::fmt::Write;
 
 /// `v` with its interval, scientific: `6.4e-5 [6.1e-5, 6.8e-5]`; `-` for a figure with nothing
@@ -12,10 +13,7 @@ fn sci(v: f64, iv: Option<[f64; 2]>) -> String {
     if !v.is_finite() {
         return "-".into();
     }
-    match iv {
-        Some([a, b]) => format!("{v:.2e} [{a:.1e}, {b:.1e}]"),
-        None => format!("{v:.2e} [-]"),
-    }
+    with_interval(format!("{v:.2e}"), iv, |x| format!("{x:.1e}"))
 }
 
 /// `v` with its interval, fixed: `0.42 [0.31, 0.55]`; `-` as for [`sci`].
@@ -23,18 +21,7 @@ fn fixed(v: f64, iv: Option<[f64; 2]>) -> String {
     if !v.is_finite() {
         return "-".into();
     }
-    match iv {
-        Some([a, b]) => format!("{v:.2} [{a:.2}, {b:.2}]"),
-        None => format!("{v:.2} [-]"),
-    }
-}
-
-/// An interval as two CSV cells, empty without one.
-fn iv_cells(iv: Option<[f64; 2]>) -> String {
-    match iv {
-        Some([a, b]) => format!("{a:e},{b:e}"),
-        None => ",".to_string(),
-    }
+    with_interval(format!("{v:.2}"), iv, |x| format!("{x:.2}"))
 }
 
 impl StudyResult {
@@ -52,8 +39,7 @@ impl StudyResult {
             LOWPASS_SIGMAS[0], LOWPASS_SIGMAS[1]
         );
         for region in REGIONS {
-            let i = Region::ALL.iter().position(|&r| r == region).unwrap_or(0);
-            if self.region_pixels[i] == 0 {
+            if self.region_pixels[region as usize] == 0 {
                 continue;
             }
             let _ = writeln!(s, "\n{}", region.name());

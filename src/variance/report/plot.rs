@@ -63,6 +63,12 @@ pub(crate) fn log_range(
     }
 }
 
+/// `v` and the ends of its interval (`v` again without one), for an axis's range.
+pub(crate) fn with_ends(v: f64, iv: Option<[f64; 2]>) -> [f64; 3] {
+    let [a, b] = iv.unwrap_or([v; 2]);
+    [v, a, b]
+}
+
 /// One panel: MSE of every sampler in `region` against `axis`, with 95% intervals.
 fn panel(
     area: &DrawingArea<BitMapBackend, Shift>,
@@ -76,33 +82,23 @@ fn panel(
         .iter()
         .filter(|r| r.region == region && r.stats.mse > 0.0)
         .collect();
-    let (y_lo, y_hi) = log_range(
-        rows.iter().flat_map(|r| {
-            let [a, b] = r.mse_interval.unwrap_or([r.stats.mse; 2]);
-            [r.stats.mse, a, b]
-        }),
-        1.6,
-        (1e-6, 1.0),
-    );
-    let (x_lo, x_hi) = log_range(
-        rows.iter().flat_map(|r| {
-            let (x, iv) = x_of(r, axis);
-            let [a, b] = iv.unwrap_or([x; 2]);
-            [x, a, b]
-        }),
-        1.5,
-        (0.5, 400.0),
-    );
-    let i = Region::ALL.iter().position(|&r| r == region).unwrap_or(0);
-    let what = match axis {
-        Axis::Budget => "MSE against N",
-        Axis::Time => "MSE against time",
+    let y_values = rows
+        .iter()
+        .flat_map(|r| with_ends(r.stats.mse, r.mse_interval));
+    let (y_lo, y_hi) = log_range(y_values, 1.6, (1e-6, 1.0));
+    let x_values = rows.iter().flat_map(|r| {
+        let (x, iv) = x_of(r, axis);
+        with_ends(x, iv)
+    });
+    let (x_lo, x_hi) = log_range(x_values, 1.5, (0.5, 400.0));
+    let (what, x_desc) = match axis {
+        Axis::Budget => ("MSE against N", "light samples N"),
+        Axis::Time => ("MSE against time", "ms per image (median)"),
     };
+    let pixels = result.region_pixels[region as usize];
+    let title = format!("{}: {what} ({pixels} px)", region.name());
     let mut chart = ChartBuilder::on(area)
-        .caption(
-            format!("{}: {what} ({} px)", region.name(), result.region_pixels[i]),
-            ("sans-serif", 20),
-        )
+        .caption(title, ("sans-serif", 20))
         .margin(12)
         .x_label_area_size(40)
         .y_label_area_size(70)
@@ -110,10 +106,7 @@ fn panel(
         .map_err(err)?;
     chart
         .configure_mesh()
-        .x_desc(match axis {
-            Axis::Budget => "light samples N",
-            Axis::Time => "ms per image (median)",
-        })
+        .x_desc(x_desc)
         .y_desc("MSE")
         .y_label_formatter(&|y| format!("{y:.0e}"))
         .x_label_formatter(&|x| {
@@ -148,41 +141,23 @@ fn panel(
             })
             .filter(|_| axis == Axis::Budget)
             .unwrap_or_default();
+        let label = format!("{}{slope}", sampler.name());
         // The lab's strategy draws random's points for N > 1: dash it so both show.
-        let series = if *sampler == LightSampler::Lab {
-            chart.draw_series(DashedLineSeries::new(
-                pts.clone(),
-                8,
-                6,
-                colour.stroke_width(2),
-            ))
-        } else {
-            chart.draw_series(LineSeries::new(pts.clone(), colour.stroke_width(2)))
-        };
-        series
-            .map_err(err)?
-            .label(format!("{}{slope}", sampler.name()))
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
-            });
+        let dashed = *sampler == LightSampler::Lab;
+        line(&mut chart, pts.clone(), colour, dashed, label)?;
         chart
             .draw_series(pts.iter().map(|&p| Circle::new(p, 4, colour.filled())))
             .map_err(err)?;
         // 95% intervals: MSE vertically, time horizontally.
+        let bar = |ends: Vec<(f64, f64)>| PathElement::new(ends, colour);
         let mut bars = Vec::new();
         for r in &mine {
-            let (x, x_iv) = x_of(r, axis);
+            let ((x, x_iv), y) = (x_of(r, axis), r.stats.mse);
             if let Some([a, b]) = r.mse_interval {
-                bars.push(PathElement::new(
-                    vec![(x, a.max(y_lo)), (x, b.min(y_hi))],
-                    colour,
-                ));
+                bars.push(bar(vec![(x, a.max(y_lo)), (x, b.min(y_hi))]));
             }
             if let Some([a, b]) = x_iv {
-                bars.push(PathElement::new(
-                    vec![(a.max(x_lo), r.stats.mse), (b.min(x_hi), r.stats.mse)],
-                    colour,
-                ));
+                bars.push(bar(vec![(a.max(x_lo), y), (b.min(x_hi), y)]));
             }
         }
         chart.draw_series(bars).map_err(err)?;
@@ -198,29 +173,63 @@ fn panel(
     Ok(())
 }
 
-/// Draws `mse.png`: MSE against N (top row) and against median time per image (bottom row),
-/// one log-log panel per region (whole, penumbra, lit), 95% intervals as bars.
-pub(crate) fn mse_plot(result: &StudyResult, path: &Path) -> Result<()> {
+/// Draws `pts` as a line of `colour`, solid or dashed, labelled `label` in the legend.
+pub(crate) fn line<X, Y>(
+    chart: &mut ChartContext<BitMapBackend, Cartesian2d<X, Y>>,
+    pts: Vec<(f64, f64)>,
+    colour: RGBColor,
+    dashed: bool,
+    label: String,
+) -> Result<()>
+where
+    X: Ranged<ValueType = f64>,
+    Y: Ranged<ValueType = f64>,
+{
+    let style = colour.stroke_width(2);
+    let series = if dashed {
+        chart.draw_series(DashedLineSeries::new(pts, 8, 6, style))
+    } else {
+        chart.draw_series(LineSeries::new(pts, style))
+    };
+    series
+        .map_err(|e| anyhow!("plot: {e}"))?
+        .label(label)
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+    Ok(())
+}
+
+/// A white `w` × `h` canvas with `draw` drawn on it, as an image.
+pub(crate) fn canvas(
+    (w, h): (u32, u32),
+    draw: impl FnOnce(&DrawingArea<BitMapBackend, Shift>) -> Result<()>,
+) -> Result<image::RgbImage> {
     register_font();
-    let (w, h) = (1500u32, 1040u32);
     let mut buffer = vec![0u8; (w * h * 3) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut buffer, (w, h)).into_drawing_area();
         root.fill(&WHITE).map_err(|e| anyhow!("plot: {e}"))?;
+        draw(&root)?;
+        root.present().map_err(|e| anyhow!("plot: {e}"))?;
+    }
+    image::RgbImage::from_raw(w, h, buffer).context("plot buffer")
+}
+
+/// Draws `mse.png`: MSE against N (top row) and against median time per image (bottom row),
+/// one log-log panel per region (whole, penumbra, lit), 95% intervals as bars.
+pub(crate) fn mse_plot(result: &StudyResult, path: &Path) -> Result<()> {
+    let img = canvas((1500, 1040), |root| {
         let panels = root.split_evenly((2, 3));
         for (j, region) in Region::ALL.iter().enumerate() {
             panel(&panels[j], result, *region, Axis::Budget)?;
             panel(&panels[3 + j], result, *region, Axis::Time)?;
         }
-        root.present().map_err(|e| anyhow!("plot: {e}"))?;
-    }
-    let img = image::RgbImage::from_raw(w, h, buffer).context("plot buffer")?;
+        Ok(())
+    })?;
     write_rgb8(&img, path)
 }
 
-/// Writes `heat_<sampler>_N<n>.png` for every sampler: per-pixel MSE over the seeds on one log
-/// scale shared by all samplers (dark = low error, bright = high), with a title and a
-/// labelled colour bar, so the maps compare directly and each reads on its own.
+/// Writes `heat_<sampler>_N<n>.png` for every sampler: per-pixel MSE over the seeds on the log
+/// scale all samplers share, with a title and a labelled colour bar, so each reads on its own.
 pub(crate) fn heatmaps(result: &StudyResult, dir: &Path) -> Result<Vec<PathBuf>> {
     let Some(scale) = Scale::from_values(result.heatmaps.iter().flat_map(|(_, m)| m), true) else {
         return Ok(Vec::new());
@@ -249,10 +258,9 @@ pub(crate) fn heatmaps(result: &StudyResult, dir: &Path) -> Result<Vec<PathBuf>>
     Ok(written)
 }
 
-/// Per-pixel MSE maps (each `w` × `h`) as images on one shared log scale
-/// ([`false_colour::Scale::from_values`]: the 1st to the 99.9th percentile of all maps' positive
-/// values; dark = low error, bright = high), so that the maps compare directly; also returns
-/// that scale as (lo, hi) in log10. `None` when no map has a positive value.
+/// Per-pixel MSE maps (each `w` × `h`) as images on one shared log scale (the 1st to the 99.9th
+/// percentile of all maps' positive values, [`false_colour::Scale::from_values`]), and that
+/// scale as (lo, hi) in log10. `None` when no map has a positive value.
 pub(crate) fn heat_images(
     maps: &[&[f32]],
     w: u32,

@@ -13,6 +13,7 @@
 
 use crate::output::false_colour::register_font;
 use crate::output::image_file::write_rgb8;
+use crate::render::sampling::LightSampler;
 use crate::variance::StudyResult;
 use anyhow::{Result, anyhow};
 use image::RgbImage;
@@ -58,15 +59,14 @@ pub fn contact_sheet(
     register_font();
     let factor = MIN_TILE.div_ceil(w.min(h)).max(1);
     let (tw, th) = (w * factor, h * factor);
-    let n_cols = cols.len() as u32;
-    let n_rows = rows.len() as u32;
-    let sw = LABEL_WIDTH + n_cols * (tw + GAP) + GAP;
-    let sh = TITLE_HEIGHT + HEADER_HEIGHT + n_rows * (th + GAP) + GAP;
+    // The left edge of column `c` and the top of row `r`; one past the last, the sheet's size.
+    let col_x = |c: usize| LABEL_WIDTH + c as u32 * (tw + GAP) + GAP;
+    let row_y = |r: usize| TITLE_HEIGHT + HEADER_HEIGHT + r as u32 * (th + GAP) + GAP;
+    let (sw, sh) = (col_x(cols.len()), row_y(rows.len()));
     let mut buffer = vec![255u8; (sw as usize) * (sh as usize) * 3];
     for (r, row) in images.iter().enumerate() {
         for (c, img) in row.iter().enumerate() {
-            let x0 = LABEL_WIDTH + c as u32 * (tw + GAP) + GAP;
-            let y0 = TITLE_HEIGHT + HEADER_HEIGHT + r as u32 * (th + GAP) + GAP;
+            let (x0, y0) = (col_x(c), row_y(r));
             for y in 0..th {
                 for x in 0..tw {
                     let px = img.get_pixel(x / factor, y / factor).0;
@@ -84,12 +84,15 @@ pub fn contact_sheet(
             .map_err(err)?;
         let label_style = ("sans-serif", 15).into_font().color(&BLACK);
         for (c, label) in cols.iter().enumerate() {
-            let x = LABEL_WIDTH + c as u32 * (tw + GAP) + GAP;
-            root.draw_text(label, &label_style, (x as i32, (TITLE_HEIGHT + 4) as i32))
-                .map_err(err)?;
+            root.draw_text(
+                label,
+                &label_style,
+                (col_x(c) as i32, (TITLE_HEIGHT + 4) as i32),
+            )
+            .map_err(err)?;
         }
         for (r, label) in rows.iter().enumerate() {
-            let y = TITLE_HEIGHT + HEADER_HEIGHT + r as u32 * (th + GAP) + GAP + th / 2;
+            let y = row_y(r) + th / 2;
             root.draw_text(label, &label_style, (GAP as i32, y as i32 - 8))
                 .map_err(err)?;
         }
@@ -101,26 +104,21 @@ pub fn contact_sheet(
 /// Writes the study's contact sheet (its warm-up renders, seed 0) to `path`; false when the
 /// study kept no renders.
 pub fn write(result: &StudyResult, path: &Path) -> Result<bool> {
-    let samplers = &result.config.samplers;
-    let budgets = &result.config.budgets;
-    let mut images = Vec::new();
-    for s in samplers {
-        let mut row = Vec::new();
-        for n in budgets {
-            match result
-                .thumbnails
-                .iter()
-                .find(|(ts, tn, _)| ts == s && tn == n)
-            {
-                Some((_, _, img)) => row.push(img),
-                None => return Ok(false),
-            }
-        }
-        images.push(row);
-    }
-    if images.is_empty() {
+    let (samplers, budgets) = (&result.config.samplers, &result.config.budgets);
+    let thumbnail = |s: &LightSampler, n: &u32| {
+        let found = result
+            .thumbnails
+            .iter()
+            .find(|(ts, tn, _)| ts == s && tn == n);
+        found.map(|(_, _, img)| img)
+    };
+    let images: Option<Vec<Vec<&RgbImage>>> = samplers
+        .iter()
+        .map(|s| budgets.iter().map(|n| thumbnail(s, n)).collect())
+        .collect();
+    let Some(images) = images.filter(|i| !i.is_empty()) else {
         return Ok(false);
-    }
+    };
     let title = format!(
         "seed 0, {}×{}: {}",
         result.config.base.width, result.config.base.height, result.scene

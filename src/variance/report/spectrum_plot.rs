@@ -3,14 +3,13 @@
 //! interval as a band, the low band (|f| ≤ 1/8) marked. A blue-noise error is a curve that
 //! starts low and rises; white noise is flat.
 
-use crate::output::false_colour::register_font;
 use crate::output::image_file::write_rgb8;
 use crate::render::sampling::LightSampler;
 use crate::variance::figures::perceived::Perceived;
 use crate::variance::figures::spectrum::{LOW_BAND, RINGS, ring_frequency};
-use crate::variance::report::plot::{PALETTE, log_range};
+use crate::variance::report::plot::{PALETTE, canvas, line, log_range, with_ends};
 use crate::variance::{Region, StudyResult};
-use anyhow::{Context, Result, anyhow};
+use anyhow::{Result, anyhow};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
@@ -25,22 +24,15 @@ pub(crate) fn file_name(n: u32) -> String {
 
 /// Writes one `spectrum_N<n>.png` per budget into `dir`; returns the paths written.
 pub(crate) fn spectra(result: &StudyResult, dir: &Path) -> Result<Vec<PathBuf>> {
-    register_font();
     let mut written = Vec::new();
     for &n in &result.config.budgets {
-        let path = dir.join(file_name(n));
-        let (w, h) = (1400u32, 560u32);
-        let mut buffer = vec![0u8; (w * h * 3) as usize];
-        {
-            let root = BitMapBackend::with_buffer(&mut buffer, (w, h)).into_drawing_area();
-            root.fill(&WHITE).map_err(|e| anyhow!("plot: {e}"))?;
-            let panels = root.split_evenly((1, 2));
-            for (area, region) in panels.iter().zip(REGIONS) {
+        let img = canvas((1400, 560), |root| {
+            for (area, region) in root.split_evenly((1, 2)).iter().zip(REGIONS) {
                 panel(area, result, n, region)?;
             }
-            root.present().map_err(|e| anyhow!("plot: {e}"))?;
-        }
-        let img = image::RgbImage::from_raw(w, h, buffer).context("plot buffer")?;
+            Ok(())
+        })?;
+        let path = dir.join(file_name(n));
         write_rgb8(&img, &path)?;
         written.push(path);
     }
@@ -62,11 +54,10 @@ fn panel(
     n: u32,
     region: Region,
 ) -> Result<()> {
-    let i = Region::ALL.iter().position(|&r| r == region).unwrap_or(0);
     let title = format!(
         "{}: error spectrum at N = {n} ({} px)",
         region.name(),
-        result.region_pixels[i]
+        result.region_pixels[region as usize]
     );
     let curves: Vec<Curve> = result
         .config
@@ -104,11 +95,7 @@ pub(crate) fn comparison_image(
     n: u32,
     (width, height): (u32, u32),
 ) -> Result<image::RgbImage> {
-    register_font();
-    let mut buffer = vec![0u8; (width * height * 3) as usize];
-    {
-        let root = BitMapBackend::with_buffer(&mut buffer, (width, height)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| anyhow!("plot: {e}"))?;
+    canvas((width, height), |root| {
         let curves: Vec<Curve> = sides
             .iter()
             .enumerate()
@@ -124,10 +111,8 @@ pub(crate) fn comparison_image(
                 perceived: p,
             })
             .collect();
-        draw_curves(&root, &format!("error spectra at N = {n}"), &curves)?;
-        root.present().map_err(|e| anyhow!("plot: {e}"))?;
-    }
-    image::RgbImage::from_raw(width, height, buffer).context("plot buffer")
+        draw_curves(root, &format!("error spectra at N = {n}"), &curves)
+    })
 }
 
 /// Draws `curves` (radially averaged power against frequency, log power) with their bands and
@@ -138,20 +123,15 @@ fn draw_curves(
     curves: &[Curve],
 ) -> Result<()> {
     let err = |e| anyhow!("plot: {e}");
-    let (y_lo, y_hi) = log_range(
-        curves.iter().flat_map(|c| {
-            let p = c.perceived;
-            p.spectrum_interval
-                .iter()
-                .zip(&p.spectrum)
-                .flat_map(|(iv, v)| {
-                    let [a, b] = iv.unwrap_or([*v; 2]);
-                    [*v, a, b]
-                })
-        }),
-        1.5,
-        (1e-8, 1.0),
-    );
+    let values = curves.iter().flat_map(|c| {
+        let p = c.perceived;
+        let ends = p.spectrum_interval.iter();
+        p.spectrum
+            .iter()
+            .zip(ends)
+            .flat_map(|(v, iv)| with_ends(*v, *iv))
+    });
+    let (y_lo, y_hi) = log_range(values, 1.5, (1e-8, 1.0));
     let mut chart = ChartBuilder::on(area)
         .caption(title, ("sans-serif", 20))
         .margin(12)
@@ -197,17 +177,7 @@ fn draw_curves(
                 )))
                 .map_err(err)?;
         }
-        let series = if curve.dashed {
-            chart.draw_series(DashedLineSeries::new(pts, 8, 6, colour.stroke_width(2)))
-        } else {
-            chart.draw_series(LineSeries::new(pts, colour.stroke_width(2)))
-        };
-        series
-            .map_err(err)?
-            .label(curve.label.clone())
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
-            });
+        line(&mut chart, pts, colour, curve.dashed, curve.label.clone())?;
     }
     chart
         .configure_series_labels()

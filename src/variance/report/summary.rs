@@ -14,8 +14,9 @@
 
 use crate::render::sampling::LightSampler;
 use crate::stats::{BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, grouped_bootstrap_interval};
-use crate::variance::figures::fits::{fit_rows, fitted, mean_at};
-use crate::variance::{Region, Row, StudyResult};
+use crate::variance::figures::fits::{against_random, fit_rows, fitted, mean_at};
+use crate::variance::report::tables::write_text;
+use crate::variance::{Region, Row, StudyResult, unique};
 use anyhow::{Context, Result};
 use serde::Serialize;
 use std::fmt::Write as _;
@@ -54,7 +55,7 @@ pub struct RatioAcross {
 }
 
 /// The summary across cases.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Default, Serialize)]
 pub struct Summary {
     /// The cases' names, in order.
     pub cases: Vec<String>,
@@ -74,14 +75,16 @@ fn interval(sizes: &[usize], stat: impl FnMut(&[Vec<usize>]) -> f64) -> Option<[
         .map(|(a, b)| [a, b])
 }
 
+/// The geometric mean of `values` (1 for none).
+fn geomean(values: impl Iterator<Item = f64>) -> f64 {
+    let (sum, count) = values.fold((0.0, 0usize), |(s, c), v| (s + v.ln(), c + 1));
+    (sum / count.max(1) as f64).exp()
+}
+
 /// The summary of `cases` (named `names`), which share samplers, budgets and seeds.
 pub fn summarize(names: &[String], cases: &[StudyResult]) -> Summary {
     let Some(first) = cases.first() else {
-        return Summary {
-            cases: Vec::new(),
-            slopes: Vec::new(),
-            ratios: Vec::new(),
-        };
+        return Summary::default();
     };
     let config = &first.config;
     let sizes: Vec<usize> = cases.iter().map(|c| c.config.seeds as usize).collect();
@@ -121,54 +124,43 @@ pub fn summarize(names: &[String], cases: &[StudyResult]) -> Summary {
     }
     let mut ratios = Vec::new();
     let random = LightSampler::Random.name();
-    if config.samplers.contains(&LightSampler::Random) {
-        for &sampler in config
-            .samplers
-            .iter()
-            .filter(|&&s| s != LightSampler::Random)
-        {
-            for &n in &config.budgets {
-                for region in Region::ALL {
-                    let pairs: Vec<Option<(&Row, &Row)>> = cases
-                        .iter()
-                        .map(|c| {
-                            row(&c.rows, random, n, region)
-                                .zip(row(&c.rows, sampler.name(), n, region))
-                                .filter(|(b, r)| b.stats.mse > 0.0 && r.stats.mse > 0.0)
-                        })
-                        .collect();
-                    let per_case: Vec<Option<f64>> = pairs
-                        .iter()
-                        .map(|p| p.map(|(b, r)| b.stats.mse / r.stats.mse))
-                        .collect();
-                    let geomean = |values: &mut dyn Iterator<Item = f64>| {
-                        let (sum, count) =
-                            values.fold((0.0, 0usize), |(s, c), v| (s + v.ln(), c + 1));
-                        (sum / count.max(1) as f64).exp()
-                    };
-                    let geometric_mean = per_case
-                        .iter()
-                        .copied()
-                        .collect::<Option<Vec<f64>>>()
-                        .map(|v| geomean(&mut v.into_iter()));
-                    let interval = geometric_mean.and_then(|_| {
-                        interval(&sizes, |idx| {
-                            geomean(&mut pairs.iter().zip(idx).map(|(p, i)| {
-                                p.map_or(f64::NAN, |(b, r)| {
-                                    mean_at(&b.seed_mse, Some(i)) / mean_at(&r.seed_mse, Some(i))
-                                })
-                            }))
-                        })
-                    });
-                    ratios.push(RatioAcross {
-                        sampler: sampler.name(),
-                        n,
-                        region,
-                        per_case,
-                        geometric_mean,
-                        interval,
-                    });
-                }
+    for sampler in against_random(&config.samplers) {
+        for &n in &config.budgets {
+            for region in Region::ALL {
+                let pairs: Vec<Option<(&Row, &Row)>> = cases
+                    .iter()
+                    .map(|c| {
+                        row(&c.rows, random, n, region)
+                            .zip(row(&c.rows, sampler.name(), n, region))
+                            .filter(|(b, r)| b.stats.mse > 0.0 && r.stats.mse > 0.0)
+                    })
+                    .collect();
+                let per_case: Vec<Option<f64>> = pairs
+                    .iter()
+                    .map(|p| p.map(|(b, r)| b.stats.mse / r.stats.mse))
+                    .collect();
+                let geometric_mean = per_case
+                    .iter()
+                    .copied()
+                    .collect::<Option<Vec<f64>>>()
+                    .map(|v| geomean(v.into_iter()));
+                let interval = geometric_mean.and_then(|_| {
+                    interval(&sizes, |idx| {
+                        geomean(pairs.iter().zip(idx).map(|(p, i)| {
+                            p.map_or(f64::NAN, |(b, r)| {
+                                mean_at(&b.seed_mse, Some(i)) / mean_at(&r.seed_mse, Some(i))
+                            })
+                        }))
+                    })
+                });
+                ratios.push(RatioAcross {
+                    sampler: sampler.name(),
+                    n,
+                    region,
+                    per_case,
+                    geometric_mean,
+                    interval,
+                });
             }
         }
     }
@@ -238,12 +230,8 @@ impl Summary {
             for x in self.slopes.iter().filter(|x| x.region == region) {
                 let _ = writeln!(s, "  {:<10} {}", x.sampler, figure(x.mean, x.interval));
             }
-            let mut samplers: Vec<&str> = Vec::new();
-            for x in self.ratios.iter().filter(|x| x.region == region) {
-                if !samplers.contains(&x.sampler) {
-                    samplers.push(x.sampler);
-                }
-            }
+            let ratios = self.ratios.iter().filter(|x| x.region == region);
+            let samplers = unique(ratios.map(|x| x.sampler));
             if samplers.is_empty() {
                 continue;
             }
@@ -272,47 +260,21 @@ impl Summary {
             let _ = write!(s, ",{c}");
         }
         s.push('\n');
-        let mut line = |kind: &str,
-                        sampler: &str,
-                        n: String,
-                        region: Region,
-                        v: Option<f64>,
-                        iv: Option<[f64; 2]>,
-                        per: &[Option<f64>]| {
-            let _ = write!(
-                s,
-                "{kind},{sampler},{n},{},{},{},{}",
-                region.name(),
-                opt(v),
-                opt(iv.map(|i| i[0])),
-                opt(iv.map(|i| i[1]))
-            );
+        let mut line = |head: String, v: Option<f64>, iv: Option<[f64; 2]>, per: &[Option<f64>]| {
+            let [low, high] = iv.map_or([None; 2], |[a, b]| [Some(a), Some(b)]);
+            let _ = write!(s, "{head},{},{},{}", opt(v), opt(low), opt(high));
             for p in per {
                 let _ = write!(s, ",{}", opt(*p));
             }
             s.push('\n');
         };
         for x in &self.slopes {
-            line(
-                "slope",
-                x.sampler,
-                String::new(),
-                x.region,
-                x.mean,
-                x.interval,
-                &x.per_case,
-            );
+            let head = format!("slope,{},,{}", x.sampler, x.region.name());
+            line(head, x.mean, x.interval, &x.per_case);
         }
         for x in &self.ratios {
-            line(
-                "error_reduction",
-                x.sampler,
-                x.n.to_string(),
-                x.region,
-                x.geometric_mean,
-                x.interval,
-                &x.per_case,
-            );
+            let head = format!("error_reduction,{},{},{}", x.sampler, x.n, x.region.name());
+            line(head, x.geometric_mean, x.interval, &x.per_case);
         }
         s
     }
@@ -326,10 +288,7 @@ impl Summary {
             ("summary.csv", self.csv()),
             ("summary.json", json),
         ] {
-            written.push(crate::variance::report::tables::write_text(
-                &dir.join(name),
-                &body,
-            )?);
+            written.push(write_text(&dir.join(name), &body)?);
         }
         Ok(written)
     }
@@ -338,10 +297,10 @@ impl Summary {
 /// The files a study of several cases writes: per case its report under `NAME/`, then the
 /// summary at the top.
 pub fn file_names(names: &[String], per_case: &[String]) -> Vec<String> {
-    let mut out = Vec::new();
-    for name in names {
-        out.extend(per_case.iter().map(|f| format!("{name}/{f}")));
-    }
+    let in_dirs = names
+        .iter()
+        .flat_map(|n| per_case.iter().map(move |f| format!("{n}/{f}")));
+    let mut out: Vec<String> = in_dirs.collect();
     out.extend(["summary.txt", "summary.csv", "summary.json"].map(String::from));
     out
 }

@@ -3,10 +3,11 @@
 //! `results.json` (schema, version, commit, machine, settings, rows, slopes, matching budgets,
 //! per-seed rows), plus the plots, heat maps and contact sheet.
 
-use super::{plot, sheet};
+use super::{plot, sheet, spectrum_plot};
 use crate::output::machine::Machine;
 use crate::render::sampling::LightSampler;
-use crate::variance::{Region, Row, StudyConfig, StudyResult};
+use crate::variance::figures::fits::{LAB_RANDOM_POINTS, against_random};
+use crate::variance::{Region, Row, StudyConfig, StudyResult, unique};
 use anyhow::{Context, Result};
 use serde::Serialize;
 use std::fmt::Write as _;
@@ -90,16 +91,16 @@ pub fn file_names(samplers: &[LightSampler], budgets: &[u32], heatmap_n: u32) ->
     ]
     .map(String::from)
     .to_vec();
-    for s in samplers {
-        names.push(format!("heat_{}_N{heatmap_n}.png", s.name()));
-    }
-    let mut seen = Vec::new();
-    for &n in budgets {
-        if !seen.contains(&n) {
-            seen.push(n);
-            names.push(crate::variance::report::spectrum_plot::file_name(n));
-        }
-    }
+    names.extend(
+        samplers
+            .iter()
+            .map(|s| format!("heat_{}_N{heatmap_n}.png", s.name())),
+    );
+    names.extend(
+        unique(budgets.iter().copied())
+            .into_iter()
+            .map(spectrum_plot::file_name),
+    );
     names
 }
 
@@ -110,12 +111,6 @@ pub(crate) fn write_text(path: &Path, body: &str) -> Result<PathBuf> {
         Ok(())
     })?;
     Ok(path.to_path_buf())
-}
-
-/// The commit this binary was built from and whether its tree was dirty (embedded by build.rs).
-fn build_commit() -> (String, Option<bool>) {
-    let build = crate::output::build_info::current();
-    (build.commit, build.dirty)
 }
 
 /// One seed's image of a (sampler, N), over one region.
@@ -154,6 +149,11 @@ struct Schema {
     fields: std::collections::BTreeMap<&'static str, &'static str>,
 }
 
+/// A per-region array as a map from the regions' names.
+fn by_region<T>(v: [T; 3]) -> std::collections::BTreeMap<&'static str, T> {
+    Region::ALL.iter().map(|r| r.name()).zip(v).collect()
+}
+
 /// `results.json`.
 #[derive(Serialize)]
 struct Document<'a> {
@@ -174,21 +174,34 @@ struct Document<'a> {
     outputs: std::collections::BTreeMap<String, String>,
 }
 
-/// `v` in scientific notation with its interval: `6.37e-4 [6.1e-4, 6.6e-4]`.
-fn sci_iv(v: f64, iv: Option<[f64; 2]>) -> String {
+/// `v [low, high]`, or `v [-]` without an interval; `end` writes each end.
+pub(crate) fn with_interval(
+    v: String,
+    iv: Option<[f64; 2]>,
+    end: impl Fn(f64) -> String,
+) -> String {
     match iv {
-        Some([a, b]) => format!("{v:.3e} [{}, {}]", end(a, 2), end(b, 2)),
-        None => format!("{v:.3e} [-]"),
+        Some([a, b]) => format!("{v} [{}, {}]", end(a), end(b)),
+        None => format!("{v} [-]"),
     }
 }
 
-/// One end of an interval, scientific with `digits` decimals, `inf` when unbounded.
-fn end(v: f64, digits: usize) -> String {
-    if v.is_finite() {
-        format!("{v:.digits$e}")
-    } else {
-        "inf".to_string()
+/// An interval as two CSV cells, empty without one.
+pub(crate) fn iv_cells(iv: Option<[f64; 2]>) -> String {
+    match iv {
+        Some([a, b]) => format!("{a:e},{b:e}"),
+        None => ",".to_string(),
     }
+}
+
+/// `text`, or `inf` where `x` is not finite (an unbounded end).
+fn or_inf(x: f64, text: String) -> String {
+    if x.is_finite() { text } else { "inf".into() }
+}
+
+/// `v` in scientific notation with its interval: `6.37e-4 [6.1e-4, 6.6e-4]`.
+fn sci_iv(v: f64, iv: Option<[f64; 2]>) -> String {
+    with_interval(format!("{v:.3e}"), iv, |x| or_inf(x, format!("{x:.2e}")))
 }
 
 /// One row of a per-region table: the sampler, then `cell` of the whole image, the penumbra
@@ -206,17 +219,8 @@ fn region_row(s: &mut String, sampler: &str, cell: impl Fn(Region) -> String) {
 
 /// A fixed-point value with its interval: `-1.49 [-1.55, -1.43]`.
 fn fixed_iv(v: f64, iv: Option<[f64; 2]>, digits: usize) -> String {
-    let e = |x: f64| {
-        if x.is_finite() {
-            format!("{x:.digits$}")
-        } else {
-            "inf".to_string()
-        }
-    };
-    match iv {
-        Some([a, b]) => format!("{} [{}, {}]", e(v), e(a), e(b)),
-        None => format!("{} [-]", e(v)),
-    }
+    let e = |x: f64| or_inf(x, format!("{x:.digits$}"));
+    with_interval(e(v), iv, e)
 }
 
 impl StudyResult {
@@ -259,12 +263,7 @@ impl StudyResult {
             "[low, high]: 95% intervals (MSE, efficiency, slopes, budgets: bootstrap over the \
              seeds; time: the median's sign-test interval, from 6 seeds)"
         );
-        let mut hosts: Vec<&str> = Vec::new();
-        for r in &self.rows {
-            if !hosts.contains(&r.host.as_str()) {
-                hosts.push(&r.host);
-            }
-        }
+        let hosts = unique(self.rows.iter().map(|r| r.host.as_str()));
         if hosts.len() > 1 {
             let _ = writeln!(
                 s,
@@ -345,11 +344,7 @@ impl StudyResult {
             "\nslope of log MSE against log N [95%] (points where the sampler ignores the seed, \
              such as lab at N = 1, are bias, not noise, and are left out):"
         );
-        let _ = writeln!(
-            s,
-            "  {:<10} {:<24} {:<24} {:<24}",
-            "sampler", "whole", "penumbra", "lit"
-        );
+        region_row(&mut s, "sampler", |region| region.name().into());
         for sampler in &self.config.samplers {
             let cell = |region: Region| {
                 self.slopes
@@ -365,14 +360,9 @@ impl StudyResult {
                 s,
                 "\nbudget matching the MSE of {} random points (the lab's choice), from the fits \
                  [95%]:",
-                crate::variance::figures::fits::LAB_RANDOM_POINTS
+                LAB_RANDOM_POINTS
             );
-            for sampler in self
-                .config
-                .samplers
-                .iter()
-                .filter(|&&x| x != LightSampler::Random)
-            {
+            for sampler in against_random(&self.config.samplers) {
                 let cell = |region: Region| {
                     self.matching
                         .iter()
@@ -396,10 +386,6 @@ impl StudyResult {
              efficiency_vs_random_low,efficiency_vs_random_high,error_reduction,\
              error_reduction_low,error_reduction_high,host\n",
         );
-        let iv = |i: Option<[f64; 2]>| match i {
-            Some([a, b]) => format!("{a:e},{b:e}"),
-            None => ",".to_string(),
-        };
         for r in &self.rows {
             let _ = writeln!(
                 s,
@@ -409,25 +395,25 @@ impl StudyResult {
                 r.region.name(),
                 r.stats.pixels,
                 r.stats.mse,
-                iv(r.mse_interval),
+                iv_cells(r.mse_interval),
                 r.stats.bias,
                 r.stats.bias_bound,
                 r.stats.variance,
                 r.excluded_from_fit,
                 r.seconds,
-                iv(r.seconds_interval),
+                iv_cells(r.seconds_interval),
                 r.rays,
                 r.rays_per_second,
                 r.efficiency,
-                iv(r.efficiency_interval),
+                iv_cells(r.efficiency_interval),
                 r.efficiency_vs_random
                     .map(|v| format!("{v:e}"))
                     .unwrap_or_default(),
-                iv(r.efficiency_vs_random_interval),
+                iv_cells(r.efficiency_vs_random_interval),
                 r.error_reduction
                     .map(|v| format!("{v:e}"))
                     .unwrap_or_default(),
-                iv(r.error_reduction_interval),
+                iv_cells(r.error_reduction_interval),
                 r.host
             );
         }
@@ -455,14 +441,7 @@ impl StudyResult {
 
     /// `results.json`: the figures with everything needed to read and reproduce them.
     pub fn json(&self) -> Result<String> {
-        let (commit, commit_dirty) = build_commit();
-        let by_region = |v: [f64; 3]| {
-            Region::ALL
-                .iter()
-                .zip(v)
-                .map(|(r, x)| (r.name(), x))
-                .collect()
-        };
+        let build = crate::output::build_info::current();
         let outputs = file_names(&self.config.samplers, &self.config.budgets, self.config.heatmap_n)
             .into_iter()
             .filter(|n| n != "results.json")
@@ -487,8 +466,8 @@ impl StudyResult {
                 fields: SCHEMA.into_iter().collect(),
             },
             raywave_version: env!("CARGO_PKG_VERSION"),
-            commit,
-            commit_dirty,
+            commit: build.commit,
+            commit_dirty: build.dirty,
             created: crate::output::bench_record::now_utc(),
             machine: Machine::current(),
             settings: Settings {
@@ -503,11 +482,7 @@ impl StudyResult {
                     unit: "seed: one resample draws K seeds with replacement, the same for every sampler, budget and region",
                 },
             },
-            region_pixels: Region::ALL
-                .iter()
-                .zip(self.region_pixels)
-                .map(|(r, x)| (r.name(), x))
-                .collect(),
+            region_pixels: by_region(self.region_pixels),
             reference_mse: by_region(self.reference_mse),
             reference_cached: self.reference_cached,
             rows: &self.rows,
@@ -523,16 +498,16 @@ impl StudyResult {
     pub fn write(&self, dir: &Path) -> Result<Vec<PathBuf>> {
         std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
         let mut written = Vec::new();
-        let text = |name: &str, body: String, written: &mut Vec<PathBuf>| -> Result<()> {
+        for (name, body) in [
+            ("table.txt", self.table()),
+            ("results.csv", self.csv()),
+            ("seeds.csv", self.seeds_csv()),
+            ("perceived.csv", self.perceived_csv()),
+            ("spectra.csv", self.spectra_csv()),
+            ("results.json", self.json()?),
+        ] {
             written.push(write_text(&dir.join(name), &body)?);
-            Ok(())
-        };
-        text("table.txt", self.table(), &mut written)?;
-        text("results.csv", self.csv(), &mut written)?;
-        text("seeds.csv", self.seeds_csv(), &mut written)?;
-        text("perceived.csv", self.perceived_csv(), &mut written)?;
-        text("spectra.csv", self.spectra_csv(), &mut written)?;
-        text("results.json", self.json()?, &mut written)?;
+        }
         let plot_path = dir.join("mse.png");
         plot::mse_plot(self, &plot_path)?;
         written.push(plot_path);
@@ -541,7 +516,7 @@ impl StudyResult {
             written.push(sheet_path);
         }
         written.extend(plot::heatmaps(self, dir)?);
-        written.extend(crate::variance::report::spectrum_plot::spectra(self, dir)?);
+        written.extend(spectrum_plot::spectra(self, dir)?);
         Ok(written)
     }
 }

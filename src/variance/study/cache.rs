@@ -15,8 +15,8 @@
 //! Shards of one study on several machines share the cache on a shared filesystem. An entry is
 //! rendered under an exclusive lock on its own `reference-KEY.lock` (`flock`, which NFS v4 and
 //! Lustre honour, and removed by its holder before unlocking), so that the first shard to need
-//! it renders it while the others wait and then read it; a reader never sees half an entry, since an entry is written to a temporary file and
-//! renamed into place.
+//! it renders it while the others wait and then read it; a reader never sees half an entry,
+//! since an entry is written to a temporary file and renamed into place.
 //!
 //! Anything else found at an entry's path (short, long, another magic or format, other
 //! dimensions, a checksum that does not match, a value that is not finite, a directory, a FIFO,
@@ -134,21 +134,13 @@ impl Cache {
         self.dir.join(format!("reference-{key:016x}.rwref"))
     }
 
-    /// The lock file of `key`'s entry.
-    fn lock_path(&self, key: u64) -> PathBuf {
-        self.dir.join(format!("reference-{key:016x}.lock"))
-    }
-
     /// Takes the exclusive lock on `key`'s entry, held until the returned guard is dropped;
     /// calls `waiting` first when another process holds it, then blocks until it is released.
-    /// An error means the filesystem cannot lock (the caller goes on without the lock).
-    ///
-    /// The lock file lives only while it is held: the holder removes it before unlocking, so a
-    /// cache directory holds no lock files between runs. A process that wakes up holding the
-    /// lock on a file that was removed meanwhile (its path now names a new file, or none) lets
-    /// it go and locks the path again.
+    /// An error means the filesystem cannot lock (the caller goes on without the lock). The lock
+    /// file lives only while held, so a process that wakes holding the lock on a removed file
+    /// (its path now names a new file, or none) lets it go and locks the path again.
     pub fn lock(&self, key: u64, waiting: impl FnOnce(&Path)) -> Result<EntryLock> {
-        let path = self.lock_path(key);
+        let path = self.entry_path(key).with_extension("lock");
         std::fs::create_dir_all(&self.dir)
             .with_context(|| format!("cannot create {}", self.dir.display()))?;
         let mut waiting = Some(waiting);
@@ -333,24 +325,18 @@ fn read_entry(
         .map_err(|e| format!("cannot read its header ({e})"))?;
     let u32_at = |i: usize| u32::from_le_bytes(header[i..i + 4].try_into().unwrap_or_default());
     let u64_at = |i: usize| u64::from_le_bytes(header[i..i + 8].try_into().unwrap_or_default());
+    let (format, w, h, made_for) = (u32_at(8), u32_at(12), u32_at(16), u64_at(20));
     if &header[..8] != MAGIC {
         return Err("not a raywave reference (wrong magic bytes)".into());
     }
-    if u32_at(8) != CACHE_FORMAT {
-        return Err(format!(
-            "cache format {}, expected {CACHE_FORMAT}",
-            u32_at(8)
-        ));
+    if format != CACHE_FORMAT {
+        return Err(format!("cache format {format}, expected {CACHE_FORMAT}"));
     }
-    let (w, h) = (u32_at(12), u32_at(16));
     if (w, h) != (width, height) {
         return Err(format!("{w}×{h} pixels, expected {width}×{height}"));
     }
-    if u64_at(20) != key {
-        return Err(format!(
-            "made for key {:016x}, expected {key:016x}",
-            u64_at(20)
-        ));
+    if made_for != key {
+        return Err(format!("made for key {made_for:016x}, expected {key:016x}"));
     }
     let expected = HEADER_LEN + payload_len(width, height);
     if len != expected {
@@ -376,19 +362,13 @@ fn read_entry(
     if bad > 0 {
         return Err(format!("{bad} values are not finite"));
     }
-    let pixels = |half: usize| {
-        let n = width as usize * height as usize;
-        values[half * n * 3..(half + 1) * n * 3]
-            .chunks_exact(3)
-            .map(|c| Vec3::new(c[0], c[1], c[2]))
-            .collect()
-    };
-    let film = |half| Film {
+    let film = |half: &[f32]| Film {
         width,
         height,
-        pixels: pixels(half),
+        pixels: half.chunks_exact(3).map(Vec3::from_slice).collect(),
     };
-    Ok([film(0), film(1)])
+    let (a, b) = values.split_at(values.len() / 2);
+    Ok([film(a), film(b)])
 }
 
 #[cfg(test)]

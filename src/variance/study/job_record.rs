@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 /// A [`JobResult`] with the per-seed values the report leaves out of its rows.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct JobRecord {
-    job: Job,
+    pub(crate) job: Job,
     rows: Vec<RowRecord>,
     heatmap: Option<Vec<f32>>,
     thumbnail: Thumbnail,
@@ -71,12 +71,5 @@ impl From<JobRecord> for JobResult {
             thumbnail: r.thumbnail,
             host: r.host,
         }
-    }
-}
-
-impl JobRecord {
-    /// The job.
-    pub fn job(&self) -> Job {
-        self.job
     }
 }

@@ -129,13 +129,6 @@ pub struct Thumbnail {
     pub rgb: Vec<u8>,
 }
 
-impl Thumbnail {
-    /// As an image.
-    pub fn image(&self) -> Option<image::RgbImage> {
-        image::RgbImage::from_raw(self.width, self.height, self.rgb.clone())
-    }
-}
-
 /// What one job measured.
 #[derive(Clone, Debug)]
 pub struct JobResult {
@@ -151,57 +144,49 @@ pub struct JobResult {
     pub host: String,
 }
 
-/// The timed images of one job.
-struct Measured<'a> {
-    sampler: LightSampler,
-    n: u32,
-    images: Vec<&'a [Vec3]>,
-    times: Vec<f64>,
+/// The rows of `job` from its timed images: their seconds each, and rays per image.
+fn rows_of(
+    job: &Job,
+    images: &[&[Vec3]],
+    times: &[f64],
     rays: u64,
-}
-
-fn rows_of(m: &Measured, reference: &Converged, masks: &[Vec<bool>; 3], host: &str) -> Vec<Row> {
-    let k = m.images.len();
-    let (seconds, lo, hi) = crate::stats::median_with_interval(&m.times);
+    setup: &Setup,
+    host: &str,
+) -> Vec<Row> {
+    let (reference, k) = (&setup.reference, images.len());
+    let (seconds, lo, hi) = crate::stats::median_with_interval(times);
     let seconds_interval = (lo.is_finite() && hi.is_finite()).then_some([lo, hi]);
-    let excluded_sampler = deterministic(m.sampler, m.n);
+    let excluded_sampler = deterministic(job.sampler, job.n);
+    let (width, height) = (
+        reference.film.width as usize,
+        reference.film.height as usize,
+    );
     Region::ALL
         .iter()
-        .zip(masks)
+        .zip(&setup.masks)
         .map(|(region, mask)| {
-            let stats = error_stats(&m.images, &reference.film.pixels, &reference.noise, mask);
-            let (width, height) = (
-                reference.film.width as usize,
-                reference.film.height as usize,
-            );
-            let perceived =
-                perceived::measure(&m.images, &reference.film.pixels, width, height, mask);
-            let per = per_image_errors(&m.images, &reference.film.pixels, mask);
-            let seed_mse: Vec<f64> = per.iter().map(|e| e.0).collect();
-            let seed_bias: Vec<f64> = per.iter().map(|e| e.1).collect();
+            let stats = error_stats(images, &reference.film.pixels, &reference.noise, mask);
+            let perceived = perceived::measure(images, &reference.film.pixels, width, height, mask);
+            let per = per_image_errors(images, &reference.film.pixels, mask);
+            let (seed_mse, seed_bias): (Vec<f64>, Vec<f64>) = per.into_iter().unzip();
             let mse_interval = fits::interval(k, |idx| fits::mean_at(&seed_mse, Some(idx)));
-            let times = &m.times;
-            let efficiency_interval = fits::interval(k, |idx| {
-                let t: Vec<f64> = idx.iter().map(|&i| times[i]).collect();
-                1.0 / (fits::mean_at(&seed_mse, Some(idx)) * crate::stats::median(&t).max(1e-12))
-            });
-            Row {
-                sampler: m.sampler.name(),
-                n: m.n,
+            let mut row = Row {
+                sampler: job.sampler.name(),
+                n: job.n,
                 region: *region,
                 stats,
                 mse_interval,
                 excluded_from_fit: excluded_sampler || (stats.pixels > 0 && stats.variance == 0.0),
                 seconds,
                 seconds_interval,
-                rays: m.rays,
-                rays_per_second: m.rays as f64 / seconds.max(1e-12),
+                rays,
+                rays_per_second: rays as f64 / seconds.max(1e-12),
                 efficiency: if stats.mse > 0.0 {
                     1.0 / (stats.mse * seconds.max(1e-12))
                 } else {
                     f64::INFINITY
                 },
-                efficiency_interval,
+                efficiency_interval: None,
                 error_reduction: None,
                 error_reduction_interval: None,
                 efficiency_vs_random: None,
@@ -210,8 +195,10 @@ fn rows_of(m: &Measured, reference: &Converged, masks: &[Vec<bool>; 3], host: &s
                 host: host.to_string(),
                 seed_mse,
                 seed_bias,
-                seed_seconds: m.times.clone(),
-            }
+                seed_seconds: times.to_vec(),
+            };
+            row.efficiency_interval = fits::interval(k, |idx| fits::efficiency_at(&row, idx));
+            row
         })
         .collect()
 }
@@ -229,12 +216,8 @@ pub fn run_jobs(
 ) -> Vec<JobResult> {
     let lights = scene.lights.len();
     let mut out = Vec::new();
-    let mut start = 0;
-    while start < jobs.len() {
-        let n = jobs[start].n;
-        let end = start + jobs[start..].iter().take_while(|j| j.n == n).count();
-        let group = &jobs[start..end];
-        start = end;
+    for group in jobs.chunk_by(|a, b| a.n == b.n) {
+        let n = group[0].n;
         let per_render = |job: &Job| cost(config, lights, job) / (config.seeds as f64 + 1.0);
         // Warm-up: caches, page tables and the thread pool reach their working state before
         // the first timed render; the images (seed 0, used by no timed render) are kept.
@@ -247,10 +230,8 @@ pub fn run_jobs(
                 height: image.height(),
                 rgb: image.into_raw(),
             });
-            progress(
-                per_render(job),
-                &format!("{} N={n} warm-up", job.sampler.name()),
-            );
+            let label = format!("{} N={n} warm-up", job.sampler.name());
+            progress(per_render(job), &label);
         }
         let mut films: Vec<Vec<Film>> = vec![Vec::new(); group.len()];
         let mut times = vec![Vec::new(); group.len()];
@@ -272,16 +253,10 @@ pub fn run_jobs(
         }
         for (i, (job, thumbnail)) in group.iter().zip(thumbnails).enumerate() {
             let images: Vec<&[Vec3]> = films[i].iter().map(|f| f.pixels.as_slice()).collect();
-            let measured = Measured {
-                sampler: job.sampler,
-                n,
-                images,
-                times: std::mem::take(&mut times[i]),
-                rays: rays[i] / config.seeds.max(1) as u64,
-            };
-            let rows = rows_of(&measured, &setup.reference, &setup.masks, host);
-            let heatmap = (n == config.heatmap_n)
-                .then(|| pixel_mse(&measured.images, &setup.reference.film.pixels));
+            let rays = rays[i] / config.seeds.max(1) as u64;
+            let rows = rows_of(job, &images, &times[i], rays, setup, host);
+            let heatmap =
+                (n == config.heatmap_n).then(|| pixel_mse(&images, &setup.reference.film.pixels));
             out.push(JobResult {
                 job: *job,
                 rows,
@@ -316,7 +291,8 @@ pub fn assemble(
         if let Some(map) = r.heatmap {
             heatmaps.push((r.job.sampler, map));
         }
-        if let Some(image) = r.thumbnail.image() {
+        let t = r.thumbnail;
+        if let Some(image) = image::RgbImage::from_raw(t.width, t.height, t.rgb) {
             thumbnails.push((r.job.sampler, r.job.n, image));
         }
     }

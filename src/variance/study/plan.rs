@@ -145,7 +145,7 @@ impl Work for Study {
         let differs = items
             .iter()
             .zip(results)
-            .any(|(&j, r)| all.get(j) != Some(&r.job()));
+            .any(|(&j, r)| all.get(j) != Some(&r.job));
         differs.then(|| {
             format!(
                 "its results are not those of its {} jobs: was it edited, or written by another \

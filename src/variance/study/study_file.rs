@@ -142,25 +142,15 @@ pub fn read(path: &Path, options: &mut VarianceOptions) -> Result<()> {
     if let Some(v) = file.sizes {
         options.sizes = v.into_iter().map(|[w, h]| [w.0, h.0]).collect();
     }
-    let set = |field: &mut u32, v: Option<u32>| {
-        if let Some(v) = v {
-            *field = v;
-        }
-    };
-    set(&mut options.seeds, file.seeds.map(|r| r.0));
-    set(&mut options.bounces, file.bounces.map(|r| r.0));
-    set(
-        &mut options.reference_samples,
-        file.reference_samples.map(|r| r.0),
-    );
-    set(&mut options.mask_samples, file.mask_samples.map(|r| r.0));
-    set(&mut options.heatmap_n, file.heatmap_n.map(|r| r.0));
-    if let Some(v) = file.light_model {
-        options.light_model = v;
-    }
-    if let Some(v) = file.engine {
-        options.engine = v;
-    }
+    options.seeds = file.seeds.map_or(options.seeds, |r| r.0);
+    options.bounces = file.bounces.map_or(options.bounces, |r| r.0);
+    options.reference_samples = file
+        .reference_samples
+        .map_or(options.reference_samples, |r| r.0);
+    options.mask_samples = file.mask_samples.map_or(options.mask_samples, |r| r.0);
+    options.heatmap_n = file.heatmap_n.map_or(options.heatmap_n, |r| r.0);
+    options.light_model = file.light_model.unwrap_or(options.light_model);
+    options.engine = file.engine.unwrap_or(options.engine);
     for (key, empty) in [
         ("samplers", options.samplers.is_empty()),
         ("budgets", options.budgets.is_empty()),
