@@ -8,6 +8,7 @@
 
 use clap::builder::{StringValueParser, TypedValueParser};
 use raywave::bench::verdict::VerdictForm;
+use raywave::diff::Metric;
 use raywave::output::cost_map::{CostKind, CostMeasure};
 use raywave::render::engine::Engine;
 use raywave::render::film::ToneMap;
@@ -124,6 +125,22 @@ mirror! {
         /// f32x16 (two 256-bit halves without AVX-512).
         #[value(name = "16")]
         Sixteen,
+    }
+}
+
+mirror! {
+    /// `--metric` of `raywave diff`.
+    MetricArg => Metric {
+        /// Mean squared error.
+        Mse,
+        /// Relative MSE: mean (a−b)²/(b+0.01)² (pbrt-v4's MRSE).
+        Relmse,
+        /// Largest |a − b|.
+        Max,
+        /// PSNR in dB against a peak of 1 (--fail-above fails when it is BELOW the value).
+        Psnr,
+        /// FLIP's mean (needs the `flip` feature).
+        Flip,
     }
 }
 
