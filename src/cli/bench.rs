@@ -2,7 +2,7 @@
 //! A B` and `raywave bench list` for saved records; `raywave bench merge` for the part files
 //! of `--shard`.
 
-use super::image::ImageArgs;
+use super::image::{ImageArgs, say};
 use super::values::{EngineArg, float};
 use anyhow::Result;
 use clap::parser::ValueSource;
@@ -87,7 +87,8 @@ pub struct BenchArgs {
     /// interval from the paired rounds; exit 3 when the whole interval lies above the threshold
     /// (a regression), "not slower" when it lies wholly at or below it.
     #[arg(long, value_name = "OTHER", conflicts_with_all = ["save", "compare", "json", "runs",
-          "export_json", "export_csv", "export_markdown"])]
+          "export_json", "export_csv", "export_markdown", "export_bmf",
+          "export_github_action_benchmark"])]
     pub against: Option<PathBuf>,
     /// Timed rounds with --against (each runs both builds once).
     #[arg(long, default_value_t = 20, requires = "against",
@@ -118,22 +119,8 @@ pub struct BenchArgs {
     /// Also write the record as JSON to FILE (`-` for stdout); one point only.
     #[arg(long, value_name = "FILE")]
     pub json: Option<PathBuf>,
-    /// Write every point's record to FILE as a JSON array (`-` for stdout).
-    #[arg(long, value_name = "FILE")]
-    pub export_json: Option<PathBuf>,
-    /// Write every point's headline figures to FILE as CSV (`-` for stdout).
-    #[arg(long, value_name = "FILE")]
-    pub export_csv: Option<PathBuf>,
-    /// Write every point's headline figures to FILE as a Markdown table (`-` for stdout).
-    #[arg(long, value_name = "FILE")]
-    pub export_markdown: Option<PathBuf>,
-    /// Write every point's headline figures to FILE in Bencher Metric Format (`-` for stdout).
-    #[arg(long, value_name = "FILE", conflicts_with = "against")]
-    pub export_bmf: Option<PathBuf>,
-    /// Write every point's headline figures to FILE as github-action-benchmark's
-    /// `customBiggerIsBetter` JSON (`-` for stdout).
-    #[arg(long, value_name = "FILE", conflicts_with = "against")]
-    pub export_github_action_benchmark: Option<PathBuf>,
+    #[command(flatten)]
+    pub exports: ExportArgs,
     /// Time only shard I of N of the sweep's points (0-based; split by estimated cost) and
     /// write them to DIR/bench-shard-I-of-N.part for `raywave bench merge`.
     #[arg(long, value_name = "I/N", requires = "out",
@@ -160,6 +147,40 @@ pub(crate) enum BenchAction {
     Merge(MergeArgs),
 }
 
+/// The `--export-*` flags of `raywave bench` and `raywave bench merge`.
+#[derive(Args, Debug, Clone)]
+pub struct ExportArgs {
+    /// Write every point's record to FILE as a JSON array (`-` for stdout).
+    #[arg(long, value_name = "FILE")]
+    pub export_json: Option<PathBuf>,
+    /// Write every point's headline figures to FILE as CSV (`-` for stdout).
+    #[arg(long, value_name = "FILE")]
+    pub export_csv: Option<PathBuf>,
+    /// Write every point's headline figures to FILE as a Markdown table (`-` for stdout).
+    #[arg(long, value_name = "FILE")]
+    pub export_markdown: Option<PathBuf>,
+    /// Write every point's headline figures to FILE in Bencher Metric Format (`-` for stdout).
+    #[arg(long, value_name = "FILE")]
+    pub export_bmf: Option<PathBuf>,
+    /// Write every point's headline figures to FILE as github-action-benchmark's
+    /// `customBiggerIsBetter` JSON (`-` for stdout).
+    #[arg(long, value_name = "FILE")]
+    pub export_github_action_benchmark: Option<PathBuf>,
+}
+
+impl ExportArgs {
+    /// The flags as the library's exports.
+    fn exports(&self) -> Exports {
+        Exports {
+            json: self.export_json.clone(),
+            csv: self.export_csv.clone(),
+            markdown: self.export_markdown.clone(),
+            bmf: self.export_bmf.clone(),
+            github_action_benchmark: self.export_github_action_benchmark.clone(),
+        }
+    }
+}
+
 /// Flags of `raywave bench merge`.
 #[derive(Args, Debug, Clone)]
 pub struct MergeArgs {
@@ -177,22 +198,8 @@ pub struct MergeArgs {
     /// Directory of saved records.
     #[arg(long, default_value = ".raywave-bench")]
     pub dir: PathBuf,
-    /// Write every point's record to FILE as a JSON array (`-` for stdout).
-    #[arg(long, value_name = "FILE")]
-    pub export_json: Option<PathBuf>,
-    /// Write every point's headline figures to FILE as CSV (`-` for stdout).
-    #[arg(long, value_name = "FILE")]
-    pub export_csv: Option<PathBuf>,
-    /// Write every point's headline figures to FILE as a Markdown table (`-` for stdout).
-    #[arg(long, value_name = "FILE")]
-    pub export_markdown: Option<PathBuf>,
-    /// Write every point's headline figures to FILE in Bencher Metric Format (`-` for stdout).
-    #[arg(long, value_name = "FILE")]
-    pub export_bmf: Option<PathBuf>,
-    /// Write every point's headline figures to FILE as github-action-benchmark's
-    /// `customBiggerIsBetter` JSON (`-` for stdout).
-    #[arg(long, value_name = "FILE")]
-    pub export_github_action_benchmark: Option<PathBuf>,
+    #[command(flatten)]
+    pub exports: ExportArgs,
     /// Print only what was merged, not every point's report.
     #[arg(short, long)]
     pub quiet: bool,
@@ -203,13 +210,7 @@ impl MergeArgs {
     fn options(&self) -> MergeOptions {
         MergeOptions {
             parts: self.parts.clone(),
-            exports: Exports {
-                json: self.export_json.clone(),
-                csv: self.export_csv.clone(),
-                markdown: self.export_markdown.clone(),
-                bmf: self.export_bmf.clone(),
-                github_action_benchmark: self.export_github_action_benchmark.clone(),
-            },
+            exports: self.exports.exports(),
             save: self.save.clone(),
             dir: self.dir.clone(),
             across_machines: self.across_machines,
@@ -312,11 +313,11 @@ impl BenchArgs {
             dir: self.dir.clone(),
             threshold: self.threshold.unwrap_or(DEFAULT_THRESHOLD_PCT),
             json: self.json.clone(),
-            export_json: self.export_json.clone(),
-            export_csv: self.export_csv.clone(),
-            export_markdown: self.export_markdown.clone(),
-            export_bmf: self.export_bmf.clone(),
-            export_github_action_benchmark: self.export_github_action_benchmark.clone(),
+            export_json: self.exports.export_json.clone(),
+            export_csv: self.exports.export_csv.clone(),
+            export_markdown: self.exports.export_markdown.clone(),
+            export_bmf: self.exports.export_bmf.clone(),
+            export_github_action_benchmark: self.exports.export_github_action_benchmark.clone(),
             shard: self.shard.zip(self.out.clone()),
             explicit,
             plan: output_plan(self, &sweep_points),
@@ -353,20 +354,11 @@ fn output_plan(args: &BenchArgs, points: &[raywave::bench::running::sweep::Point
             }
         }
     }
-    for (flag, path) in [
-        ("--json", &args.json),
-        ("--export-json", &args.export_json),
-        ("--export-csv", &args.export_csv),
-        ("--export-markdown", &args.export_markdown),
-        ("--export-bmf", &args.export_bmf),
-        (
-            "--export-github-action-benchmark",
-            &args.export_github_action_benchmark,
-        ),
-    ] {
-        if let Some(p) = path {
-            plan = plan.output(flag, p);
-        }
+    if let Some(json) = &args.json {
+        plan = plan.output("--json", json);
+    }
+    for (flag, path) in args.exports.exports().flags() {
+        plan = plan.output(flag, path);
     }
     if let (Some(shard), Some(dir)) = (args.shard, &args.out) {
         plan = plan.output_in_new_dir("--out", &dir.join(part_name::<SweepPoints>(shard)));
@@ -400,11 +392,7 @@ pub fn run(args: &BenchArgs, matches: Option<&ArgMatches>) -> Result<u8> {
             // Standard output may carry an export; the report then goes to stderr.
             let plan = (options.exports.flags().into_iter())
                 .fold(OutputPlan::new(), |plan, (flag, p)| plan.output(flag, p));
-            if plan.uses_stdout() {
-                eprint!("{text}");
-            } else {
-                raywave::output::terminal::print(&text)?;
-            }
+            say(&plan, &text)?;
             return Ok(0);
         }
         None => {}
@@ -443,11 +431,7 @@ pub fn run(args: &BenchArgs, matches: Option<&ArgMatches>) -> Result<u8> {
         )?;
         let text = outcome.text(args.quiet, options.compare.as_deref());
         // Standard output may carry an export (`--json -`); the report then goes to stderr.
-        if output_plan(args, &[]).uses_stdout() {
-            eprint!("{text}");
-        } else {
-            raywave::output::terminal::print(&text)?;
-        }
+        say(&output_plan(args, &[]), &text)?;
         return Ok(outcome.exit_code());
     };
     let points = options.sweep.points().len();
