@@ -4,7 +4,7 @@
 use super::image::ThreadsArg;
 use super::values::{EngineArg, LightModelArg, SamplerArg};
 use anyhow::Result;
-use clap::{Args, Subcommand};
+use clap::{Args, Subcommand, ValueEnum};
 use raywave::output::OutputPlan;
 use raywave::output::terminal::{print, with_bar};
 use raywave::render::engine::clamped_warning;
@@ -104,7 +104,7 @@ pub(crate) struct StudyArgs {
     pub budgets: Vec<u32>,
     /// Samplers to compare: comma- or space-separated (`random,sobol` or `random sobol`; with
     /// spaces, give SCENE before this flag).
-    #[arg(long, value_enum, num_args = 1.., value_delimiter = ',', default_values_t = SamplerArg::ALL)]
+    #[arg(long, value_enum, num_args = 1.., value_delimiter = ',', default_values_t = SamplerArg::value_variants())]
     pub samplers: Vec<SamplerArg>,
     /// Seeds (independent renders) per sampler and budget; at least 2, for the variance.
     #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(2..=1024))]
