@@ -76,6 +76,18 @@ pub struct TracePixelArgs {
     pub workers: ThreadsArg,
 }
 
+impl TracePixelArgs {
+    /// The output flags, with their paths.
+    fn outputs(&self) -> [(&'static str, &Option<PathBuf>); 4] {
+        [
+            ("--json", &self.json),
+            ("--obj", &self.obj),
+            ("--ply", &self.ply),
+            ("--png", &self.png),
+        ]
+    }
+}
+
 /// Traces, checks and writes as the flags say.
 pub fn run(args: &TracePixelArgs) -> Result<()> {
     if let Some(png) = &args.png {
@@ -106,10 +118,9 @@ pub fn run(args: &TracePixelArgs) -> Result<()> {
         }),
         distance: args.view_distance,
     };
-    let view_camera = match &args.png {
-        Some(_) => Some(placement.camera(&scene.camera).map_err(UsageError)?),
-        None => None,
-    };
+    let view_camera = (args.png.as_ref())
+        .map(|_| placement.camera(&scene.camera).map_err(UsageError))
+        .transpose()?;
     tree.check = Some(check_pixel(&scene, &settings, &tree));
 
     // Text meant for the terminal goes to stderr when an output goes to stdout.
@@ -121,8 +132,7 @@ pub fn run(args: &TracePixelArgs) -> Result<()> {
     if let Some(path) = &args.json {
         write_output(path, |w| {
             serde_json::to_writer_pretty(&mut *w, &tree)?;
-            writeln!(w)?;
-            Ok(())
+            Ok(writeln!(w)?)
         })?;
     }
     if args.obj.is_some() || args.ply.is_some() {
@@ -180,15 +190,9 @@ pub fn run(args: &TracePixelArgs) -> Result<()> {
         raywave::output::image_file::write_rgb8(&img, path)
             .with_context(|| format!("cannot write --png {}", path.display()))?;
     }
-    let wrote: Vec<String> = [
-        ("--json", &args.json),
-        ("--obj", &args.obj),
-        ("--ply", &args.ply),
-        ("--png", &args.png),
-    ]
-    .iter()
-    .filter_map(|(flag, p)| p.as_ref().map(|p| format!("{flag} {}", p.display())))
-    .collect();
+    let wrote: Vec<String> = (args.outputs().iter())
+        .filter_map(|(flag, p)| p.as_ref().map(|p| format!("{flag} {}", p.display())))
+        .collect();
     if wrote.is_empty() {
         say(&summary(&tree))?;
     } else {
@@ -242,12 +246,7 @@ fn output_plan(args: &TracePixelArgs) -> OutputPlan {
     if let Some(scene) = &args.scene {
         plan = plan.input("SCENE", scene);
     }
-    for (flag, path) in [
-        ("--json", &args.json),
-        ("--obj", &args.obj),
-        ("--ply", &args.ply),
-        ("--png", &args.png),
-    ] {
+    for (flag, path) in args.outputs() {
         if let Some(p) = path {
             plan = plan.output(flag, p);
         }
