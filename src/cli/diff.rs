@@ -166,11 +166,9 @@ pub fn run(args: &DiffArgs) -> Result<u8> {
     }
     let region = region(args, &a, &plan)?;
     let mut comparison = diff::compare(&a, &b, &region)?;
-    let flip_map = if want_flip {
-        Some(diff::add_flip(&mut comparison, &a, &b, &region)?)
-    } else {
-        None
-    };
+    let flip_map = want_flip
+        .then(|| diff::add_flip(&mut comparison, &a, &b, &region))
+        .transpose()?;
     text.push_str(&diff::text::table(&comparison));
 
     let value = comparison.value(metric);
