@@ -14,7 +14,7 @@ use raywave::render::settings::RenderSettings;
 use raywave::render::wavefront::DEFAULT_BATCH_SIZE;
 use raywave::shard::Shard;
 use raywave::variance::command::{VarianceOptions, load_cases, prepare, run_shard, study};
-use raywave::variance::study::plan::Case;
+use raywave::variance::study::plan::{Case, Study, identity};
 use std::path::{Path, PathBuf};
 
 /// Flags of `raywave variance`. A scene file literally named `prepare` or `merge` is given as
@@ -178,7 +178,8 @@ impl StudyArgs {
     }
 
     /// The inputs: the scene files and the study file.
-    fn inputs(&self, options: &VarianceOptions, mut plan: OutputPlan) -> OutputPlan {
+    fn inputs(&self, options: &VarianceOptions) -> OutputPlan {
+        let mut plan = OutputPlan::new();
         if let Some(file) = &self.study {
             plan = plan.input("--study", file);
         }
@@ -262,16 +263,14 @@ pub fn run(args: &VarianceArgs) -> Result<()> {
     }
     let cases = cases(&options)?;
     let pool = args.workers.pool()?;
-    let plan = args.study.inputs(&options, OutputPlan::new());
+    let plan = args.study.inputs(&options);
+    let work = identity(&cases, options.engine.name()).work;
     if let Some(shard) = args.shard {
-        let part = options.out.join(raywave::shard::part_name::<
-            raywave::variance::study::plan::Study,
-        >(shard));
+        let part = options.out.join(raywave::shard::part_name::<Study>(shard));
         let plan = plan.output_in_new_dir("--out", &part);
         plan.check()?;
         check_textures(&plan, &cases)?;
-        let identity = raywave::variance::study::plan::identity(&cases, options.engine.name());
-        let jobs = identity.work.assignment(shard.count)[shard.index].len();
+        let jobs = work.assignment(shard.count)[shard.index].len();
         let prefix = format!("variance shard {shard}, {jobs} jobs");
         let (path, jobs) = with_progress(&options, prefix, |render, progress| {
             pool.install(|| run_shard(&options, &cases, shard, render, progress))
@@ -282,17 +281,12 @@ pub fn run(args: &VarianceArgs) -> Result<()> {
             path.display()
         ));
     }
-    let mut plan = plan;
-    for name in report_files(&options, &cases) {
-        plan = plan.output_in_new_dir("--out", &options.out.join(name));
-    }
+    let plan = (report_files(&options, &cases).into_iter()).fold(plan, |plan, name| {
+        plan.output_in_new_dir("--out", &options.out.join(name))
+    });
     plan.check()?;
     check_textures(&plan, &cases)?;
-    let jobs = raywave::variance::study::plan::identity(&cases, options.engine.name())
-        .work
-        .jobs()
-        .len();
-    let prefix = format!("variance, {jobs} jobs");
+    let prefix = format!("variance, {} jobs", work.jobs().len());
     let outcome = with_progress(&options, prefix, |render, progress| {
         pool.install(|| study(&options, &cases, render, progress))
     })?;
