@@ -1,6 +1,5 @@
-//! `raywave bench` flags, turned into `raywave::bench::BenchOptions`; `raywave bench compare
-//! A B` and `raywave bench list` for saved records; `raywave bench merge` for the part files
-//! of `--shard`.
+//! `raywave bench` flags, turned into `raywave::bench::BenchOptions`, and its subcommands:
+//! `compare` and `list` on saved records, `merge` on the part files of `--shard`.
 
 use super::image::{ImageArgs, say};
 use super::values::{EngineArg, float};
@@ -135,7 +134,7 @@ pub struct BenchArgs {
     pub quiet: bool,
 }
 
-/// `raywave bench compare` and `raywave bench list`.
+/// The subcommands of `raywave bench`.
 #[derive(Subcommand, Debug, Clone)]
 pub(crate) enum BenchAction {
     /// Compare two saved records (B against A) by the verdict rule; exit 3 if B regressed.
@@ -268,25 +267,15 @@ impl BenchArgs {
             .collect()
     }
 
-    /// The swept values: every `--size W H`, every shadow-sample count, every thread count.
-    fn sweep(&self) -> Sweep {
-        let sizes = self
-            .image
-            .size
-            .as_ref()
-            .map(|v| v.chunks_exact(2).map(|c| [c[0], c[1]]).collect())
-            .unwrap_or_default();
-        Sweep {
-            sizes,
-            shadow_samples: Vec::new(),
-            threads: self.threads.clone(),
-        }
-    }
-
     /// The flags as the library's options; `matches` are bench's own (for the shadow-sample
     /// list and which flags were given).
     pub fn options(&self, matches: Option<&ArgMatches>) -> BenchOptions {
-        let mut sweep = self.sweep();
+        let sizes = self.image.size.as_deref().unwrap_or_default();
+        let mut sweep = Sweep {
+            sizes: sizes.chunks_exact(2).map(|c| [c[0], c[1]]).collect(),
+            shadow_samples: Vec::new(),
+            threads: self.threads.clone(),
+        };
         let mut explicit = Vec::new();
         if let Some(m) = matches {
             sweep.shadow_samples = m
@@ -328,10 +317,9 @@ impl BenchArgs {
 /// The threshold of `--against` when none is given, in percent.
 const AB_THRESHOLD_PCT: f64 = 5.0;
 
-/// The scene and the `--compare` record (inputs), the `--save` records (one per point of
-/// `labels`, or one), `--json` and the exports (outputs). `--save` may name the `--compare`
-/// record (see below), no other input. Names `record_path` refuses are left to the bench,
-/// which reports them.
+/// The scene and the `--compare` record (inputs), the `--save` records (one per point),
+/// `--json` and the exports (outputs). `--save` may name the `--compare` record (see below), no
+/// other input. Names `record_path` refuses are left to the bench, which reports them.
 fn output_plan(args: &BenchArgs, points: &[raywave::bench::running::sweep::Point]) -> OutputPlan {
     let mut plan = OutputPlan::new();
     if let Some(scene) = args.scene.as_ref().or(args.input.as_ref()) {
@@ -366,11 +354,8 @@ fn output_plan(args: &BenchArgs, points: &[raywave::bench::running::sweep::Point
     plan
 }
 
-/// Runs the bench or one of its subcommands; the exit code is 3
-/// (`raywave::bench::EXIT_REGRESSION`) when `--compare`, `--against` or `bench compare` finds
-/// a regression, 4 (`EXIT_UNDECIDED`) when `--until-decided` ends undecided at its budget,
-/// else 0 (with `--against`: not slower, or with `--verdict three-way` faster or within, or a
-/// fixed-rounds run left undecided). `matches` are bench's own.
+/// Runs the bench or one of its subcommands and returns the exit code (3 for a regression, 4
+/// when `--until-decided` ends undecided; main.rs has the details). `matches` are bench's own.
 pub fn run(args: &BenchArgs, matches: Option<&ArgMatches>) -> Result<u8> {
     match &args.action {
         Some(BenchAction::Compare(c)) => {
@@ -389,7 +374,6 @@ pub fn run(args: &BenchArgs, matches: Option<&ArgMatches>) -> Result<u8> {
         Some(BenchAction::Merge(m)) => {
             let options = m.options();
             let text = merge::merge(&options)?.text(m.quiet);
-            // Standard output may carry an export; the report then goes to stderr.
             let plan = (options.exports.flags().into_iter())
                 .fold(OutputPlan::new(), |plan, (flag, p)| plan.output(flag, p));
             say(&plan, &text)?;
@@ -430,7 +414,6 @@ pub fn run(args: &BenchArgs, matches: Option<&ArgMatches>) -> Result<u8> {
             |progress| raywave::bench::run(&options, progress),
         )?;
         let text = outcome.text(args.quiet, options.compare.as_deref());
-        // Standard output may carry an export (`--json -`); the report then goes to stderr.
         say(&output_plan(args, &[]), &text)?;
         return Ok(outcome.exit_code());
     };
