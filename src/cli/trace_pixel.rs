@@ -145,10 +145,8 @@ pub fn run(args: &TracePixelArgs) -> Result<()> {
         }
     }
     if let (Some(path), Some(camera)) = (&args.png, view_camera) {
-        let (width, height) = match &args.view_size {
-            Some(s) => (s[0], s[1]),
-            None => (settings.width, settings.height),
-        };
+        let (width, height) =
+            (args.view_size.as_ref()).map_or((settings.width, settings.height), |s| (s[0], s[1]));
         let mut view_scene = scene.clone();
         view_scene.camera = camera;
         let view_settings = raywave::render::settings::RenderSettings {

@@ -349,11 +349,9 @@ fn run_prepare(args: &PrepareArgs) -> Result<()> {
 
 fn run_merge(args: &MergeArgs) -> Result<()> {
     let started = std::time::Instant::now();
-    let mut plan = OutputPlan::new();
-    for part in &args.parts {
-        plan = plan.input("PARTS", part);
-    }
-    plan.check()?;
+    (args.parts.iter())
+        .fold(OutputPlan::new(), |plan, part| plan.input("PARTS", part))
+        .check()?;
     let merged = raywave::variance::merge::merge(&args.parts, &args.out, &|w| eprintln!("{w}"))?;
     print(&format!(
         "{}\n{}merge   {:.2} s\nwrote   {}\n",
