@@ -47,11 +47,9 @@ enum Dashes {
 struct ForeignFlag {
     /// The name without its dashes.
     name: &'static str,
-    /// How it is spelled.
     dashes: Dashes,
     /// The values that follow it.
     values: &'static [Value],
-    /// What raywave does with it.
     meaning: Meaning,
 }
 
@@ -80,13 +78,10 @@ use Meaning::{Flag, NoEffect, ShadowSamples, Tokens};
 use Value::{Count, Number, Text};
 
 /// Every flag of the lab's ArgParser and RPI's (single-dash, and the 2023 double-dash forms),
-/// with raywave's meaning: one place to read and extend. Sources: the lab's `argparser.h`
-/// (`-input`, `-size`, `-sphere_rasterization`, `-num_bounces`, `-num_shadow_samples`,
-/// `-num_glossy_samples`, `-num_form_factor_samples`, `-background_color`, `-soft_shadow`),
-/// RPI's `argparser.h` (adds `-i`, `-cylinder_ring_rasterization`, `-num_antialias_samples`,
-/// `-ambient_light` and the photon-mapping flags) and RPI's 2023 `argparser.cpp` (the same with
-/// two dashes, without `-i`). `-output` is raywave's own single-dash spelling of `-o`, kept for
-/// lab-style lines.
+/// with raywave's meaning: one place to read and extend. Sources: the lab's `argparser.h`,
+/// RPI's (adding `-i`, the ring, antialiasing and ambient flags and photon mapping's) and RPI's
+/// 2023 `argparser.cpp` (the same with two dashes, without `-i`). `-output` is raywave's own
+/// single-dash spelling of `-o`, kept for lab-style lines.
 #[rustfmt::skip]
 const FOREIGN_FLAGS: &[ForeignFlag] = &[
     flag("input",                       Both, &[Text],                   Flag("--input")),

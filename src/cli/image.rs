@@ -1,14 +1,12 @@
-//! The flags that shape the image, shared by `raywave render` and `raywave bench`.
+//! The flags several commands share (the image's, the seed's, the threads'), and [`say`].
 
 use super::values::{DefaultsArg, LightModelArg, SamplerArg, ShadowArg, colour_component};
 use clap::Args;
 use raywave::output::OutputPlan;
 use raywave::render::settings::options::ImageOptions;
 
-/// The flags that shape the image, shared by `render` and `bench` so that both default alike
-/// (a bench record then measures what the same flags render). The defaults are the same with
-/// or without a scene file: the built-in scene and the same file read from `scenes/` get the
-/// same settings.
+/// The flags that shape the image: shared so that every command defaults alike (a bench record
+/// measures what the same flags render), with or without a scene file.
 #[derive(Args, Debug, Clone)]
 pub struct ImageArgs {
     /// Image size in pixels [default: 512 512; the lab's 100 100; RPI's 500 500].

@@ -120,7 +120,6 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let outcome = with_bar(template, args.quiet, |progress| {
         frame::run(&options, &pool, progress, &mut phases)
     })?;
-    // Text meant for the terminal goes to stderr when an image or record goes to stdout.
     let say = |text: &str| super::image::say(&options.plan, text);
     if let Some(text) = &outcome.pixel_rays {
         say(text)?;

@@ -123,7 +123,6 @@ pub fn run(args: &TracePixelArgs) -> Result<()> {
         .transpose()?;
     tree.check = Some(check_pixel(&scene, &settings, &tree));
 
-    // Text meant for the terminal goes to stderr when an output goes to stdout.
     let say = |text: &str| super::image::say(&plan, text);
     let title = format!(
         "raywave trace-pixel {} {}: {}",
