@@ -134,13 +134,6 @@ pub struct ThreadsArg {
     pub threads: Option<u32>,
 }
 
-impl ThreadsArg {
-    /// The pool the flag asks for.
-    pub fn pool(&self) -> anyhow::Result<rayon::ThreadPool> {
-        raywave::render::engine::thread_pool(self.threads)
-    }
-}
-
 /// Prints text meant for the terminal: on stdout, or on stderr when one of `plan`'s outputs
 /// goes to stdout (so the text does not mix into it).
 pub fn say(plan: &OutputPlan, text: &str) -> anyhow::Result<()> {

@@ -11,7 +11,7 @@ use raywave::output::image_file::ldr_format;
 use raywave::output::terminal::with_bar;
 use raywave::output::{OutputPlan, write_output};
 use raywave::render::camera::CameraRays;
-use raywave::render::engine::{Engine, clamped_warning};
+use raywave::render::engine::{Engine, clamped_warning, thread_pool};
 use raywave::render::error::UsageError;
 use raywave::trace::draw::{Overlay, depth_buffer};
 use raywave::trace::view::ViewPlacement;
@@ -153,7 +153,7 @@ pub fn run(args: &TracePixelArgs) -> Result<()> {
             height,
             ..settings.clone()
         };
-        let pool = args.workers.pool()?;
+        let pool = thread_pool(args.workers.threads)?;
         let engine = Engine::Wavefront.prepare(
             &view_scene,
             &view_settings,

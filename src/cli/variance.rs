@@ -7,7 +7,7 @@ use anyhow::Result;
 use clap::{Args, Subcommand, ValueEnum};
 use raywave::output::OutputPlan;
 use raywave::output::terminal::{print, with_bar};
-use raywave::render::engine::clamped_warning;
+use raywave::render::engine::{clamped_warning, thread_pool};
 use raywave::render::progress::Progress;
 use raywave::render::scene::Scene;
 use raywave::render::settings::RenderSettings;
@@ -262,7 +262,7 @@ pub fn run(args: &VarianceArgs) -> Result<()> {
         ));
     }
     let cases = cases(&options)?;
-    let pool = args.workers.pool()?;
+    let pool = thread_pool(args.workers.threads)?;
     let plan = args.study.inputs(&options);
     let work = identity(&cases, options.engine.name()).work;
     if let Some(shard) = args.shard {
@@ -328,7 +328,7 @@ fn run_prepare(args: &PrepareArgs) -> Result<()> {
         .study
         .options(Path::new("variance-report"), args.quiet)?;
     let cases = cases(&options)?;
-    let pool = args.workers.pool()?;
+    let pool = thread_pool(args.workers.threads)?;
     let prepared = with_progress(&options, "prepare".into(), |render, progress| {
         pool.install(|| prepare(&options, &cases, render, progress))
     })?;
