@@ -260,10 +260,10 @@ const ADOPTABLE: [&str; 12] = [
 impl BenchArgs {
     /// The engines `--engine` names, each once, in record order (reference, then wavefront).
     fn engines(&self) -> Vec<Engine> {
-        let given: Vec<Engine> = self.engine.iter().map(|&e| e.into()).collect();
-        [Engine::Reference, Engine::Wavefront]
+        [EngineArg::Reference, EngineArg::Wavefront]
             .into_iter()
-            .filter(|e| given.contains(e))
+            .filter(|e| self.engine.contains(e))
+            .map(Engine::from)
             .collect()
     }
 
