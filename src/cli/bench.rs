@@ -1,8 +1,7 @@
-//! `raywave bench` flags, turned into `raywave::bench::BenchOptions`; `raywave bench compare
-//! A B` and `raywave bench list` for saved records; `raywave bench merge` for the part files
-//! of `--shard`.
+//! `raywave bench` flags, turned into `raywave::bench::BenchOptions`, and its subcommands:
+//! `compare` and `list` on saved records, `merge` on the part files of `--shard`.
 
-use super::image::ImageArgs;
+use super::image::{ImageArgs, say};
 use super::values::{EngineArg, float};
 use anyhow::Result;
 use clap::parser::ValueSource;
@@ -87,7 +86,8 @@ pub struct BenchArgs {
     /// interval from the paired rounds; exit 3 when the whole interval lies above the threshold
     /// (a regression), "not slower" when it lies wholly at or below it.
     #[arg(long, value_name = "OTHER", conflicts_with_all = ["save", "compare", "json", "runs",
-          "export_json", "export_csv", "export_markdown"])]
+          "export_json", "export_csv", "export_markdown", "export_bmf",
+          "export_github_action_benchmark"])]
     pub against: Option<PathBuf>,
     /// Timed rounds with --against (each runs both builds once).
     #[arg(long, default_value_t = 20, requires = "against",
@@ -118,22 +118,8 @@ pub struct BenchArgs {
     /// Also write the record as JSON to FILE (`-` for stdout); one point only.
     #[arg(long, value_name = "FILE")]
     pub json: Option<PathBuf>,
-    /// Write every point's record to FILE as a JSON array (`-` for stdout).
-    #[arg(long, value_name = "FILE")]
-    pub export_json: Option<PathBuf>,
-    /// Write every point's headline figures to FILE as CSV (`-` for stdout).
-    #[arg(long, value_name = "FILE")]
-    pub export_csv: Option<PathBuf>,
-    /// Write every point's headline figures to FILE as a Markdown table (`-` for stdout).
-    #[arg(long, value_name = "FILE")]
-    pub export_markdown: Option<PathBuf>,
-    /// Write every point's headline figures to FILE in Bencher Metric Format (`-` for stdout).
-    #[arg(long, value_name = "FILE", conflicts_with = "against")]
-    pub export_bmf: Option<PathBuf>,
-    /// Write every point's headline figures to FILE as github-action-benchmark's
-    /// `customBiggerIsBetter` JSON (`-` for stdout).
-    #[arg(long, value_name = "FILE", conflicts_with = "against")]
-    pub export_github_action_benchmark: Option<PathBuf>,
+    #[command(flatten)]
+    pub exports: ExportArgs,
     /// Time only shard I of N of the sweep's points (0-based; split by estimated cost) and
     /// write them to DIR/bench-shard-I-of-N.part for `raywave bench merge`.
     #[arg(long, value_name = "I/N", requires = "out",
@@ -148,7 +134,7 @@ pub struct BenchArgs {
     pub quiet: bool,
 }
 
-/// `raywave bench compare` and `raywave bench list`.
+/// The subcommands of `raywave bench`.
 #[derive(Subcommand, Debug, Clone)]
 pub(crate) enum BenchAction {
     /// Compare two saved records (B against A) by the verdict rule; exit 3 if B regressed.
@@ -158,6 +144,40 @@ pub(crate) enum BenchAction {
     /// Merge the part files of `raywave bench --shard I/N` into the sweep's reports, exports
     /// and records; refuses missing, duplicated, damaged or mismatched parts.
     Merge(MergeArgs),
+}
+
+/// The `--export-*` flags of `raywave bench` and `raywave bench merge`.
+#[derive(Args, Debug, Clone)]
+pub struct ExportArgs {
+    /// Write every point's record to FILE as a JSON array (`-` for stdout).
+    #[arg(long, value_name = "FILE")]
+    pub export_json: Option<PathBuf>,
+    /// Write every point's headline figures to FILE as CSV (`-` for stdout).
+    #[arg(long, value_name = "FILE")]
+    pub export_csv: Option<PathBuf>,
+    /// Write every point's headline figures to FILE as a Markdown table (`-` for stdout).
+    #[arg(long, value_name = "FILE")]
+    pub export_markdown: Option<PathBuf>,
+    /// Write every point's headline figures to FILE in Bencher Metric Format (`-` for stdout).
+    #[arg(long, value_name = "FILE")]
+    pub export_bmf: Option<PathBuf>,
+    /// Write every point's headline figures to FILE as github-action-benchmark's
+    /// `customBiggerIsBetter` JSON (`-` for stdout).
+    #[arg(long, value_name = "FILE")]
+    pub export_github_action_benchmark: Option<PathBuf>,
+}
+
+impl ExportArgs {
+    /// The flags as the library's exports.
+    fn exports(&self) -> Exports {
+        Exports {
+            json: self.export_json.clone(),
+            csv: self.export_csv.clone(),
+            markdown: self.export_markdown.clone(),
+            bmf: self.export_bmf.clone(),
+            github_action_benchmark: self.export_github_action_benchmark.clone(),
+        }
+    }
 }
 
 /// Flags of `raywave bench merge`.
@@ -177,22 +197,8 @@ pub struct MergeArgs {
     /// Directory of saved records.
     #[arg(long, default_value = ".raywave-bench")]
     pub dir: PathBuf,
-    /// Write every point's record to FILE as a JSON array (`-` for stdout).
-    #[arg(long, value_name = "FILE")]
-    pub export_json: Option<PathBuf>,
-    /// Write every point's headline figures to FILE as CSV (`-` for stdout).
-    #[arg(long, value_name = "FILE")]
-    pub export_csv: Option<PathBuf>,
-    /// Write every point's headline figures to FILE as a Markdown table (`-` for stdout).
-    #[arg(long, value_name = "FILE")]
-    pub export_markdown: Option<PathBuf>,
-    /// Write every point's headline figures to FILE in Bencher Metric Format (`-` for stdout).
-    #[arg(long, value_name = "FILE")]
-    pub export_bmf: Option<PathBuf>,
-    /// Write every point's headline figures to FILE as github-action-benchmark's
-    /// `customBiggerIsBetter` JSON (`-` for stdout).
-    #[arg(long, value_name = "FILE")]
-    pub export_github_action_benchmark: Option<PathBuf>,
+    #[command(flatten)]
+    pub exports: ExportArgs,
     /// Print only what was merged, not every point's report.
     #[arg(short, long)]
     pub quiet: bool,
@@ -203,13 +209,7 @@ impl MergeArgs {
     fn options(&self) -> MergeOptions {
         MergeOptions {
             parts: self.parts.clone(),
-            exports: Exports {
-                json: self.export_json.clone(),
-                csv: self.export_csv.clone(),
-                markdown: self.export_markdown.clone(),
-                bmf: self.export_bmf.clone(),
-                github_action_benchmark: self.export_github_action_benchmark.clone(),
-            },
+            exports: self.exports.exports(),
             save: self.save.clone(),
             dir: self.dir.clone(),
             across_machines: self.across_machines,
@@ -260,32 +260,22 @@ const ADOPTABLE: [&str; 12] = [
 impl BenchArgs {
     /// The engines `--engine` names, each once, in record order (reference, then wavefront).
     fn engines(&self) -> Vec<Engine> {
-        let given: Vec<Engine> = self.engine.iter().map(|&e| e.into()).collect();
-        [Engine::Reference, Engine::Wavefront]
+        [EngineArg::Reference, EngineArg::Wavefront]
             .into_iter()
-            .filter(|e| given.contains(e))
+            .filter(|e| self.engine.contains(e))
+            .map(Engine::from)
             .collect()
-    }
-
-    /// The swept values: every `--size W H`, every shadow-sample count, every thread count.
-    fn sweep(&self) -> Sweep {
-        let sizes = self
-            .image
-            .size
-            .as_ref()
-            .map(|v| v.chunks_exact(2).map(|c| [c[0], c[1]]).collect())
-            .unwrap_or_default();
-        Sweep {
-            sizes,
-            shadow_samples: Vec::new(),
-            threads: self.threads.clone(),
-        }
     }
 
     /// The flags as the library's options; `matches` are bench's own (for the shadow-sample
     /// list and which flags were given).
     pub fn options(&self, matches: Option<&ArgMatches>) -> BenchOptions {
-        let mut sweep = self.sweep();
+        let sizes = self.image.size.as_deref().unwrap_or_default();
+        let mut sweep = Sweep {
+            sizes: sizes.chunks_exact(2).map(|c| [c[0], c[1]]).collect(),
+            shadow_samples: Vec::new(),
+            threads: self.threads.clone(),
+        };
         let mut explicit = Vec::new();
         if let Some(m) = matches {
             sweep.shadow_samples = m
@@ -312,11 +302,11 @@ impl BenchArgs {
             dir: self.dir.clone(),
             threshold: self.threshold.unwrap_or(DEFAULT_THRESHOLD_PCT),
             json: self.json.clone(),
-            export_json: self.export_json.clone(),
-            export_csv: self.export_csv.clone(),
-            export_markdown: self.export_markdown.clone(),
-            export_bmf: self.export_bmf.clone(),
-            export_github_action_benchmark: self.export_github_action_benchmark.clone(),
+            export_json: self.exports.export_json.clone(),
+            export_csv: self.exports.export_csv.clone(),
+            export_markdown: self.exports.export_markdown.clone(),
+            export_bmf: self.exports.export_bmf.clone(),
+            export_github_action_benchmark: self.exports.export_github_action_benchmark.clone(),
             shard: self.shard.zip(self.out.clone()),
             explicit,
             plan: output_plan(self, &sweep_points),
@@ -327,10 +317,9 @@ impl BenchArgs {
 /// The threshold of `--against` when none is given, in percent.
 const AB_THRESHOLD_PCT: f64 = 5.0;
 
-/// The scene and the `--compare` record (inputs), the `--save` records (one per point of
-/// `labels`, or one), `--json` and the exports (outputs). `--save` may name the `--compare`
-/// record (see below), no other input. Names `record_path` refuses are left to the bench,
-/// which reports them.
+/// The scene and the `--compare` record (inputs), the `--save` records (one per point),
+/// `--json` and the exports (outputs). `--save` may name the `--compare` record (see below), no
+/// other input. Names `record_path` refuses are left to the bench, which reports them.
 fn output_plan(args: &BenchArgs, points: &[raywave::bench::running::sweep::Point]) -> OutputPlan {
     let mut plan = OutputPlan::new();
     if let Some(scene) = args.scene.as_ref().or(args.input.as_ref()) {
@@ -353,20 +342,11 @@ fn output_plan(args: &BenchArgs, points: &[raywave::bench::running::sweep::Point
             }
         }
     }
-    for (flag, path) in [
-        ("--json", &args.json),
-        ("--export-json", &args.export_json),
-        ("--export-csv", &args.export_csv),
-        ("--export-markdown", &args.export_markdown),
-        ("--export-bmf", &args.export_bmf),
-        (
-            "--export-github-action-benchmark",
-            &args.export_github_action_benchmark,
-        ),
-    ] {
-        if let Some(p) = path {
-            plan = plan.output(flag, p);
-        }
+    if let Some(json) = &args.json {
+        plan = plan.output("--json", json);
+    }
+    for (flag, path) in args.exports.exports().flags() {
+        plan = plan.output(flag, path);
     }
     if let (Some(shard), Some(dir)) = (args.shard, &args.out) {
         plan = plan.output_in_new_dir("--out", &dir.join(part_name::<SweepPoints>(shard)));
@@ -374,11 +354,8 @@ fn output_plan(args: &BenchArgs, points: &[raywave::bench::running::sweep::Point
     plan
 }
 
-/// Runs the bench or one of its subcommands; the exit code is 3
-/// (`raywave::bench::EXIT_REGRESSION`) when `--compare`, `--against` or `bench compare` finds
-/// a regression, 4 (`EXIT_UNDECIDED`) when `--until-decided` ends undecided at its budget,
-/// else 0 (with `--against`: not slower, or with `--verdict three-way` faster or within, or a
-/// fixed-rounds run left undecided). `matches` are bench's own.
+/// Runs the bench or one of its subcommands and returns the exit code (3 for a regression, 4
+/// when `--until-decided` ends undecided; main.rs has the details). `matches` are bench's own.
 pub fn run(args: &BenchArgs, matches: Option<&ArgMatches>) -> Result<u8> {
     match &args.action {
         Some(BenchAction::Compare(c)) => {
@@ -397,14 +374,9 @@ pub fn run(args: &BenchArgs, matches: Option<&ArgMatches>) -> Result<u8> {
         Some(BenchAction::Merge(m)) => {
             let options = m.options();
             let text = merge::merge(&options)?.text(m.quiet);
-            // Standard output may carry an export; the report then goes to stderr.
             let plan = (options.exports.flags().into_iter())
                 .fold(OutputPlan::new(), |plan, (flag, p)| plan.output(flag, p));
-            if plan.uses_stdout() {
-                eprint!("{text}");
-            } else {
-                raywave::output::terminal::print(&text)?;
-            }
+            say(&plan, &text)?;
             return Ok(0);
         }
         None => {}
@@ -442,12 +414,7 @@ pub fn run(args: &BenchArgs, matches: Option<&ArgMatches>) -> Result<u8> {
             |progress| raywave::bench::run(&options, progress),
         )?;
         let text = outcome.text(args.quiet, options.compare.as_deref());
-        // Standard output may carry an export (`--json -`); the report then goes to stderr.
-        if output_plan(args, &[]).uses_stdout() {
-            eprint!("{text}");
-        } else {
-            raywave::output::terminal::print(&text)?;
-        }
+        say(&output_plan(args, &[]), &text)?;
         return Ok(outcome.exit_code());
     };
     let points = options.sweep.points().len();

@@ -2,9 +2,9 @@
 //! or a mask, prints the figures (and writes them as JSON), draws the per-pixel error, and
 //! exits 3 when `--fail-above` is passed.
 
-use super::values::{DefaultsArg, float};
+use super::values::{DefaultsArg, MetricArg, float};
 use anyhow::{Result, bail};
-use clap::{Args, ValueEnum};
+use clap::Args;
 use raywave::diff::{self, Comparison, EXIT_FAILED, FileInfo, Image, Metric, Region, read_image};
 use raywave::output::image_file::{ldr_format, write_atomically};
 use raywave::output::terminal::print;
@@ -16,33 +16,6 @@ use raywave::render::settings::options::ImageOptions;
 use serde::Serialize;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
-
-/// `--metric` on the command line.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub(crate) enum MetricArg {
-    /// Mean squared error.
-    Mse,
-    /// Relative MSE: mean (a−b)²/(b+0.01)² (pbrt-v4's MRSE).
-    Relmse,
-    /// Largest |a − b|.
-    Max,
-    /// PSNR in dB against a peak of 1 (--fail-above fails when it is BELOW the value).
-    Psnr,
-    /// FLIP's mean (needs the `flip` feature).
-    Flip,
-}
-
-impl From<MetricArg> for Metric {
-    fn from(m: MetricArg) -> Metric {
-        match m {
-            MetricArg::Mse => Metric::Mse,
-            MetricArg::Relmse => Metric::Relmse,
-            MetricArg::Max => Metric::Max,
-            MetricArg::Psnr => Metric::Psnr,
-            MetricArg::Flip => Metric::Flip,
-        }
-    }
-}
 
 /// Flags of `raywave diff`.
 #[derive(Args, Debug, Clone)]
@@ -193,11 +166,9 @@ pub fn run(args: &DiffArgs) -> Result<u8> {
     }
     let region = region(args, &a, &plan)?;
     let mut comparison = diff::compare(&a, &b, &region)?;
-    let flip_map = if want_flip {
-        Some(diff::add_flip(&mut comparison, &a, &b, &region)?)
-    } else {
-        None
-    };
+    let flip_map = want_flip
+        .then(|| diff::add_flip(&mut comparison, &a, &b, &region))
+        .transpose()?;
     text.push_str(&diff::text::table(&comparison));
 
     let value = comparison.value(metric);

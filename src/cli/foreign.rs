@@ -3,6 +3,7 @@
 //! and clap validates every spelling the same way.
 
 use super::values::DefaultsArg;
+use clap::CommandFactory;
 use raywave::render::error::UsageError;
 use raywave::render::settings::options::Defaults;
 use std::ffi::OsString;
@@ -46,11 +47,9 @@ enum Dashes {
 struct ForeignFlag {
     /// The name without its dashes.
     name: &'static str,
-    /// How it is spelled.
     dashes: Dashes,
     /// The values that follow it.
     values: &'static [Value],
-    /// What raywave does with it.
     meaning: Meaning,
 }
 
@@ -79,13 +78,10 @@ use Meaning::{Flag, NoEffect, ShadowSamples, Tokens};
 use Value::{Count, Number, Text};
 
 /// Every flag of the lab's ArgParser and RPI's (single-dash, and the 2023 double-dash forms),
-/// with raywave's meaning: one place to read and extend. Sources: the lab's `argparser.h`
-/// (`-input`, `-size`, `-sphere_rasterization`, `-num_bounces`, `-num_shadow_samples`,
-/// `-num_glossy_samples`, `-num_form_factor_samples`, `-background_color`, `-soft_shadow`),
-/// RPI's `argparser.h` (adds `-i`, `-cylinder_ring_rasterization`, `-num_antialias_samples`,
-/// `-ambient_light` and the photon-mapping flags) and RPI's 2023 `argparser.cpp` (the same with
-/// two dashes, without `-i`). `-output` is raywave's own single-dash spelling of `-o`, kept for
-/// lab-style lines.
+/// with raywave's meaning: one place to read and extend. Sources: the lab's `argparser.h`,
+/// RPI's (adding `-i`, the ring, antialiasing and ambient flags and photon mapping's) and RPI's
+/// 2023 `argparser.cpp` (the same with two dashes, without `-i`). `-output` is raywave's own
+/// single-dash spelling of `-o`, kept for lab-style lines.
 #[rustfmt::skip]
 const FOREIGN_FLAGS: &[ForeignFlag] = &[
     flag("input",                       Both, &[Text],                   Flag("--input")),
@@ -128,24 +124,11 @@ const TARGETS: &[(&str, &str)] = &[
 /// The subcommands that take the image flags, and so the lab's and RPI's spellings.
 const IMAGE_COMMANDS: &[&str] = &["render", "bench"];
 
-const SUBCOMMANDS: &[&str] = &[
-    "render",
-    "info",
-    "meshgen",
-    "variance",
-    "diff",
-    "view",
-    "bench",
-    "trace-pixel",
-    "help",
-    "-h",
-    "--help",
-    "-V",
-    "--version",
-];
+/// The words besides clap's subcommands that clap reads in a subcommand's place.
+const NOT_RENDER: &[&str] = &["help", "-h", "--help", "-V", "--version"];
 
 /// argv rewritten for clap, and the notes to print on stderr.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub(crate) struct Normalized {
     /// The arguments clap reads.
     pub args: Vec<OsString>,
@@ -213,34 +196,30 @@ fn take_values<'a>(
         (Some(Value::Number), n) => format!("{n} numbers"),
         _ => "a file name".to_string(),
     };
-    let mut values = Vec::with_capacity(kinds.len());
-    for kind in kinds {
-        let found = rest.next().map(|v| v.to_string_lossy().into_owned());
-        let ok = match (&found, kind) {
-            (None, _) => false,
-            (Some(v), Value::Count) => v.parse::<u32>().is_ok(),
-            (Some(v), Value::Number) => v.parse::<f32>().is_ok_and(f32::is_finite),
-            (Some(_), Value::Text) => true,
-        };
-        if !ok {
-            // `1e39` is a number, just not an f32: say so, as the scene parser does.
-            let past_f32 = matches!((&found, kind), (Some(v), Value::Number)
-                if v.parse::<f32>().is_ok_and(|x| !x.is_finite())
-                    && raywave::render::scene::beyond_range(v));
-            let found = found.map_or("the end of the command line".to_string(), |v| {
-                if past_f32 {
-                    format!("`{v}`, of magnitude past the largest f32, 3.4e38")
-                } else {
-                    format!("`{v}`")
+    kinds
+        .iter()
+        .map(|kind| {
+            let found = match (rest.next().map(|v| v.to_string_lossy().into_owned()), kind) {
+                (Some(v), Value::Count) if v.parse::<u32>().is_ok() => return Ok(v),
+                (Some(v), Value::Number) if v.parse::<f32>().is_ok_and(f32::is_finite) => {
+                    return Ok(v);
                 }
-            });
-            return Err(UsageError(format!(
+                (Some(v), Value::Text) => return Ok(v),
+                (None, _) => "the end of the command line".to_string(),
+                // `1e39` is a number, just not an f32: say so, as the scene parser does.
+                (Some(v), Value::Number)
+                    if v.parse::<f32>().is_ok_and(|x| !x.is_finite())
+                        && raywave::render::scene::beyond_range(&v) =>
+                {
+                    format!("`{v}`, of magnitude past the largest f32, 3.4e38")
+                }
+                (Some(v), _) => format!("`{v}`"),
+            };
+            Err(UsageError(format!(
                 "{spelling}: expected {what}, found {found}"
-            )));
-        }
-        values.push(found.unwrap_or_default());
-    }
-    Ok(values)
+            )))
+        })
+        .collect()
 }
 
 /// Rewrites argv so clap can read it. A command line without a subcommand (`raywave`,
@@ -257,14 +236,13 @@ fn take_values<'a>(
 /// - the lab's and RPI 2023's spellings on one line, or one setting given twice under two
 ///   spellings (`-num_bounces 0 --bounces 3`), are usage errors.
 pub fn normalize_args(args: impl IntoIterator<Item = OsString>) -> Result<Normalized, UsageError> {
-    let mut args: Vec<OsString> = args.into_iter().collect();
-    let program = if args.is_empty() {
-        OsString::from("raywave")
-    } else {
-        args.remove(0)
-    };
+    let mut args = args.into_iter();
+    let program = args.next().unwrap_or_else(|| "raywave".into());
+    let args: Vec<OsString> = args.collect();
     let first = args.first().and_then(|a| a.to_str()).unwrap_or("");
-    let (command, rest) = if SUBCOMMANDS.contains(&first) {
+    let named = NOT_RENDER.contains(&first)
+        || (super::Cli::command().get_subcommands()).any(|c| c.get_name() == first);
+    let (command, rest) = if named {
         (first.to_string(), args[1..].to_vec())
     } else {
         ("render".to_string(), args)
@@ -274,8 +252,7 @@ pub fn normalize_args(args: impl IntoIterator<Item = OsString>) -> Result<Normal
         out.extend(rest);
         return Ok(Normalized {
             args: out,
-            notes: Vec::new(),
-            spellings: Vec::new(),
+            ..Default::default()
         });
     }
 
@@ -290,16 +267,11 @@ pub fn normalize_args(args: impl IntoIterator<Item = OsString>) -> Result<Normal
             .ok()
             .map(Defaults::from)
     });
-    let mut lab_spelling = None;
-    let mut rpi_spelling = None;
-    for arg in rest.iter().filter_map(|a| a.to_str()) {
-        match foreign(arg) {
-            Some((_, Some(Defaults::Lab))) => lab_spelling = lab_spelling.or(Some(arg)),
-            Some((_, Some(Defaults::Rpi))) => rpi_spelling = rpi_spelling.or(Some(arg)),
-            _ => {}
-        }
-    }
-    let detected = match (lab_spelling, rpi_spelling) {
+    let spelling = |dialect| {
+        (rest.iter().filter_map(|a| a.to_str()))
+            .find(|a| matches!(foreign(a), Some((_, Some(d))) if d == dialect))
+    };
+    let detected = match (spelling(Defaults::Lab), spelling(Defaults::Rpi)) {
         (Some(lab), Some(rpi)) => {
             return Err(UsageError(format!(
                 "`{lab}` is the lab's spelling and `{rpi}` RPI 2023's: expected one program's flags on a command line"
@@ -363,41 +335,27 @@ pub fn normalize_args(args: impl IntoIterator<Item = OsString>) -> Result<Normal
             continue;
         };
         let values = take_values(text, flag.values, &mut rest)?;
-        match flag.meaning {
-            Meaning::Flag(target) => {
-                claim(target, text)?;
-                if target != text {
-                    spellings.push((target, text.to_string()));
-                }
-                out.push(target.into());
-                out.extend(values.into_iter().map(OsString::from));
+        // The raywave flag it stands for, and the values that follow that flag.
+        let (target, values) = match flag.meaning {
+            Meaning::Flag(target) => (target, values),
+            Meaning::Tokens(args) => (args[0], args[1..].iter().map(|a| a.to_string()).collect()),
+            Meaning::ShadowSamples if values[0] != "0" => ("--shadow-samples", values),
+            Meaning::ShadowSamples if dialect == Defaults::Rpi => {
+                ("--shadows", vec!["off".to_string()])
             }
-            Meaning::Tokens(args) => {
-                claim(args[0], text)?;
-                spellings.push((args[0], text.to_string()));
-                out.extend(args.iter().map(OsString::from));
-            }
-            Meaning::ShadowSamples => match (values[0].as_str(), dialect) {
-                ("0", Defaults::Rpi) => {
-                    claim("--shadows", text)?;
-                    spellings.push(("--shadows", text.to_string()));
-                    out.extend(["--shadows", "off"].map(OsString::from));
-                }
-                ("0", _) => {}
-                (n, _) => {
-                    claim("--shadow-samples", text)?;
-                    spellings.push(("--shadow-samples", text.to_string()));
-                    out.extend(["--shadow-samples", n].map(OsString::from));
-                }
-            },
+            Meaning::ShadowSamples => continue,
             Meaning::NoEffect(why) => {
-                let given = std::iter::once(text.to_string())
-                    .chain(values)
-                    .collect::<Vec<_>>()
-                    .join(" ");
+                let given = [vec![text.to_string()], values].concat().join(" ");
                 notes.push(format!("{given}: accepted, no effect in raywave ({why})"));
+                continue;
             }
+        };
+        claim(target, text)?;
+        if target != text {
+            spellings.push((target, text.to_string()));
         }
+        out.push(target.into());
+        out.extend(values.into_iter().map(OsString::from));
     }
     Ok(Normalized {
         args: out,

@@ -1,14 +1,12 @@
-//! The flags that shape the image, shared by `raywave render` and `raywave bench`.
+//! The flags several commands share (the image's, the seed's, the threads'), and [`say`].
 
 use super::values::{DefaultsArg, LightModelArg, SamplerArg, ShadowArg, colour_component};
 use clap::Args;
 use raywave::output::OutputPlan;
 use raywave::render::settings::options::ImageOptions;
 
-/// The flags that shape the image, shared by `render` and `bench` so that both default alike
-/// (a bench record then measures what the same flags render). The defaults are the same with
-/// or without a scene file: the built-in scene and the same file read from `scenes/` get the
-/// same settings.
+/// The flags that shape the image: shared so that every command defaults alike (a bench record
+/// measures what the same flags render), with or without a scene file.
 #[derive(Args, Debug, Clone)]
 pub struct ImageArgs {
     /// Image size in pixels [default: 512 512; the lab's 100 100; RPI's 500 500].
@@ -79,9 +77,7 @@ impl ImageArgs {
             two_sided: false,
         }
     }
-}
 
-impl ImageArgs {
     /// The flags as given, spelled for another build's `raywave render` (`bench --against`):
     /// only what was set, so each build fills the rest with its own defaults, as a user running
     /// both with the same command line would see.
@@ -92,43 +88,29 @@ impl ImageArgs {
                 .get_name()
                 .to_string()
         }
-        let mut out = Vec::new();
-        let mut push = |flag: &str, values: Vec<String>| {
-            out.push(flag.to_string());
-            out.extend(values);
-        };
-        if let Some(s) = &self.size {
-            push("--size", s.iter().map(u32::to_string).collect());
+        fn all<T: ToString>(values: &Option<Vec<T>>) -> Option<Vec<String>> {
+            Some(values.as_ref()?.iter().map(T::to_string).collect())
         }
-        if let Some(b) = self.bounces {
-            push("--bounces", vec![b.to_string()]);
+        fn one(value: Option<impl ToString>) -> Option<Vec<String>> {
+            value.map(|v| vec![v.to_string()])
         }
-        if let Some(s) = self.shadows {
-            push("--shadows", vec![name(s)]);
-        }
-        if let Some(n) = self.shadow_samples {
-            push("--shadow-samples", vec![n.to_string()]);
-        }
-        push("--sampler", vec![name(self.sampler)]);
-        if let Some(n) = self.aa {
-            push("--aa", vec![n.to_string()]);
-        }
-        if let Some(c) = &self.background {
-            push("--background", c.iter().map(f32::to_string).collect());
-        }
-        if let Some(c) = &self.ambient {
-            push("--ambient", c.iter().map(f32::to_string).collect());
-        }
-        if let Some(m) = self.light_model {
-            push("--light-model", vec![name(m)]);
-        }
-        if let Some(n) = self.ring_segments {
-            push("--ring-segments", vec![n.to_string()]);
-        }
-        if let Some(d) = self.defaults {
-            push("--defaults", vec![name(d)]);
-        }
-        out
+        [
+            ("--size", all(&self.size)),
+            ("--bounces", one(self.bounces)),
+            ("--shadows", one(self.shadows.map(name))),
+            ("--shadow-samples", one(self.shadow_samples)),
+            ("--sampler", one(Some(name(self.sampler)))),
+            ("--aa", one(self.aa)),
+            ("--background", all(&self.background)),
+            ("--ambient", all(&self.ambient)),
+            ("--light-model", one(self.light_model.map(name))),
+            ("--ring-segments", one(self.ring_segments)),
+            ("--defaults", one(self.defaults.map(name))),
+        ]
+        .into_iter()
+        .filter_map(|(flag, values)| Some([vec![flag.to_string()], values?].concat()))
+        .flatten()
+        .collect()
     }
 }
 
@@ -152,13 +134,6 @@ pub struct ThreadsArg {
     pub threads: Option<u32>,
 }
 
-impl ThreadsArg {
-    /// The pool the flag asks for.
-    pub fn pool(&self) -> anyhow::Result<rayon::ThreadPool> {
-        raywave::render::engine::thread_pool(self.threads)
-    }
-}
-
 /// Prints text meant for the terminal: on stdout, or on stderr when one of `plan`'s outputs
 /// goes to stdout (so the text does not mix into it).
 pub fn say(plan: &OutputPlan, text: &str) -> anyhow::Result<()> {
@@ -167,5 +142,38 @@ pub fn say(plan: &OutputPlan, text: &str) -> anyhow::Result<()> {
         Ok(())
     } else {
         raywave::output::terminal::print(text)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Parser)]
+    struct Wrapper {
+        #[command(flatten)]
+        image: ImageArgs,
+    }
+
+    fn flags(line: &str) -> String {
+        let parsed = Wrapper::parse_from(std::iter::once("x").chain(line.split_whitespace()));
+        parsed.image.flags().join(" ")
+    }
+
+    #[test]
+    fn flags_spell_only_what_was_set_in_declaration_order() {
+        assert_eq!(flags(""), "--sampler stratified");
+        let all = "--size 3 4 --bounces 2 --shadows hard --shadow-samples 4 --sampler sobol --aa 2 \
+                   --background 0.5 1 0 --ambient 0.1 0.25 3 --light-model rpi \
+                   --ring-segments 8 --defaults lab";
+        assert_eq!(
+            flags(all),
+            all.split_whitespace().collect::<Vec<_>>().join(" ")
+        );
+        assert_eq!(
+            flags("--defaults rpi --aa 3 --size 1 2"),
+            "--size 1 2 --sampler stratified --aa 3 --defaults rpi"
+        );
     }
 }

@@ -33,10 +33,5 @@ pub fn run(args: &MeshgenArgs) -> Result<()> {
         args.output.display(),
         triangle_count(bands)
     );
-    if plan.uses_stdout() {
-        eprint!("{text}");
-        Ok(())
-    } else {
-        raywave::output::terminal::print(&text)
-    }
+    super::image::say(&plan, &text)
 }

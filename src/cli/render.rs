@@ -10,6 +10,7 @@ use raywave::frame::report::{stats_table, summary};
 use raywave::frame::{self, FrameOptions};
 use raywave::output::OutputPlan;
 use raywave::output::terminal::with_bar;
+use raywave::render::engine::thread_pool;
 use std::path::PathBuf;
 
 /// `raywave render` flags.
@@ -84,19 +85,12 @@ pub struct RenderArgs {
     pub mse_reference: Option<PathBuf>,
 }
 
-impl RenderArgs {
-    /// The scene path, from the positional argument or the lab's `-input`.
-    pub fn scene_path(&self) -> Option<&PathBuf> {
-        self.scene.as_ref().or(self.input.as_ref())
-    }
-}
-
 /// Renders as the flags say, then prints the summary.
 pub fn run(args: &RenderArgs) -> Result<()> {
     let mut phases = Phases::since_main();
     phases.mark("arguments and signals");
     let options = FrameOptions {
-        scene: args.scene_path().cloned(),
+        scene: args.scene.clone().or_else(|| args.input.clone()),
         image: args.image.with_seed(&args.seed),
         engine: args.engine.into(),
         lanes: args.lanes.into(),
@@ -115,12 +109,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         mse_reference: args.mse_reference.clone(),
         plan: output_plan(args),
     };
-    let pool = args.workers.pool()?;
+    let pool = thread_pool(args.workers.threads)?;
     let template = "{spinner} {msg} [{bar:40}] {pos}/{len}, {elapsed} (eta {eta})";
     let outcome = with_bar(template, args.quiet, |progress| {
         frame::run(&options, &pool, progress, &mut phases)
     })?;
-    // Text meant for the terminal goes to stderr when an image or record goes to stdout.
     let say = |text: &str| super::image::say(&options.plan, text);
     if let Some(text) = &outcome.pixel_rays {
         say(text)?;

@@ -11,7 +11,7 @@ use raywave::output::image_file::ldr_format;
 use raywave::output::terminal::with_bar;
 use raywave::output::{OutputPlan, write_output};
 use raywave::render::camera::CameraRays;
-use raywave::render::engine::{Engine, clamped_warning};
+use raywave::render::engine::{Engine, clamped_warning, thread_pool};
 use raywave::render::error::UsageError;
 use raywave::trace::draw::{Overlay, depth_buffer};
 use raywave::trace::view::ViewPlacement;
@@ -76,6 +76,18 @@ pub struct TracePixelArgs {
     pub workers: ThreadsArg,
 }
 
+impl TracePixelArgs {
+    /// The output flags, with their paths.
+    fn outputs(&self) -> [(&'static str, &Option<PathBuf>); 4] {
+        [
+            ("--json", &self.json),
+            ("--obj", &self.obj),
+            ("--ply", &self.ply),
+            ("--png", &self.png),
+        ]
+    }
+}
+
 /// Traces, checks and writes as the flags say.
 pub fn run(args: &TracePixelArgs) -> Result<()> {
     if let Some(png) = &args.png {
@@ -106,13 +118,11 @@ pub fn run(args: &TracePixelArgs) -> Result<()> {
         }),
         distance: args.view_distance,
     };
-    let view_camera = match &args.png {
-        Some(_) => Some(placement.camera(&scene.camera).map_err(UsageError)?),
-        None => None,
-    };
+    let view_camera = (args.png.as_ref())
+        .map(|_| placement.camera(&scene.camera).map_err(UsageError))
+        .transpose()?;
     tree.check = Some(check_pixel(&scene, &settings, &tree));
 
-    // Text meant for the terminal goes to stderr when an output goes to stdout.
     let say = |text: &str| super::image::say(&plan, text);
     let title = format!(
         "raywave trace-pixel {} {}: {}",
@@ -121,8 +131,7 @@ pub fn run(args: &TracePixelArgs) -> Result<()> {
     if let Some(path) = &args.json {
         write_output(path, |w| {
             serde_json::to_writer_pretty(&mut *w, &tree)?;
-            writeln!(w)?;
-            Ok(())
+            Ok(writeln!(w)?)
         })?;
     }
     if args.obj.is_some() || args.ply.is_some() {
@@ -135,10 +144,8 @@ pub fn run(args: &TracePixelArgs) -> Result<()> {
         }
     }
     if let (Some(path), Some(camera)) = (&args.png, view_camera) {
-        let (width, height) = match &args.view_size {
-            Some(s) => (s[0], s[1]),
-            None => (settings.width, settings.height),
-        };
+        let (width, height) =
+            (args.view_size.as_ref()).map_or((settings.width, settings.height), |s| (s[0], s[1]));
         let mut view_scene = scene.clone();
         view_scene.camera = camera;
         let view_settings = raywave::render::settings::RenderSettings {
@@ -146,7 +153,7 @@ pub fn run(args: &TracePixelArgs) -> Result<()> {
             height,
             ..settings.clone()
         };
-        let pool = args.workers.pool()?;
+        let pool = thread_pool(args.workers.threads)?;
         let engine = Engine::Wavefront.prepare(
             &view_scene,
             &view_settings,
@@ -180,15 +187,9 @@ pub fn run(args: &TracePixelArgs) -> Result<()> {
         raywave::output::image_file::write_rgb8(&img, path)
             .with_context(|| format!("cannot write --png {}", path.display()))?;
     }
-    let wrote: Vec<String> = [
-        ("--json", &args.json),
-        ("--obj", &args.obj),
-        ("--ply", &args.ply),
-        ("--png", &args.png),
-    ]
-    .iter()
-    .filter_map(|(flag, p)| p.as_ref().map(|p| format!("{flag} {}", p.display())))
-    .collect();
+    let wrote: Vec<String> = (args.outputs().iter())
+        .filter_map(|(flag, p)| p.as_ref().map(|p| format!("{flag} {}", p.display())))
+        .collect();
     if wrote.is_empty() {
         say(&summary(&tree))?;
     } else {
@@ -242,12 +243,7 @@ fn output_plan(args: &TracePixelArgs) -> OutputPlan {
     if let Some(scene) = &args.scene {
         plan = plan.input("SCENE", scene);
     }
-    for (flag, path) in [
-        ("--json", &args.json),
-        ("--obj", &args.obj),
-        ("--ply", &args.ply),
-        ("--png", &args.png),
-    ] {
+    for (flag, path) in args.outputs() {
         if let Some(p) = path {
             plan = plan.output(flag, p);
         }

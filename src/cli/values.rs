@@ -8,6 +8,7 @@
 
 use clap::builder::{StringValueParser, TypedValueParser};
 use raywave::bench::verdict::VerdictForm;
+use raywave::diff::Metric;
 use raywave::output::cost_map::{CostKind, CostMeasure};
 use raywave::render::engine::Engine;
 use raywave::render::film::ToneMap;
@@ -17,25 +18,21 @@ use raywave::render::settings::{LightModel, ShadowMode};
 use raywave::render::wavefront::lanes::LaneWidth;
 
 /// The float types of flags.
-pub trait Float: std::str::FromStr + Copy + Send + Sync + 'static {
+pub trait Float: std::str::FromStr + Copy + Into<f64> + Send + Sync + 'static {
     /// The type's name and its largest finite value, for messages.
     const RANGE: &'static str;
     /// Not an infinity nor NaN.
-    fn finite(self) -> bool;
+    fn finite(self) -> bool {
+        self.into().is_finite()
+    }
 }
 
 impl Float for f32 {
     const RANGE: &'static str = "the largest f32, 3.4e38";
-    fn finite(self) -> bool {
-        self.is_finite()
-    }
 }
 
 impl Float for f64 {
     const RANGE: &'static str = "the largest f64, 1.8e308";
-    fn finite(self) -> bool {
-        self.is_finite()
-    }
 }
 
 /// A float that `ok` accepts, refused otherwise with "expected {what}, found `text`" (clap
@@ -128,6 +125,22 @@ mirror! {
 }
 
 mirror! {
+    /// `--metric` of `raywave diff`.
+    MetricArg => Metric {
+        /// Mean squared error.
+        Mse,
+        /// Relative MSE: mean (a−b)²/(b+0.01)² (pbrt-v4's MRSE).
+        Relmse,
+        /// Largest |a − b|.
+        Max,
+        /// PSNR in dB against a peak of 1 (--fail-above fails when it is BELOW the value).
+        Psnr,
+        /// FLIP's mean (needs the `flip` feature).
+        Flip,
+    }
+}
+
+mirror! {
     /// Which rays a cost map counts.
     CostKindArg => CostKind {
         /// Camera rays' closest hits.
@@ -213,20 +226,6 @@ mirror! {
     }
 }
 
-impl SamplerArg {
-    /// Every sampler, in the order reports list them (`LightSampler::ALL`).
-    pub const ALL: [SamplerArg; 8] = [
-        SamplerArg::Random,
-        SamplerArg::Stratified,
-        SamplerArg::Sobol,
-        SamplerArg::Lab,
-        SamplerArg::Halton,
-        SamplerArg::Pmj02,
-        SamplerArg::Zsobol,
-        SamplerArg::Bluenoise,
-    ];
-}
-
 mirror! {
     /// Whose defaults fill the settings that no flag sets.
     DefaultsArg => Defaults {
@@ -242,10 +241,14 @@ mirror! {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use clap::ValueEnum;
 
     #[test]
     fn sampler_spellings_list_every_sampler_in_the_library_order() {
-        let ours: Vec<LightSampler> = SamplerArg::ALL.into_iter().map(Into::into).collect();
+        let ours: Vec<LightSampler> = SamplerArg::value_variants()
+            .iter()
+            .map(|&s| s.into())
+            .collect();
         assert_eq!(ours, LightSampler::ALL);
     }
 }

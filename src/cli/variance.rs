@@ -4,17 +4,17 @@
 use super::image::ThreadsArg;
 use super::values::{EngineArg, LightModelArg, SamplerArg};
 use anyhow::Result;
-use clap::{Args, Subcommand};
+use clap::{Args, Subcommand, ValueEnum};
 use raywave::output::OutputPlan;
 use raywave::output::terminal::{print, with_bar};
-use raywave::render::engine::clamped_warning;
+use raywave::render::engine::{clamped_warning, thread_pool};
 use raywave::render::progress::Progress;
 use raywave::render::scene::Scene;
 use raywave::render::settings::RenderSettings;
 use raywave::render::wavefront::DEFAULT_BATCH_SIZE;
 use raywave::shard::Shard;
 use raywave::variance::command::{VarianceOptions, load_cases, prepare, run_shard, study};
-use raywave::variance::study::plan::Case;
+use raywave::variance::study::plan::{Case, Study, identity};
 use std::path::{Path, PathBuf};
 
 /// Flags of `raywave variance`. A scene file literally named `prepare` or `merge` is given as
@@ -104,7 +104,7 @@ pub(crate) struct StudyArgs {
     pub budgets: Vec<u32>,
     /// Samplers to compare: comma- or space-separated (`random,sobol` or `random sobol`; with
     /// spaces, give SCENE before this flag).
-    #[arg(long, value_enum, num_args = 1.., value_delimiter = ',', default_values_t = SamplerArg::ALL)]
+    #[arg(long, value_enum, num_args = 1.., value_delimiter = ',', default_values_t = SamplerArg::value_variants())]
     pub samplers: Vec<SamplerArg>,
     /// Seeds (independent renders) per sampler and budget; at least 2, for the variance.
     #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(2..=1024))]
@@ -178,7 +178,8 @@ impl StudyArgs {
     }
 
     /// The inputs: the scene files and the study file.
-    fn inputs(&self, options: &VarianceOptions, mut plan: OutputPlan) -> OutputPlan {
+    fn inputs(&self, options: &VarianceOptions) -> OutputPlan {
+        let mut plan = OutputPlan::new();
         if let Some(file) = &self.study {
             plan = plan.input("--study", file);
         }
@@ -261,17 +262,15 @@ pub fn run(args: &VarianceArgs) -> Result<()> {
         ));
     }
     let cases = cases(&options)?;
-    let pool = args.workers.pool()?;
-    let plan = args.study.inputs(&options, OutputPlan::new());
+    let pool = thread_pool(args.workers.threads)?;
+    let plan = args.study.inputs(&options);
+    let work = identity(&cases, options.engine.name()).work;
     if let Some(shard) = args.shard {
-        let part = options.out.join(raywave::shard::part_name::<
-            raywave::variance::study::plan::Study,
-        >(shard));
+        let part = options.out.join(raywave::shard::part_name::<Study>(shard));
         let plan = plan.output_in_new_dir("--out", &part);
         plan.check()?;
         check_textures(&plan, &cases)?;
-        let identity = raywave::variance::study::plan::identity(&cases, options.engine.name());
-        let jobs = identity.work.assignment(shard.count)[shard.index].len();
+        let jobs = work.assignment(shard.count)[shard.index].len();
         let prefix = format!("variance shard {shard}, {jobs} jobs");
         let (path, jobs) = with_progress(&options, prefix, |render, progress| {
             pool.install(|| run_shard(&options, &cases, shard, render, progress))
@@ -282,17 +281,12 @@ pub fn run(args: &VarianceArgs) -> Result<()> {
             path.display()
         ));
     }
-    let mut plan = plan;
-    for name in report_files(&options, &cases) {
-        plan = plan.output_in_new_dir("--out", &options.out.join(name));
-    }
+    let plan = (report_files(&options, &cases).into_iter()).fold(plan, |plan, name| {
+        plan.output_in_new_dir("--out", &options.out.join(name))
+    });
     plan.check()?;
     check_textures(&plan, &cases)?;
-    let jobs = raywave::variance::study::plan::identity(&cases, options.engine.name())
-        .work
-        .jobs()
-        .len();
-    let prefix = format!("variance, {jobs} jobs");
+    let prefix = format!("variance, {} jobs", work.jobs().len());
     let outcome = with_progress(&options, prefix, |render, progress| {
         pool.install(|| study(&options, &cases, render, progress))
     })?;
@@ -334,7 +328,7 @@ fn run_prepare(args: &PrepareArgs) -> Result<()> {
         .study
         .options(Path::new("variance-report"), args.quiet)?;
     let cases = cases(&options)?;
-    let pool = args.workers.pool()?;
+    let pool = thread_pool(args.workers.threads)?;
     let prepared = with_progress(&options, "prepare".into(), |render, progress| {
         pool.install(|| prepare(&options, &cases, render, progress))
     })?;
@@ -355,11 +349,9 @@ fn run_prepare(args: &PrepareArgs) -> Result<()> {
 
 fn run_merge(args: &MergeArgs) -> Result<()> {
     let started = std::time::Instant::now();
-    let mut plan = OutputPlan::new();
-    for part in &args.parts {
-        plan = plan.input("PARTS", part);
-    }
-    plan.check()?;
+    (args.parts.iter())
+        .fold(OutputPlan::new(), |plan, part| plan.input("PARTS", part))
+        .check()?;
     let merged = raywave::variance::merge::merge(&args.parts, &args.out, &|w| eprintln!("{w}"))?;
     print(&format!(
         "{}\n{}merge   {:.2} s\nwrote   {}\n",

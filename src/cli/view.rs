@@ -45,7 +45,7 @@ pub struct ViewArgs {
     /// start]: 16 to 256 of A-Z a-z 0-9 - . _ ~. For scripts; prefer the variable, which other
     /// users cannot read in the process list.
     #[arg(long, value_name = "TOKEN", env = "RAYWAVE_VIEW_TOKEN", hide_env_values = true,
-          value_parser = parse_token, conflicts_with = "no_token")]
+          value_parser = Token::parse, conflicts_with = "no_token")]
     pub token: Option<Token>,
     /// Serve without a token: every local user and process can then drive the server.
     /// Loopback only.
@@ -55,10 +55,6 @@ pub struct ViewArgs {
     #[arg(long, value_name = "N", default_value_t = DEFAULT_MAX_CONNECTIONS as u32,
           value_parser = clap::value_parser!(u32).range(1..=65536))]
     pub max_connections: u32,
-}
-
-fn parse_token(value: &str) -> Result<Token, String> {
-    Token::parse(value)
 }
 
 /// Serves the page until Ctrl-C (exit 130) or SIGTERM (143); returns the exit code.
