@@ -257,14 +257,8 @@ pub(crate) fn head(reply: &Reply, body_len: usize) -> Vec<u8> {
             "no-store"
         },
     );
-    if let Some(allow) = reply.allow {
-        head += &format!("Allow: {allow}\r\n");
-    }
-    if let Some(seconds) = reply.retry_after {
-        head += &format!("Retry-After: {seconds}\r\n");
-    }
-    if let Some(cookie) = &reply.set_cookie {
-        head += &format!("Set-Cookie: {cookie}\r\n");
+    for (name, value) in &reply.headers {
+        head += &format!("{name}: {value}\r\n");
     }
     head += "\r\n";
     head.into_bytes()
@@ -424,9 +418,11 @@ mod tests {
     #[test]
     fn replies_carry_their_headers() {
         let reply = Reply {
-            retry_after: Some(1),
-            set_cookie: Some("a=b".into()),
-            allow: Some("GET"),
+            headers: vec![
+                ("Retry-After", "1".into()),
+                ("Set-Cookie", "a=b".into()),
+                ("Allow", "GET".into()),
+            ],
             ..Reply::bytes("text/plain", b"hi".to_vec())
         };
         let head = String::from_utf8(head(&reply, 2)).unwrap();

@@ -45,8 +45,10 @@ pub(crate) fn answer(request: &Request, state: &State, gate: &Gate) -> Reply {
             route(request, path, query, state)
         })
         .unwrap_or_else(Reply::from);
-    if reply.status == 200 {
-        reply.set_cookie = cookie;
+    if reply.status == 200
+        && let Some(cookie) = cookie
+    {
+        reply.headers.push(("Set-Cookie", cookie));
     }
     reply
 }
@@ -72,66 +74,33 @@ fn check(
     )
 }
 
-/// The routing table.
+/// The routing table: each path's method and handler. The method is checked before the
+/// handler runs (GET allows HEAD).
 fn route(request: &Request, path: &str, query: &str, state: &State) -> Result<Reply, ApiError> {
-    let method = request.method.as_str();
-    let segments: Vec<&str> = path.split('/').skip(1).collect();
-    let get = |allow: &'static str| {
-        if method == "GET" || method == "HEAD" {
-            Ok(())
-        } else {
-            Err(ApiError::method(method, path, allow))
-        }
-    };
-    let post = || {
-        if method == "POST" {
-            Ok(())
-        } else {
-            Err(ApiError::method(method, path, "POST"))
-        }
-    };
+    type Handler<'a> = &'a dyn Fn() -> Result<Reply, ApiError>;
     let body = &request.body;
-    match segments.as_slice() {
-        [""] | ["index.html"] => {
-            get("GET")?;
-            assets::page()
+    let segments: Vec<&str> = path.split('/').skip(1).collect();
+    let (allow, handler): (&str, Handler) = match segments.as_slice() {
+        [""] | ["index.html"] => ("GET", &assets::page),
+        ["assets", name] => ("GET", &|| assets::asset(name)),
+        ["api", "scene"] => ("GET", &|| Ok(api::scene(state))),
+        ["api", "render"] => ("POST", &|| api::render(state, body)),
+        ["api", "render", job] => ("GET", &|| api::render_status(state, job)),
+        ["api", "render", job, level] => ("GET", &|| api::render_png(state, job, level)),
+        ["api", "pixel"] => ("GET", &|| api::pixel(state, query)),
+        ["api", "compare"] => ("POST", &|| api::compare(state, body)),
+        ["api", "compare", id, name] => ("GET", &|| api::compare_png(state, id, name)),
+        _ => {
+            return Err(ApiError::not_found(format!(
+                "no such path: {} (the page is at /, the API under /api/)",
+                quote(path)
+            )));
         }
-        ["assets", name] => {
-            get("GET")?;
-            assets::asset(name)
-        }
-        ["api", "scene"] => {
-            get("GET")?;
-            Ok(api::scene(state))
-        }
-        ["api", "render"] => {
-            post()?;
-            api::render(state, body)
-        }
-        ["api", "render", job] => {
-            get("GET")?;
-            api::render_status(state, job)
-        }
-        ["api", "render", job, level] => {
-            get("GET")?;
-            api::render_png(state, job, level)
-        }
-        ["api", "pixel"] => {
-            get("GET")?;
-            api::pixel(state, query)
-        }
-        ["api", "compare"] => {
-            post()?;
-            api::compare(state, body)
-        }
-        ["api", "compare", id, name] => {
-            get("GET")?;
-            api::compare_png(state, id, name)
-        }
-        _ => Err(ApiError::not_found(format!(
-            "no such path: {} (the page is at /, the API under /api/)",
-            quote(path)
-        ))),
+    };
+    let method = request.method.as_str();
+    match (allow, method) {
+        ("GET", "GET" | "HEAD") | ("POST", "POST") => handler(),
+        _ => Err(ApiError::method(method, path, allow)),
     }
 }
 
