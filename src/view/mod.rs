@@ -110,14 +110,9 @@ pub fn run(options: ViewOptions, say: &dyn Fn(&str) -> Result<()>) -> Result<i32
 
 /// The page's URL, with the token: on every interface, the loopback one.
 pub fn url(addr: SocketAddr, access: &Access) -> String {
-    let host = match addr.ip() {
-        IpAddr::V4(ip) if ip.is_unspecified() => "127.0.0.1".to_string(),
-        IpAddr::V6(ip) if ip.is_unspecified() => "[::1]".to_string(),
-        IpAddr::V4(ip) => ip.to_string(),
-        IpAddr::V6(ip) => format!("[{ip}]"),
-    };
+    let addr = server::local_address(addr);
     match access {
-        Access::Token(token) => format!("http://{host}:{}/?token={}", addr.port(), token.as_str()),
-        Access::Open => format!("http://{host}:{}/", addr.port()),
+        Access::Token(token) => format!("http://{addr}/?token={}", token.as_str()),
+        Access::Open => format!("http://{addr}/"),
     }
 }

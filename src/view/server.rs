@@ -22,7 +22,7 @@ use anyhow::{Context, Result};
 use std::net::{IpAddr, Ipv4Addr, Ipv6Addr, SocketAddr, TcpListener, TcpStream};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use std::sync::mpsc::{Receiver, SyncSender, TrySendError};
+use std::sync::mpsc::{Receiver, SyncSender};
 use std::time::{Duration, Instant};
 
 /// The connections open at once by default; past it, new ones get a 503.
@@ -85,7 +85,7 @@ impl Server {
         handle.close();
         shared.stop.store(true, Ordering::SeqCst);
         // Wake the acceptor from accept(2) with a connection of our own.
-        let _ = TcpStream::connect_timeout(&wake_address(self.addr), Duration::from_secs(1));
+        let _ = TcpStream::connect_timeout(&local_address(self.addr), Duration::from_secs(1));
         let _ = acceptor.join();
         let end = Instant::now() + DRAIN_TIME;
         while shared.open.load(Ordering::SeqCst) > 0 && Instant::now() < end {
@@ -114,9 +114,9 @@ impl Drop for Slot {
     }
 }
 
-/// The address a connection to the server itself goes to: the bound one, or loopback when
+/// The address a client on this machine reaches the server at: the bound one, or loopback when
 /// bound to every interface.
-fn wake_address(addr: SocketAddr) -> SocketAddr {
+pub(crate) fn local_address(addr: SocketAddr) -> SocketAddr {
     match addr.ip() {
         IpAddr::V4(ip) if ip.is_unspecified() => (Ipv4Addr::LOCALHOST, addr.port()).into(),
         IpAddr::V6(ip) if ip.is_unspecified() => (Ipv6Addr::LOCALHOST, addr.port()).into(),
@@ -141,9 +141,8 @@ fn accept(listener: &TcpListener, shared: &Arc<Shared>, refuse: &SyncSender<TcpS
         let accepted = Instant::now();
         if shared.open.fetch_add(1, Ordering::SeqCst) >= shared.max_connections {
             shared.open.fetch_sub(1, Ordering::SeqCst);
-            if let Err(TrySendError::Full(_)) = refuse.try_send(stream) {
-                // Already refusing as fast as it can: close this one unanswered.
-            }
+            // When the refuser's queue is full, this one is closed unanswered.
+            let _ = refuse.try_send(stream);
             continue;
         }
         let slot = Slot(shared.clone());
