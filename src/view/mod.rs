@@ -34,8 +34,9 @@ pub(crate) mod tree;
 
 use anyhow::Result;
 use request::Resolved;
+use std::collections::VecDeque;
 use std::net::{IpAddr, SocketAddr};
-use std::sync::Arc;
+use std::sync::{Arc, Mutex, MutexGuard};
 use token::Access;
 
 /// What `raywave view` was started with.
@@ -114,5 +115,19 @@ pub fn url(addr: SocketAddr, access: &Access) -> String {
     match access {
         Access::Token(token) => format!("http://{addr}/?token={}", token.as_str()),
         Access::Open => format!("http://{addr}/"),
+    }
+}
+
+/// `mutex`'s guard, also after a thread panicked holding it: what it guards stays usable.
+fn lock<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
+    mutex.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Appends `item` to `kept`, dropping the oldest past `max`.
+fn keep<T>(kept: &Mutex<VecDeque<T>>, item: T, max: usize) {
+    let mut kept = lock(kept);
+    kept.push_back(item);
+    while kept.len() > max {
+        kept.pop_front();
     }
 }

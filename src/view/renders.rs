@@ -22,12 +22,12 @@ use crate::render::engine::{Engine, Prepared, clamp_to_finite};
 use crate::render::film::ToneMap;
 use crate::render::progress::Progress;
 use crate::render::scene::Scene;
-use crate::view::CountedRender;
 use crate::view::request::{CostMeasureView, CostOverlay, Resolved, ViewSettings};
+use crate::view::{CountedRender, keep, lock};
 use serde::Serialize;
 use std::collections::VecDeque;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
-use std::sync::{Arc, Condvar, Mutex, MutexGuard};
+use std::sync::{Arc, Condvar, Mutex};
 use std::time::{Duration, Instant};
 
 /// How many finished jobs are kept for their images and pixels.
@@ -47,12 +47,13 @@ pub(crate) const RENDER_RATE: f64 = 20.0;
 const LEVEL_DIVISORS: [u32; 4] = [8, 4, 2, 1];
 
 /// Where a job is.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
 #[serde(rename_all = "lowercase", tag = "state", content = "error")]
 pub(crate) enum Status {
     /// Waiting for the render thread.
+    #[default]
     Queued,
-    /// Rendering level `levels_done`.
+    /// Rendering the level after the last in `levels`.
     Running,
     /// Every level rendered.
     Done,
@@ -128,6 +129,7 @@ pub(crate) struct RenderJob {
     state: Mutex<RenderState>,
 }
 
+#[derive(Default)]
 struct RenderState {
     status: Status,
     levels: Vec<Level>,
@@ -139,7 +141,7 @@ struct RenderState {
 impl RenderJob {
     /// The status for the page.
     pub(crate) fn status(&self) -> RenderStatus {
-        let state = self.lock();
+        let state = lock(&self.state);
         RenderStatus {
             job: self.id,
             status: state.status.clone(),
@@ -155,7 +157,7 @@ impl RenderJob {
 
     /// Where it is now.
     pub(crate) fn state(&self) -> Status {
-        self.lock().status.clone()
+        lock(&self.state).status.clone()
     }
 
     /// The job that superseded this one, once one has.
@@ -165,20 +167,16 @@ impl RenderJob {
 
     /// Level `k`'s PNG, once rendered.
     pub(crate) fn png(&self, k: usize) -> Option<Arc<Vec<u8>>> {
-        self.lock().pngs.get(k).cloned()
+        lock(&self.state).pngs.get(k).cloned()
     }
 
     /// Level `k`'s cost-map overlay, once rendered, when the job asked for one.
     pub(crate) fn cost_png(&self, k: usize) -> Option<Arc<Vec<u8>>> {
-        self.lock().cost_pngs.get(k).cloned().flatten()
-    }
-
-    fn lock(&self) -> MutexGuard<'_, RenderState> {
-        self.state.lock().unwrap_or_else(|e| e.into_inner())
+        lock(&self.state).cost_pngs.get(k).cloned().flatten()
     }
 
     fn set_status(&self, status: Status) {
-        self.lock().status = status;
+        lock(&self.state).status = status;
     }
 
     /// Marks the job superseded by `by` (unless a job did before) and tells its render, if
@@ -222,13 +220,9 @@ struct Queue {
 }
 
 impl Queue {
-    fn lock(&self) -> MutexGuard<'_, Inbox> {
-        self.inbox.lock().unwrap_or_else(|e| e.into_inner())
-    }
-
     /// Stops the render thread: the running job is cancelled, the waiting one dropped.
     fn close(&self) {
-        let mut inbox = self.lock();
+        let mut inbox = lock(&self.inbox);
         inbox.closed = true;
         if let Some(job) = &inbox.running {
             job.cancel.store(true, Ordering::Relaxed);
@@ -311,10 +305,7 @@ impl Renders {
     /// Queues a job, unless the rate limit refuses it. It takes the place of the job waiting,
     /// which is superseded without starting, and cancels the job running.
     pub(crate) fn submit(&self, resolved: Resolved) -> Result<Arc<RenderJob>, RateLimited> {
-        self.bucket
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .take(Instant::now())?;
+        lock(&self.bucket).take(Instant::now())?;
         let id = self.next.fetch_add(1, Ordering::Relaxed);
         let sizes = level_sizes(resolved.settings.width, resolved.settings.height);
         let job = Arc::new(RenderJob {
@@ -325,20 +316,10 @@ impl Renders {
             superseded_by: AtomicU64::new(0),
             done_units: AtomicU64::new(0),
             total_units: AtomicU64::new(0),
-            state: Mutex::new(RenderState {
-                status: Status::Queued,
-                levels: Vec::new(),
-                pngs: Vec::new(),
-                cost_pngs: Vec::new(),
-            }),
+            state: Mutex::default(),
         });
-        let mut kept = self.kept.lock().unwrap_or_else(|e| e.into_inner());
-        kept.push_back(job.clone());
-        while kept.len() > KEPT_RENDERS {
-            kept.pop_front();
-        }
-        drop(kept);
-        let mut inbox = self.queue.lock();
+        keep(&self.kept, job.clone(), KEPT_RENDERS);
+        let mut inbox = lock(&self.queue.inbox);
         if inbox.closed {
             job.set_status(Status::Failed("the render thread has stopped".into()));
             return Ok(job);
@@ -357,8 +338,7 @@ impl Renders {
 
     /// The job `id`, while it is kept.
     pub(crate) fn get(&self, id: u64) -> Option<Arc<RenderJob>> {
-        let kept = self.kept.lock().unwrap_or_else(|e| e.into_inner());
-        kept.iter().find(|j| j.id == id).cloned()
+        lock(&self.kept).iter().find(|j| j.id == id).cloned()
     }
 
     /// The newest job's id (0 before the first).
@@ -393,7 +373,7 @@ fn render_thread(
     let _close = CloseOnExit(queue);
     loop {
         let job = {
-            let mut inbox = queue.lock();
+            let mut inbox = lock(&queue.inbox);
             loop {
                 if inbox.closed {
                     return;
@@ -424,7 +404,7 @@ fn render_thread(
             )),
         };
         job.set_status(status);
-        queue.lock().running = None;
+        lock(&queue.inbox).running = None;
     }
 }
 
@@ -488,11 +468,7 @@ fn render_levels(
                             totals: &costs.totals,
                             rays: &stats.counts,
                         };
-                        (
-                            overlay(&input, kind, job.resolved.cost_measure.count()),
-                            width,
-                            height,
-                        )
+                        overlay(&input, kind, job.resolved.cost_measure.count())
                     });
                     (film, stats, overlay)
                 }),
@@ -506,7 +482,7 @@ fn render_levels(
         let seconds = start.elapsed().as_secs_f64();
         let png = png_bytes(&film.to_rgb8(ToneMap::Clamp))?;
         let (cost, cost_png) = match overlay {
-            Some((map, w, h)) => (
+            Some(map) => (
                 Some(CostLegend {
                     kind: job.resolved.cost_map,
                     measure: job.resolved.cost_measure,
@@ -514,11 +490,11 @@ fn render_levels(
                     largest: map.largest,
                     per_ray: map.per_ray,
                 }),
-                Some(Arc::new(png_bytes(&map.image(w, h))?)),
+                Some(Arc::new(png_bytes(&map.image(width, height))?)),
             ),
             None => (None, None),
         };
-        let mut state = job.lock();
+        let mut state = lock(&job.state);
         state.levels.push(Level {
             width,
             height,
@@ -571,7 +547,7 @@ mod tests {
         let a = jobs.submit(resolved()).unwrap();
         // The render thread takes it.
         {
-            let mut inbox = jobs.queue.lock();
+            let mut inbox = lock(&jobs.queue.inbox);
             inbox.running = inbox.waiting.take();
         }
         let b = jobs.submit(resolved()).unwrap();
@@ -588,7 +564,7 @@ mod tests {
         assert_eq!(a.superseded_by(), Some(b.id), "the first to supersede it");
         assert!(!c.cancel.load(Ordering::Relaxed));
         {
-            let inbox = jobs.queue.lock();
+            let inbox = lock(&jobs.queue.inbox);
             assert_eq!(inbox.waiting.as_ref().map(|j| j.id), Some(c.id));
             assert_eq!(inbox.running.as_ref().map(|j| j.id), Some(a.id));
         }

@@ -189,6 +189,17 @@ pub struct Resolved {
     pub cost_measure: CostMeasureView,
 }
 
+/// `v`, or a 400 saying `name` must be in `lo..=hi`.
+pub(crate) fn in_range(name: &str, v: u32, lo: u32, hi: u32) -> Result<u32, ApiError> {
+    if (lo..=hi).contains(&v) {
+        Ok(v)
+    } else {
+        Err(ApiError::bad(format!(
+            "{name} must be in {lo}..={hi}, found {v}"
+        )))
+    }
+}
+
 impl ViewSettings {
     /// Parses a request body: malformed JSON, unknown fields and wrong types are a 400 naming
     /// the place (serde's line and column).
@@ -203,42 +214,28 @@ impl ViewSettings {
     /// These settings over `base`, checked.
     pub fn resolve(&self, base: &Resolved) -> Result<Resolved, ApiError> {
         let mut s = base.settings.clone();
-        let check = |name: &str, v: u32, lo: u32, hi: u32| -> Result<u32, ApiError> {
-            if (lo..=hi).contains(&v) {
-                Ok(v)
-            } else {
-                Err(ApiError::bad(format!(
-                    "{name} must be in {lo}..={hi}, found {v}"
-                )))
+        let ranged = [
+            ("width", self.width, &mut s.width, 1, MAX_SIDE),
+            ("height", self.height, &mut s.height, 1, MAX_SIDE),
+            ("bounces", self.bounces, &mut s.bounces, 0, MAX_BOUNCES),
+            (
+                "shadow_samples",
+                self.shadow_samples,
+                &mut s.shadow_samples,
+                1,
+                MAX_SHADOW_SAMPLES,
+            ),
+            ("aa", self.aa, &mut s.aa_samples, 1, 64),
+        ];
+        for (name, given, field, lo, hi) in ranged {
+            if let Some(v) = given {
+                *field = in_range(name, v, lo, hi)?;
             }
-        };
-        if let Some(w) = self.width {
-            s.width = check("width", w, 1, MAX_SIDE)?;
         }
-        if let Some(h) = self.height {
-            s.height = check("height", h, 1, MAX_SIDE)?;
-        }
-        if let Some(b) = self.bounces {
-            s.bounces = check("bounces", b, 0, MAX_BOUNCES)?;
-        }
-        if let Some(n) = self.shadow_samples {
-            s.shadow_samples = check("shadow_samples", n, 1, MAX_SHADOW_SAMPLES)?;
-        }
-        if let Some(a) = self.aa {
-            s.aa_samples = check("aa", a, 1, 64)?;
-        }
-        if let Some(m) = self.shadows {
-            s.shadows = m;
-        }
-        if let Some(m) = self.sampler {
-            s.sampler = m;
-        }
-        if let Some(m) = self.light_model {
-            s.light_model = m;
-        }
-        if let Some(seed) = self.seed {
-            s.seed = seed;
-        }
+        s.shadows = self.shadows.unwrap_or(s.shadows);
+        s.sampler = self.sampler.unwrap_or(s.sampler);
+        s.light_model = self.light_model.unwrap_or(s.light_model);
+        s.seed = self.seed.unwrap_or(s.seed);
         let samples = s.width as u64 * s.height as u64 * s.aa_samples as u64;
         if samples > MAX_CAMERA_SAMPLES {
             return Err(ApiError::bad(format!(
