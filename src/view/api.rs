@@ -3,7 +3,10 @@
 
 use super::compare::{CompareRequest, Comparisons};
 use super::http::{ApiError, Reply, number, query};
-use super::renders::{ENGINES, RENDER_BURST, RENDER_RATE, Renders, Status};
+use super::renders::{
+    ENGINES, KEPT_RENDERS, RENDER_BURST, RENDER_RATE, RenderJob, RenderStatus, Renders, Status,
+    with_camera,
+};
 use super::request::{Resolved, ViewSettings};
 use super::scene_json::{CameraFrame, SceneJson};
 use super::tree;
@@ -75,11 +78,11 @@ pub(crate) fn render(state: &State, body: &[u8]) -> Result<Reply, ApiError> {
 }
 
 /// The job status with the render camera's frame, for the 3D view.
-fn with_frame(status: super::renders::RenderStatus, resolved: &Resolved) -> Reply {
+fn with_frame(status: RenderStatus, resolved: &Resolved) -> Reply {
     #[derive(Serialize)]
     struct Body {
         #[serde(flatten)]
-        status: super::renders::RenderStatus,
+        status: RenderStatus,
         frame: CameraFrame,
     }
     Reply::json(&Body {
@@ -92,20 +95,19 @@ fn with_frame(status: super::renders::RenderStatus, resolved: &Resolved) -> Repl
     })
 }
 
-fn job_id(text: &str) -> Result<u64, ApiError> {
-    text.parse()
-        .map_err(|_| ApiError::bad(format!("expected a job number, found `{}`", quote(text))))
+/// The job a path names, or a 400 (not a number) or 404 (not kept).
+fn find_job(state: &State, text: &str) -> Result<Arc<RenderJob>, ApiError> {
+    let id = text
+        .parse()
+        .map_err(|_| ApiError::bad(format!("expected a job number, found `{}`", quote(text))))?;
+    job_by_id(state, id)
 }
 
-fn find_job(state: &State, text: &str) -> Result<Arc<super::renders::RenderJob>, ApiError> {
-    job_by_id(state, job_id(text)?)
-}
-
-fn job_by_id(state: &State, id: u64) -> Result<Arc<super::renders::RenderJob>, ApiError> {
+fn job_by_id(state: &State, id: u64) -> Result<Arc<RenderJob>, ApiError> {
     state.jobs.get(id).ok_or_else(|| {
         ApiError::not_found(format!(
             "no render job {id}: only the last {} are kept",
-            super::renders::KEPT_RENDERS
+            KEPT_RENDERS
         ))
     })
 }
@@ -119,7 +121,6 @@ pub(crate) fn render_status(state: &State, job: &str) -> Result<Reply, ApiError>
 /// `GET /api/render/{job}/{level}.png`, and `{level}.cost.png`: the level's cost-map overlay.
 pub(crate) fn render_png(state: &State, job: &str, level: &str) -> Result<Reply, ApiError> {
     let job = find_job(state, job)?;
-    // `N.png` the level's image, `N.cost.png` its cost-map overlay.
     let (k, cost) = match level.strip_suffix(".cost.png") {
         Some(k) => (k, true),
         None => (level.strip_suffix(".png").unwrap_or(""), false),
@@ -137,21 +138,20 @@ pub(crate) fn render_png(state: &State, job: &str, level: &str) -> Result<Reply,
             job.sizes.len()
         )));
     }
-    if cost {
-        let png = job.cost_png(k).ok_or_else(|| {
-            ApiError::not_found(format!(
-                "level {k} of job {} has no cost map: ask for one with cost_map in the settings (the level may not be rendered yet: see GET /api/render/{})",
-                job.id, job.id
-            ))
-        })?;
-        return Ok(Reply::bytes("image/png", png.as_ref().clone()));
-    }
-    let png = job.png(k).ok_or_else(|| {
-        ApiError::not_found(format!(
-            "level {k} of job {} is not rendered (yet): see GET /api/render/{}",
+    let png = if cost {
+        job.cost_png(k).ok_or_else(|| format!(
+            "level {k} of job {} has no cost map: ask for one with cost_map in the settings (the level may not be rendered yet: see GET /api/render/{})",
             job.id, job.id
         ))
-    })?;
+    } else {
+        job.png(k).ok_or_else(|| {
+            format!(
+                "level {k} of job {} is not rendered (yet): see GET /api/render/{}",
+                job.id, job.id
+            )
+        })
+    };
+    let png = png.map_err(ApiError::not_found)?;
     Ok(Reply::bytes("image/png", png.as_ref().clone()))
 }
 
@@ -195,7 +195,7 @@ pub(crate) fn pixel(state: &State, q: &str) -> Result<Reply, ApiError> {
         Status::Queued | Status::Running | Status::Done => {}
     }
     let (x, y): (u32, u32) = (number(&pairs, "x")?, number(&pairs, "y")?);
-    let scene = super::renders::with_camera(&state.scene, &job.resolved.camera);
+    let scene = with_camera(&state.scene, &job.resolved.camera);
     Ok(Reply::json(&tree::pixel_tree(
         &scene,
         &job.resolved.settings,
