@@ -13,6 +13,7 @@ use super::tree;
 use crate::render::quote::quote;
 use crate::render::sampling::LightSampler;
 use crate::render::scene::Scene;
+use crate::trace::palette::Rgb;
 use serde::Serialize;
 use std::sync::Arc;
 
@@ -46,7 +47,12 @@ pub(crate) fn scene_json(scene: &Scene, base: &Resolved) -> Vec<u8> {
         samplers: Vec<&'a str>,
         engines: Vec<&'a str>,
         simd: &'a str,
-        palette: tree::Palette,
+        /// An object, name to colour, in [`tree::PALETTE`]'s order.
+        #[serde(serialize_with = "as_object")]
+        palette: [(&'a str, Rgb); 6],
+    }
+    fn as_object<S: serde::Serializer>(pairs: &[(&str, Rgb); 6], s: S) -> Result<S::Ok, S::Error> {
+        s.collect_map(pairs.iter().copied())
     }
     serde_json::to_vec(&Body {
         scene: SceneJson::new(scene),

@@ -87,24 +87,22 @@ pub(crate) fn read_request(
 ) -> Result<Request, ReadError> {
     let deadline = accepted + limit;
     let mut buf: Vec<u8> = Vec::with_capacity(2048);
-    let (head_len, method, target, headers) = loop {
+    let (head_len, mut request) = loop {
         let mut slots = [httparse::EMPTY_HEADER; MAX_HEADERS];
         let mut parsed = httparse::Request::new(&mut slots);
         match parsed.parse(&buf) {
             Ok(httparse::Status::Complete(n)) => {
-                let headers = parsed
-                    .headers
-                    .iter()
-                    .map(|h| {
-                        (
-                            h.name.to_ascii_lowercase(),
-                            String::from_utf8_lossy(h.value).into_owned(),
-                        )
-                    })
-                    .collect::<Vec<_>>();
-                let method = parsed.method.unwrap_or_default().to_string();
-                let target = parsed.path.unwrap_or_default().to_string();
-                break (n, method, target, headers);
+                let headers = parsed.headers.iter().map(|h| {
+                    let value = String::from_utf8_lossy(h.value).into_owned();
+                    (h.name.to_ascii_lowercase(), value)
+                });
+                let request = Request {
+                    method: parsed.method.unwrap_or_default().to_string(),
+                    target: parsed.path.unwrap_or_default().to_string(),
+                    headers: headers.collect(),
+                    body: Vec::new(),
+                };
+                break (n, request);
             }
             Ok(httparse::Status::Partial) => {}
             Err(httparse::Error::TooManyHeaders) => {
@@ -126,12 +124,6 @@ pub(crate) fn read_request(
             .into());
         }
         read_some(stream, &mut buf, MAX_HEAD_BYTES, deadline, limit)?;
-    };
-    let mut request = Request {
-        method,
-        target,
-        headers,
-        body: Vec::new(),
     };
     if request.one("transfer-encoding")?.is_some() {
         return Err(ApiError::status(

@@ -32,10 +32,14 @@ pub mod server;
 pub mod token;
 pub(crate) mod tree;
 
+use crate::render::film::Film;
+use crate::render::progress::Progress;
+use crate::render::wavefront::{Wavefront, cost::CostReport, stats::RenderStats};
 use anyhow::Result;
 use request::Resolved;
 use std::collections::VecDeque;
 use std::net::{IpAddr, SocketAddr};
+use std::sync::atomic::AtomicBool;
 use std::sync::{Arc, Mutex, MutexGuard};
 use token::Access;
 
@@ -65,15 +69,8 @@ pub struct ViewOptions {
 
 /// A counted render of every tile with per-pixel counts, stopped once the flag is set
 /// (`Wavefront::render_counted_until(progress, true, cancel)`); `None` when stopped.
-pub type CountedRender = fn(
-    &crate::render::wavefront::Wavefront,
-    &crate::render::progress::Progress,
-    &std::sync::atomic::AtomicBool,
-) -> Option<(
-    crate::render::film::Film,
-    crate::render::wavefront::stats::RenderStats,
-    crate::render::wavefront::cost::CostReport,
-)>;
+pub type CountedRender =
+    fn(&Wavefront, &Progress, &AtomicBool) -> Option<(Film, RenderStats, CostReport)>;
 
 /// Binds, prints the URL with `say`, and serves until SIGINT or SIGTERM; returns the signal's
 /// number.

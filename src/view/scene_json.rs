@@ -44,8 +44,9 @@ pub(crate) struct SphereJson {
 }
 
 /// The colour a surface is drawn with: its emission for lights, else its diffuse colour plus
-/// half its mirror colour (so mirrors read as light grey), clamped to [0, 1].
-fn display_colour(m: &Material) -> [f32; 3] {
+/// half its mirror colour (so mirrors read as light grey), clamped to [0, 1]; grey without one.
+fn display_colour(m: Option<&Material>) -> [f32; 3] {
+    let Some(m) = m else { return [0.5; 3] };
     let c = if m.emitted.max_element() > 0.0 {
         m.emitted / m.emitted.max_element()
     } else {
@@ -68,8 +69,7 @@ impl SceneJson {
                 lo = lo.min(p);
                 hi = hi.max(p);
             }
-            let m = scene.materials.get(t.material as usize);
-            colors.extend_from_slice(&m.map_or([0.5; 3], display_colour));
+            colors.extend_from_slice(&display_colour(scene.materials.get(t.material as usize)));
         }
         let spheres = scene
             .spheres
@@ -80,10 +80,7 @@ impl SceneJson {
                 SphereJson {
                     center: s.center.to_array(),
                     radius: s.radius,
-                    color: scene
-                        .materials
-                        .get(s.material as usize)
-                        .map_or([0.5; 3], display_colour),
+                    color: display_colour(scene.materials.get(s.material as usize)),
                 }
             })
             .collect();
