@@ -54,6 +54,11 @@ impl Request {
             .collect()
     }
 
+    /// The path and the query (after `?`, possibly empty).
+    pub(crate) fn path_and_query(&self) -> (&str, &str) {
+        self.target.split_once('?').unwrap_or((&self.target, ""))
+    }
+
     /// The one value of header `name`, None when absent; given twice is a 400.
     pub(crate) fn one(&self, name: &str) -> Result<Option<&str>, ApiError> {
         match self.all(name).as_slice() {

@@ -17,7 +17,7 @@ use super::api::{self, State};
 use super::assets;
 use super::connection::Request;
 use super::http::{ApiError, Reply};
-use super::token::{Access, Presented};
+use super::token::Access;
 use crate::render::quote::quote;
 
 /// Who may reach the routes.
@@ -34,12 +34,9 @@ pub(crate) struct Gate {
 
 /// Answers `request`: the checks, then the handler. Errors become their JSON reply.
 pub(crate) fn answer(request: &Request, state: &State, gate: &Gate) -> Reply {
-    let (path, query) = request
-        .target
-        .split_once('?')
-        .unwrap_or((&request.target, ""));
+    let (path, query) = request.path_and_query();
     let mut cookie = None;
-    let mut reply = check(request, path, query, gate)
+    let mut reply = check(request, gate)
         .and_then(|set_cookie| {
             cookie = set_cookie;
             route(request, path, query, state)
@@ -54,24 +51,11 @@ pub(crate) fn answer(request: &Request, state: &State, gate: &Gate) -> Reply {
 }
 
 /// The Host, Origin and token checks; the cookie to set when the page came with the token.
-fn check(
-    request: &Request,
-    path: &str,
-    query: &str,
-    gate: &Gate,
-) -> Result<Option<String>, ApiError> {
+fn check(request: &Request, gate: &Gate) -> Result<Option<String>, ApiError> {
     let host = request.one("host")?;
     check_host(host, gate)?;
     check_origin(request.one("origin")?, host.unwrap_or(""))?;
-    gate.access.check(
-        &Presented {
-            path,
-            query,
-            cookies: request.all("cookie"),
-            authorization: request.all("authorization"),
-        },
-        gate.port,
-    )
+    gate.access.check(request, gate.port)
 }
 
 /// The routing table: each path's method and handler. The method is checked before the
