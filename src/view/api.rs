@@ -23,9 +23,7 @@ pub(crate) struct State {
     pub scene: Arc<Scene>,
     /// The settings the command line gave: what a request leaves out.
     pub base: Resolved,
-    /// The render jobs.
     pub jobs: Arc<Renders>,
-    /// The comparisons.
     pub comparisons: Comparisons,
     /// The worker threads renders run on.
     pub pool: Arc<rayon::ThreadPool>,

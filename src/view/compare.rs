@@ -41,7 +41,6 @@ pub(crate) struct CompareRequest {
     /// Bounces, light model, camera, engine (size, shadows, sampler and seed are the
     /// comparison's own).
     pub settings: ViewSettings,
-    /// The two samplers.
     pub samplers: [LightSampler; 2],
     /// The budget: points per light per hit, the same for both.
     pub n: u32,
@@ -102,7 +101,6 @@ impl CompareRequest {
 /// A mean over seeds and its standard error.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub(crate) struct Estimate {
-    /// Mean.
     pub mean: f64,
     /// Standard error of the mean (sample standard deviation / √K).
     pub se: f64,
@@ -127,7 +125,6 @@ impl Estimate {
 /// One sampler's side.
 #[derive(Clone, Debug, Serialize)]
 pub(crate) struct Side {
-    /// The sampler.
     pub sampler: LightSampler,
     /// URL of its first render (seed 1).
     pub image: String,
@@ -153,9 +150,7 @@ pub(crate) struct Side {
 pub(crate) struct Comparison {
     /// Its id (for the image URLs).
     pub id: u64,
-    /// Image size.
     pub width: u32,
-    /// Image size.
     pub height: u32,
     /// Points per light per hit, for both samplers.
     pub n: u32,
@@ -173,7 +168,6 @@ pub(crate) struct Comparison {
     pub penumbra_pixels: usize,
     /// URL of the two sides' error spectra, one plot.
     pub spectrum: String,
-    /// The two sides.
     pub sides: Vec<Side>,
     /// Seconds for the whole comparison.
     pub seconds: f64,

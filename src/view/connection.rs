@@ -40,7 +40,6 @@ pub(crate) struct Request {
     pub target: String,
     /// The headers, names in lower case, in order.
     pub headers: Vec<(String, String)>,
-    /// The body.
     pub body: Vec<u8>,
 }
 

@@ -65,11 +65,8 @@ impl ApiError {
 /// What a handler answers: a status, a content type and the bytes.
 #[derive(Clone, Debug, PartialEq)]
 pub(crate) struct Reply {
-    /// HTTP status.
     pub status: u16,
-    /// `Content-Type`.
     pub content_type: &'static str,
-    /// The body.
     pub body: Vec<u8>,
     /// Whether the client may cache it (assets compiled into the binary may).
     pub cacheable: bool,

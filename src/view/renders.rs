@@ -66,9 +66,7 @@ pub(crate) enum Status {
 /// One rendered level.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub(crate) struct Level {
-    /// Image width.
     pub width: u32,
-    /// Image height.
     pub height: u32,
     /// Rays by kind, each kind per thread-second of its own work (null when not measured: the
     /// reference renders without kind timers), and all rays over the seconds the engine took
@@ -97,9 +95,7 @@ pub(crate) struct CostLegend {
 /// What the page polls.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub(crate) struct RenderStatus {
-    /// The job's id.
     pub job: u64,
-    /// Where it is.
     #[serde(flatten)]
     pub status: Status,
     /// Sizes of every level, coarse to fine.
@@ -118,7 +114,6 @@ pub(crate) struct RenderJob {
     pub id: u64,
     /// The settings and camera at full resolution.
     pub resolved: Resolved,
-    /// The level sizes.
     pub sizes: Vec<[u32; 2]>,
     /// Set when a newer job supersedes this one: the engines read it before each work unit.
     cancel: AtomicBool,

@@ -24,7 +24,6 @@ pub(crate) struct SceneJson {
     pub triangle_count: usize,
     /// True when only the first [`MAX_DRAWN_TRIANGLES`] are sent.
     pub truncated: bool,
-    /// Spheres.
     pub spheres: Vec<SphereJson>,
     /// Area lights: corners in order around the outline.
     pub lights: Vec<Vec<[f32; 3]>>,
@@ -35,9 +34,7 @@ pub(crate) struct SceneJson {
 /// A sphere for WebGL.
 #[derive(Serialize)]
 pub(crate) struct SphereJson {
-    /// Centre.
     pub center: [f32; 3],
-    /// Radius.
     pub radius: f32,
     /// Display colour.
     pub color: [f32; 3],
@@ -118,7 +115,6 @@ impl SceneJson {
 /// distance along the view direction, top-left first, clockwise.
 #[derive(Serialize)]
 pub(crate) struct CameraFrame {
-    /// Eye.
     pub eye: [f32; 3],
     /// Image corners one unit in front of the eye.
     pub corners: [[f32; 3]; 4],
