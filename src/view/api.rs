@@ -4,11 +4,10 @@
 use super::compare::{CompareRequest, Comparisons};
 use super::http::{ApiError, Reply, number, query};
 use super::renders::{
-    ENGINES, KEPT_RENDERS, RENDER_BURST, RENDER_RATE, RenderJob, RenderStatus, Renders, Status,
-    with_camera,
+    ENGINES, KEPT_RENDERS, RENDER_BURST, RENDER_RATE, RenderJob, Renders, Status, with_camera,
 };
 use super::request::{Resolved, ViewSettings};
-use super::scene_json::{CameraFrame, SceneJson};
+use super::scene_json::SceneJson;
 use super::tree;
 use crate::render::quote::quote;
 use crate::render::sampling::LightSampler;
@@ -78,25 +77,7 @@ pub(crate) fn render(state: &State, body: &[u8]) -> Result<Reply, ApiError> {
             ),
         )
     })?;
-    Ok(with_frame(job.status(), &job.resolved))
-}
-
-/// The job status with the render camera's frame, for the 3D view.
-fn with_frame(status: RenderStatus, resolved: &Resolved) -> Reply {
-    #[derive(Serialize)]
-    struct Body {
-        #[serde(flatten)]
-        status: RenderStatus,
-        frame: CameraFrame,
-    }
-    Reply::json(&Body {
-        status,
-        frame: CameraFrame::new(
-            &resolved.camera,
-            resolved.settings.width,
-            resolved.settings.height,
-        ),
-    })
+    Ok(Reply::json(&job.status()))
 }
 
 /// The job a path names, or a 400 (not a number) or 404 (not kept).
@@ -119,7 +100,7 @@ fn job_by_id(state: &State, id: u64) -> Result<Arc<RenderJob>, ApiError> {
 /// `GET /api/render/{job}`.
 pub(crate) fn render_status(state: &State, job: &str) -> Result<Reply, ApiError> {
     let job = find_job(state, job)?;
-    Ok(with_frame(job.status(), &job.resolved))
+    Ok(Reply::json(&job.status()))
 }
 
 /// `GET /api/render/{job}/{level}.png`, and `{level}.cost.png`: the level's cost-map overlay.

@@ -23,6 +23,7 @@ use crate::render::film::ToneMap;
 use crate::render::progress::Progress;
 use crate::render::scene::Scene;
 use crate::view::request::{CostMeasureView, CostOverlay, Resolved, ViewSettings};
+use crate::view::scene_json::CameraFrame;
 use crate::view::{CountedRender, keep, lock};
 use serde::Serialize;
 use std::collections::VecDeque;
@@ -106,6 +107,8 @@ pub(crate) struct RenderStatus {
     pub progress: [u64; 2],
     /// The settings, all filled in.
     pub settings: ViewSettings,
+    /// The render camera's frame, for the 3D view.
+    pub frame: CameraFrame,
 }
 
 /// One job: its inputs, and what it has produced so far.
@@ -136,6 +139,7 @@ struct RenderState {
 impl RenderJob {
     /// The status for the page.
     pub(crate) fn status(&self) -> RenderStatus {
+        let r = &self.resolved;
         let state = lock(&self.state);
         RenderStatus {
             job: self.id,
@@ -146,7 +150,8 @@ impl RenderJob {
                 self.done_units.load(Ordering::Relaxed),
                 self.total_units.load(Ordering::Relaxed),
             ],
-            settings: self.resolved.to_json(),
+            settings: r.to_json(),
+            frame: CameraFrame::new(&r.camera, r.settings.width, r.settings.height),
         }
     }
 

@@ -59,11 +59,7 @@ impl CameraJson {
                 "camera: expected finite coordinates of magnitude at most 1e6",
             ));
         }
-        let (p, l, u) = (
-            Vec3::from_array(self.position),
-            Vec3::from_array(self.look_at),
-            Vec3::from_array(self.up),
-        );
+        let [p, l, u] = all.map(Vec3::from_array);
         let forward = l - p;
         if forward.length() < 1e-6 {
             return Err(ApiError::bad(

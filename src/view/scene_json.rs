@@ -113,7 +113,7 @@ impl SceneJson {
 
 /// The render camera's frame for drawing: its eye and the four corners of the image at unit
 /// distance along the view direction, top-left first, clockwise.
-#[derive(Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize)]
 pub(crate) struct CameraFrame {
     pub eye: [f32; 3],
     /// Image corners one unit in front of the eye.

@@ -8,11 +8,9 @@
 //! SIGINT/SIGTERM -> stop accepting -> wait for the open connections (at most DRAIN_TIME) -> return
 //! ```
 //!
-//! A thread per connection, bounded by the connection limit, and a deadline per request: a slow
-//! client holds one thread for at most the request time and never blocks another's request.
-//! (tiny_http, used before, spawns a thread per connection without a bound and has no read
-//! timeout; an async server would add a runtime to every build for a page with a few requests
-//! a second.)
+//! So a slow client holds one thread for at most the request time and never blocks another's
+//! request. Rejected: tiny_http (a thread per connection without a bound, no read timeout) and an
+//! async server (a runtime in every build, for a page with a few requests a second).
 
 use super::api::State;
 use super::connection::{self, REQUEST_TIME, ReadError, Request};
