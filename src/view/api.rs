@@ -6,7 +6,7 @@ use super::http::{ApiError, Reply, number, query};
 use super::renders::{
     ENGINES, KEPT_RENDERS, RENDER_BURST, RENDER_RATE, RenderJob, Renders, Status, with_camera,
 };
-use super::request::{Resolved, ViewSettings};
+use super::request::{Resolved, ViewSettings, parse_json};
 use super::scene_json::SceneJson;
 use super::tree;
 use crate::render::quote::quote;
@@ -65,7 +65,7 @@ pub(crate) fn scene_json(scene: &Scene, base: &Resolved) -> Vec<u8> {
 /// `POST /api/render`: starts a job, unless more than the rate limit's starts came in the
 /// last second (429 with `Retry-After`).
 pub(crate) fn render(state: &State, body: &[u8]) -> Result<Reply, ApiError> {
-    let resolved = ViewSettings::parse(body)?.resolve(&state.base)?;
+    let resolved = parse_json::<ViewSettings>(body, "settings")?.resolve(&state.base)?;
     let job = state.jobs.submit(resolved).map_err(|limited| {
         ApiError::retry(
             429,

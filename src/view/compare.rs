@@ -13,7 +13,7 @@
 //! ```
 
 use super::http::ApiError;
-use super::request::{Resolved, ViewSettings, in_range};
+use super::request::{Resolved, ViewSettings, in_range, parse_json};
 use super::{keep, lock};
 use crate::output::image_file::png_bytes;
 use crate::render::film::{Film, ToneMap};
@@ -69,17 +69,7 @@ impl Default for CompareRequest {
 impl CompareRequest {
     /// Parses and range-checks a request body (an empty body is every default).
     pub(crate) fn parse(body: &[u8]) -> Result<CompareRequest, ApiError> {
-        let text = if body.iter().all(u8::is_ascii_whitespace) {
-            &b"{}"[..]
-        } else {
-            body
-        };
-        let r: CompareRequest = serde_json::from_slice(text).map_err(|e| {
-            ApiError::bad(format!(
-                "comparison: {}",
-                crate::render::quote::quote(&e.to_string())
-            ))
-        })?;
+        let r: CompareRequest = parse_json(body, "comparison")?;
         for (name, v, lo, hi) in [
             ("n", r.n, 1, 256),
             ("seeds", r.seeds, 2, 16),

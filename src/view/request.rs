@@ -10,6 +10,7 @@ use crate::render::sampling::LightSampler;
 use crate::render::scene::Camera;
 use crate::render::settings::{LightModel, RenderSettings, ShadowMode};
 use glam::Vec3;
+use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
 /// The largest image side the viewer renders (the command line allows more; a browser tab does
@@ -196,17 +197,20 @@ pub(crate) fn in_range(name: &str, v: u32, lo: u32, hi: u32) -> Result<u32, ApiE
     }
 }
 
-impl ViewSettings {
-    /// Parses a request body: malformed JSON, unknown fields and wrong types are a 400 naming
-    /// the place (serde's line and column).
-    pub fn parse(body: &[u8]) -> Result<ViewSettings, ApiError> {
-        if body.iter().all(u8::is_ascii_whitespace) {
-            return Ok(ViewSettings::default());
-        }
-        serde_json::from_slice(body)
-            .map_err(|e| ApiError::bad(format!("settings: {}", quote(&e.to_string()))))
+/// Parses a request body (blank: every default): malformed JSON, unknown fields and wrong
+/// types are a 400 naming `what` and the place (serde's line and column).
+pub(crate) fn parse_json<T: Default + DeserializeOwned>(
+    body: &[u8],
+    what: &str,
+) -> Result<T, ApiError> {
+    if body.iter().all(u8::is_ascii_whitespace) {
+        return Ok(T::default());
     }
+    serde_json::from_slice(body)
+        .map_err(|e| ApiError::bad(format!("{what}: {}", quote(&e.to_string()))))
+}
 
+impl ViewSettings {
     /// These settings over `base`, checked.
     pub fn resolve(&self, base: &Resolved) -> Result<Resolved, ApiError> {
         let mut s = base.settings.clone();
@@ -287,6 +291,10 @@ impl Resolved {
 mod tests {
     use super::*;
 
+    fn parse(body: &[u8]) -> Result<ViewSettings, ApiError> {
+        parse_json(body, "settings")
+    }
+
     fn base() -> Resolved {
         Resolved {
             settings: RenderSettings::preview(),
@@ -299,10 +307,7 @@ mod tests {
 
     #[test]
     fn empty_body_keeps_the_base() {
-        let r = ViewSettings::parse(b" \n")
-            .unwrap()
-            .resolve(&base())
-            .unwrap();
+        let r = parse(b" \n").unwrap().resolve(&base()).unwrap();
         assert_eq!(r, base());
     }
 
@@ -310,7 +315,7 @@ mod tests {
     fn fields_override_and_round_trip() {
         let body = br#"{"width": 40, "shadows": "soft", "shadow_samples": 9, "sampler": "sobol",
                         "engine": "reference", "light_model": "rpi"}"#;
-        let r = ViewSettings::parse(body).unwrap().resolve(&base()).unwrap();
+        let r = parse(body).unwrap().resolve(&base()).unwrap();
         assert_eq!(r.settings.width, 40);
         assert_eq!(r.settings.height, 64);
         assert_eq!(r.settings.shadows, ShadowMode::Soft);
@@ -320,7 +325,7 @@ mod tests {
         let again = r.to_json().resolve(&base()).unwrap();
         assert_eq!(again.settings, r.settings);
         let body = br#"{"cost_map": "shadow", "cost_measure": "tests"}"#;
-        let r = ViewSettings::parse(body).unwrap().resolve(&base()).unwrap();
+        let r = parse(body).unwrap().resolve(&base()).unwrap();
         assert_eq!(
             (r.cost_map, r.cost_measure),
             (CostOverlay::Shadow, CostMeasureView::Tests)
@@ -352,9 +357,7 @@ mod tests {
             ),
         ];
         for (body, expected) in cases {
-            let err = ViewSettings::parse(body)
-                .and_then(|v| v.resolve(&base()))
-                .unwrap_err();
+            let err = parse(body).and_then(|v| v.resolve(&base())).unwrap_err();
             assert_eq!(err.status, 400);
             assert!(
                 err.message.contains(expected),
