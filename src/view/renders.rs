@@ -21,15 +21,16 @@ use crate::output::image_file::png_bytes;
 use crate::render::engine::{Engine, Prepared, clamp_to_finite};
 use crate::render::film::ToneMap;
 use crate::render::progress::Progress;
-use crate::render::scene::Scene;
+use crate::render::scene::{Camera, Scene};
 use crate::view::request::{CostMeasureView, CostOverlay, Resolved, ViewSettings};
 use crate::view::scene_json::CameraFrame;
 use crate::view::{CountedRender, keep, lock};
 use serde::Serialize;
+use std::borrow::Cow;
 use std::collections::VecDeque;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Condvar, Mutex};
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 /// How many finished jobs are kept for their images and pixels.
 pub(crate) const KEPT_RENDERS: usize = 8;
@@ -261,9 +262,9 @@ impl TokenBucket {
             self.tokens -= 1.0;
             Ok(())
         } else {
-            let wait = Duration::from_secs_f64((1.0 - self.tokens) / RENDER_RATE);
+            let wait = (1.0 - self.tokens) / RENDER_RATE;
             Err(RateLimited {
-                retry_after: (wait.as_secs_f64().ceil() as u32).max(1),
+                retry_after: (wait.ceil() as u32).max(1),
             })
         }
     }
@@ -406,16 +407,13 @@ fn render_thread(
 }
 
 /// The scene seen through `camera`: a copy only when the camera differs from the file's.
-pub(crate) fn with_camera<'a>(
-    scene: &'a Scene,
-    camera: &crate::render::scene::Camera,
-) -> std::borrow::Cow<'a, Scene> {
+pub(crate) fn with_camera<'a>(scene: &'a Scene, camera: &Camera) -> Cow<'a, Scene> {
     if scene.camera == *camera {
-        std::borrow::Cow::Borrowed(scene)
+        Cow::Borrowed(scene)
     } else {
         let mut copy = scene.clone();
         copy.camera = *camera;
-        std::borrow::Cow::Owned(copy)
+        Cow::Owned(copy)
     }
 }
 
@@ -510,6 +508,7 @@ pub(crate) const ENGINES: [Engine; 2] = [Engine::Wavefront, Engine::Reference];
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::time::Duration;
 
     #[test]
     fn levels_go_coarse_to_fine_without_repeats() {
