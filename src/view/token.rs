@@ -87,20 +87,6 @@ pub enum Access {
     Open,
 }
 
-/// The cookie's name: one per port, so that two viewers on one machine keep their own.
-fn cookie_name(port: u16) -> String {
-    format!("raywave_token_{port}")
-}
-
-/// The `Set-Cookie` value that keeps `token` for the page's later requests.
-fn set_cookie(token: &Token, port: u16) -> String {
-    format!(
-        "{}={}; Path=/; HttpOnly; SameSite=Strict",
-        cookie_name(port),
-        token.as_str()
-    )
-}
-
 impl Access {
     /// Checks a request. `Ok(Some(cookie))` when the page was opened with the token in its URL:
     /// the reply sets that cookie. `port` is the server's (it names the cookie).
@@ -122,7 +108,8 @@ impl Access {
         for value in request.all("authorization") {
             bearer.push(bearer_token(value)?);
         }
-        let name = cookie_name(port);
+        // One cookie per port, so that two viewers on one machine keep their own.
+        let name = format!("raywave_token_{port}");
         let cookies: Vec<&str> = request
             .all("cookie")
             .into_iter()
@@ -132,7 +119,12 @@ impl Access {
             .map(|(_, v)| v)
             .collect();
         if in_query.is_some_and(|t| token.matches(t)) {
-            return Ok(Some(set_cookie(token, port)));
+            // Keeps the token for the page's later requests.
+            let cookie = format!(
+                "{name}={}; Path=/; HttpOnly; SameSite=Strict",
+                token.as_str()
+            );
+            return Ok(Some(cookie));
         }
         let presented = in_query.is_some() || !bearer.is_empty() || !cookies.is_empty();
         if bearer.iter().chain(&cookies).any(|t| token.matches(t)) {
