@@ -277,11 +277,10 @@ impl Comparisons {
         }
         let map_refs: Vec<&[f32]> = maps.iter().map(Vec::as_slice).collect();
         let (wc, hc) = (config.base.width, config.base.height);
-        let heat = heat_images(&map_refs, wc, hc);
-        let heat_scale = heat.as_ref().map(|(_, s)| *s);
-        let heat_imgs = heat
-            .map(|(imgs, _)| imgs)
-            .unwrap_or_else(|| vec![image::RgbImage::new(wc, hc); 2]);
+        let (heat_imgs, heat_scale) = match heat_images(&map_refs, wc, hc) {
+            Some((imgs, scale)) => (imgs, Some(scale)),
+            None => (vec![image::RgbImage::new(wc, hc); 2], None),
+        };
         for (img, name) in heat_imgs.iter().zip(["heat-a", "heat-b"]) {
             pngs.push((name.to_string(), encode(img)?));
         }

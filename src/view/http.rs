@@ -133,8 +133,7 @@ pub(crate) fn query<'a>(q: &'a str, allowed: &[&str]) -> Result<Vec<(&'a str, &'
     Ok(out)
 }
 
-/// The parameter `name` of `pairs` as a whole number, or a 400 saying it is missing or what was
-/// found instead.
+/// The parameter `name` as a whole number, or a 400 saying it is missing or what was found.
 pub(crate) fn number<T: std::str::FromStr>(
     pairs: &[(&str, &str)],
     name: &str,

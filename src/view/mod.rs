@@ -72,8 +72,7 @@ pub struct ViewOptions {
 pub type CountedRender =
     fn(&Wavefront, &Progress, &AtomicBool) -> Option<(Film, RenderStats, CostReport)>;
 
-/// Binds, prints the URL with `say`, and serves until SIGINT or SIGTERM; returns the signal's
-/// number.
+/// Binds, prints the URL with `say`, serves until SIGINT or SIGTERM; returns the signal.
 pub fn run(options: ViewOptions, say: &dyn Fn(&str) -> Result<()>) -> Result<i32> {
     let server = server::Server::bind(options.bind, options.port)?;
     let pool = Arc::new(crate::render::engine::thread_pool(options.threads)?);
@@ -85,7 +84,6 @@ pub fn run(options: ViewOptions, say: &dyn Fn(&str) -> Result<()>) -> Result<i32
         options.counted,
     )
     .map_err(|e| anyhow::anyhow!("cannot start the render thread: {e}"))?;
-    let port = server.addr.port();
     let state = Arc::new(api::State {
         scene_json: api::scene_json(&scene, &options.base),
         scene,
@@ -101,7 +99,7 @@ pub fn run(options: ViewOptions, say: &dyn Fn(&str) -> Result<()>) -> Result<i32
     let gate = routes::Gate {
         access: options.access,
         loopback: options.bind.is_loopback(),
-        port,
+        port: server.addr.port(),
     };
     server.serve(state, gate, options.max_connections)
 }

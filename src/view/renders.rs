@@ -190,8 +190,8 @@ impl RenderJob {
     }
 }
 
-/// The sizes of the levels of a `width` × `height` image: each divisor's, rounded up, without
-/// repeats (a 10-pixel image has fewer than four levels).
+/// The level sizes of a `width` × `height` image, rounded up, without repeats (a 10-pixel image
+/// has fewer than four levels).
 fn level_sizes(width: u32, height: u32) -> Vec<[u32; 2]> {
     let mut sizes: Vec<[u32; 2]> = LEVEL_DIVISORS
         .map(|d| [width.div_ceil(d), height.div_ceil(d)])

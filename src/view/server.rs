@@ -112,8 +112,7 @@ impl Drop for Slot {
     }
 }
 
-/// The address a client on this machine reaches the server at: the bound one, or loopback when
-/// bound to every interface.
+/// Where a client on this machine reaches the server: loopback when bound to every interface.
 pub(crate) fn local_address(addr: SocketAddr) -> SocketAddr {
     match addr.ip() {
         IpAddr::V4(ip) if ip.is_unspecified() => (Ipv4Addr::LOCALHOST, addr.port()).into(),
@@ -177,8 +176,7 @@ fn answer(request: &Request, shared: &Shared) -> Reply {
     })
 }
 
-/// Answers the connections over the limit with 503 and `Retry-After`, one at a time, each in a
-/// bounded time.
+/// Answers the connections over the limit with 503 and `Retry-After`, one at a time.
 fn refuser(queue: &Receiver<TcpStream>, max_connections: usize) {
     let reply = Reply::from(ApiError::retry(
         503,
