@@ -147,7 +147,7 @@ pub(crate) fn pixel(state: &State, q: &str) -> Result<Reply, ApiError> {
     let pairs = query(q, &["job", "x", "y"])?;
     let job = job_by_id(state, number(&pairs, "job")?)?;
     let newest = state.jobs.newest();
-    match job.state() {
+    let gone = match job.state() {
         Status::Superseded => {
             let by = job.superseded_by().unwrap_or(newest);
             let ask = if newest == by {
@@ -155,13 +155,10 @@ pub(crate) fn pixel(state: &State, q: &str) -> Result<Reply, ApiError> {
             } else {
                 format!("ask for the newest job's pixels, job {newest}")
             };
-            return Err(ApiError::status(
-                410,
-                format!(
-                    "job {} was superseded by job {by} before its image was finished: {ask}",
-                    job.id
-                ),
-            ));
+            Some(format!(
+                "job {} was superseded by job {by} before its image was finished: {ask}",
+                job.id
+            ))
         }
         Status::Failed(error) => {
             let ask = if newest == job.id {
@@ -169,24 +166,20 @@ pub(crate) fn pixel(state: &State, q: &str) -> Result<Reply, ApiError> {
             } else {
                 format!("ask for job {newest}'s pixels")
             };
-            return Err(ApiError::status(
-                410,
-                format!(
-                    "job {} failed before its image was finished ({error}): {ask}",
-                    job.id
-                ),
-            ));
+            Some(format!(
+                "job {} failed before its image was finished ({error}): {ask}",
+                job.id
+            ))
         }
-        Status::Queued | Status::Running | Status::Done => {}
+        Status::Queued | Status::Running | Status::Done => None,
+    };
+    if let Some(message) = gone {
+        return Err(ApiError::status(410, message));
     }
     let (x, y): (u32, u32) = (number(&pairs, "x")?, number(&pairs, "y")?);
     let scene = with_camera(&state.scene, &job.resolved.camera);
-    Ok(Reply::json(&tree::pixel_tree(
-        &scene,
-        &job.resolved.settings,
-        x,
-        y,
-    )?))
+    let tree = tree::pixel_tree(&scene, &job.resolved.settings, x, y)?;
+    Ok(Reply::json(&tree))
 }
 
 /// `POST /api/compare`.
