@@ -80,14 +80,13 @@ pub(crate) fn render(state: &State, body: &[u8]) -> Result<Reply, ApiError> {
     Ok(Reply::json(&job.status()))
 }
 
-/// The job a path names, or a 400 (not a number) or 404 (not kept).
-fn find_job(state: &State, text: &str) -> Result<Arc<RenderJob>, ApiError> {
-    let id = text
-        .parse()
-        .map_err(|_| ApiError::bad(format!("expected a job number, found `{}`", quote(text))))?;
-    job_by_id(state, id)
+/// A path's `text` as a number, or a 400 saying `what` was expected.
+fn path_number(text: &str, what: &str) -> Result<u64, ApiError> {
+    text.parse()
+        .map_err(|_| ApiError::bad(format!("expected {what}, found `{}`", quote(text))))
 }
 
+/// Job `id`, or a 404 when it is not kept.
 fn job_by_id(state: &State, id: u64) -> Result<Arc<RenderJob>, ApiError> {
     state.jobs.get(id).ok_or_else(|| {
         ApiError::not_found(format!(
@@ -99,13 +98,13 @@ fn job_by_id(state: &State, id: u64) -> Result<Arc<RenderJob>, ApiError> {
 
 /// `GET /api/render/{job}`.
 pub(crate) fn render_status(state: &State, job: &str) -> Result<Reply, ApiError> {
-    let job = find_job(state, job)?;
+    let job = job_by_id(state, path_number(job, "a job number")?)?;
     Ok(Reply::json(&job.status()))
 }
 
 /// `GET /api/render/{job}/{level}.png`, and `{level}.cost.png`: the level's cost-map overlay.
 pub(crate) fn render_png(state: &State, job: &str, level: &str) -> Result<Reply, ApiError> {
-    let job = find_job(state, job)?;
+    let job = job_by_id(state, path_number(job, "a job number")?)?;
     let (k, cost) = match level.strip_suffix(".cost.png") {
         Some(k) => (k, true),
         None => (level.strip_suffix(".png").unwrap_or(""), false),
@@ -193,12 +192,7 @@ pub(crate) fn compare(state: &State, body: &[u8]) -> Result<Reply, ApiError> {
 
 /// `GET /api/compare/{id}/{name}.png`.
 pub(crate) fn compare_png(state: &State, id: &str, name: &str) -> Result<Reply, ApiError> {
-    let n: u64 = id.parse().map_err(|_| {
-        ApiError::bad(format!(
-            "expected a comparison number, found `{}`",
-            quote(id)
-        ))
-    })?;
+    let n = path_number(id, "a comparison number")?;
     let png = name
         .strip_suffix(".png")
         .and_then(|name| state.comparisons.png(n, name))

@@ -92,10 +92,8 @@ pub fn run(options: ViewOptions, say: &dyn Fn(&str) -> Result<()>) -> Result<i32
         comparisons: compare::Comparisons::default(),
         pool,
     });
-    say(&format!(
-        "raywave view: {} (Ctrl-C stops it)\n",
-        url(server.addr, &options.access)
-    ))?;
+    let url = url(server.addr, &options.access);
+    say(&format!("raywave view: {url} (Ctrl-C stops it)\n"))?;
     let gate = routes::Gate {
         access: options.access,
         loopback: options.bind.is_loopback(),
