@@ -37,8 +37,7 @@ fn main() -> ExitCode {
         }
     };
     // SIGINT/SIGTERM: remove unfinished temporary files, exit 130/143. `raywave view` writes no
-    // files and stops on them by design: it handles them itself, finishing the requests in
-    // hand, and exits 130/143 too.
+    // files and handles them itself (module doc).
     if !matches!(cli.command, Command::View(_))
         && let Err(e) = raywave::output::install_signal_cleanup()
     {
