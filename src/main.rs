@@ -37,8 +37,7 @@ fn main() -> ExitCode {
         }
     };
     // SIGINT/SIGTERM: remove unfinished temporary files, exit 130/143. `raywave view` writes no
-    // files and stops on them by design: it handles them itself, finishing the requests in
-    // hand, and exits 130/143 too.
+    // files and handles them itself (module doc).
     if !matches!(cli.command, Command::View(_))
         && let Err(e) = raywave::output::install_signal_cleanup()
     {
@@ -56,30 +55,23 @@ fn main() -> ExitCode {
     for warning in cli::combos::meaningless(&cli.command, &|flag| normalized.typed(flag)) {
         eprintln!("warning: {warning}");
     }
-    // Each command's own exit code when it succeeds (0 but for the ones noted).
+    // Each command's own exit code when it succeeds (module doc).
     let result: anyhow::Result<u8> = match cli.command {
         Command::Render(args) => cli::render::run(&args).map(|()| 0),
         Command::Info => cli::info::run().map(|()| 0),
         Command::Meshgen(args) => cli::meshgen::run(&args).map(|()| 0),
         Command::Variance(args) => cli::variance::run(&args).map(|()| 0),
-        // Exit 130 after SIGINT and 143 after SIGTERM, once the requests in hand are answered.
         Command::View(args) => cli::view::run(&args),
         Command::TracePixel(args) => cli::trace_pixel::run(&args).map(|()| 0),
-        // Exit 3 when --compare or --against finds a regression
-        // (raywave::bench::EXIT_REGRESSION), 4 when --until-decided ends undecided
-        // (EXIT_UNDECIDED).
+        // raywave::bench::EXIT_REGRESSION, EXIT_UNDECIDED.
         Command::Bench(args) => cli::bench::run(&args, matches.subcommand_matches("bench")),
-        // Exit 3 when the figure is past --fail-above (raywave::diff::EXIT_FAILED).
+        // raywave::diff::EXIT_FAILED.
         Command::Diff(args) => cli::diff::run(&args),
     };
     // A run that failed changes no output; one that succeeded puts them all in place.
-    let result = match result {
-        Ok(code) => raywave::output::commit_outputs().map(|()| code),
-        Err(e) => {
-            raywave::output::discard_outputs();
-            Err(e)
-        }
-    };
+    let result = result
+        .inspect_err(|_| raywave::output::discard_outputs())
+        .and_then(|code| raywave::output::commit_outputs().map(|()| code));
     match result {
         Ok(code) => ExitCode::from(code),
         Err(e) if e.downcast_ref::<UsageError>().is_some() => {

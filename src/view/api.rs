@@ -3,13 +3,16 @@
 
 use super::compare::{CompareRequest, Comparisons};
 use super::http::{ApiError, Reply, number, query};
-use super::renders::{ENGINES, RENDER_BURST, RENDER_RATE, Renders, Status};
-use super::request::{Resolved, ViewSettings};
-use super::scene_json::{CameraFrame, SceneJson};
+use super::renders::{
+    ENGINES, KEPT_RENDERS, RENDER_BURST, RENDER_RATE, RenderJob, Renders, Status, with_camera,
+};
+use super::request::{Resolved, ViewSettings, parse_json};
+use super::scene_json::SceneJson;
 use super::tree;
 use crate::render::quote::quote;
 use crate::render::sampling::LightSampler;
 use crate::render::scene::Scene;
+use crate::trace::palette::Rgb;
 use serde::Serialize;
 use std::sync::Arc;
 
@@ -19,9 +22,7 @@ pub(crate) struct State {
     pub scene: Arc<Scene>,
     /// The settings the command line gave: what a request leaves out.
     pub base: Resolved,
-    /// The render jobs.
     pub jobs: Arc<Renders>,
-    /// The comparisons.
     pub comparisons: Comparisons,
     /// The worker threads renders run on.
     pub pool: Arc<rayon::ThreadPool>,
@@ -43,7 +44,12 @@ pub(crate) fn scene_json(scene: &Scene, base: &Resolved) -> Vec<u8> {
         samplers: Vec<&'a str>,
         engines: Vec<&'a str>,
         simd: &'a str,
-        palette: tree::Palette,
+        /// An object, name to colour, in [`tree::PALETTE`]'s order.
+        #[serde(serialize_with = "as_object")]
+        palette: [(&'a str, Rgb); 6],
+    }
+    fn as_object<S: serde::Serializer>(pairs: &[(&str, Rgb); 6], s: S) -> Result<S::Ok, S::Error> {
+        s.collect_map(pairs.iter().copied())
     }
     serde_json::to_vec(&Body {
         scene: SceneJson::new(scene),
@@ -59,7 +65,7 @@ pub(crate) fn scene_json(scene: &Scene, base: &Resolved) -> Vec<u8> {
 /// `POST /api/render`: starts a job, unless more than the rate limit's starts came in the
 /// last second (429 with `Retry-After`).
 pub(crate) fn render(state: &State, body: &[u8]) -> Result<Reply, ApiError> {
-    let resolved = ViewSettings::parse(body)?.resolve(&state.base)?;
+    let resolved = parse_json::<ViewSettings>(body, "settings")?.resolve(&state.base)?;
     let job = state.jobs.submit(resolved).map_err(|limited| {
         ApiError::retry(
             429,
@@ -71,55 +77,34 @@ pub(crate) fn render(state: &State, body: &[u8]) -> Result<Reply, ApiError> {
             ),
         )
     })?;
-    Ok(with_frame(job.status(), &job.resolved))
+    Ok(Reply::json(&job.status()))
 }
 
-/// The job status with the render camera's frame, for the 3D view.
-fn with_frame(status: super::renders::RenderStatus, resolved: &Resolved) -> Reply {
-    #[derive(Serialize)]
-    struct Body {
-        #[serde(flatten)]
-        status: super::renders::RenderStatus,
-        frame: CameraFrame,
-    }
-    Reply::json(&Body {
-        status,
-        frame: CameraFrame::new(
-            &resolved.camera,
-            resolved.settings.width,
-            resolved.settings.height,
-        ),
-    })
-}
-
-fn job_id(text: &str) -> Result<u64, ApiError> {
+/// A path's `text` as a number, or a 400 saying `what` was expected.
+fn path_number(text: &str, what: &str) -> Result<u64, ApiError> {
     text.parse()
-        .map_err(|_| ApiError::bad(format!("expected a job number, found `{}`", quote(text))))
+        .map_err(|_| ApiError::bad(format!("expected {what}, found `{}`", quote(text))))
 }
 
-fn find_job(state: &State, text: &str) -> Result<Arc<super::renders::RenderJob>, ApiError> {
-    job_by_id(state, job_id(text)?)
-}
-
-fn job_by_id(state: &State, id: u64) -> Result<Arc<super::renders::RenderJob>, ApiError> {
+/// Job `id`, or a 404 when it is not kept.
+fn job_by_id(state: &State, id: u64) -> Result<Arc<RenderJob>, ApiError> {
     state.jobs.get(id).ok_or_else(|| {
         ApiError::not_found(format!(
             "no render job {id}: only the last {} are kept",
-            super::renders::KEPT_RENDERS
+            KEPT_RENDERS
         ))
     })
 }
 
 /// `GET /api/render/{job}`.
 pub(crate) fn render_status(state: &State, job: &str) -> Result<Reply, ApiError> {
-    let job = find_job(state, job)?;
-    Ok(with_frame(job.status(), &job.resolved))
+    let job = job_by_id(state, path_number(job, "a job number")?)?;
+    Ok(Reply::json(&job.status()))
 }
 
 /// `GET /api/render/{job}/{level}.png`, and `{level}.cost.png`: the level's cost-map overlay.
 pub(crate) fn render_png(state: &State, job: &str, level: &str) -> Result<Reply, ApiError> {
-    let job = find_job(state, job)?;
-    // `N.png` the level's image, `N.cost.png` its cost-map overlay.
+    let job = job_by_id(state, path_number(job, "a job number")?)?;
     let (k, cost) = match level.strip_suffix(".cost.png") {
         Some(k) => (k, true),
         None => (level.strip_suffix(".png").unwrap_or(""), false),
@@ -137,21 +122,20 @@ pub(crate) fn render_png(state: &State, job: &str, level: &str) -> Result<Reply,
             job.sizes.len()
         )));
     }
-    if cost {
-        let png = job.cost_png(k).ok_or_else(|| {
-            ApiError::not_found(format!(
-                "level {k} of job {} has no cost map: ask for one with cost_map in the settings (the level may not be rendered yet: see GET /api/render/{})",
-                job.id, job.id
-            ))
-        })?;
-        return Ok(Reply::bytes("image/png", png.as_ref().clone()));
-    }
-    let png = job.png(k).ok_or_else(|| {
-        ApiError::not_found(format!(
-            "level {k} of job {} is not rendered (yet): see GET /api/render/{}",
+    let png = if cost {
+        job.cost_png(k).ok_or_else(|| format!(
+            "level {k} of job {} has no cost map: ask for one with cost_map in the settings (the level may not be rendered yet: see GET /api/render/{})",
             job.id, job.id
         ))
-    })?;
+    } else {
+        job.png(k).ok_or_else(|| {
+            format!(
+                "level {k} of job {} is not rendered (yet): see GET /api/render/{}",
+                job.id, job.id
+            )
+        })
+    };
+    let png = png.map_err(ApiError::not_found)?;
     Ok(Reply::bytes("image/png", png.as_ref().clone()))
 }
 
@@ -162,7 +146,7 @@ pub(crate) fn pixel(state: &State, q: &str) -> Result<Reply, ApiError> {
     let pairs = query(q, &["job", "x", "y"])?;
     let job = job_by_id(state, number(&pairs, "job")?)?;
     let newest = state.jobs.newest();
-    match job.state() {
+    let gone = match job.state() {
         Status::Superseded => {
             let by = job.superseded_by().unwrap_or(newest);
             let ask = if newest == by {
@@ -170,13 +154,10 @@ pub(crate) fn pixel(state: &State, q: &str) -> Result<Reply, ApiError> {
             } else {
                 format!("ask for the newest job's pixels, job {newest}")
             };
-            return Err(ApiError::status(
-                410,
-                format!(
-                    "job {} was superseded by job {by} before its image was finished: {ask}",
-                    job.id
-                ),
-            ));
+            Some(format!(
+                "job {} was superseded by job {by} before its image was finished: {ask}",
+                job.id
+            ))
         }
         Status::Failed(error) => {
             let ask = if newest == job.id {
@@ -184,24 +165,20 @@ pub(crate) fn pixel(state: &State, q: &str) -> Result<Reply, ApiError> {
             } else {
                 format!("ask for job {newest}'s pixels")
             };
-            return Err(ApiError::status(
-                410,
-                format!(
-                    "job {} failed before its image was finished ({error}): {ask}",
-                    job.id
-                ),
-            ));
+            Some(format!(
+                "job {} failed before its image was finished ({error}): {ask}",
+                job.id
+            ))
         }
-        Status::Queued | Status::Running | Status::Done => {}
+        Status::Queued | Status::Running | Status::Done => None,
+    };
+    if let Some(message) = gone {
+        return Err(ApiError::status(410, message));
     }
     let (x, y): (u32, u32) = (number(&pairs, "x")?, number(&pairs, "y")?);
-    let scene = super::renders::with_camera(&state.scene, &job.resolved.camera);
-    Ok(Reply::json(&tree::pixel_tree(
-        &scene,
-        &job.resolved.settings,
-        x,
-        y,
-    )?))
+    let scene = with_camera(&state.scene, &job.resolved.camera);
+    let tree = tree::pixel_tree(&scene, &job.resolved.settings, x, y)?;
+    Ok(Reply::json(&tree))
 }
 
 /// `POST /api/compare`.
@@ -215,12 +192,7 @@ pub(crate) fn compare(state: &State, body: &[u8]) -> Result<Reply, ApiError> {
 
 /// `GET /api/compare/{id}/{name}.png`.
 pub(crate) fn compare_png(state: &State, id: &str, name: &str) -> Result<Reply, ApiError> {
-    let n: u64 = id.parse().map_err(|_| {
-        ApiError::bad(format!(
-            "expected a comparison number, found `{}`",
-            quote(id)
-        ))
-    })?;
+    let n = path_number(id, "a comparison number")?;
     let png = name
         .strip_suffix(".png")
         .and_then(|name| state.comparisons.png(n, name))

@@ -13,9 +13,9 @@
 //! ```
 
 use super::http::ApiError;
-use super::request::{Resolved, ViewSettings};
+use super::request::{Resolved, ViewSettings, in_range, parse_json};
+use super::{keep, lock};
 use crate::output::image_file::png_bytes;
-use crate::render::engine::Engine;
 use crate::render::film::{Film, ToneMap};
 use crate::render::sampling::LightSampler;
 use crate::render::scene::Scene;
@@ -34,74 +34,50 @@ pub(crate) const KEPT: usize = 4;
 /// Points per light per hit for the penumbra mask.
 const MASK_SAMPLES: u32 = 64;
 
-fn default_samplers() -> [LightSampler; 2] {
-    [LightSampler::Random, LightSampler::Stratified]
-}
-fn default_n() -> u32 {
-    4
-}
-fn default_seeds() -> u32 {
-    4
-}
-fn default_size() -> u32 {
-    64
-}
-fn default_reference_samples() -> u32 {
-    1024
-}
-
 /// What the page asks to compare.
 #[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(default, deny_unknown_fields)]
 pub(crate) struct CompareRequest {
     /// Bounces, light model, camera, engine (size, shadows, sampler and seed are the
     /// comparison's own).
-    #[serde(default)]
     pub settings: ViewSettings,
-    /// The two samplers.
-    #[serde(default = "default_samplers")]
     pub samplers: [LightSampler; 2],
     /// The budget: points per light per hit, the same for both.
-    #[serde(default = "default_n")]
     pub n: u32,
     /// Renders (seeds) per sampler, for the heat map and the standard error.
-    #[serde(default = "default_seeds")]
     pub seeds: u32,
     /// The longer side of the images.
-    #[serde(default = "default_size")]
     pub size: u32,
     /// Stratified points per light in each half of the converged reference.
-    #[serde(default = "default_reference_samples")]
     pub reference_samples: u32,
+}
+
+/// What a request leaves out.
+impl Default for CompareRequest {
+    fn default() -> Self {
+        CompareRequest {
+            settings: ViewSettings::default(),
+            samplers: [LightSampler::Random, LightSampler::Stratified],
+            n: 4,
+            seeds: 4,
+            size: 64,
+            reference_samples: 1024,
+        }
+    }
 }
 
 impl CompareRequest {
     /// Parses and range-checks a request body (an empty body is every default).
     pub(crate) fn parse(body: &[u8]) -> Result<CompareRequest, ApiError> {
-        let text = if body.iter().all(u8::is_ascii_whitespace) {
-            &b"{}"[..]
-        } else {
-            body
-        };
-        let r: CompareRequest = serde_json::from_slice(text).map_err(|e| {
-            ApiError::bad(format!(
-                "comparison: {}",
-                crate::render::quote::quote(&e.to_string())
-            ))
-        })?;
-        let check = |name: &str, v: u32, lo: u32, hi: u32| {
-            if (lo..=hi).contains(&v) {
-                Ok(())
-            } else {
-                Err(ApiError::bad(format!(
-                    "comparison: {name} must be in {lo}..={hi}, found {v}"
-                )))
-            }
-        };
-        check("n", r.n, 1, 256)?;
-        check("seeds", r.seeds, 2, 16)?;
-        check("size", r.size, 8, 256)?;
-        check("reference_samples", r.reference_samples, 16, 4096)?;
+        let r: CompareRequest = parse_json(body, "comparison")?;
+        for (name, v, lo, hi) in [
+            ("n", r.n, 1, 256),
+            ("seeds", r.seeds, 2, 16),
+            ("size", r.size, 8, 256),
+            ("reference_samples", r.reference_samples, 16, 4096),
+        ] {
+            in_range(&format!("comparison: {name}"), v, lo, hi)?;
+        }
         if r.reference_samples < 4 * r.n {
             return Err(ApiError::bad(format!(
                 "comparison: reference_samples ({}) must be at least 4 × n ({}), or the reference is no better than what it measures",
@@ -115,7 +91,6 @@ impl CompareRequest {
 /// A mean over seeds and its standard error.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub(crate) struct Estimate {
-    /// Mean.
     pub mean: f64,
     /// Standard error of the mean (sample standard deviation / √K).
     pub se: f64,
@@ -140,7 +115,6 @@ impl Estimate {
 /// One sampler's side.
 #[derive(Clone, Debug, Serialize)]
 pub(crate) struct Side {
-    /// The sampler.
     pub sampler: LightSampler,
     /// URL of its first render (seed 1).
     pub image: String,
@@ -166,9 +140,7 @@ pub(crate) struct Side {
 pub(crate) struct Comparison {
     /// Its id (for the image URLs).
     pub id: u64,
-    /// Image size.
     pub width: u32,
-    /// Image size.
     pub height: u32,
     /// Points per light per hit, for both samplers.
     pub n: u32,
@@ -186,7 +158,6 @@ pub(crate) struct Comparison {
     pub penumbra_pixels: usize,
     /// URL of the two sides' error spectra, one plot.
     pub spectrum: String,
-    /// The two sides.
     pub sides: Vec<Side>,
     /// Seconds for the whole comparison.
     pub seconds: f64,
@@ -207,8 +178,8 @@ pub(crate) struct Comparisons {
 impl Comparisons {
     /// The PNG `name` of comparison `id`.
     pub(crate) fn png(&self, id: u64, name: &str) -> Option<Arc<Vec<u8>>> {
-        let kept = self.kept.lock().unwrap_or_else(|e| e.into_inner());
-        kept.iter()
+        lock(&self.kept)
+            .iter()
             .find(|(i, _)| *i == id)
             .and_then(|(_, imgs)| imgs.iter().find(|(n, _)| n == name))
             .map(|(_, png)| png.clone())
@@ -247,22 +218,21 @@ impl Comparisons {
             heatmap_n: request.n,
             ..StudyConfig::standard(base_settings)
         };
-        let engine: Engine = resolved.engine;
         let render = |s: &Scene, settings: &crate::render::settings::RenderSettings| {
-            pool.install(|| engine.image(s, settings))
+            pool.install(|| resolved.engine.image(s, settings))
         };
         let internal = |e: anyhow::Error| ApiError::status(500, format!("{e:#}"));
+        let encode = |img: &image::RgbImage| png_bytes(img).map(Arc::new).map_err(internal);
+        let film_png = |film: &Film| encode(&film.to_rgb8(ToneMap::Clamp));
         let reference =
             converged_reference(&scene, b"raywave view", &config, &render, None, &|_| {})
                 .map_err(internal)?;
         let regions = pool.install(|| penumbra_mask(&scene, &config.base, MASK_SAMPLES));
         let whole = regions.whole();
+        let penumbra_pixels = regions.penumbra.iter().filter(|&&b| b).count();
         let id = self.next.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
         let url = |name: &str| format!("/api/compare/{id}/{name}.png");
-        let mut pngs = vec![(
-            "reference".to_string(),
-            Arc::new(png(&reference.film).map_err(internal)?),
-        )];
+        let mut pngs = vec![("reference".to_string(), film_png(&reference.film)?)];
         let mut maps = Vec::new();
         let mut sides = Vec::new();
         for (i, &sampler) in request.samplers.iter().enumerate() {
@@ -285,10 +255,7 @@ impl Comparisons {
             };
             let all = error_stats(&images, &reference.film.pixels, &reference.noise, &whole);
             let side_name = if i == 0 { "a" } else { "b" };
-            pngs.push((
-                format!("image-{side_name}"),
-                Arc::new(png(&films[0]).map_err(internal)?),
-            ));
+            pngs.push((format!("image-{side_name}"), film_png(&films[0])?));
             maps.push(pixel_mse(&images, &reference.film.pixels));
             let perceived = perceived::measure(
                 &images,
@@ -302,11 +269,7 @@ impl Comparisons {
                 image: url(&format!("image-{side_name}")),
                 heat: url(&format!("heat-{side_name}")),
                 mse: per_seed(&whole),
-                mse_penumbra: regions
-                    .penumbra
-                    .iter()
-                    .any(|&b| b)
-                    .then(|| per_seed(&regions.penumbra)),
+                mse_penumbra: (penumbra_pixels > 0).then(|| per_seed(&regions.penumbra)),
                 bias: [all.bias, all.bias_bound],
                 seconds: median(&times),
                 perceived,
@@ -314,32 +277,21 @@ impl Comparisons {
         }
         let map_refs: Vec<&[f32]> = maps.iter().map(Vec::as_slice).collect();
         let (wc, hc) = (config.base.width, config.base.height);
-        let heat = heat_images(&map_refs, wc, hc);
-        let heat_scale = heat.as_ref().map(|(_, s)| *s);
-        let heat_imgs = heat
-            .map(|(imgs, _)| imgs)
-            .unwrap_or_else(|| vec![image::RgbImage::new(wc, hc); 2]);
+        let (heat_imgs, heat_scale) = match heat_images(&map_refs, wc, hc) {
+            Some((imgs, scale)) => (imgs, Some(scale)),
+            None => (vec![image::RgbImage::new(wc, hc); 2], None),
+        };
         for (img, name) in heat_imgs.iter().zip(["heat-a", "heat-b"]) {
-            pngs.push((
-                name.to_string(),
-                Arc::new(png_bytes(img).map_err(internal)?),
-            ));
+            pngs.push((name.to_string(), encode(img)?));
         }
         let spectra: Vec<(LightSampler, &Perceived)> =
             sides.iter().map(|s| (s.sampler, &s.perceived)).collect();
         let spectrum =
             spectrum_plot::comparison_image(&spectra, request.n, (640, 400)).map_err(internal)?;
-        pngs.push((
-            "spectrum".to_string(),
-            Arc::new(png_bytes(&spectrum).map_err(internal)?),
-        ));
+        pngs.push(("spectrum".to_string(), encode(&spectrum)?));
         let noise = reference.noise.iter().map(|&v| v as f64).sum::<f64>()
             / reference.noise.len().max(1) as f64;
-        let mut kept = self.kept.lock().unwrap_or_else(|e| e.into_inner());
-        kept.push_back((id, pngs));
-        while kept.len() > KEPT {
-            kept.pop_front();
-        }
+        keep(&self.kept, (id, pngs), KEPT);
         Ok(Comparison {
             id,
             width: wc,
@@ -350,16 +302,12 @@ impl Comparisons {
             reference_noise: noise,
             reference: url("reference"),
             heat_scale,
-            penumbra_pixels: regions.penumbra.iter().filter(|&&b| b).count(),
+            penumbra_pixels,
             spectrum: url("spectrum"),
             sides,
             seconds: start.elapsed().as_secs_f64(),
         })
     }
-}
-
-fn png(film: &Film) -> anyhow::Result<Vec<u8>> {
-    png_bytes(&film.to_rgb8(ToneMap::Clamp))
 }
 
 #[cfg(test)]
@@ -369,7 +317,7 @@ mod tests {
     #[test]
     fn requests_are_checked() {
         let r = CompareRequest::parse(b"").unwrap();
-        assert_eq!(r.samplers, default_samplers());
+        assert_eq!(r.samplers, [LightSampler::Random, LightSampler::Stratified]);
         assert_eq!((r.n, r.seeds, r.size), (4, 4, 64));
         for (body, expected) in [
             (&br#"{"n": 0}"#[..], "n must be in"),

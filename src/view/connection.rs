@@ -40,7 +40,6 @@ pub(crate) struct Request {
     pub target: String,
     /// The headers, names in lower case, in order.
     pub headers: Vec<(String, String)>,
-    /// The body.
     pub body: Vec<u8>,
 }
 
@@ -52,6 +51,11 @@ impl Request {
             .filter(|(n, _)| n == name)
             .map(|(_, v)| v.as_str())
             .collect()
+    }
+
+    /// The path and the query (after `?`, possibly empty).
+    pub(crate) fn path_and_query(&self) -> (&str, &str) {
+        self.target.split_once('?').unwrap_or((&self.target, ""))
     }
 
     /// The one value of header `name`, None when absent; given twice is a 400.
@@ -87,24 +91,22 @@ pub(crate) fn read_request(
 ) -> Result<Request, ReadError> {
     let deadline = accepted + limit;
     let mut buf: Vec<u8> = Vec::with_capacity(2048);
-    let (head_len, method, target, headers) = loop {
+    let (head_len, mut request) = loop {
         let mut slots = [httparse::EMPTY_HEADER; MAX_HEADERS];
         let mut parsed = httparse::Request::new(&mut slots);
         match parsed.parse(&buf) {
             Ok(httparse::Status::Complete(n)) => {
-                let headers = parsed
-                    .headers
-                    .iter()
-                    .map(|h| {
-                        (
-                            h.name.to_ascii_lowercase(),
-                            String::from_utf8_lossy(h.value).into_owned(),
-                        )
-                    })
-                    .collect::<Vec<_>>();
-                let method = parsed.method.unwrap_or_default().to_string();
-                let target = parsed.path.unwrap_or_default().to_string();
-                break (n, method, target, headers);
+                let headers = parsed.headers.iter().map(|h| {
+                    let value = String::from_utf8_lossy(h.value).into_owned();
+                    (h.name.to_ascii_lowercase(), value)
+                });
+                let request = Request {
+                    method: parsed.method.unwrap_or_default().to_string(),
+                    target: parsed.path.unwrap_or_default().to_string(),
+                    headers: headers.collect(),
+                    body: Vec::new(),
+                };
+                break (n, request);
             }
             Ok(httparse::Status::Partial) => {}
             Err(httparse::Error::TooManyHeaders) => {
@@ -126,12 +128,6 @@ pub(crate) fn read_request(
             .into());
         }
         read_some(stream, &mut buf, MAX_HEAD_BYTES, deadline, limit)?;
-    };
-    let mut request = Request {
-        method,
-        target,
-        headers,
-        body: Vec::new(),
     };
     if request.one("transfer-encoding")?.is_some() {
         return Err(ApiError::status(
@@ -257,14 +253,8 @@ pub(crate) fn head(reply: &Reply, body_len: usize) -> Vec<u8> {
             "no-store"
         },
     );
-    if let Some(allow) = reply.allow {
-        head += &format!("Allow: {allow}\r\n");
-    }
-    if let Some(seconds) = reply.retry_after {
-        head += &format!("Retry-After: {seconds}\r\n");
-    }
-    if let Some(cookie) = &reply.set_cookie {
-        head += &format!("Set-Cookie: {cookie}\r\n");
+    for (name, value) in &reply.headers {
+        head += &format!("{name}: {value}\r\n");
     }
     head += "\r\n";
     head.into_bytes()
@@ -424,9 +414,11 @@ mod tests {
     #[test]
     fn replies_carry_their_headers() {
         let reply = Reply {
-            retry_after: Some(1),
-            set_cookie: Some("a=b".into()),
-            allow: Some("GET"),
+            headers: vec![
+                ("Retry-After", "1".into()),
+                ("Set-Cookie", "a=b".into()),
+                ("Allow", "GET".into()),
+            ],
             ..Reply::bytes("text/plain", b"hi".to_vec())
         };
         let head = String::from_utf8(head(&reply, 2)).unwrap();

@@ -14,10 +14,8 @@ pub struct ApiError {
     pub status: u16,
     /// What went wrong, in one sentence.
     pub message: String,
-    /// The methods the path allows, for a 405's `Allow` header.
-    pub allow: Option<&'static str>,
-    /// Seconds to wait before trying again, for a 429's or 503's `Retry-After` header.
-    pub retry_after: Option<u32>,
+    /// A header for the reply: a 405's `Allow`, or a 429's or 503's `Retry-After` (seconds).
+    pub header: Option<(&'static str, String)>,
 }
 
 impl ApiError {
@@ -36,29 +34,29 @@ impl ApiError {
         ApiError {
             status,
             message: message.into(),
-            allow: None,
-            retry_after: None,
+            header: None,
         }
     }
 
     /// A 405 Method Not Allowed for `method` on `path`, which allows `allow`.
     pub fn method(method: &str, path: &str, allow: &'static str) -> Self {
         ApiError {
-            status: 405,
-            message: format!(
-                "{} is not allowed on {}: expected {allow}",
-                quote(method),
-                quote(path)
-            ),
-            allow: Some(allow),
-            retry_after: None,
+            header: Some(("Allow", allow.to_string())),
+            ..ApiError::status(
+                405,
+                format!(
+                    "{} is not allowed on {}: expected {allow}",
+                    quote(method),
+                    quote(path)
+                ),
+            )
         }
     }
 
     /// A `status` (429 or 503) that asks the client to try again in `seconds`.
     pub fn retry(status: u16, seconds: u32, message: impl Into<String>) -> Self {
         ApiError {
-            retry_after: Some(seconds),
+            header: Some(("Retry-After", seconds.to_string())),
             ..ApiError::status(status, message)
         }
     }
@@ -67,20 +65,14 @@ impl ApiError {
 /// What a handler answers: a status, a content type and the bytes.
 #[derive(Clone, Debug, PartialEq)]
 pub(crate) struct Reply {
-    /// HTTP status.
     pub status: u16,
-    /// `Content-Type`.
     pub content_type: &'static str,
-    /// The body.
     pub body: Vec<u8>,
     /// Whether the client may cache it (assets compiled into the binary may).
     pub cacheable: bool,
-    /// `Allow`, for 405.
-    pub allow: Option<&'static str>,
-    /// `Retry-After` in seconds, for 429 and 503.
-    pub retry_after: Option<u32>,
-    /// `Set-Cookie`: the access token, when the page was opened with it.
-    pub set_cookie: Option<String>,
+    /// Headers past the fixed ones, in order: `Allow` (405), `Retry-After` (429, 503),
+    /// `Set-Cookie` (the access token, when the page was opened with it).
+    pub headers: Vec<(&'static str, String)>,
 }
 
 impl Reply {
@@ -102,33 +94,18 @@ impl Reply {
             content_type,
             body,
             cacheable: false,
-            allow: None,
-            retry_after: None,
-            set_cookie: None,
+            headers: Vec::new(),
         }
     }
 }
 
 impl From<ApiError> for Reply {
     fn from(e: ApiError) -> Reply {
-        #[derive(Serialize)]
-        struct Body<'a> {
-            error: &'a str,
-            status: u16,
-        }
-        let body = serde_json::to_vec(&Body {
-            error: &e.message,
-            status: e.status,
-        })
-        .unwrap_or_else(|_| b"{\"error\":\"unencodable error\"}".to_vec());
+        let body = serde_json::json!({"error": e.message, "status": e.status});
         Reply {
             status: e.status,
-            content_type: "application/json",
-            body,
-            cacheable: false,
-            allow: e.allow,
-            retry_after: e.retry_after,
-            set_cookie: None,
+            headers: e.header.into_iter().collect(),
+            ..Reply::bytes("application/json", body.to_string().into_bytes())
         }
     }
 }
@@ -156,8 +133,7 @@ pub(crate) fn query<'a>(q: &'a str, allowed: &[&str]) -> Result<Vec<(&'a str, &'
     Ok(out)
 }
 
-/// The parameter `name` of `pairs` as a whole number, or a 400 saying it is missing or what was
-/// found instead.
+/// The parameter `name` as a whole number, or a 400 saying it is missing or what was found.
 pub(crate) fn number<T: std::str::FromStr>(
     pairs: &[(&str, &str)],
     name: &str,

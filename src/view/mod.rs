@@ -32,10 +32,15 @@ pub mod server;
 pub mod token;
 pub(crate) mod tree;
 
+use crate::render::film::Film;
+use crate::render::progress::Progress;
+use crate::render::wavefront::{Wavefront, cost::CostReport, stats::RenderStats};
 use anyhow::Result;
 use request::Resolved;
+use std::collections::VecDeque;
 use std::net::{IpAddr, SocketAddr};
-use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
+use std::sync::{Arc, Mutex, MutexGuard};
 use token::Access;
 
 /// What `raywave view` was started with.
@@ -64,18 +69,10 @@ pub struct ViewOptions {
 
 /// A counted render of every tile with per-pixel counts, stopped once the flag is set
 /// (`Wavefront::render_counted_until(progress, true, cancel)`); `None` when stopped.
-pub type CountedRender = fn(
-    &crate::render::wavefront::Wavefront,
-    &crate::render::progress::Progress,
-    &std::sync::atomic::AtomicBool,
-) -> Option<(
-    crate::render::film::Film,
-    crate::render::wavefront::stats::RenderStats,
-    crate::render::wavefront::cost::CostReport,
-)>;
+pub type CountedRender =
+    fn(&Wavefront, &Progress, &AtomicBool) -> Option<(Film, RenderStats, CostReport)>;
 
-/// Binds, prints the URL with `say`, and serves until SIGINT or SIGTERM; returns the signal's
-/// number.
+/// Binds, prints the URL with `say`, serves until SIGINT or SIGTERM; returns the signal.
 pub fn run(options: ViewOptions, say: &dyn Fn(&str) -> Result<()>) -> Result<i32> {
     let server = server::Server::bind(options.bind, options.port)?;
     let pool = Arc::new(crate::render::engine::thread_pool(options.threads)?);
@@ -87,7 +84,6 @@ pub fn run(options: ViewOptions, say: &dyn Fn(&str) -> Result<()>) -> Result<i32
         options.counted,
     )
     .map_err(|e| anyhow::anyhow!("cannot start the render thread: {e}"))?;
-    let port = server.addr.port();
     let state = Arc::new(api::State {
         scene_json: api::scene_json(&scene, &options.base),
         scene,
@@ -96,28 +92,35 @@ pub fn run(options: ViewOptions, say: &dyn Fn(&str) -> Result<()>) -> Result<i32
         comparisons: compare::Comparisons::default(),
         pool,
     });
-    say(&format!(
-        "raywave view: {} (Ctrl-C stops it)\n",
-        url(server.addr, &options.access)
-    ))?;
+    let url = url(server.addr, &options.access);
+    say(&format!("raywave view: {url} (Ctrl-C stops it)\n"))?;
     let gate = routes::Gate {
         access: options.access,
         loopback: options.bind.is_loopback(),
-        port,
+        port: server.addr.port(),
     };
     server.serve(state, gate, options.max_connections)
 }
 
 /// The page's URL, with the token: on every interface, the loopback one.
 pub fn url(addr: SocketAddr, access: &Access) -> String {
-    let host = match addr.ip() {
-        IpAddr::V4(ip) if ip.is_unspecified() => "127.0.0.1".to_string(),
-        IpAddr::V6(ip) if ip.is_unspecified() => "[::1]".to_string(),
-        IpAddr::V4(ip) => ip.to_string(),
-        IpAddr::V6(ip) => format!("[{ip}]"),
-    };
+    let addr = server::local_address(addr);
     match access {
-        Access::Token(token) => format!("http://{host}:{}/?token={}", addr.port(), token.as_str()),
-        Access::Open => format!("http://{host}:{}/", addr.port()),
+        Access::Token(token) => format!("http://{addr}/?token={}", token.as_str()),
+        Access::Open => format!("http://{addr}/"),
+    }
+}
+
+/// `mutex`'s guard, also after a thread panicked holding it: what it guards stays usable.
+fn lock<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
+    mutex.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Appends `item` to `kept`, dropping the oldest past `max`.
+fn keep<T>(kept: &Mutex<VecDeque<T>>, item: T, max: usize) {
+    let mut kept = lock(kept);
+    kept.push_back(item);
+    while kept.len() > max {
+        kept.pop_front();
     }
 }

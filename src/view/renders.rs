@@ -21,14 +21,16 @@ use crate::output::image_file::png_bytes;
 use crate::render::engine::{Engine, Prepared, clamp_to_finite};
 use crate::render::film::ToneMap;
 use crate::render::progress::Progress;
-use crate::render::scene::Scene;
-use crate::view::CountedRender;
+use crate::render::scene::{Camera, Scene};
 use crate::view::request::{CostMeasureView, CostOverlay, Resolved, ViewSettings};
+use crate::view::scene_json::CameraFrame;
+use crate::view::{CountedRender, keep, lock};
 use serde::Serialize;
+use std::borrow::Cow;
 use std::collections::VecDeque;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
-use std::sync::{Arc, Condvar, Mutex, MutexGuard};
-use std::time::{Duration, Instant};
+use std::sync::{Arc, Condvar, Mutex};
+use std::time::Instant;
 
 /// How many finished jobs are kept for their images and pixels.
 pub(crate) const KEPT_RENDERS: usize = 8;
@@ -47,12 +49,13 @@ pub(crate) const RENDER_RATE: f64 = 20.0;
 const LEVEL_DIVISORS: [u32; 4] = [8, 4, 2, 1];
 
 /// Where a job is.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
 #[serde(rename_all = "lowercase", tag = "state", content = "error")]
 pub(crate) enum Status {
     /// Waiting for the render thread.
+    #[default]
     Queued,
-    /// Rendering level `levels_done`.
+    /// Rendering the level after the last in `levels`.
     Running,
     /// Every level rendered.
     Done,
@@ -65,9 +68,7 @@ pub(crate) enum Status {
 /// One rendered level.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub(crate) struct Level {
-    /// Image width.
     pub width: u32,
-    /// Image height.
     pub height: u32,
     /// Rays by kind, each kind per thread-second of its own work (null when not measured: the
     /// reference renders without kind timers), and all rays over the seconds the engine took
@@ -96,9 +97,7 @@ pub(crate) struct CostLegend {
 /// What the page polls.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub(crate) struct RenderStatus {
-    /// The job's id.
     pub job: u64,
-    /// Where it is.
     #[serde(flatten)]
     pub status: Status,
     /// Sizes of every level, coarse to fine.
@@ -109,6 +108,8 @@ pub(crate) struct RenderStatus {
     pub progress: [u64; 2],
     /// The settings, all filled in.
     pub settings: ViewSettings,
+    /// The render camera's frame, for the 3D view.
+    pub frame: CameraFrame,
 }
 
 /// One job: its inputs, and what it has produced so far.
@@ -117,7 +118,6 @@ pub(crate) struct RenderJob {
     pub id: u64,
     /// The settings and camera at full resolution.
     pub resolved: Resolved,
-    /// The level sizes.
     pub sizes: Vec<[u32; 2]>,
     /// Set when a newer job supersedes this one: the engines read it before each work unit.
     cancel: AtomicBool,
@@ -128,6 +128,7 @@ pub(crate) struct RenderJob {
     state: Mutex<RenderState>,
 }
 
+#[derive(Default)]
 struct RenderState {
     status: Status,
     levels: Vec<Level>,
@@ -139,7 +140,8 @@ struct RenderState {
 impl RenderJob {
     /// The status for the page.
     pub(crate) fn status(&self) -> RenderStatus {
-        let state = self.lock();
+        let r = &self.resolved;
+        let state = lock(&self.state);
         RenderStatus {
             job: self.id,
             status: state.status.clone(),
@@ -149,13 +151,14 @@ impl RenderJob {
                 self.done_units.load(Ordering::Relaxed),
                 self.total_units.load(Ordering::Relaxed),
             ],
-            settings: self.resolved.to_json(),
+            settings: r.to_json(),
+            frame: CameraFrame::new(&r.camera, r.settings.width, r.settings.height),
         }
     }
 
     /// Where it is now.
     pub(crate) fn state(&self) -> Status {
-        self.lock().status.clone()
+        lock(&self.state).status.clone()
     }
 
     /// The job that superseded this one, once one has.
@@ -165,20 +168,16 @@ impl RenderJob {
 
     /// Level `k`'s PNG, once rendered.
     pub(crate) fn png(&self, k: usize) -> Option<Arc<Vec<u8>>> {
-        self.lock().pngs.get(k).cloned()
+        lock(&self.state).pngs.get(k).cloned()
     }
 
     /// Level `k`'s cost-map overlay, once rendered, when the job asked for one.
     pub(crate) fn cost_png(&self, k: usize) -> Option<Arc<Vec<u8>>> {
-        self.lock().cost_pngs.get(k).cloned().flatten()
-    }
-
-    fn lock(&self) -> MutexGuard<'_, RenderState> {
-        self.state.lock().unwrap_or_else(|e| e.into_inner())
+        lock(&self.state).cost_pngs.get(k).cloned().flatten()
     }
 
     fn set_status(&self, status: Status) {
-        self.lock().status = status;
+        lock(&self.state).status = status;
     }
 
     /// Marks the job superseded by `by` (unless a job did before) and tells its render, if
@@ -191,16 +190,13 @@ impl RenderJob {
     }
 }
 
-/// The sizes of the levels of a `width` × `height` image: each divisor's, rounded up, without
-/// repeats (a 10-pixel image has fewer than four levels).
+/// The level sizes of a `width` × `height` image, rounded up, without repeats (a 10-pixel image
+/// has fewer than four levels).
 fn level_sizes(width: u32, height: u32) -> Vec<[u32; 2]> {
-    let mut sizes: Vec<[u32; 2]> = Vec::new();
-    for d in LEVEL_DIVISORS {
-        let s = [width.div_ceil(d), height.div_ceil(d)];
-        if sizes.last() != Some(&s) {
-            sizes.push(s);
-        }
-    }
+    let mut sizes: Vec<[u32; 2]> = LEVEL_DIVISORS
+        .map(|d| [width.div_ceil(d), height.div_ceil(d)])
+        .to_vec();
+    sizes.dedup();
     sizes
 }
 
@@ -222,13 +218,9 @@ struct Queue {
 }
 
 impl Queue {
-    fn lock(&self) -> MutexGuard<'_, Inbox> {
-        self.inbox.lock().unwrap_or_else(|e| e.into_inner())
-    }
-
     /// Stops the render thread: the running job is cancelled, the waiting one dropped.
     fn close(&self) {
-        let mut inbox = self.lock();
+        let mut inbox = lock(&self.inbox);
         inbox.closed = true;
         if let Some(job) = &inbox.running {
             job.cancel.store(true, Ordering::Relaxed);
@@ -270,9 +262,9 @@ impl TokenBucket {
             self.tokens -= 1.0;
             Ok(())
         } else {
-            let wait = Duration::from_secs_f64((1.0 - self.tokens) / RENDER_RATE);
+            let wait = (1.0 - self.tokens) / RENDER_RATE;
             Err(RateLimited {
-                retry_after: (wait.as_secs_f64().ceil() as u32).max(1),
+                retry_after: (wait.ceil() as u32).max(1),
             })
         }
     }
@@ -311,10 +303,7 @@ impl Renders {
     /// Queues a job, unless the rate limit refuses it. It takes the place of the job waiting,
     /// which is superseded without starting, and cancels the job running.
     pub(crate) fn submit(&self, resolved: Resolved) -> Result<Arc<RenderJob>, RateLimited> {
-        self.bucket
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .take(Instant::now())?;
+        lock(&self.bucket).take(Instant::now())?;
         let id = self.next.fetch_add(1, Ordering::Relaxed);
         let sizes = level_sizes(resolved.settings.width, resolved.settings.height);
         let job = Arc::new(RenderJob {
@@ -325,20 +314,10 @@ impl Renders {
             superseded_by: AtomicU64::new(0),
             done_units: AtomicU64::new(0),
             total_units: AtomicU64::new(0),
-            state: Mutex::new(RenderState {
-                status: Status::Queued,
-                levels: Vec::new(),
-                pngs: Vec::new(),
-                cost_pngs: Vec::new(),
-            }),
+            state: Mutex::default(),
         });
-        let mut kept = self.kept.lock().unwrap_or_else(|e| e.into_inner());
-        kept.push_back(job.clone());
-        while kept.len() > KEPT_RENDERS {
-            kept.pop_front();
-        }
-        drop(kept);
-        let mut inbox = self.queue.lock();
+        keep(&self.kept, job.clone(), KEPT_RENDERS);
+        let mut inbox = lock(&self.queue.inbox);
         if inbox.closed {
             job.set_status(Status::Failed("the render thread has stopped".into()));
             return Ok(job);
@@ -357,8 +336,7 @@ impl Renders {
 
     /// The job `id`, while it is kept.
     pub(crate) fn get(&self, id: u64) -> Option<Arc<RenderJob>> {
-        let kept = self.kept.lock().unwrap_or_else(|e| e.into_inner());
-        kept.iter().find(|j| j.id == id).cloned()
+        lock(&self.kept).iter().find(|j| j.id == id).cloned()
     }
 
     /// The newest job's id (0 before the first).
@@ -393,7 +371,7 @@ fn render_thread(
     let _close = CloseOnExit(queue);
     loop {
         let job = {
-            let mut inbox = queue.lock();
+            let mut inbox = lock(&queue.inbox);
             loop {
                 if inbox.closed {
                     return;
@@ -424,21 +402,18 @@ fn render_thread(
             )),
         };
         job.set_status(status);
-        queue.lock().running = None;
+        lock(&queue.inbox).running = None;
     }
 }
 
 /// The scene seen through `camera`: a copy only when the camera differs from the file's.
-pub(crate) fn with_camera<'a>(
-    scene: &'a Scene,
-    camera: &crate::render::scene::Camera,
-) -> std::borrow::Cow<'a, Scene> {
+pub(crate) fn with_camera<'a>(scene: &'a Scene, camera: &Camera) -> Cow<'a, Scene> {
     if scene.camera == *camera {
-        std::borrow::Cow::Borrowed(scene)
+        Cow::Borrowed(scene)
     } else {
         let mut copy = scene.clone();
         copy.camera = *camera;
-        std::borrow::Cow::Owned(copy)
+        Cow::Owned(copy)
     }
 }
 
@@ -488,11 +463,7 @@ fn render_levels(
                             totals: &costs.totals,
                             rays: &stats.counts,
                         };
-                        (
-                            overlay(&input, kind, job.resolved.cost_measure.count()),
-                            width,
-                            height,
-                        )
+                        overlay(&input, kind, job.resolved.cost_measure.count())
                     });
                     (film, stats, overlay)
                 }),
@@ -506,7 +477,7 @@ fn render_levels(
         let seconds = start.elapsed().as_secs_f64();
         let png = png_bytes(&film.to_rgb8(ToneMap::Clamp))?;
         let (cost, cost_png) = match overlay {
-            Some((map, w, h)) => (
+            Some(map) => (
                 Some(CostLegend {
                     kind: job.resolved.cost_map,
                     measure: job.resolved.cost_measure,
@@ -514,11 +485,11 @@ fn render_levels(
                     largest: map.largest,
                     per_ray: map.per_ray,
                 }),
-                Some(Arc::new(png_bytes(&map.image(w, h))?)),
+                Some(Arc::new(png_bytes(&map.image(width, height))?)),
             ),
             None => (None, None),
         };
-        let mut state = job.lock();
+        let mut state = lock(&job.state);
         state.levels.push(Level {
             width,
             height,
@@ -537,6 +508,7 @@ pub(crate) const ENGINES: [Engine; 2] = [Engine::Wavefront, Engine::Reference];
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::time::Duration;
 
     #[test]
     fn levels_go_coarse_to_fine_without_repeats() {
@@ -571,7 +543,7 @@ mod tests {
         let a = jobs.submit(resolved()).unwrap();
         // The render thread takes it.
         {
-            let mut inbox = jobs.queue.lock();
+            let mut inbox = lock(&jobs.queue.inbox);
             inbox.running = inbox.waiting.take();
         }
         let b = jobs.submit(resolved()).unwrap();
@@ -588,7 +560,7 @@ mod tests {
         assert_eq!(a.superseded_by(), Some(b.id), "the first to supersede it");
         assert!(!c.cancel.load(Ordering::Relaxed));
         {
-            let inbox = jobs.queue.lock();
+            let inbox = lock(&jobs.queue.inbox);
             assert_eq!(inbox.waiting.as_ref().map(|j| j.id), Some(c.id));
             assert_eq!(inbox.running.as_ref().map(|j| j.id), Some(a.id));
         }

@@ -10,6 +10,7 @@ use crate::render::sampling::LightSampler;
 use crate::render::scene::Camera;
 use crate::render::settings::{LightModel, RenderSettings, ShadowMode};
 use glam::Vec3;
+use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
 /// The largest image side the viewer renders (the command line allows more; a browser tab does
@@ -59,11 +60,7 @@ impl CameraJson {
                 "camera: expected finite coordinates of magnitude at most 1e6",
             ));
         }
-        let (p, l, u) = (
-            Vec3::from_array(self.position),
-            Vec3::from_array(self.look_at),
-            Vec3::from_array(self.up),
-        );
+        let [p, l, u] = all.map(Vec3::from_array);
         let forward = l - p;
         if forward.length() < 1e-6 {
             return Err(ApiError::bad(
@@ -189,56 +186,56 @@ pub struct Resolved {
     pub cost_measure: CostMeasureView,
 }
 
-impl ViewSettings {
-    /// Parses a request body: malformed JSON, unknown fields and wrong types are a 400 naming
-    /// the place (serde's line and column).
-    pub fn parse(body: &[u8]) -> Result<ViewSettings, ApiError> {
-        if body.iter().all(u8::is_ascii_whitespace) {
-            return Ok(ViewSettings::default());
-        }
-        serde_json::from_slice(body)
-            .map_err(|e| ApiError::bad(format!("settings: {}", quote(&e.to_string()))))
+/// `v`, or a 400 saying `name` must be in `lo..=hi`.
+pub(crate) fn in_range(name: &str, v: u32, lo: u32, hi: u32) -> Result<u32, ApiError> {
+    if (lo..=hi).contains(&v) {
+        Ok(v)
+    } else {
+        Err(ApiError::bad(format!(
+            "{name} must be in {lo}..={hi}, found {v}"
+        )))
     }
+}
 
+/// Parses a request body (blank: every default): malformed JSON, unknown fields and wrong
+/// types are a 400 naming `what` and the place (serde's line and column).
+pub(crate) fn parse_json<T: Default + DeserializeOwned>(
+    body: &[u8],
+    what: &str,
+) -> Result<T, ApiError> {
+    if body.iter().all(u8::is_ascii_whitespace) {
+        return Ok(T::default());
+    }
+    serde_json::from_slice(body)
+        .map_err(|e| ApiError::bad(format!("{what}: {}", quote(&e.to_string()))))
+}
+
+impl ViewSettings {
     /// These settings over `base`, checked.
     pub fn resolve(&self, base: &Resolved) -> Result<Resolved, ApiError> {
         let mut s = base.settings.clone();
-        let check = |name: &str, v: u32, lo: u32, hi: u32| -> Result<u32, ApiError> {
-            if (lo..=hi).contains(&v) {
-                Ok(v)
-            } else {
-                Err(ApiError::bad(format!(
-                    "{name} must be in {lo}..={hi}, found {v}"
-                )))
+        let ranged = [
+            ("width", self.width, &mut s.width, 1, MAX_SIDE),
+            ("height", self.height, &mut s.height, 1, MAX_SIDE),
+            ("bounces", self.bounces, &mut s.bounces, 0, MAX_BOUNCES),
+            (
+                "shadow_samples",
+                self.shadow_samples,
+                &mut s.shadow_samples,
+                1,
+                MAX_SHADOW_SAMPLES,
+            ),
+            ("aa", self.aa, &mut s.aa_samples, 1, 64),
+        ];
+        for (name, given, field, lo, hi) in ranged {
+            if let Some(v) = given {
+                *field = in_range(name, v, lo, hi)?;
             }
-        };
-        if let Some(w) = self.width {
-            s.width = check("width", w, 1, MAX_SIDE)?;
         }
-        if let Some(h) = self.height {
-            s.height = check("height", h, 1, MAX_SIDE)?;
-        }
-        if let Some(b) = self.bounces {
-            s.bounces = check("bounces", b, 0, MAX_BOUNCES)?;
-        }
-        if let Some(n) = self.shadow_samples {
-            s.shadow_samples = check("shadow_samples", n, 1, MAX_SHADOW_SAMPLES)?;
-        }
-        if let Some(a) = self.aa {
-            s.aa_samples = check("aa", a, 1, 64)?;
-        }
-        if let Some(m) = self.shadows {
-            s.shadows = m;
-        }
-        if let Some(m) = self.sampler {
-            s.sampler = m;
-        }
-        if let Some(m) = self.light_model {
-            s.light_model = m;
-        }
-        if let Some(seed) = self.seed {
-            s.seed = seed;
-        }
+        s.shadows = self.shadows.unwrap_or(s.shadows);
+        s.sampler = self.sampler.unwrap_or(s.sampler);
+        s.light_model = self.light_model.unwrap_or(s.light_model);
+        s.seed = self.seed.unwrap_or(s.seed);
         let samples = s.width as u64 * s.height as u64 * s.aa_samples as u64;
         if samples > MAX_CAMERA_SAMPLES {
             return Err(ApiError::bad(format!(
@@ -294,6 +291,10 @@ impl Resolved {
 mod tests {
     use super::*;
 
+    fn parse(body: &[u8]) -> Result<ViewSettings, ApiError> {
+        parse_json(body, "settings")
+    }
+
     fn base() -> Resolved {
         Resolved {
             settings: RenderSettings::preview(),
@@ -306,10 +307,7 @@ mod tests {
 
     #[test]
     fn empty_body_keeps_the_base() {
-        let r = ViewSettings::parse(b" \n")
-            .unwrap()
-            .resolve(&base())
-            .unwrap();
+        let r = parse(b" \n").unwrap().resolve(&base()).unwrap();
         assert_eq!(r, base());
     }
 
@@ -317,7 +315,7 @@ mod tests {
     fn fields_override_and_round_trip() {
         let body = br#"{"width": 40, "shadows": "soft", "shadow_samples": 9, "sampler": "sobol",
                         "engine": "reference", "light_model": "rpi"}"#;
-        let r = ViewSettings::parse(body).unwrap().resolve(&base()).unwrap();
+        let r = parse(body).unwrap().resolve(&base()).unwrap();
         assert_eq!(r.settings.width, 40);
         assert_eq!(r.settings.height, 64);
         assert_eq!(r.settings.shadows, ShadowMode::Soft);
@@ -327,7 +325,7 @@ mod tests {
         let again = r.to_json().resolve(&base()).unwrap();
         assert_eq!(again.settings, r.settings);
         let body = br#"{"cost_map": "shadow", "cost_measure": "tests"}"#;
-        let r = ViewSettings::parse(body).unwrap().resolve(&base()).unwrap();
+        let r = parse(body).unwrap().resolve(&base()).unwrap();
         assert_eq!(
             (r.cost_map, r.cost_measure),
             (CostOverlay::Shadow, CostMeasureView::Tests)
@@ -359,9 +357,7 @@ mod tests {
             ),
         ];
         for (body, expected) in cases {
-            let err = ViewSettings::parse(body)
-                .and_then(|v| v.resolve(&base()))
-                .unwrap_err();
+            let err = parse(body).and_then(|v| v.resolve(&base())).unwrap_err();
             assert_eq!(err.status, 400);
             assert!(
                 err.message.contains(expected),

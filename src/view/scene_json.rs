@@ -24,7 +24,6 @@ pub(crate) struct SceneJson {
     pub triangle_count: usize,
     /// True when only the first [`MAX_DRAWN_TRIANGLES`] are sent.
     pub truncated: bool,
-    /// Spheres.
     pub spheres: Vec<SphereJson>,
     /// Area lights: corners in order around the outline.
     pub lights: Vec<Vec<[f32; 3]>>,
@@ -35,17 +34,16 @@ pub(crate) struct SceneJson {
 /// A sphere for WebGL.
 #[derive(Serialize)]
 pub(crate) struct SphereJson {
-    /// Centre.
     pub center: [f32; 3],
-    /// Radius.
     pub radius: f32,
     /// Display colour.
     pub color: [f32; 3],
 }
 
 /// The colour a surface is drawn with: its emission for lights, else its diffuse colour plus
-/// half its mirror colour (so mirrors read as light grey), clamped to [0, 1].
-fn display_colour(m: &Material) -> [f32; 3] {
+/// half its mirror colour (so mirrors read as light grey), clamped to [0, 1]; grey without one.
+fn display_colour(m: Option<&Material>) -> [f32; 3] {
+    let Some(m) = m else { return [0.5; 3] };
     let c = if m.emitted.max_element() > 0.0 {
         m.emitted / m.emitted.max_element()
     } else {
@@ -68,8 +66,7 @@ impl SceneJson {
                 lo = lo.min(p);
                 hi = hi.max(p);
             }
-            let m = scene.materials.get(t.material as usize);
-            colors.extend_from_slice(&m.map_or([0.5; 3], display_colour));
+            colors.extend_from_slice(&display_colour(scene.materials.get(t.material as usize)));
         }
         let spheres = scene
             .spheres
@@ -80,10 +77,7 @@ impl SceneJson {
                 SphereJson {
                     center: s.center.to_array(),
                     radius: s.radius,
-                    color: scene
-                        .materials
-                        .get(s.material as usize)
-                        .map_or([0.5; 3], display_colour),
+                    color: display_colour(scene.materials.get(s.material as usize)),
                 }
             })
             .collect();
@@ -119,9 +113,8 @@ impl SceneJson {
 
 /// The render camera's frame for drawing: its eye and the four corners of the image at unit
 /// distance along the view direction, top-left first, clockwise.
-#[derive(Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize)]
 pub(crate) struct CameraFrame {
-    /// Eye.
     pub eye: [f32; 3],
     /// Image corners one unit in front of the eye.
     pub corners: [[f32; 3]; 4],

@@ -8,11 +8,9 @@
 //! SIGINT/SIGTERM -> stop accepting -> wait for the open connections (at most DRAIN_TIME) -> return
 //! ```
 //!
-//! A thread per connection, bounded by the connection limit, and a deadline per request: a slow
-//! client holds one thread for at most the request time and never blocks another's request.
-//! (tiny_http, used before, spawns a thread per connection without a bound and has no read
-//! timeout; an async server would add a runtime to every build for a page with a few requests
-//! a second.)
+//! So a slow client holds one thread for at most the request time and never blocks another's
+//! request. Rejected: tiny_http (a thread per connection without a bound, no read timeout) and an
+//! async server (a runtime in every build, for a page with a few requests a second).
 
 use super::api::State;
 use super::connection::{self, REQUEST_TIME, ReadError, Request};
@@ -22,7 +20,7 @@ use anyhow::{Context, Result};
 use std::net::{IpAddr, Ipv4Addr, Ipv6Addr, SocketAddr, TcpListener, TcpStream};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use std::sync::mpsc::{Receiver, SyncSender, TrySendError};
+use std::sync::mpsc::{Receiver, SyncSender};
 use std::time::{Duration, Instant};
 
 /// The connections open at once by default; past it, new ones get a 503.
@@ -85,7 +83,7 @@ impl Server {
         handle.close();
         shared.stop.store(true, Ordering::SeqCst);
         // Wake the acceptor from accept(2) with a connection of our own.
-        let _ = TcpStream::connect_timeout(&wake_address(self.addr), Duration::from_secs(1));
+        let _ = TcpStream::connect_timeout(&local_address(self.addr), Duration::from_secs(1));
         let _ = acceptor.join();
         let end = Instant::now() + DRAIN_TIME;
         while shared.open.load(Ordering::SeqCst) > 0 && Instant::now() < end {
@@ -114,9 +112,8 @@ impl Drop for Slot {
     }
 }
 
-/// The address a connection to the server itself goes to: the bound one, or loopback when
-/// bound to every interface.
-fn wake_address(addr: SocketAddr) -> SocketAddr {
+/// Where a client on this machine reaches the server: loopback when bound to every interface.
+pub(crate) fn local_address(addr: SocketAddr) -> SocketAddr {
     match addr.ip() {
         IpAddr::V4(ip) if ip.is_unspecified() => (Ipv4Addr::LOCALHOST, addr.port()).into(),
         IpAddr::V6(ip) if ip.is_unspecified() => (Ipv6Addr::LOCALHOST, addr.port()).into(),
@@ -141,9 +138,8 @@ fn accept(listener: &TcpListener, shared: &Arc<Shared>, refuse: &SyncSender<TcpS
         let accepted = Instant::now();
         if shared.open.fetch_add(1, Ordering::SeqCst) >= shared.max_connections {
             shared.open.fetch_sub(1, Ordering::SeqCst);
-            if let Err(TrySendError::Full(_)) = refuse.try_send(stream) {
-                // Already refusing as fast as it can: close this one unanswered.
-            }
+            // When the refuser's queue is full, this one is closed unanswered.
+            let _ = refuse.try_send(stream);
             continue;
         }
         let slot = Slot(shared.clone());
@@ -180,8 +176,7 @@ fn answer(request: &Request, shared: &Shared) -> Reply {
     })
 }
 
-/// Answers the connections over the limit with 503 and `Retry-After`, one at a time, each in a
-/// bounded time.
+/// Answers the connections over the limit with 503 and `Retry-After`, one at a time.
 fn refuser(queue: &Receiver<TcpStream>, max_connections: usize) {
     let reply = Reply::from(ApiError::retry(
         503,

@@ -12,6 +12,7 @@
 //! Authorization: Bearer T        every path        another scheme, or no scheme
 //! ```
 
+use super::connection::Request;
 use super::http::ApiError;
 use crate::render::quote::quote;
 use subtle::ConstantTimeEq;
@@ -86,67 +87,44 @@ pub enum Access {
     Open,
 }
 
-/// The parts of a request the check reads.
-pub(crate) struct Presented<'a> {
-    /// The path, without the query.
-    pub path: &'a str,
-    /// The query string (after `?`), possibly empty.
-    pub query: &'a str,
-    /// Every `Cookie` header's value.
-    pub cookies: Vec<&'a str>,
-    /// Every `Authorization` header's value.
-    pub authorization: Vec<&'a str>,
-}
-
-/// The cookie's name: one per port, so that two viewers on one machine keep their own.
-fn cookie_name(port: u16) -> String {
-    format!("raywave_token_{port}")
-}
-
-/// The `Set-Cookie` value that keeps `token` for the page's later requests.
-fn set_cookie(token: &Token, port: u16) -> String {
-    format!(
-        "{}={}; Path=/; HttpOnly; SameSite=Strict",
-        cookie_name(port),
-        token.as_str()
-    )
-}
-
 impl Access {
     /// Checks a request. `Ok(Some(cookie))` when the page was opened with the token in its URL:
     /// the reply sets that cookie. `port` is the server's (it names the cookie).
-    pub(crate) fn check(
-        &self,
-        request: &Presented<'_>,
-        port: u16,
-    ) -> Result<Option<String>, ApiError> {
+    pub(crate) fn check(&self, request: &Request, port: u16) -> Result<Option<String>, ApiError> {
         let Access::Token(token) = self else {
             return Ok(None);
         };
-        let in_query = query_token(request.query)?;
-        let is_page = matches!(request.path, "/" | "/index.html");
+        let (path, query) = request.path_and_query();
+        let in_query = query_token(query)?;
+        let is_page = matches!(path, "/" | "/index.html");
         if in_query.is_some() && !is_page {
             return Err(ApiError::bad(format!(
                 "the token is in the query string of {}: it belongs only in the page's URL (/?token=...); \
                  requests send it in `Authorization: Bearer TOKEN` (or the page's cookie), so that it stays out of logs",
-                quote(request.path)
+                quote(path)
             )));
         }
         let mut bearer = Vec::new();
-        for value in &request.authorization {
+        for value in request.all("authorization") {
             bearer.push(bearer_token(value)?);
         }
-        let name = cookie_name(port);
+        // One cookie per port, so that two viewers on one machine keep their own.
+        let name = format!("raywave_token_{port}");
         let cookies: Vec<&str> = request
-            .cookies
-            .iter()
+            .all("cookie")
+            .into_iter()
             .flat_map(|header| header.split(';'))
             .filter_map(|pair| pair.trim().split_once('='))
             .filter(|(n, _)| *n == name)
             .map(|(_, v)| v)
             .collect();
         if in_query.is_some_and(|t| token.matches(t)) {
-            return Ok(Some(set_cookie(token, port)));
+            // Keeps the token for the page's later requests.
+            let cookie = format!(
+                "{name}={}; Path=/; HttpOnly; SameSite=Strict",
+                token.as_str()
+            );
+            return Ok(Some(cookie));
         }
         let presented = in_query.is_some() || !bearer.is_empty() || !cookies.is_empty();
         if bearer.iter().chain(&cookies).any(|t| token.matches(t)) {
@@ -208,12 +186,12 @@ mod tests {
         Access::Token(Token::parse(T).unwrap())
     }
 
-    fn presented<'a>(path: &'a str, query: &'a str) -> Presented<'a> {
-        Presented {
-            path,
-            query,
-            cookies: Vec::new(),
-            authorization: Vec::new(),
+    fn presented(path: &str, query: &str) -> Request {
+        Request {
+            method: "GET".into(),
+            target: format!("{path}?{query}"),
+            headers: Vec::new(),
+            body: Vec::new(),
         }
     }
 
@@ -253,13 +231,13 @@ mod tests {
     fn the_cookie_and_the_bearer_header_are_accepted() {
         let cookie = format!("other=1; raywave_token_8000={T}");
         let mut p = presented("/api/scene", "");
-        p.cookies.push(&cookie);
+        p.headers.push(("cookie".into(), cookie));
         assert_eq!(access().check(&p, 8000).unwrap(), None);
         // Another port's cookie is another server's.
         assert_eq!(access().check(&p, 8001).unwrap_err().status, 403);
         let bearer = format!("Bearer {T}");
         let mut p = presented("/api/scene", "");
-        p.authorization.push(&bearer);
+        p.headers.push(("authorization".into(), bearer));
         assert_eq!(access().check(&p, 8000).unwrap(), None);
     }
 
@@ -280,7 +258,7 @@ mod tests {
         assert_eq!(misplaced.status, 400);
         assert!(misplaced.message.contains("Authorization: Bearer"));
         let mut p = presented("/api/scene", "");
-        p.authorization.push(T);
+        p.headers.push(("authorization".into(), T.into()));
         assert_eq!(access().check(&p, 8000).unwrap_err().status, 400);
         let twice = format!("token={T}&token={T}");
         assert_eq!(

@@ -7,7 +7,6 @@ use crate::render::scene::Scene;
 use crate::render::settings::RenderSettings;
 use crate::trace::palette::{self, Rgb};
 use crate::trace::{RayTree, TraceError, check_pixel, trace_pixel};
-use serde::Serialize;
 
 /// The most segments a tree may have before it is traced (its JSON is about 1 KB a segment, and
 /// the page draws and lists each one).
@@ -42,29 +41,13 @@ pub(crate) fn pixel_tree(
     Ok(tree)
 }
 
-/// The colours of the 3D view, `raywave::trace::palette`'s (the lab's).
-#[derive(Serialize)]
-pub(crate) struct Palette {
-    /// Camera rays.
-    pub camera: Rgb,
-    /// Reflection rays.
-    pub reflection: Rgb,
-    /// Shadow rays that reach their light point.
-    pub shadow_visible: Rgb,
-    /// Shadow rays that something blocks (drawn dashed past the blocker).
-    pub shadow_blocked: Rgb,
-    /// Shadow rays with shadows off (not tested).
-    pub shadow_untested: Rgb,
-    /// The render camera.
-    pub main_camera: Rgb,
-}
-
-/// The palette.
-pub(crate) const PALETTE: Palette = Palette {
-    camera: palette::CAMERA,
-    reflection: palette::REFLECTION,
-    shadow_visible: palette::SHADOW_VISIBLE,
-    shadow_blocked: palette::SHADOW_BLOCKED,
-    shadow_untested: palette::SHADOW_UNTESTED,
-    main_camera: palette::MAIN_CAMERA,
-};
+/// The colours of the 3D view, `raywave::trace::palette`'s (the lab's), by the names the page
+/// reads them by (shadow_blocked rays are drawn dashed past the blocker).
+pub(crate) const PALETTE: [(&str, Rgb); 6] = [
+    ("camera", palette::CAMERA),
+    ("reflection", palette::REFLECTION),
+    ("shadow_visible", palette::SHADOW_VISIBLE),
+    ("shadow_blocked", palette::SHADOW_BLOCKED),
+    ("shadow_untested", palette::SHADOW_UNTESTED),
+    ("main_camera", palette::MAIN_CAMERA),
+];
