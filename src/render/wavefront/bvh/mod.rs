@@ -59,7 +59,7 @@ use crate::render::geometry::{Hit, Ray, T_MIN, intersect_sphere};
 use crate::render::scene::{NO_HIT, Scene, Triangle};
 use crate::render::wavefront::batch::HitRays;
 use crate::render::wavefront::cost::{Costs, Counter};
-use crate::render::wavefront::lanes::{LANES, f32x8, i32x8, ids, set_bits};
+use crate::render::wavefront::lanes::{LANES, cast, f32x8, i32x8, set_bits};
 use std::time::Duration;
 pub use traverse::Stack;
 use traverse::{RayLanes, triangles8, triangles8_block};
@@ -118,7 +118,7 @@ impl Block {
     /// From the ids, not the vertices: a triangle built in code may have a NaN vertex.
     #[inline(always)]
     fn len(&self) -> u32 {
-        let unused = ids(self.prim)
+        let unused = cast::<_, i32x8>(self.prim)
             .simd_eq(i32x8::splat(NO_HIT as i32))
             .to_bitmask();
         (unused | 1 << WIDTH).trailing_zeros()
