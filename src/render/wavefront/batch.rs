@@ -60,6 +60,12 @@ impl Vec3Column {
         self.z.clear();
     }
 
+    /// `n` vectors of zeros (the radiance of a new tile).
+    pub fn reset(&mut self, n: usize) {
+        self.clear();
+        self.resize(n, 0.0);
+    }
+
     /// Resizes the three columns to `n`, new entries `value`.
     pub fn resize(&mut self, n: usize, value: f32) {
         self.x.resize(n, value);
@@ -259,16 +265,6 @@ pub struct ShadowQueue {
 }
 
 impl ShadowQueue {
-    /// Number of queued entries (live or not).
-    pub fn len(&self) -> usize {
-        self.len
-    }
-
-    /// True when empty.
-    pub fn is_empty(&self) -> bool {
-        self.len == 0
-    }
-
     /// Empties the queue and makes room for `capacity` entries, with the `dist` column only
     /// when `with_dist` (a light model with fall-off).
     pub fn reset(&mut self, capacity: usize, with_dist: bool) {
@@ -388,29 +384,5 @@ impl<A: AsRef<[f32]>> HitRays<A> {
     }
 }
 
-/// Per camera sample of a tile: the radiance gathered so far.
-#[derive(Clone, Debug, Default)]
-pub struct Radiance {
-    /// Red, green, blue per slot.
-    pub sum: Vec3Column,
-}
-
-impl Radiance {
-    /// `n` black slots.
-    pub fn reset(&mut self, n: usize) {
-        self.sum.clear();
-        self.sum.resize(n, 0.0);
-    }
-
-    /// Adds `c` to slot `i`.
-    #[inline]
-    pub fn add(&mut self, i: usize, c: Vec3) {
-        self.sum.add(i, c);
-    }
-
-    /// Slot `i`.
-    #[inline]
-    pub fn get(&self, i: usize) -> Vec3 {
-        self.sum.get(i)
-    }
-}
+/// Per camera sample of a tile: the radiance gathered so far (red, green, blue per slot).
+pub type Radiance = Vec3Column;
