@@ -309,21 +309,9 @@ pub fn occluded<V: Lanes, S: Costs>(
         // A lane with tmax ≤ 0 (dead, or a light point within T_MIN) can never be blocked, so
         // it does not hold up the early exit.
         let live = live_lanes::<V>(i, n) & tmax.simd_gt(V::ZERO).to_bitmask();
-        let blocked = if live == 0 {
-            0
-        } else {
-            let mut c = S::Counter::default();
-            let blocked = occluded8(
-                triangles,
-                spheres,
-                live,
-                |s| sphere8_blocks(s, &r, tmax),
-                |tri| triangle8_blocks(tri, &r, tmax, two_sided),
-                &mut c,
-            );
-            costs.add_lanes(i, live, c);
-            blocked
-        };
+        let mut c = S::Counter::default();
+        let blocked = rays_occluded(triangles, spheres, &r, tmax, live, two_sided, &mut c);
+        costs.add_lanes(i, live, c);
         let lanes = (n - i).min(V::N);
         store_mask::<V>(&mut out[i..i + lanes], blocked);
     }
@@ -342,15 +330,10 @@ pub fn block_occluded<V: Lanes, C: Counter>(
     two_sided: bool,
     c: &mut C,
 ) -> u32 {
-    let o = block.origin;
-    let r = Rays {
-        ox: V::splat(o.x),
-        oy: V::splat(o.y),
-        oz: V::splat(o.z),
-        dx: V::from_array(block.l[0]),
-        dy: V::from_array(block.l[1]),
-        dz: V::from_array(block.l[2]),
-    };
+    let r = Rays::new(
+        block.origin.to_array().map(V::splat),
+        block.l.map(V::from_array),
+    );
     let tmax = V::from_array(block.tmax);
     let live = tmax.simd_gt(V::ZERO).to_bitmask();
     rays_occluded(triangles, spheres, &r, tmax, live, two_sided, c)
@@ -369,14 +352,7 @@ pub fn hit_rays_occluded<V: Lanes, C: Counter>(
     two_sided: bool,
     c: &mut C,
 ) -> u32 {
-    let r = Rays {
-        ox: V::from_array(rays.origin[0]),
-        oy: V::from_array(rays.origin[1]),
-        oz: V::from_array(rays.origin[2]),
-        dx: V::from_array(rays.l[0]),
-        dy: V::from_array(rays.l[1]),
-        dz: V::from_array(rays.l[2]),
-    };
+    let r = Rays::new(rays.origin.map(V::from_array), rays.l.map(V::from_array));
     rays_occluded(
         triangles,
         spheres,

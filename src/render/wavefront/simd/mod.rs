@@ -92,34 +92,33 @@ pub struct Rays<V = f32x8> {
     dz: V,
 }
 
-/// Eight rays in registers.
-pub(crate) type Rays8 = Rays<f32x8>;
-
 impl<V: Lanes> Rays<V> {
+    /// Rays from origins `o` and directions `d`, as x, y, z.
+    #[inline(always)]
+    fn new([ox, oy, oz]: [V; 3], [dx, dy, dz]: [V; 3]) -> Rays<V> {
+        Rays {
+            ox,
+            oy,
+            oz,
+            dx,
+            dy,
+            dz,
+        }
+    }
+
     /// Loads rays `i..i + N` (padding past the end with NaN directions).
     #[inline(always)]
     fn load(r: &RayColumns, i: usize) -> Rays<V> {
-        Rays {
-            ox: V::load(r.origin[0], i, 0.0),
-            oy: V::load(r.origin[1], i, 0.0),
-            oz: V::load(r.origin[2], i, 0.0),
-            dx: V::load(r.direction[0], i, f32::NAN),
-            dy: V::load(r.direction[1], i, f32::NAN),
-            dz: V::load(r.direction[2], i, f32::NAN),
-        }
+        Rays::new(
+            r.origin.map(|c| V::load(c, i, 0.0)),
+            r.direction.map(|c| V::load(c, i, f32::NAN)),
+        )
     }
 
     /// N rays given as a slice of `N` rays.
     fn from_rays(rays: &[Ray]) -> Rays<V> {
-        let col = |f: fn(&Ray) -> f32| V::from_fn(|k| f(&rays[k]));
-        Rays {
-            ox: col(|r| r.origin.x),
-            oy: col(|r| r.origin.y),
-            oz: col(|r| r.origin.z),
-            dx: col(|r| r.direction.x),
-            dy: col(|r| r.direction.y),
-            dz: col(|r| r.direction.z),
-        }
+        let col = |f: fn(&Ray) -> Vec3| [0, 1, 2].map(|a| V::from_fn(|k| f(&rays[k])[a]));
+        Rays::new(col(|r| r.origin), col(|r| r.direction))
     }
 }
 
@@ -127,10 +126,6 @@ impl<V: Lanes> Rays<V> {
 /// arrays.
 pub mod arrays {
     use super::*;
-
-    fn rays8(rays: &[Ray; LANES]) -> Rays8 {
-        Rays::from_rays(rays)
-    }
 
     /// [`triangle8`] at the width of `V`, on `V::N` rays and tmaxes.
     pub fn triangle_lanes<V: Lanes>(
@@ -162,11 +157,11 @@ pub mod arrays {
         tmax: [f32; LANES],
         two_sided: bool,
     ) -> [f32; LANES] {
-        triangle8(tri, &rays8(rays), f32x8::new(tmax), two_sided).to_array()
+        triangle_lanes::<f32x8>(tri, rays, &tmax, two_sided)
     }
 
     /// [`sphere8`] on arrays.
     pub fn sphere(s: &Sphere, rays: &[Ray; LANES], tmax: [f32; LANES]) -> [f32; LANES] {
-        sphere8(s, &rays8(rays), f32x8::new(tmax)).to_array()
+        sphere_lanes::<f32x8>(s, rays, &tmax)
     }
 }
