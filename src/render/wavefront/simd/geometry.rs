@@ -11,9 +11,8 @@ use crate::render::wavefront::lanes::{Lanes, f32x8, live_lanes, store_mask};
 use glam::Vec3;
 
 /// Möller–Trumbore's operands on N lanes (8 by default), as columns: ray origin o and
-/// direction d, triangle corner v0 and edges e1, e2. [`triangle8`] splats the triangle (8 rays, one triangle), the
-/// mesh BVH's leaf test splats the ray (one ray, 8 triangles); the arithmetic is
-/// [`moller_trumbore8`] and [`moller_trumbore8_blocks`] either way.
+/// direction d, triangle corner v0 and edges e1, e2. [`triangle8`] splats the triangle, the
+/// mesh BVH's leaf test splats the ray; the arithmetic is the same either way.
 #[derive(Clone, Copy)]
 pub(crate) struct TriangleLanes<V = f32x8> {
     pub o: [V; 3],
@@ -134,12 +133,6 @@ pub(crate) fn moller_trumbore8_blocks<V: Lanes>(
 #[inline(always)]
 pub fn triangle8<V: Lanes>(tri: &Triangle, r: &Rays<V>, tmax: V, two_sided: bool) -> V {
     moller_trumbore8(&TriangleLanes::splat_triangle(tri, r), tmax, two_sided)
-}
-
-/// The lanes that `tri` blocks, as a bitmask (`moller_trumbore8_blocks`).
-#[inline(always)]
-fn triangle8_blocks<V: Lanes>(tri: &Triangle, r: &Rays<V>, tmax: V, two_sided: bool) -> u32 {
-    moller_trumbore8_blocks(&TriangleLanes::splat_triangle(tri, r), tmax, two_sided)
 }
 
 /// Ray–sphere for N rays; lane k equals `intersect_sphere(sphere, ray_k, tmax_k)`: the stable
@@ -319,9 +312,8 @@ pub fn occluded<V: Lanes, S: Costs>(
 
 /// The lanes of one block of shadow rays (`simd::shadow_rays`: N rays from one origin, dead
 /// lanes with tmax = 0) that something blocks, as a bit mask: for every live lane, the answer
-/// [`occluded`] gives for the same ray in a queue (the same rays, loaded from registers
-/// instead of the queue's columns); dead lanes' bits mean nothing. The primitives the block
-/// tested are counted in `c` once for the block (each of its live rays did those tests).
+/// [`occluded`] gives for the same ray in a queue; dead lanes' bits mean nothing. The
+/// primitives tested are counted in `c` once for the block (each live ray did those tests).
 #[inline(always)]
 pub fn block_occluded<V: Lanes, C: Counter>(
     triangles: &[Triangle],
@@ -339,10 +331,8 @@ pub fn block_occluded<V: Lanes, C: Counter>(
     rays_occluded(triangles, spheres, &r, tmax, live, two_sided, c)
 }
 
-/// The `live` lanes of one ray per hit (`simd::hit_shadow_rays`) that something blocks, as a
-/// bit mask: for every live lane, the answer [`occluded`] gives for the same ray in a queue;
-/// the other lanes' bits mean nothing. The primitives tested are counted in `c` once for the
-/// block (each live lane did those tests).
+/// [`block_occluded`] for one ray per hit (`simd::hit_shadow_rays`), `live` the lanes with a
+/// ray.
 #[inline(always)]
 pub fn hit_rays_occluded<V: Lanes, C: Counter>(
     triangles: &[Triangle],
@@ -364,7 +354,8 @@ pub fn hit_rays_occluded<V: Lanes, C: Counter>(
     )
 }
 
-/// [`occluded8`] on rays in registers, `live` the lanes that count.
+/// The `live` lanes of rays `r` that something blocks: spheres, then triangles, until every
+/// live lane is blocked. `c` counts the primitives tested.
 #[inline(always)]
 fn rays_occluded<V: Lanes, C: Counter>(
     triangles: &[Triangle],
@@ -378,38 +369,17 @@ fn rays_occluded<V: Lanes, C: Counter>(
     if live == 0 {
         return 0;
     }
-    occluded8(
-        triangles,
-        spheres,
-        live,
-        |s| sphere8_blocks(s, r, tmax),
-        |tri| triangle8_blocks(tri, r, tmax, two_sided),
-        c,
-    )
-}
-
-/// Spheres, then triangles, until every live lane is blocked; returns the blocked lanes. `c`
-/// counts the primitives tested.
-#[inline(always)]
-fn occluded8<C: Counter>(
-    triangles: &[Triangle],
-    spheres: &[Sphere],
-    live: u32,
-    sphere_blocks: impl Fn(&Sphere) -> u32,
-    triangle_blocks: impl Fn(&Triangle) -> u32,
-    c: &mut C,
-) -> u32 {
     let mut blocked = 0;
     for s in spheres {
         c.tests(1);
-        blocked |= sphere_blocks(s);
+        blocked |= sphere8_blocks(s, r, tmax);
         if blocked & live == live {
             return blocked;
         }
     }
     for tri in triangles {
         c.tests(1);
-        blocked |= triangle_blocks(tri);
+        blocked |= moller_trumbore8_blocks(&TriangleLanes::splat_triangle(tri, r), tmax, two_sided);
         if blocked & live == live {
             return blocked;
         }
@@ -418,15 +388,10 @@ fn occluded8<C: Counter>(
 }
 
 /// The lanes `s` blocks: lane k is `geometry::sphere_blocks(s, ray_k, tmax_k)` (the roots
-/// tested against (0, tmax) by multiplication, no division of c by q), returning early when no
-/// lane can hit (most shadow rays miss most spheres; that skips the square root and the
-/// division).
-///
-/// The early test is the textbook discriminant b² − a·c, which needs no division, with a margin
-/// that makes it prove the stable discriminant negative too (`geometry::MISS_MARGIN`), so the
-/// lanes it drops are misses of the full test as well.
-/// (With the margin added as a separate term, this test cost 15% more instructions in the
-/// occlusion loop than folded into c.)
+/// tested against (0, tmax) by multiplication, no division of c by q). Most shadow rays miss
+/// most spheres, so it returns before the square root and the division when
+/// [`SphereLanes::all_miss`] proves every lane a miss (with the margin as a separate term
+/// rather than folded into c, that test cost 15% more instructions in the occlusion loop).
 #[inline(always)]
 fn sphere8_blocks<V: Lanes>(s: &Sphere, r: &Rays<V>, tmax: V) -> u32 {
     let lanes = SphereLanes::new(s, r);
