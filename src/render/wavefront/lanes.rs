@@ -1,18 +1,15 @@
 //! The lane layer: everything the SIMD kernels share about lanes, in one place (like
-//! memchr's `vector.rs`). It owns the lane count, the padded loads from columns, the mask
-//! tables, the view of a vector as its 8 lanes, the bit casts between lane types, and the
-//! iterator over a bitmask's set lanes.
+//! memchr's `vector.rs`): the lane count, padded loads from columns, mask tables, the view of
+//! a vector as its 8 lanes, bit casts, and the iterator over a bitmask's set lanes.
 //!
-//! It also owns the one lane abstraction, [`Lanes`] (and its unsigned sibling [`LanesU`]):
-//! the handful of operations the brute-force, light-sampling and shading kernels use,
-//! implemented for `f32x8` and `f32x16` by one macro. Those kernels are written once, generic
-//! over `V: Lanes`, and monomorphised for 8 and 16 lanes; the engine picks the width
-//! ([`LaneWidth`]). The mesh BVH stays 8-wide (8 children, 8 triangles per block) and uses the
-//! concrete `f32x8` and the free functions below.
+//! It also owns the one lane abstraction, [`Lanes`] (and its unsigned sibling [`LanesU`]),
+//! implemented for `f32x8` and `f32x16` by one macro: the brute-force, light-sampling and
+//! shading kernels are written once against it and monomorphised for 8 and 16 lanes (the
+//! engine picks the width, [`LaneWidth`]). The mesh BVH stays 8-wide (8 children, 8 triangles
+//! per block) and uses the concrete `f32x8` and the free functions below.
 //!
-//! This is the only file of the crate that names the `wide` crate or `bytemuck`: the kernels
-//! (`simd/`, `shade.rs`, `bvh/`) take the lane types from here, and `tests/gates/layering.rs` checks
-//! that nothing else reaches for them.
+//! This is the only file of the crate that names the `wide` crate or `bytemuck`
+//! (`tests/gates/layering.rs` checks): the kernels take the lane types from here.
 
 use std::ops::{Add, BitAnd, BitOr, BitXor, Div, Mul, Neg, Not, Shl, Shr, Sub};
 pub use wide::{f32x8, f32x16};
