@@ -28,8 +28,7 @@ use glam::Vec3;
 /// appended to `hits.terms` (which starts as the context's materials) and pointed to by
 /// `hits.material`.
 pub fn fill(ctx: &Context, hits: &mut HitBatch, n: usize) {
-    let mut i0 = 0;
-    while i0 < n {
+    for i0 in (0..n).step_by(LANES) {
         let lanes = (n - i0).min(LANES);
         let mut mask = 0u32;
         for k in 0..lanes {
@@ -52,7 +51,6 @@ pub fn fill(ctx: &Context, hits: &mut HitBatch, n: usize) {
                 hits.material[i] = (hits.terms.len() - 1) as u32;
             }
         }
-        i0 += LANES;
     }
 }
 
