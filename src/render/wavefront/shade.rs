@@ -133,7 +133,11 @@ pub fn shade_lanes<V: Lanes>(at: &HitLight, rays: &ShadowLanes) -> [V::Array; 3]
         falloff,
     } = *rays;
     let lanes = ShadowRegisters {
-        l: l.map(|c| V::load(c, 0, 0.0)),
+        l: [
+            V::load(l[0], 0, 0.0),
+            V::load(l[1], 0, 0.0),
+            V::load(l[2], 0, 0.0),
+        ],
         n_dot_l: V::load(n_dot_l, 0, 0.0),
         open: V::from_fn(|k| if blocked[k] { 0.0 } else { 1.0 }),
         falloff: falloff.map(|f| V::load(f, 0, 1.0)),
@@ -173,8 +177,18 @@ pub fn shade_registers<V: Lanes>(at: &HitLight, rays: &ShadowRegisters<V>) -> [V
     } = *rays;
     // Each lane's light colour: Lc · falloff (`spawn::falloff`), or Lc itself in the lab's
     // model, whose fall-off is exactly 1 (x · 1 = x, so both give the twin's bits).
-    let lc = light_color.to_array().map(V::splat);
-    let lc = falloff.map_or(lc, |f| lc.map(|c| c * f));
+    let lc = {
+        let splat = |c: f32| V::splat(c);
+        let (r, g, b) = (
+            splat(light_color.x),
+            splat(light_color.y),
+            splat(light_color.z),
+        );
+        match falloff {
+            None => [r, g, b],
+            Some(f) => [r * f, g * f, b * f],
+        }
+    };
     let adds = ndl.simd_gt(V::ZERO) & open.simd_gt(V::ZERO);
     let nothing = V::splat(-0.0);
     let cr = V::splat(m.ambient_emitted.x) + lc[0] * V::splat(m.diffuse.x) * ndl;

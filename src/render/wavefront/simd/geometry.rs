@@ -322,10 +322,15 @@ pub fn block_occluded<V: Lanes, C: Counter>(
     two_sided: bool,
     c: &mut C,
 ) -> u32 {
-    let r = Rays::new(
-        block.origin.to_array().map(V::splat),
-        block.l.map(V::from_array),
-    );
+    let o = block.origin;
+    let r = Rays {
+        ox: V::splat(o.x),
+        oy: V::splat(o.y),
+        oz: V::splat(o.z),
+        dx: V::from_array(block.l[0]),
+        dy: V::from_array(block.l[1]),
+        dz: V::from_array(block.l[2]),
+    };
     let tmax = V::from_array(block.tmax);
     let live = tmax.simd_gt(V::ZERO).to_bitmask();
     rays_occluded(triangles, spheres, &r, tmax, live, two_sided, c)
@@ -342,7 +347,14 @@ pub fn hit_rays_occluded<V: Lanes, C: Counter>(
     two_sided: bool,
     c: &mut C,
 ) -> u32 {
-    let r = Rays::new(rays.origin.map(V::from_array), rays.l.map(V::from_array));
+    let r = Rays {
+        ox: V::from_array(rays.origin[0]),
+        oy: V::from_array(rays.origin[1]),
+        oz: V::from_array(rays.origin[2]),
+        dx: V::from_array(rays.l[0]),
+        dy: V::from_array(rays.l[1]),
+        dz: V::from_array(rays.l[2]),
+    };
     rays_occluded(
         triangles,
         spheres,
@@ -354,8 +366,7 @@ pub fn hit_rays_occluded<V: Lanes, C: Counter>(
     )
 }
 
-/// The `live` lanes of rays `r` that something blocks: spheres, then triangles, until every
-/// live lane is blocked. `c` counts the primitives tested.
+/// [`occluded8`] on rays in registers, `live` the lanes that count.
 #[inline(always)]
 fn rays_occluded<V: Lanes, C: Counter>(
     triangles: &[Triangle],
@@ -369,17 +380,38 @@ fn rays_occluded<V: Lanes, C: Counter>(
     if live == 0 {
         return 0;
     }
+    occluded8(
+        triangles,
+        spheres,
+        live,
+        |s| sphere8_blocks(s, r, tmax),
+        |tri| moller_trumbore8_blocks(&TriangleLanes::splat_triangle(tri, r), tmax, two_sided),
+        c,
+    )
+}
+
+/// Spheres, then triangles, until every live lane is blocked; returns the blocked lanes. `c`
+/// counts the primitives tested.
+#[inline(always)]
+fn occluded8<C: Counter>(
+    triangles: &[Triangle],
+    spheres: &[Sphere],
+    live: u32,
+    sphere_blocks: impl Fn(&Sphere) -> u32,
+    triangle_blocks: impl Fn(&Triangle) -> u32,
+    c: &mut C,
+) -> u32 {
     let mut blocked = 0;
     for s in spheres {
         c.tests(1);
-        blocked |= sphere8_blocks(s, r, tmax);
+        blocked |= sphere_blocks(s);
         if blocked & live == live {
             return blocked;
         }
     }
     for tri in triangles {
         c.tests(1);
-        blocked |= moller_trumbore8_blocks(&TriangleLanes::splat_triangle(tri, r), tmax, two_sided);
+        blocked |= triangle_blocks(tri);
         if blocked & live == live {
             return blocked;
         }

@@ -26,8 +26,12 @@ impl<V: Lanes> HitLanes<V> {
     pub fn load(hits: &HitBatch, i0: usize) -> HitLanes<V> {
         let col = |c: &[f32]| V::load(c, i0, 0.0);
         HitLanes {
-            point: [&hits.point.x, &hits.point.y, &hits.point.z].map(|c| col(c)),
-            normal: [&hits.normal.x, &hits.normal.y, &hits.normal.z].map(|c| col(c)),
+            point: [col(&hits.point.x), col(&hits.point.y), col(&hits.point.z)],
+            normal: [
+                col(&hits.normal.x),
+                col(&hits.normal.y),
+                col(&hits.normal.z),
+            ],
             offset: col(&hits.offset),
         }
     }

@@ -89,32 +89,30 @@ pub struct Rays<V = f32x8> {
 }
 
 impl<V: Lanes> Rays<V> {
-    /// Rays from origins `o` and directions `d`, as x, y, z.
-    #[inline(always)]
-    fn new([ox, oy, oz]: [V; 3], [dx, dy, dz]: [V; 3]) -> Rays<V> {
-        Rays {
-            ox,
-            oy,
-            oz,
-            dx,
-            dy,
-            dz,
-        }
-    }
-
     /// Loads rays `i..i + N` (padding past the end with NaN directions).
     #[inline(always)]
     fn load(r: &RayColumns, i: usize) -> Rays<V> {
-        Rays::new(
-            r.origin.map(|c| V::load(c, i, 0.0)),
-            r.direction.map(|c| V::load(c, i, f32::NAN)),
-        )
+        Rays {
+            ox: V::load(r.origin[0], i, 0.0),
+            oy: V::load(r.origin[1], i, 0.0),
+            oz: V::load(r.origin[2], i, 0.0),
+            dx: V::load(r.direction[0], i, f32::NAN),
+            dy: V::load(r.direction[1], i, f32::NAN),
+            dz: V::load(r.direction[2], i, f32::NAN),
+        }
     }
 
     /// N rays given as a slice of `N` rays.
     fn from_rays(rays: &[Ray]) -> Rays<V> {
-        let col = |f: fn(&Ray) -> Vec3| [0, 1, 2].map(|a| V::from_fn(|k| f(&rays[k])[a]));
-        Rays::new(col(|r| r.origin), col(|r| r.direction))
+        let col = |f: fn(&Ray) -> f32| V::from_fn(|k| f(&rays[k]));
+        Rays {
+            ox: col(|r| r.origin.x),
+            oy: col(|r| r.origin.y),
+            oz: col(|r| r.origin.z),
+            dx: col(|r| r.direction.x),
+            dy: col(|r| r.direction.y),
+            dz: col(|r| r.direction.z),
+        }
     }
 }
 
