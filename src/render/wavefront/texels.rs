@@ -28,7 +28,8 @@ use glam::Vec3;
 /// appended to `hits.terms` (which starts as the context's materials) and pointed to by
 /// `hits.material`.
 pub fn fill(ctx: &Context, hits: &mut HitBatch, n: usize) {
-    for i0 in (0..n).step_by(LANES) {
+    let mut i0 = 0;
+    while i0 < n {
         let lanes = (n - i0).min(LANES);
         let mut mask = 0u32;
         for k in 0..lanes {
@@ -51,6 +52,7 @@ pub fn fill(ctx: &Context, hits: &mut HitBatch, n: usize) {
                 hits.material[i] = (hits.terms.len() - 1) as u32;
             }
         }
+        i0 += LANES;
     }
 }
 

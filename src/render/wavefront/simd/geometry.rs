@@ -135,6 +135,12 @@ pub fn triangle8<V: Lanes>(tri: &Triangle, r: &Rays<V>, tmax: V, two_sided: bool
     moller_trumbore8(&TriangleLanes::splat_triangle(tri, r), tmax, two_sided)
 }
 
+/// The lanes that `tri` blocks, as a bitmask (`moller_trumbore8_blocks`).
+#[inline(always)]
+fn triangle8_blocks<V: Lanes>(tri: &Triangle, r: &Rays<V>, tmax: V, two_sided: bool) -> u32 {
+    moller_trumbore8_blocks(&TriangleLanes::splat_triangle(tri, r), tmax, two_sided)
+}
+
 /// Ray–sphere for N rays; lane k equals `intersect_sphere(sphere, ray_k, tmax_k)`: the stable
 /// form, see there.
 ///
@@ -302,9 +308,21 @@ pub fn occluded<V: Lanes, S: Costs>(
         // A lane with tmax ≤ 0 (dead, or a light point within T_MIN) can never be blocked, so
         // it does not hold up the early exit.
         let live = live_lanes::<V>(i, n) & tmax.simd_gt(V::ZERO).to_bitmask();
-        let mut c = S::Counter::default();
-        let blocked = rays_occluded(triangles, spheres, &r, tmax, live, two_sided, &mut c);
-        costs.add_lanes(i, live, c);
+        let blocked = if live == 0 {
+            0
+        } else {
+            let mut c = S::Counter::default();
+            let blocked = occluded8(
+                triangles,
+                spheres,
+                live,
+                |s| sphere8_blocks(s, &r, tmax),
+                |tri| triangle8_blocks(tri, &r, tmax, two_sided),
+                &mut c,
+            );
+            costs.add_lanes(i, live, c);
+            blocked
+        };
         let lanes = (n - i).min(V::N);
         store_mask::<V>(&mut out[i..i + lanes], blocked);
     }
@@ -385,7 +403,7 @@ fn rays_occluded<V: Lanes, C: Counter>(
         spheres,
         live,
         |s| sphere8_blocks(s, r, tmax),
-        |tri| moller_trumbore8_blocks(&TriangleLanes::splat_triangle(tri, r), tmax, two_sided),
+        |tri| triangle8_blocks(tri, r, tmax, two_sided),
         c,
     )
 }
