@@ -193,7 +193,7 @@ pub trait Lanes:
     fn to_array(self) -> Self::Array;
     /// `col[i..i + N]`, `pad` in the lanes past the column's end.
     fn load(col: &[f32], i: usize, pad: f32) -> Self;
-    /// The lane indices 0..N as floats (a constant, as the 8-lane kernels' table was).
+    /// The lane indices 0..N as floats.
     const LANE_INDEX: Self;
     /// Lane-wise `<`, all ones where true.
     fn simd_lt(self, rhs: Self) -> Self;

@@ -126,10 +126,9 @@ pub fn key_prefix(key: &SampleKey) -> u32 {
     mix32(h ^ key.light)
 }
 
-/// Fills every hit's `direct` column; returns the number of shadow rays cast (queued rays: a
-/// point behind the surface casts none, and no ray is cast with shadows off). Each shadow
-/// ray's traversal work is added to `costs` at the index of the hit that cast it
-/// (`cost::NoCount` counts nothing).
+/// Fills every hit's `direct` column; returns the number of shadow rays cast (a point behind
+/// the surface casts none, nor does anything with shadows off). Each ray's traversal work is
+/// added to `costs` at the index of the hit that cast it (`cost::NoCount` counts nothing).
 pub fn direct_light<S: Remap>(
     ctx: &Context,
     rays: &RayBatch,

@@ -286,11 +286,10 @@ pub fn closest_hits<V: Lanes>(
     }
 }
 
-/// For every ray, whether anything blocks it in (T_MIN, tmax), N rays at a time (`V`: 8 or 16
-/// lanes, the same answers). Spheres first, then triangles; a block of N lanes stops as soon as
-/// all its live lanes are blocked, and each of its live rays is charged the primitives the
-/// block tested, added to `costs` (`NoCount`: nothing is counted). Never inlined, so that the
-/// queued shadow stage calls it as a function of its own at either width.
+/// For every ray, whether anything blocks it in (T_MIN, tmax), N rays at a time. Spheres
+/// first, then triangles; a block of N lanes stops as soon as all its live lanes are blocked,
+/// and each of its live rays is charged the primitives the block tested, in `costs`. Never
+/// inlined, so that the queued shadow stage calls it as a function of its own at either width.
 #[inline(never)]
 pub fn occluded<V: Lanes, S: Costs>(
     triangles: &[Triangle],
