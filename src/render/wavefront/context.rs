@@ -210,10 +210,7 @@ impl<'a> Context<'a> {
     /// of them, except the lab's strategy at N = 1 (the centroid), which goes through the
     /// scalar `PointSet::point`.
     pub fn simd_light_sampling(&self) -> bool {
-        match self.settings.sampler {
-            LightSampler::Lab => self.points_per_light > 1,
-            _ => true,
-        }
+        self.settings.sampler != LightSampler::Lab || self.points_per_light > 1
     }
 
     /// The N-lane sampler for the stream of `key` (when `simd_light_sampling()`).
