@@ -140,7 +140,7 @@ fn triangle_kernel_equals_scalar_on_edge_cases() {
         for two_sided in [false, true] {
             check_lanes(
                 &edge_rays(),
-                |r, tm| arrays::triangle(tri, r, tm, two_sided),
+                |r, tm| arrays::triangle_lanes::<f32x8>(tri, r, &tm, two_sided),
                 |r, tm| intersect_triangle(tri, r, tm, two_sided),
             );
         }
@@ -157,7 +157,7 @@ fn sphere_kernel_equals_scalar_on_edge_cases() {
         };
         check_lanes(
             &edge_rays(),
-            |r, tm| arrays::sphere(&sphere, r, tm),
+            |r, tm| arrays::sphere_lanes::<f32x8>(&sphere, r, &tm),
             |r, tm| intersect_sphere(&sphere, r, tm),
         );
     }
@@ -464,8 +464,8 @@ proptest! {
             direction: dirs[k].normalize_or_zero(),
         });
         let tm: [f32; 8] = std::array::from_fn(|k| tmax[k]);
-        let got_t = arrays::triangle(&tri, &rays, tm, two_sided);
-        let got_s = arrays::sphere(&sphere, &rays, tm);
+        let got_t = arrays::triangle_lanes::<f32x8>(&tri, &rays, &tm, two_sided);
+        let got_s = arrays::sphere_lanes::<f32x8>(&sphere, &rays, &tm);
         for k in 0..8 {
             prop_assert_eq!(got_t[k].to_bits(), intersect_triangle(&tri, &rays[k], tm[k], two_sided).to_bits());
             prop_assert_eq!(got_s[k].to_bits(), intersect_sphere(&sphere, &rays[k], tm[k]).to_bits());

@@ -60,6 +60,12 @@ impl Vec3Column {
         self.z.clear();
     }
 
+    /// `n` vectors of zeros (the radiance of a new tile).
+    pub fn reset(&mut self, n: usize) {
+        self.clear();
+        self.resize(n, 0.0);
+    }
+
     /// Resizes the three columns to `n`, new entries `value`.
     pub fn resize(&mut self, n: usize, value: f32) {
         self.x.resize(n, value);
@@ -259,16 +265,6 @@ pub struct ShadowQueue {
 }
 
 impl ShadowQueue {
-    /// Number of queued entries (live or not).
-    pub fn len(&self) -> usize {
-        self.len
-    }
-
-    /// True when empty.
-    pub fn is_empty(&self) -> bool {
-        self.len == 0
-    }
-
     /// Empties the queue and makes room for `capacity` entries, with the `dist` column only
     /// when `with_dist` (a light model with fall-off).
     pub fn reset(&mut self, capacity: usize, with_dist: bool) {
@@ -332,43 +328,30 @@ impl ShadowQueue {
     }
 }
 
-/// 8 (or 16: `A` is the lanes' array) shadow rays from one hit to one light, as
-/// `simd::shadow_rays` makes them: lane k is `spawn::shadow_ray`'s answer for point k, or a
-/// dead lane (tmax = 0, n·l = 0).
+/// 8 (or 16: `A` is the lanes' array) shadow rays towards one light, as the SIMD spawns make
+/// them: from one hit to N light points (`simd::shadow_rays`: `O` is their common origin, and
+/// a dead lane has tmax = 0, n·l = 0), or from N hits to one point ([`HitRays`]). Lane k is
+/// `spawn::shadow_ray`'s answer for point (or hit) k where `live` is set.
 #[derive(Clone, Copy, Debug)]
-pub struct ShadowBlock<A = [f32; 8]> {
-    /// The rays' common origin, off the surface.
-    pub origin: Vec3,
-    /// l x, y, z per lane.
+pub struct ShadowBlock<A = [f32; 8], O = Vec3> {
+    /// The rays' origin off the surface: one for all, or x, y, z per lane.
+    pub origin: O,
+    /// l x, y, z per lane: each ray's unit direction.
     pub l: [A; 3],
-    /// tmax per lane, 0 for a dead one.
+    /// Where each ray meets the light's moved plane; 0 for a dead lane of one hit's block.
     pub tmax: A,
-    /// n·l per lane, 0 for a dead one.
+    /// n·l per lane; 0 for a dead lane of one hit's block.
     pub n_dot_l: A,
-    /// |target − point| per lane.
-    pub dist: A,
-    /// Live lanes as a bitmask.
-    pub live: u32,
-}
-
-/// One shadow ray from each of N hits towards one light point, as arrays (`A` = the lanes'
-/// array): lane k is `spawn::shadow_ray`'s answer for hit k, or a dead lane (`live` clear;
-/// its other entries mean nothing).
-#[derive(Clone, Copy, Debug)]
-pub struct HitRays<A> {
-    /// Each ray's origin: its hit's leaving point.
-    pub origin: [A; 3],
-    /// l, each ray's unit direction.
-    pub l: [A; 3],
-    /// Where each ray meets the light's moved plane.
-    pub tmax: A,
-    /// n·l of each ray.
-    pub n_dot_l: A,
-    /// |target − point| of each ray, for the light model's fall-off.
+    /// |target − point| per lane, for the light model's fall-off.
     pub dist: A,
     /// The lanes with a ray, as a bit mask.
     pub live: u32,
 }
+
+/// One shadow ray from each of N hits towards one light point (`simd::hit_shadow_rays`): each
+/// ray's origin is its hit's leaving point, and a lane without a ray (`live` clear) holds
+/// entries that mean nothing.
+pub type HitRays<A> = ShadowBlock<A, [A; 3]>;
 
 impl<A: AsRef<[f32]>> HitRays<A> {
     /// Lane `k` as the scalar spawn gives it (meaningful for a live lane).
@@ -388,29 +371,5 @@ impl<A: AsRef<[f32]>> HitRays<A> {
     }
 }
 
-/// Per camera sample of a tile: the radiance gathered so far.
-#[derive(Clone, Debug, Default)]
-pub struct Radiance {
-    /// Red, green, blue per slot.
-    pub sum: Vec3Column,
-}
-
-impl Radiance {
-    /// `n` black slots.
-    pub fn reset(&mut self, n: usize) {
-        self.sum.clear();
-        self.sum.resize(n, 0.0);
-    }
-
-    /// Adds `c` to slot `i`.
-    #[inline]
-    pub fn add(&mut self, i: usize, c: Vec3) {
-        self.sum.add(i, c);
-    }
-
-    /// Slot `i`.
-    #[inline]
-    pub fn get(&self, i: usize) -> Vec3 {
-        self.sum.get(i)
-    }
-}
+/// Per camera sample of a tile: the radiance gathered so far (red, green, blue per slot).
+pub type Radiance = Vec3Column;

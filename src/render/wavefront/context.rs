@@ -210,15 +210,10 @@ impl<'a> Context<'a> {
     /// of them, except the lab's strategy at N = 1 (the centroid), which goes through the
     /// scalar `PointSet::point`.
     pub fn simd_light_sampling(&self) -> bool {
-        match self.settings.sampler {
-            // The lab's strategy is random points, except the centroid for N = 1.
-            LightSampler::Lab => self.points_per_light > 1,
-            _ => true,
-        }
+        self.settings.sampler != LightSampler::Lab || self.points_per_light > 1
     }
 
-    /// The 8-wide sampler for a stream whose SampleKey is `key` (when
-    /// `simd_light_sampling()`).
+    /// The N-lane sampler for the stream of `key` (when `simd_light_sampling()`).
     pub fn block_sampler(&self, key: &SampleKey) -> BlockSampler<'_> {
         match self.settings.sampler {
             LightSampler::Stratified => BlockSampler::Stratified {

@@ -16,6 +16,7 @@
 //! tested. The counts are integers and each pixel's are summed inside its tile, so they are
 //! the same for any thread count.
 
+use super::lanes::set_bits;
 use crate::render::per_kind::{PerKind, RayKind};
 use serde::{Deserialize, Serialize};
 use std::ops::{Add, AddAssign};
@@ -33,20 +34,12 @@ pub trait Counter: Copy + Default {
     /// [`Counter::node`] for every lane of `lanes` set in `active` (a packet at a node).
     #[inline(always)]
     fn node_lanes(lanes: &mut [Self], active: u32) {
-        for (k, c) in lanes.iter_mut().enumerate() {
-            if active >> k & 1 == 1 {
-                c.node();
-            }
-        }
+        set_bits(active).for_each(|k| lanes[k].node());
     }
     /// [`Counter::leaf`] for every lane of `lanes` set in `active` (a packet at a leaf).
     #[inline(always)]
     fn leaf_lanes(lanes: &mut [Self], active: u32, triangles: u32) {
-        for (k, c) in lanes.iter_mut().enumerate() {
-            if active >> k & 1 == 1 {
-                c.leaf(triangles);
-            }
-        }
+        set_bits(active).for_each(|k| lanes[k].leaf(triangles));
     }
 }
 
@@ -59,11 +52,7 @@ pub trait Costs {
     /// Adds `c` to rays `i0 + k` for every bit k set in `lanes` (a block's live lanes).
     #[inline(always)]
     fn add_lanes(&mut self, i0: usize, lanes: u32, c: Self::Counter) {
-        let mut m = lanes;
-        while m != 0 {
-            self.add(i0 + m.trailing_zeros() as usize, c);
-            m &= m - 1;
-        }
+        set_bits(lanes).for_each(|k| self.add(i0 + k, c));
     }
 }
 

@@ -2,7 +2,7 @@
 //! (pixel, sample) order. At one sample per pixel (the lab's), the directions come N pixels
 //! at a time from `simd::camera_directions`; with antialiasing, from the scalar
 //! `CameraRays::rays_of` (each sample's offset is drawn from its own stream). Both give the
-//! reference's rays to the bit. The columns every camera ray shares are filled whole.
+//! reference's rays to the bit.
 
 use super::batch::RayBatch;
 use super::context::Context;

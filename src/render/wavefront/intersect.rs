@@ -4,8 +4,7 @@
 //! Small scenes (below `BVH_MIN_TRIANGLES` triangles) go through the brute-force kernel over
 //! every primitive, 8 or 16 rays at a time (the engine's lane width); meshes go through the
 //! engine's 8-wide BVH (`bvh::MeshBvh`) at either width: camera rays in packets of 8
-//! neighbouring pixels (8 rays against one child box or one triangle per test),
-//! all other rays one at a time (one ray against 8 child boxes or 8 triangles). Its hits are
+//! neighbouring pixels, all other rays one at a time ([`mesh_hits`]). Its hits are
 //! brute force's (same t bits, ties to the lowest triangle id), as are the reference's
 //! (`Accel::closest` over obvhs's CWBVH), except for the few axis-parallel rays obvhs's box
 //! test misses (docs/ARCHITECTURE.md, "The mesh path").
@@ -31,10 +30,8 @@ pub fn columns(rays: &RayBatch) -> RayColumns<'_> {
 }
 
 /// t and primitive id of every ray's closest hit through the mesh BVH, each ray's traversal
-/// work added to `costs`. Camera rays (depth 0: 8 consecutive rays are neighbouring pixels) go
-/// through the tree 8 at a time; mirror rays, which fan out, one at a time (docs/TRIED.md,
-/// "The mesh BVH"). Both give brute force's hits, except on the rare grazing triangle (`bvh`
-/// module docs).
+/// work added to `costs`: camera rays (depth 0: 8 consecutive rays are neighbouring pixels) 8
+/// at a time, mirror rays, which fan out, one at a time (docs/TRIED.md, "The mesh BVH").
 pub fn mesh_hits<S: Costs>(
     bvh: &MeshBvh,
     scene: &Scene,

@@ -1,18 +1,15 @@
 //! The lane layer: everything the SIMD kernels share about lanes, in one place (like
-//! memchr's `vector.rs`). It owns the lane count, the padded loads from columns, the mask
-//! tables, the view of a vector as its 8 lanes, the bit casts between lane types, and the
-//! iterator over a bitmask's set lanes.
+//! memchr's `vector.rs`): the lane count, padded loads from columns, mask tables, the view of
+//! a vector as its 8 lanes, bit casts, and the iterator over a bitmask's set lanes.
 //!
-//! It also owns the one lane abstraction, [`Lanes`] (and its unsigned sibling [`LanesU`]):
-//! the handful of operations the brute-force, light-sampling and shading kernels use,
-//! implemented for `f32x8` and `f32x16` by one macro. Those kernels are written once, generic
-//! over `V: Lanes`, and monomorphised for 8 and 16 lanes; the engine picks the width
-//! ([`LaneWidth`]). The mesh BVH stays 8-wide (8 children, 8 triangles per block) and uses the
-//! concrete `f32x8` and the free functions below.
+//! It also owns the one lane abstraction, [`Lanes`] (and its unsigned sibling [`LanesU`]),
+//! implemented for `f32x8` and `f32x16` by one macro: the brute-force, light-sampling and
+//! shading kernels are written once against it and monomorphised for 8 and 16 lanes (the
+//! engine picks the width, [`LaneWidth`]). The mesh BVH stays 8-wide (8 children, 8 triangles
+//! per block) and uses the concrete `f32x8` and the free functions below.
 //!
-//! This is the only file of the crate that names the `wide` crate or `bytemuck`: the kernels
-//! (`simd/`, `shade.rs`, `bvh/`) take the lane types from here, and `tests/gates/layering.rs` checks
-//! that nothing else reaches for them.
+//! This is the only file of the crate that names the `wide` crate or `bytemuck`
+//! (`tests/gates/layering.rs` checks): the kernels take the lane types from here.
 
 use std::ops::{Add, BitAnd, BitOr, BitXor, Div, Mul, Neg, Not, Shl, Shr, Sub};
 pub use wide::{f32x8, f32x16};
@@ -50,34 +47,12 @@ pub(crate) fn view(v: &f32x8) -> &[f32; LANES] {
     wide::bytemuck::cast_ref(v)
 }
 
-/// The bits of every lane, as unsigned integers.
+/// The same bits as another type of the same size: a float vector's lanes as unsigned or
+/// signed integers (a lane's sign bit is its sign) and back (masks), or 8 ids as signed lanes
+/// (to compare them in one instruction).
 #[inline(always)]
-pub(crate) fn f32_bits(v: f32x8) -> u32x8 {
-    wide::bytemuck::cast(v)
-}
-
-/// The bits of every lane, as signed integers (a lane's sign bit is its sign).
-#[inline(always)]
-pub(crate) fn f32_bits_signed(v: f32x8) -> i32x8 {
-    wide::bytemuck::cast(v)
-}
-
-/// Every lane's bits read as a float.
-#[inline(always)]
-pub(crate) fn f32_from_bits(v: u32x8) -> f32x8 {
-    wide::bytemuck::cast(v)
-}
-
-/// Every lane's bits moved from a signed integer vector to a float vector (masks).
-#[inline(always)]
-pub(crate) fn f32_from_signed(v: i32x8) -> f32x8 {
-    wide::bytemuck::cast(v)
-}
-
-/// 8 ids as signed lanes (same bits), to compare them in one instruction.
-#[inline(always)]
-pub(crate) fn ids(v: [u32; LANES]) -> i32x8 {
-    wide::bytemuck::cast(v)
+pub(crate) fn cast<A: wide::bytemuck::Pod, B: wide::bytemuck::Pod>(a: A) -> B {
+    wide::bytemuck::cast(a)
 }
 
 /// Lane k of an 8-lane bitmask as a bool, for all 256 masks: a chunk's results are stored with
@@ -218,7 +193,7 @@ pub trait Lanes:
     fn to_array(self) -> Self::Array;
     /// `col[i..i + N]`, `pad` in the lanes past the column's end.
     fn load(col: &[f32], i: usize, pad: f32) -> Self;
-    /// The lane indices 0..N as floats (a constant, as the 8-lane kernels' table was).
+    /// The lane indices 0..N as floats.
     const LANE_INDEX: Self;
     /// Lane-wise `<`, all ones where true.
     fn simd_lt(self, rhs: Self) -> Self;
@@ -234,8 +209,6 @@ pub trait Lanes:
     fn select(self, t: Self, f: Self) -> Self;
     /// The sign bit of every lane, lane k in bit k.
     fn to_bitmask(self) -> u32;
-    /// Some lane's mask set.
-    fn any(self) -> bool;
     /// Every lane's mask set.
     fn all(self) -> bool;
     /// No lane's mask set.
@@ -246,8 +219,6 @@ pub trait Lanes:
     fn abs(self) -> Self;
     /// Lane-wise minimum, NaN handling unspecified (`minps`).
     fn fast_min(self, rhs: Self) -> Self;
-    /// Lane-wise minimum with `f32::min`'s NaN rule.
-    fn min(self, rhs: Self) -> Self;
 }
 
 /// The unsigned sibling of a [`Lanes`] type: u32 lanes, wrapping arithmetic.
@@ -291,6 +262,16 @@ pub trait LanesU:
     fn lookup(self, table: Self) -> Self;
 }
 
+/// Trait methods that are the lane type's inherent method of the same name.
+macro_rules! forward {
+    ($t:ident: $(fn $name:ident(self $(, $arg:ident: $ty:ty)*) -> $ret:ty;)*) => {$(
+        #[inline(always)]
+        fn $name(self $(, $arg: $ty)*) -> $ret {
+            $t::$name(self $(, $arg)*)
+        }
+    )*};
+}
+
 macro_rules! impl_lanes {
     ($f:ident, $u:ident, $i:ident, $n:literal, $from_i:ident) => {
         impl Lanes for $f {
@@ -313,10 +294,6 @@ macro_rules! impl_lanes {
                 $f::new(std::array::from_fn(f))
             }
             #[inline(always)]
-            fn to_array(self) -> [f32; $n] {
-                $f::to_array(self)
-            }
-            #[inline(always)]
             fn load(col: &[f32], i: usize, pad: f32) -> Self {
                 match col.get(i..i + $n) {
                     Some(s) => $f::new(s.try_into().expect("N lanes")),
@@ -337,61 +314,20 @@ macro_rules! impl_lanes {
                 }
                 $f::new(a)
             };
-            #[inline(always)]
-            fn simd_lt(self, rhs: Self) -> Self {
-                $f::simd_lt(self, rhs)
-            }
-            #[inline(always)]
-            fn simd_gt(self, rhs: Self) -> Self {
-                $f::simd_gt(self, rhs)
-            }
-            #[inline(always)]
-            fn simd_le(self, rhs: Self) -> Self {
-                $f::simd_le(self, rhs)
-            }
-            #[inline(always)]
-            fn simd_ge(self, rhs: Self) -> Self {
-                $f::simd_ge(self, rhs)
-            }
-            #[inline(always)]
-            fn simd_ne(self, rhs: Self) -> Self {
-                $f::simd_ne(self, rhs)
-            }
-            #[inline(always)]
-            fn select(self, t: Self, f: Self) -> Self {
-                $f::select(self, t, f)
-            }
-            #[inline(always)]
-            fn to_bitmask(self) -> u32 {
-                $f::to_bitmask(self)
-            }
-            #[inline(always)]
-            fn any(self) -> bool {
-                $f::any(self)
-            }
-            #[inline(always)]
-            fn all(self) -> bool {
-                $f::all(self)
-            }
-            #[inline(always)]
-            fn none(self) -> bool {
-                $f::none(self)
-            }
-            #[inline(always)]
-            fn sqrt(self) -> Self {
-                $f::sqrt(self)
-            }
-            #[inline(always)]
-            fn abs(self) -> Self {
-                $f::abs(self)
-            }
-            #[inline(always)]
-            fn fast_min(self, rhs: Self) -> Self {
-                $f::fast_min(self, rhs)
-            }
-            #[inline(always)]
-            fn min(self, rhs: Self) -> Self {
-                $f::min(self, rhs)
+            forward! { $f:
+                fn to_array(self) -> [f32; $n];
+                fn simd_lt(self, rhs: Self) -> Self;
+                fn simd_gt(self, rhs: Self) -> Self;
+                fn simd_le(self, rhs: Self) -> Self;
+                fn simd_ge(self, rhs: Self) -> Self;
+                fn simd_ne(self, rhs: Self) -> Self;
+                fn select(self, t: Self, f: Self) -> Self;
+                fn to_bitmask(self) -> u32;
+                fn all(self) -> bool;
+                fn none(self) -> bool;
+                fn sqrt(self) -> Self;
+                fn abs(self) -> Self;
+                fn fast_min(self, rhs: Self) -> Self;
             }
         }
 

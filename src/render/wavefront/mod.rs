@@ -142,11 +142,8 @@ impl<'a> Wavefront<'a> {
 
     /// Number of tiles (for progress reporting).
     pub fn tile_count(&self) -> usize {
-        self.pixel_count().div_ceil(self.tile_pixels)
-    }
-
-    fn pixel_count(&self) -> usize {
-        self.ctx.settings.width as usize * self.ctx.settings.height as usize
+        let s = self.ctx.settings;
+        (s.width as usize * s.height as usize).div_ceil(self.tile_pixels)
     }
 
     /// Renders on the current rayon pool, reporting each tile to `progress`.
@@ -164,35 +161,47 @@ impl<'a> Wavefront<'a> {
         progress: &Progress,
         cancel: &AtomicBool,
     ) -> Option<(Film, RenderStats)> {
+        let (film, tiles) = self.tiles(progress, cancel, |first, out, ws| {
+            let mut stats = RenderStats::default();
+            self.render_tile(first, out, ws, &mut stats);
+            stats
+        })?;
+        Some((
+            film,
+            tiles.into_iter().fold(RenderStats::default(), |a, b| a + b),
+        ))
+    }
+
+    /// Runs `tile(first pixel, its pixels, a workspace)` on every tile, on the current rayon
+    /// pool, one pooled workspace per rayon job; the tiles' results in tile order, or `None`
+    /// when `cancel` made a worker skip a tile (one relaxed load per tile).
+    #[inline]
+    fn tiles<T: Send>(
+        &self,
+        progress: &Progress,
+        cancel: &AtomicBool,
+        tile: impl Fn(u32, &mut [Vec3], &mut Workspace) -> T + Sync + Send,
+    ) -> Option<(Film, Vec<T>)> {
         let s = self.ctx.settings;
-        let tiles = progress.steps(self.tile_count() as u64, "tiles");
+        let steps = progress.steps(self.tile_count() as u64, "tiles");
         let mut film = Film::new(s.width, s.height);
-        // Set only on the skip path: the loop itself adds one relaxed load per tile.
-        let skipped = AtomicBool::new(false);
-        let stats = film
+        let tiles: Vec<Option<T>> = film
             .pixels
             .par_chunks_mut(self.tile_pixels)
             .enumerate()
             .map_init(
                 || self.pooled(),
-                |pooled, (tile, out)| {
-                    let mut stats = RenderStats::default();
+                |pooled, (i, out)| {
                     if cancel.load(Ordering::Relaxed) {
-                        skipped.store(true, Ordering::Relaxed);
-                        return stats;
+                        return None;
                     }
-                    self.render_tile(
-                        (tile * self.tile_pixels) as u32,
-                        out,
-                        &mut pooled.ws,
-                        &mut stats,
-                    );
-                    tiles.step();
-                    stats
+                    let t = tile((i * self.tile_pixels) as u32, out, &mut pooled.ws);
+                    steps.step();
+                    Some(t)
                 },
             )
-            .reduce(RenderStats::default, |a, b| a + b);
-        (!skipped.into_inner()).then_some((film, stats))
+            .collect();
+        Some((film, tiles.into_iter().collect::<Option<_>>()?))
     }
 
     /// A workspace from the pool (or a new one) for one rayon job.
@@ -211,9 +220,8 @@ impl<'a> Wavefront<'a> {
 
     /// [`Wavefront::render`] with the traversal counted (`cost.rs`): the same image and ray
     /// counts, and every ray's nodes, leaves and primitive tests by kind, summed over the frame
-    /// and, when `per_pixel`, kept for each pixel. A separate instantiation of the stages:
-    /// `render` runs none of the counting. Each pixel's counts are summed inside its tile, so
-    /// they are the same for any thread count.
+    /// and, when `per_pixel`, kept for each pixel (summed inside its tile, so the same for any
+    /// thread count). A separate instantiation of the stages: `render` runs none of the counting.
     ///
     /// `#[inline]` so that the counting instantiation of the stages is compiled in the crate
     /// that calls this (the binary, a test), never beside the library's uncounted stages: in one
@@ -239,37 +247,19 @@ impl<'a> Wavefront<'a> {
         per_pixel: bool,
         cancel: &AtomicBool,
     ) -> Option<(Film, RenderStats, CostReport)> {
-        let s = self.ctx.settings;
-        let steps = progress.steps(self.tile_count() as u64, "tiles");
-        let mut film = Film::new(s.width, s.height);
-        let tiles: Vec<_> = film
-            .pixels
-            .par_chunks_mut(self.tile_pixels)
-            .enumerate()
-            .map_init(
-                || self.pooled(),
-                |pooled, (tile, out)| {
-                    if cancel.load(Ordering::Relaxed) {
-                        return None;
-                    }
-                    let first = (tile * self.tile_pixels) as u32;
-                    let mut stats = RenderStats::default();
-                    let mut costs = TileCosts::new(first, out.len());
-                    self.render_tile_with(first, out, &mut pooled.ws, &mut stats, &mut costs);
-                    steps.step();
-                    let totals = costs.totals();
-                    Some((stats, totals, per_pixel.then_some(costs.pixels)))
-                },
-            )
-            .collect();
+        let (film, tiles) = self.tiles(progress, cancel, |first, out, ws| {
+            let mut stats = RenderStats::default();
+            let mut costs = TileCosts::new(first, out.len());
+            self.render_tile_with(first, out, ws, &mut stats, &mut costs);
+            (stats, costs.totals(), per_pixel.then_some(costs.pixels))
+        })?;
         let mut stats = RenderStats::default();
         let mut report = CostReport {
             pixels: per_pixel.then(Vec::new),
             ..CostReport::default()
         };
         // In tile order: the pixels' counts come out row-major.
-        for tile in tiles {
-            let (tile_stats, totals, pixels) = tile?;
+        for (tile_stats, totals, pixels) in tiles {
             stats = stats + tile_stats;
             report.totals = report.totals + totals;
             if let (Some(all), Some(p)) = (&mut report.pixels, pixels) {

@@ -14,12 +14,10 @@
 //!
 //! Which of three paths a render takes is [`ShadowPath`], chosen once when the context is
 //! built; its table below says when each is taken and what it costs. Every path gives the
-//! queue's sums bit for bit: the same (hit, light, point) order, the same kernels.
-//!
-//! Queue order is the reference's loop order, so each hit's sum is added in the same order and
-//! comes out bit-identical. Soft shadows on a parallelogram light (every lab light) go N points
-//! at a time, every sampler with a SIMD twin (`simd::light_points`); hard shadows and other
-//! light shapes call the scalar sampling code one point at a time.
+//! queue's sums bit for bit: the same kernels, and the (hit, light, point) order, which is the
+//! reference's loop order, so each hit's sum comes out bit-identical. Soft shadows on a
+//! parallelogram light (every lab light) go N points at a time (`simd::light_points`); hard
+//! shadows and other light shapes call the scalar sampling code one point at a time.
 //!
 //! N is the engine's lane width (`lanes::LaneWidth`, 8 or 16): the stage is generic over the
 //! lane type, and with 16 lanes the queue holds aligned blocks of 16 points per (hit, light).
@@ -85,26 +83,16 @@ impl ShadowPath {
 
     /// The path's name, as `render --stats` and `--stats-json` give it.
     pub fn name(self) -> &'static str {
-        match self {
-            ShadowPath::FusedSoft => "FusedSoft",
-            ShadowPath::FusedHard => "FusedHard",
-            ShadowPath::QueuedPerHit => "QueuedPerHit",
-        }
+        ["FusedSoft", "FusedHard", "QueuedPerHit"][self as usize]
     }
 
     /// What the path does, in a few words, for `render --stats`.
     pub fn describe(self) -> &'static str {
-        match self {
-            ShadowPath::FusedSoft => {
-                "each block of N light points spawned, tested against the shadow casters and shaded in registers"
-            }
-            ShadowPath::FusedHard => {
-                "one ray per light for N hits at a time, tested (against the casters, or each through the BVH) and shaded in registers"
-            }
-            ShadowPath::QueuedPerHit => {
-                "every hit's rays queued in (light, point) order, then tested and shaded from the queue"
-            }
-        }
+        [
+            "each block of N light points spawned, tested against the shadow casters and shaded in registers",
+            "one ray per light for N hits at a time, tested (against the casters, or each through the BVH) and shaded in registers",
+            "every hit's rays queued in (light, point) order, then tested and shaded from the queue",
+        ][self as usize]
     }
 
     /// The fastest path `ctx` admits.
@@ -128,10 +116,9 @@ pub fn key_prefix(key: &SampleKey) -> u32 {
     mix32(h ^ key.light)
 }
 
-/// Fills every hit's `direct` column; returns the number of shadow rays cast (queued rays: a
-/// point behind the surface casts none, and no ray is cast with shadows off). Each shadow
-/// ray's traversal work is added to `costs` at the index of the hit that cast it
-/// (`cost::NoCount` counts nothing).
+/// Fills every hit's `direct` column; returns the number of shadow rays cast (a point behind
+/// the surface casts none, nor does anything with shadows off). Each ray's traversal work is
+/// added to `costs` at the index of the hit that cast it (`cost::NoCount` counts nothing).
 pub fn direct_light<S: Remap>(
     ctx: &Context,
     rays: &RayBatch,
@@ -143,9 +130,8 @@ pub fn direct_light<S: Remap>(
     at_width!(ctx.lane_width, V => direct_light_lanes::<V, S>(ctx, rays, hits, queue, capacity, costs))
 }
 
-/// [`direct_light`] at the lane width of `V`. Never inlined, so that the 8-lane stage is one
-/// function as it was before the 16-lane path, whatever codegen unit the dispatcher lands in
-/// (inlined, its instruction count in tests/gates/icount.rs moved by 0.5–2.2% from build to build).
+/// [`direct_light`] at the lane width of `V`. Never inlined: inlined into the dispatcher, its
+/// instruction count (tests/gates/icount.rs) moved by 0.5–2.2% with the codegen unit.
 #[inline(never)]
 fn direct_light_lanes<V: Lanes, S: Remap>(
     ctx: &Context,
@@ -221,11 +207,9 @@ fn first_block<'c>(
     }
 }
 
-/// [`direct_light`] without the queue: for hit, for light, for each block of N points, the
-/// block's rays (`simd::shadow_rays`), their blockers (`simd::block_occluded`) and their Shade
-/// (`shade_registers`) in registers, added to the hit lane by lane in point order, as
-/// [`shade`] adds a queued block. Returns the rays cast. Never inlined, so that profiles name
-/// it apart from the queued stage.
+/// [`direct_light`] without the queue (`ShadowPath::FusedSoft`): each block of N points is
+/// spawned, tested and shaded in registers, and added to its hit in point order as [`shade`]
+/// adds a queued block. Returns the rays cast. Never inlined, so that profiles name it apart.
 #[inline(never)]
 fn fused<V: Lanes, S: Costs>(
     ctx: &Context,
@@ -297,11 +281,10 @@ fn fused<V: Lanes, S: Costs>(
     cast
 }
 
-/// [`direct_light`] without the queue for one ray per (hit, light): for each group of N hits,
-/// for light, the group's rays (`simd::hit_shadow_rays`) and their blockers
-/// (`simd::hit_rays_occluded`) in registers, then the Shade of each unblocked ray added to its
-/// hit as [`shade`] adds a queued one. Each hit's rays come in light order, so its sum is the
-/// queue's, bit for bit. Returns the rays cast. Never inlined, as [`fused`] is not.
+/// [`direct_light`] without the queue for one ray per (hit, light) (`ShadowPath::FusedHard`):
+/// for each group of N hits, for light, the rays spawned and tested in registers, then each
+/// unblocked ray's Shade added as [`shade`] adds a queued one; each hit's rays come in light
+/// order, so its sum is the queue's, bit for bit. Returns the rays cast. Never inlined.
 #[inline(never)]
 fn fused_hard<V: Lanes, S: Costs, const MESH: bool>(
     ctx: &Context,
@@ -360,8 +343,15 @@ fn fused_hard<V: Lanes, S: Costs, const MESH: bool>(
                     falloff(model, s.dist)
                 };
                 let light_color = light.color * fall;
-                let c = shade_ray(rays, hits, i, s.ray.direction, s.n_dot_l, light_color);
-                hits.direct.add(i, c * weight);
+                add_ray(
+                    rays,
+                    hits,
+                    i,
+                    s.ray.direction,
+                    s.n_dot_l,
+                    light_color,
+                    weight,
+                );
             }
         }
     }
@@ -375,8 +365,7 @@ fn present_hits<V: Lanes>(hits: &HitBatch, i0: usize, len: usize) -> u32 {
         .fold(0, |m, k| m | 1 << k)
 }
 
-/// Queues the shadow rays of hit `i`, in (light, point) order.
-/// Returns the number of live rays queued.
+/// Queues the shadow rays of hit `i`, in (light, point) order; returns how many are live.
 fn spawn<V: Lanes>(
     ctx: &Context,
     rays: &RayBatch,
@@ -469,26 +458,22 @@ fn add_in_order<V: Lanes>(sum: (f32, f32, f32), c: &[V::Array; 3]) -> (f32, f32,
     (r, g, b)
 }
 
-/// The Shade of one unblocked shadow ray with direction `l` from ray `i`'s hit, its light's
-/// colour `light_color` (fall-off included), before the 1/N weight.
+/// Adds Shade · `weight` of one unblocked shadow ray with direction `l` to ray `i`'s hit,
+/// `light_color` its light's colour with the fall-off.
 #[inline(always)]
-fn shade_ray(
+fn add_ray(
     rays: &RayBatch,
-    hits: &HitBatch,
+    hits: &mut HitBatch,
     i: usize,
     l: Vec3,
     n_dot_l: f32,
     light_color: Vec3,
-) -> Vec3 {
+    weight: f32,
+) {
     let m = &hits.terms[hits.material[i] as usize];
-    shade_terms(
-        m,
-        hits.normal.get(i),
-        -rays.direction.get(i),
-        l,
-        n_dot_l,
-        light_color,
-    )
+    let (n, e) = (hits.normal.get(i), -rays.direction.get(i));
+    let c = shade_terms(m, n, e, l, n_dot_l, light_color);
+    hits.direct.add(i, c * weight);
 }
 
 /// Adds Shade / N of every unblocked queued ray to its hit, in queue order. Aligned blocks of
@@ -542,8 +527,7 @@ fn shade<V: Lanes>(ctx: &Context, rays: &RayBatch, hits: &mut HitBatch, queue: &
             let fall = queue.dist.get(q).map_or(1.0, |&d| falloff(model, d));
             let light_color = ctx.lights[queue.light[q] as usize].color * fall;
             let (l, n_dot_l) = (queue.direction.get(q), queue.n_dot_l[q]);
-            let c = shade_ray(rays, hits, i, l, n_dot_l, light_color) * weight;
-            hits.direct.add(i, c);
+            add_ray(rays, hits, i, l, n_dot_l, light_color, weight);
         }
         q += 1;
     }

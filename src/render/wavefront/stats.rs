@@ -32,13 +32,7 @@ impl Stage {
 
     /// Lower-case name.
     pub fn name(self) -> &'static str {
-        match self {
-            Stage::Generate => "generate",
-            Stage::Intersect => "intersect",
-            Stage::Shadow => "shadow",
-            Stage::Reflect => "reflect",
-            Stage::Film => "film",
-        }
+        ["generate", "intersect", "shadow", "reflect", "film"][self as usize]
     }
 }
 

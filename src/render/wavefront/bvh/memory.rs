@@ -1,14 +1,11 @@
 //! Memory advice for the tree's arrays: transparent huge pages for large trees.
 
 /// `v` moved into memory advised for 2 MiB transparent huge pages (Linux, arrays of at least
-/// 4 MiB), else `v` itself. A deep ray through a 1M-triangle tree touches
-/// nodes and blocks spread over 65 MB: in 4 KiB pages that is a TLB miss at almost every
-/// level, in 2 MiB pages 33 entries cover it all. Embree's BVH gets huge pages too: before
-/// this, the `mesh_rays` process held 62 MB of `AnonHugePages` with Embree and none without.
-/// With the kernel's THP mode at `madvise`, as on this machine, nothing else in raywave gets
-/// them. The advice is only a hint: where the kernel declines, the copy behaves as before.
-/// Measured in one process against a second tree without the advice: +2–4% on 1M-triangle
-/// rays (docs/TRIED.md, "The mesh BVH").
+/// 4 MiB), else `v` itself. A deep ray through a 1M-triangle tree touches nodes and blocks
+/// spread over 65 MB: in 4 KiB pages a TLB miss at almost every level, in 2 MiB pages 33
+/// entries cover it all (Embree's BVH gets huge pages too; under THP mode `madvise`, nothing
+/// else in raywave does). Only a hint: where the kernel declines, the copy is a plain copy.
+/// +2–4% on 1M-triangle rays against a tree without the advice (docs/TRIED.md, "The mesh BVH").
 pub(super) fn huge_pages<T: Copy>(v: Vec<T>) -> Vec<T> {
     #[cfg(target_os = "linux")]
     {

@@ -30,19 +30,18 @@
 //! in the same order, so each t is bit-equal to the scalar kernel's: the BVH only decides which
 //! triangles are tested. Boxes are padded outward (`build::pad`) so that the kernel's edge slack
 //! (u, v ≥ −EDGE_EPSILON) and the slab test's rounding never cull a triangle the kernel would
-//! hit, for ray origins within about 100 box sizes of a box; from farther away the origin's
-//! own rounding (about 2⁻²⁴·|origin|) can exceed the padding, in the fused slab test as in
-//! the unfused one before it. Ties (two triangles at the same t: a shared edge, a corner of
-//! two walls) go to the lowest triangle id (`geometry::closer`, the pair (t, id) is minimised),
-//! as in a brute-force loop in index order, so the closest hit is brute force's.
+//! hit, for ray origins within about 100 box sizes of a box (from farther away the origin's
+//! own rounding, about 2⁻²⁴·|origin|, can exceed the padding). Ties (two triangles at the same
+//! t: a shared edge, a corner of two walls) go to the lowest triangle id (`geometry::closer`
+//! minimises the pair (t, id)), as in a brute-force loop, so the closest hit is brute force's.
 //!
 //! # The grazing exception
 //!
 //! The one case where the tree's answer is not brute force's is a triangle the ray grazes: its
 //! computed t is off by about ε / sin θ and can lie before the entry of the box that holds it,
 //! which is then pruned by a hit found first. In `tests/kernels/mesh_bvh.rs`, 1 of 8,000 grazing
-//! queries differs (one ray at a time and in packets alike; 3 in an earlier tree; every
-//! difference measured was at |n·d| ≤ 1.5e-5), for a triangle with |n·d| ≈ 2e-6. The test
+//! queries differs (one ray at a time and in packets alike; every difference measured was at
+//! |n·d| ≤ 1.5e-5), for a triangle with |n·d| ≈ 2e-6. The test
 //! holds every difference to that: brute force's hit grazes (|n·d| < 1e-3), and the tree's
 //! answer is another real hit of the kernel. Which hit is found first depends on the visiting
 //! order, so packets (the first entering lane's order) and one ray may differ from each other
@@ -59,7 +58,7 @@ use crate::render::geometry::{Hit, Ray, T_MIN, intersect_sphere};
 use crate::render::scene::{NO_HIT, Scene, Triangle};
 use crate::render::wavefront::batch::HitRays;
 use crate::render::wavefront::cost::{Costs, Counter};
-use crate::render::wavefront::lanes::{LANES, f32x8, i32x8, ids, set_bits};
+use crate::render::wavefront::lanes::{LANES, cast, f32x8, i32x8, set_bits};
 use std::time::Duration;
 pub use traverse::Stack;
 use traverse::{RayLanes, triangles8, triangles8_block};
@@ -118,7 +117,7 @@ impl Block {
     /// From the ids, not the vertices: a triangle built in code may have a NaN vertex.
     #[inline(always)]
     fn len(&self) -> u32 {
-        let unused = ids(self.prim)
+        let unused = cast::<_, i32x8>(self.prim)
             .simd_eq(i32x8::splat(NO_HIT as i32))
             .to_bitmask();
         (unused | 1 << WIDTH).trailing_zeros()
@@ -225,9 +224,8 @@ impl MeshBvh {
 
     /// Whether anything (spheres, then triangles through the tree) blocks every ray in
     /// (T_MIN, tmax), as `Accel::occluded`. Rays with tmax ≤ T_MIN cannot be blocked and are
-    /// not traced (the shadow queue's dead lanes have tmax = 0). Each traced ray's spheres
-    /// tested, nodes, leaves and triangle tests are added to `costs` (rays not traced add
-    /// nothing).
+    /// not traced (the shadow queue's dead lanes have tmax = 0); each traced ray's work is
+    /// added to `costs`.
     ///
     /// (An occluder cache, a ray after a blocked one testing the leaf that blocked that one
     /// first, cost 6.6% more instructions on the gate's mesh tile: docs/TRIED.md, "The mesh BVH".)
@@ -255,10 +253,8 @@ impl MeshBvh {
     }
 
     /// The `live` lanes of one ray per hit (`simd::hit_shadow_rays`) that something blocks, as
-    /// a bit mask: lane k is what [`Self::occluded`] answers for that ray in a queue (a lane
-    /// with tmax ≤ T_MIN is not traced). Each traced lane's work goes to `costs` at index
-    /// `i0 + k`. The hard-shadow stage walks its rays from registers with this, one at a time,
-    /// without queueing them.
+    /// a bit mask: lane k is what [`Self::occluded`] answers for that ray in a queue, its work
+    /// added to `costs` at `i0 + k`. The hard-shadow stage walks its rays with this, unqueued.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     pub fn hit_rays_occluded<A: AsRef<[f32]>, S: Costs>(

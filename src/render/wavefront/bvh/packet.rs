@@ -23,8 +23,7 @@ use crate::render::geometry::{T_MIN, closer};
 use crate::render::scene::NO_HIT;
 use crate::render::wavefront::cost::Counter;
 use crate::render::wavefront::lanes::{
-    MASK_LANES, f32_bits, f32_bits_signed, f32_from_bits, f32_from_signed, f32x8, i32x8, load_live,
-    set_bits, u32x8, view,
+    MASK_LANES, cast, f32x8, i32x8, load_live, set_bits, u32x8, view,
 };
 use crate::render::wavefront::simd::{self, RayColumns, TriangleLanes};
 
@@ -59,7 +58,7 @@ impl Packet {
         let tiny = f32x8::splat(1e-18);
         let sign = f32x8::splat(-0.0);
         let inv = d.map(|c| f32x8::ONE / c.abs().simd_lt(tiny).select(tiny | (c & sign), c));
-        let negative = inv.map(|v| f32_from_signed(f32_bits_signed(v).simd_lt(i32x8::ZERO)));
+        let negative = inv.map(|v| cast(cast::<_, i32x8>(v).simd_lt(i32x8::ZERO)));
         Packet {
             o,
             d,
@@ -161,7 +160,7 @@ impl PacketBest {
         // next_up(t) as bits + 1: t > T_MIN ≥ 0 here (so t is positive, not −0.0), and finite
         // (t < limit).
         const _: () = assert!(T_MIN >= 0.0);
-        let up = f32_from_bits(f32_bits(t) + u32x8::ONE);
+        let up: f32x8 = cast(cast::<_, u32x8>(t) + u32x8::ONE);
         self.limit = take_lanes.select(up, self.limit);
         for k in set_bits(take) {
             self.prim[k] = prim;

@@ -74,10 +74,9 @@ impl RayLanes {
     }
 }
 
-/// The traversal stack: (child reference, entry distance; 0 for occlusion). Sized by the tree:
-/// a node leaves at most 7 children on it (8 pushed, one popped at once, in `occluded_in`), so
-/// 7 · depth + 1 entries always suffice, however deep a degenerate mesh makes the tree. One is
-/// allocated per batch, not per ray ([`MeshBvh::stack`] for callers outside the tree).
+/// The traversal stack: (child reference, entry distance; 0 for occlusion). A node leaves at
+/// most 7 children on it, so 7 · depth + 1 entries always suffice, however deep a degenerate
+/// mesh makes the tree. One per batch, not per ray ([`MeshBvh::stack`] outside the tree).
 #[derive(Default)]
 pub struct Stack(Vec<(u32, f32)>);
 

@@ -8,8 +8,7 @@ use crate::render::wavefront::lanes::Lanes;
 
 /// Writes the directions of the camera rays through the centres of pixels
 /// `first..first + count` into `out` (x, y, z columns, `count` long), N pixels at a time along
-/// each row. Bit-equal to `rays_of(first, count, 1, ..)`'s directions, which it is tested
-/// against.
+/// each row: bit-equal to `rays_of(first, count, 1, ..)`'s directions.
 pub fn camera_directions<V: Lanes>(
     camera: &CameraRays,
     first: u32,

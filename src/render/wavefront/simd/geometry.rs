@@ -11,9 +11,8 @@ use crate::render::wavefront::lanes::{Lanes, f32x8, live_lanes, store_mask};
 use glam::Vec3;
 
 /// Möller–Trumbore's operands on N lanes (8 by default), as columns: ray origin o and
-/// direction d, triangle corner v0 and edges e1, e2. [`triangle8`] splats the triangle (8 rays, one triangle), the
-/// mesh BVH's leaf test splats the ray (one ray, 8 triangles); the arithmetic is
-/// [`moller_trumbore8`] and [`moller_trumbore8_blocks`] either way.
+/// direction d, triangle corner v0 and edges e1, e2. [`triangle8`] splats the triangle, the
+/// mesh BVH's leaf test splats the ray; the arithmetic is the same either way.
 #[derive(Clone, Copy)]
 pub(crate) struct TriangleLanes<V = f32x8> {
     pub o: [V; 3],
@@ -287,11 +286,10 @@ pub fn closest_hits<V: Lanes>(
     }
 }
 
-/// For every ray, whether anything blocks it in (T_MIN, tmax), N rays at a time (`V`: 8 or 16
-/// lanes, the same answers). Spheres first, then triangles; a block of N lanes stops as soon as
-/// all its live lanes are blocked, and each of its live rays is charged the primitives the
-/// block tested, added to `costs` (`NoCount`: nothing is counted). Never inlined, so that the
-/// queued shadow stage calls it as a function of its own at either width.
+/// For every ray, whether anything blocks it in (T_MIN, tmax), N rays at a time. Spheres
+/// first, then triangles; a block of N lanes stops as soon as all its live lanes are blocked,
+/// and each of its live rays is charged the primitives the block tested, in `costs`. Never
+/// inlined, so that the queued shadow stage calls it as a function of its own at either width.
 #[inline(never)]
 pub fn occluded<V: Lanes, S: Costs>(
     triangles: &[Triangle],
@@ -331,9 +329,8 @@ pub fn occluded<V: Lanes, S: Costs>(
 
 /// The lanes of one block of shadow rays (`simd::shadow_rays`: N rays from one origin, dead
 /// lanes with tmax = 0) that something blocks, as a bit mask: for every live lane, the answer
-/// [`occluded`] gives for the same ray in a queue (the same rays, loaded from registers
-/// instead of the queue's columns); dead lanes' bits mean nothing. The primitives the block
-/// tested are counted in `c` once for the block (each of its live rays did those tests).
+/// [`occluded`] gives for the same ray in a queue; dead lanes' bits mean nothing. The
+/// primitives tested are counted in `c` once for the block (each live ray did those tests).
 #[inline(always)]
 pub fn block_occluded<V: Lanes, C: Counter>(
     triangles: &[Triangle],
@@ -356,10 +353,8 @@ pub fn block_occluded<V: Lanes, C: Counter>(
     rays_occluded(triangles, spheres, &r, tmax, live, two_sided, c)
 }
 
-/// The `live` lanes of one ray per hit (`simd::hit_shadow_rays`) that something blocks, as a
-/// bit mask: for every live lane, the answer [`occluded`] gives for the same ray in a queue;
-/// the other lanes' bits mean nothing. The primitives tested are counted in `c` once for the
-/// block (each live lane did those tests).
+/// [`block_occluded`] for one ray per hit (`simd::hit_shadow_rays`), `live` the lanes with a
+/// ray.
 #[inline(always)]
 pub fn hit_rays_occluded<V: Lanes, C: Counter>(
     triangles: &[Triangle],
@@ -442,15 +437,10 @@ fn occluded8<C: Counter>(
 }
 
 /// The lanes `s` blocks: lane k is `geometry::sphere_blocks(s, ray_k, tmax_k)` (the roots
-/// tested against (0, tmax) by multiplication, no division of c by q), returning early when no
-/// lane can hit (most shadow rays miss most spheres; that skips the square root and the
-/// division).
-///
-/// The early test is the textbook discriminant b² − a·c, which needs no division, with a margin
-/// that makes it prove the stable discriminant negative too (`geometry::MISS_MARGIN`), so the
-/// lanes it drops are misses of the full test as well.
-/// (With the margin added as a separate term, this test cost 15% more instructions in the
-/// occlusion loop than folded into c.)
+/// tested against (0, tmax) by multiplication, no division of c by q). Most shadow rays miss
+/// most spheres, so it returns before the square root and the division when
+/// [`SphereLanes::all_miss`] proves every lane a miss (with the margin as a separate term
+/// rather than folded into c, that test cost 15% more instructions in the occlusion loop).
 #[inline(always)]
 fn sphere8_blocks<V: Lanes>(s: &Sphere, r: &Rays<V>, tmax: V) -> u32 {
     let lanes = SphereLanes::new(s, r);

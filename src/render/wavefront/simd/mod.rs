@@ -1,17 +1,13 @@
-//! The SIMD kernels of the stages, by idea: ray–primitive tests (`geometry.rs`) and light
+//! The SIMD kernels of the stages, by idea: ray–primitive tests (`geometry.rs`), light
 //! sampling with shadow-ray spawning (`light.rs`, the per-stream point sets in
-//! `point_sets.rs`); the shading kernel sits with its scalar twin
-//! in `wavefront/shade.rs`, and the mesh BVH's node and leaf tests in `wavefront/bvh/`. Lanes,
-//! loads and masks come from `wavefront/lanes.rs`.
+//! `point_sets.rs`) and camera rays (`camera.rs`); the shading kernel sits with its scalar twin
+//! in `wavefront/shade.rs`, and the mesh BVH's node and leaf tests in `wavefront/bvh/`.
 //!
-//! The brute-force, light and shading kernels are written once, generic over the lane type
-//! (`lanes::Lanes`), and run 8 or 16 lanes wide (`lanes::LaneWidth`). Each has one entry
-//! point, which takes the width as a type parameter (`closest_hits::<V>`, `occluded::<V, _>`,
-//! `light_points::<V>`, `shadow_rays::<V>`, `shade::shade_lanes::<V>`; a width chosen at run
-//! time becomes that type in `lanes::at_width!`), or from its operands (`triangle8`,
-//! `sphere8` and `moller_trumbore8`, names from the 8-wide days). The kernels that count their
-//! work (`occluded`, `block_occluded`, `hit_rays_occluded`) take the count's sink too, and
-//! `cost::NoCount` compiles it away. The mesh BVH's kernels stay 8-wide.
+//! The brute-force, light and shading kernels are written once over `lanes::Lanes` and take
+//! the width (8 or 16) as a type parameter (`closest_hits::<V>`; a width chosen at run time
+//! becomes that type in `lanes::at_width!`) or from their operands (`triangle8`, `sphere8`,
+//! `moller_trumbore8`: names from the 8-wide days). The kernels that count their work take the
+//! count's sink too, which `cost::NoCount` compiles away. The mesh BVH's kernels stay 8-wide.
 //!
 //! Every kernel is a lane-by-lane copy of a scalar twin, with the same operations in the
 //! same order, so that with IEEE arithmetic (no FMA contraction: Rust never fuses `a * b + c`,
@@ -45,7 +41,7 @@ pub use geometry::{block_occluded, closest_hits, hit_rays_occluded, occluded, sp
 pub use hit_rays::{HitLanes, hit_shadow_rays};
 pub use light::{BlockSampler, LightBlock, light_points, shadow_rays};
 
-use super::lanes::{LANES, Lanes, f32x8};
+use super::lanes::{Lanes, f32x8};
 use crate::render::geometry::Ray;
 use crate::render::scene::{Sphere, Triangle};
 use glam::Vec3;
@@ -92,9 +88,6 @@ pub struct Rays<V = f32x8> {
     dz: V,
 }
 
-/// Eight rays in registers.
-pub(crate) type Rays8 = Rays<f32x8>;
-
 impl<V: Lanes> Rays<V> {
     /// Loads rays `i..i + N` (padding past the end with NaN directions).
     #[inline(always)]
@@ -123,14 +116,9 @@ impl<V: Lanes> Rays<V> {
     }
 }
 
-/// Lane-level entry points for tests: 8 (or N) rays given as arrays, the kernels' answers as
-/// arrays.
+/// Lane-level entry points for tests: N rays given as slices, the kernels' answers as arrays.
 pub mod arrays {
     use super::*;
-
-    fn rays8(rays: &[Ray; LANES]) -> Rays8 {
-        Rays::from_rays(rays)
-    }
 
     /// [`triangle8`] at the width of `V`, on `V::N` rays and tmaxes.
     pub fn triangle_lanes<V: Lanes>(
@@ -153,20 +141,5 @@ pub mod arrays {
     pub fn sphere_lanes<V: Lanes>(s: &Sphere, rays: &[Ray], tmax: &[f32]) -> V::Array {
         assert!(rays.len() == V::N && tmax.len() == V::N);
         sphere8(s, &Rays::<V>::from_rays(rays), V::load(tmax, 0, 0.0)).to_array()
-    }
-
-    /// [`triangle8`] on arrays.
-    pub fn triangle(
-        tri: &Triangle,
-        rays: &[Ray; LANES],
-        tmax: [f32; LANES],
-        two_sided: bool,
-    ) -> [f32; LANES] {
-        triangle8(tri, &rays8(rays), f32x8::new(tmax), two_sided).to_array()
-    }
-
-    /// [`sphere8`] on arrays.
-    pub fn sphere(s: &Sphere, rays: &[Ray; LANES], tmax: [f32; LANES]) -> [f32; LANES] {
-        sphere8(s, &rays8(rays), f32x8::new(tmax)).to_array()
     }
 }
