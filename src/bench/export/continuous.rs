@@ -19,6 +19,7 @@
 
 use crate::output::bench_record::{BenchRecord, FigureSummary};
 use crate::render::settings::ShadowMode;
+use anyhow::{Result, bail};
 
 /// The scene's short name: a built-in scene's name, else the file name without extension.
 fn scene_name(source: &str) -> String {
@@ -54,20 +55,29 @@ fn figure_name(r: &BenchRecord, engine: &str, figure: &str, by_host: bool) -> St
     name
 }
 
-/// Every headline figure of every record, with its name.
+/// Every headline figure of every record, with its name; two figures with one name (two
+/// machines of one host name, say) are an error rather than one overwriting the other.
 pub(super) fn figures(
     records: &[BenchRecord],
     by_host: bool,
-) -> Vec<(String, &BenchRecord, &FigureSummary)> {
+) -> Result<Vec<(String, &BenchRecord, &FigureSummary)>> {
     let mut out = Vec::new();
+    let mut names = std::collections::HashSet::new();
     for r in records {
         for e in &r.engines {
             for f in &e.summary {
-                out.push((figure_name(r, &e.engine, &f.figure, by_host), r, f));
+                let name = figure_name(r, &e.engine, &f.figure, by_host);
+                if !names.insert(name.clone()) {
+                    bail!(
+                        "two figures share the benchmark name `{name}`: give each machine its own \
+                         host name"
+                    );
+                }
+                out.push((name, r, f));
             }
         }
     }
-    out
+    Ok(out)
 }
 
 #[cfg(test)]
