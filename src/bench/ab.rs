@@ -45,7 +45,6 @@ use crate::render::progress::{Progress, Steps};
 use crate::stats::looks::LookPlan;
 use crate::stats::{MIN_FOR_INTERVAL, median};
 use anyhow::{Context, Result, bail};
-use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
@@ -176,16 +175,16 @@ fn time_one(
         .output()
         .with_context(|| format!("cannot run {}", binary.display()))?;
     if !out.status.success() {
-        let args: Vec<OsString> = cmd.get_args().map(OsString::from).collect();
+        let args: Vec<_> = cmd
+            .get_args()
+            .skip(1)
+            .map(|a| a.to_string_lossy())
+            .collect();
         bail!(
             "{} failed ({}) on `render {}`:\n{}",
             binary.display(),
             out.status,
-            args[1..]
-                .iter()
-                .map(|a| a.to_string_lossy())
-                .collect::<Vec<_>>()
-                .join(" "),
+            args.join(" "),
             String::from_utf8_lossy(&out.stderr).trim_end()
         );
     }
@@ -235,25 +234,22 @@ impl Builds<'_> {
         result: &mut EngineAb,
         runs: &Steps,
     ) -> Result<(f64, f64)> {
+        let run = |binary: &Path| -> Result<(f64, String)> {
+            let time = time_one(binary, self.options, engine, self.scratch.path())?;
+            runs.step();
+            Ok(time)
+        };
         // Alternate which build goes first, so that neither always runs on a warmer or cooler
         // machine.
-        let order = if round.is_multiple_of(2) {
-            [&self.this, &self.options.other]
-        } else {
-            [&self.options.other, &self.this]
-        };
-        let mut times = [(0.0, String::new()), (0.0, String::new())];
-        for (slot, binary) in order.into_iter().enumerate() {
-            times[slot] = time_one(binary, self.options, engine, self.scratch.path())?;
-            runs.step();
-        }
         let (mine, theirs) = if round.is_multiple_of(2) {
-            (&times[0], &times[1])
+            let mine = run(&self.this)?;
+            (mine, run(&self.options.other)?)
         } else {
-            (&times[1], &times[0])
+            let theirs = run(&self.options.other)?;
+            (run(&self.this)?, theirs)
         };
         if mine.1 != theirs.1 && result.different_work.is_none() {
-            result.different_work = Some((mine.1.clone(), theirs.1.clone()));
+            result.different_work = Some((mine.1.clone(), theirs.1));
         }
         Ok((mine.0, theirs.0))
     }

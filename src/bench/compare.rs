@@ -37,11 +37,9 @@ fn diff(
     }
     match (a, b) {
         (Object(ma), Object(mb)) => {
-            let mut keys: Vec<&String> = ma.keys().chain(mb.keys()).collect();
-            keys.sort();
-            keys.dedup();
+            let null = serde_json::Value::Null;
+            let keys: std::collections::BTreeSet<&String> = ma.keys().chain(mb.keys()).collect();
             for k in keys {
-                let null = serde_json::Value::Null;
                 let p = if path.is_empty() {
                     k.clone()
                 } else {
@@ -86,11 +84,6 @@ pub struct Comparison {
     pub notes: Vec<String>,
 }
 
-/// The figure in the unit the tables print (Mrays/s or Mrays/thread-s).
-fn mega(x: f64) -> f64 {
-    x / 1e6
-}
-
 impl Comparison {
     /// Whether any headline figure regressed.
     pub fn regressed(&self) -> bool {
@@ -106,8 +99,9 @@ impl Comparison {
     /// The table with the two columns named `a` and `b` (`raywave bench compare A B`).
     pub fn table_with(&self, a: &str, b: &str) -> String {
         let mut s = String::new();
+        // In the unit the tables print: Mrays/s or Mrays/thread-s.
         let cell =
-            |f: &FigureSummary| format!("{:.2} {}", mega(f.median), f.interval_text(1e-6, 2));
+            |f: &FigureSummary| format!("{:.2} {}", f.median / 1e6, f.interval_text(1e-6, 2));
         let _ = writeln!(
             s,
             "{:<10} {:<17} {:>26} {:>26} {:>8}  verdict",
@@ -186,15 +180,6 @@ pub enum Refusal {
     /// A record lacks figures the other has, holds figures that are not positive finite
     /// rates, or has no intervals (fewer than 6 runs): a verdict on them could not fail.
     Incomparable(Vec<String>),
-}
-
-impl Refusal {
-    /// The lines, whichever the kind.
-    pub fn lines(&self) -> &[String] {
-        match self {
-            Refusal::Setup(l) | Refusal::Incomparable(l) => l,
-        }
-    }
 }
 
 /// A headline rate that a verdict can rest on: finite and above zero.

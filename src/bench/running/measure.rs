@@ -38,67 +38,51 @@ pub(crate) fn measure(
     notice: &(dyn Fn(&str) + Sync),
 ) -> Vec<EngineRecord> {
     pool.install(|| {
-        timed(
-            scene, settings, engines, lanes, warmup, runs, runs_done, notice,
-        )
-    })
-}
-
-#[allow(clippy::too_many_arguments)]
-fn timed(
-    scene: &Scene,
-    settings: &RenderSettings,
-    engines: &[Engine],
-    lanes: LaneWidth,
-    warmup: u32,
-    runs: u32,
-    runs_done: &Steps,
-    notice: &(dyn Fn(&str) + Sync),
-) -> Vec<EngineRecord> {
-    let prepared: Vec<Prepared> = engines
-        .iter()
-        .map(|engine| engine.prepare_lanes(scene, settings, DEFAULT_BATCH_SIZE, lanes))
-        .collect();
-    let time = |engine: &Prepared| {
-        let start = Instant::now();
-        let (film, stats) = engine.render(&Progress::SILENT);
-        let seconds = start.elapsed().as_secs_f64();
-        drop::<Film>(film);
-        if let Some(w) = clamped_warning(&stats) {
-            notice(&w);
-        }
-        let stages = match engine.engine() {
-            Engine::Wavefront => stats.stage_figures(),
-            Engine::Reference => Vec::new(),
+        let prepared: Vec<Prepared> = engines
+            .iter()
+            .map(|engine| engine.prepare_lanes(scene, settings, DEFAULT_BATCH_SIZE, lanes))
+            .collect();
+        let time = |engine: &Prepared| {
+            let start = Instant::now();
+            let (film, stats) = engine.render(&Progress::SILENT);
+            let seconds = start.elapsed().as_secs_f64();
+            drop::<Film>(film);
+            if let Some(w) = clamped_warning(&stats) {
+                notice(&w);
+            }
+            let stages = match engine.engine() {
+                Engine::Wavefront => stats.stage_figures(),
+                Engine::Reference => Vec::new(),
+            };
+            Measurement {
+                rays: KindFigures::new(&stats, seconds),
+                stages,
+            }
         };
-        Measurement {
-            rays: KindFigures::new(&stats, seconds),
-            stages,
+        for _ in 0..warmup {
+            for engine in &prepared {
+                time(engine);
+                runs_done.step();
+            }
         }
-    };
-    for _ in 0..warmup {
-        for engine in &prepared {
-            time(engine);
-            runs_done.step();
+        let mut measured: Vec<Vec<Measurement>> = vec![Vec::new(); prepared.len()];
+        for round in 0..runs as usize {
+            for i in round_order(prepared.len(), round) {
+                measured[i].push(time(&prepared[i]));
+                runs_done.step();
+            }
         }
-    }
-    let mut measured: Vec<Vec<Measurement>> = vec![Vec::new(); prepared.len()];
-    for round in 0..runs as usize {
-        for i in round_order(prepared.len(), round) {
-            measured[i].push(time(&prepared[i]));
-            runs_done.step();
-        }
-    }
-    prepared
-        .iter()
-        .zip(measured)
-        .map(|(engine, runs)| EngineRecord {
-            engine: engine.engine().name().to_string(),
-            median: Measurement::median_of(&runs),
-            summary: summarise(&runs),
-            runs,
-        })
-        .collect()
+        prepared
+            .iter()
+            .zip(measured)
+            .map(|(engine, runs)| EngineRecord {
+                engine: engine.engine().name().to_string(),
+                median: Measurement::median_of(&runs),
+                summary: summarise(&runs),
+                runs,
+            })
+            .collect()
+    })
 }
 
 /// The order in which round `round` runs `n` engines: 0..n rotated by `round`, so each engine
