@@ -12,26 +12,15 @@
 //!     each run: `BUILD render SCENE FLAGS --engine E --threads T -q -o tmp --stats-json tmp`,
 //!               its render seconds from the JSON (parsing and file writing excluded)
 //!     ratio_r = this_r / other_r
-//! per engine: median ratio, 95% interval of the median from order statistics (no resampling),
-//!             verdict against the threshold t (`Rule::judge`):
-//!     slower      when the whole interval lies above 1 + t          → exit 3 (both forms)
-//!     --verdict regression (the default), one-sided:
-//!     not slower  when the whole interval lies at or below 1 + t
-//!     --verdict three-way:
-//!     faster      when it lies below 1 / (1 + t)
-//!     within      when it lies inside [1 / (1 + t), 1 + t]
-//!     undecided otherwise (the interval straddles a boundary: more rounds narrow it)
+//! per engine: median ratio, its 95% interval (order statistics, no resampling; n ≥ 6:
+//!             `stats::median_interval_rank_at`) and the verdict against the threshold t
+//!             (`Rule::judge`; the words in verdict.rs). Slower → exit 3 in both forms
 //! ```
 //!
-//! The interval is distribution-free (`stats::median_interval_rank_at`): for n paired ratios
-//! sorted, the median lies between the k-th and the (n − k + 1)-th with probability ≥ 95%, k the
-//! largest with P(Binomial(n, ½) < k) ≤ 2.5%. It needs n ≥ 6.
-//!
 //! The default form asks a pull request's one question, "is this build slower than the other by
-//! more than t?", so a build faster than the other by about t is decided as soon as its
-//! interval's high end is at or below 1 + t; the three-way form must also place it on one side
-//! of 1 / (1 + t), and a build about t faster straddles that line for as long as the rounds go
-//! on. Both forms judge the same interval, and the regression boundary is the same test in both.
+//! more than t?", so a build about t faster is decided as soon as its interval's high end is at
+//! or below 1 + t; the three-way form must also place it on one side of 1 / (1 + t), which it
+//! straddles for as long as the rounds go on.
 //!
 //! With `--until-decided` the rounds go on until the verdict is decided, judged at planned
 //! looks with narrower levels (`sequential`), within `--max-rounds` and `--max-time`.

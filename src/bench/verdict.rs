@@ -78,7 +78,10 @@ pub struct Rule {
     pub form: VerdictForm,
 }
 
+#[cfg(test)]
 impl Rule {
+    // For the tests: the command line builds its `Rule` whole.
+
     /// The pull-request gate's rule at `threshold_pct`: one-sided, a regression or not.
     pub fn regression(threshold_pct: f64) -> Rule {
         Rule {
@@ -94,7 +97,9 @@ impl Rule {
             form: VerdictForm::ThreeWay,
         }
     }
+}
 
+impl Rule {
     /// The verdict of an interval [`low`, `high`] of the ratio this / other.
     ///
     /// "Slower by more than t" needs the whole interval above 1 + t (strictly: a low end at
