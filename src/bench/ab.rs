@@ -26,12 +26,12 @@
 //! looks with narrower levels (`sequential`), within `--max-rounds` and `--max-time`.
 
 use super::running::sequential::{self, Budget};
-use super::verdict::{RatioSummary, Rule, Verdict, summarize};
+use super::verdict::{RatioSummary, Rule, Verdict, summarize_at};
 use super::{EXIT_REGRESSION, EXIT_UNDECIDED};
 use crate::render::engine::Engine;
 use crate::render::error::UsageError;
 use crate::render::progress::{Progress, Steps};
-use crate::stats::looks::LookPlan;
+use crate::stats::looks::{self, LookPlan};
 use crate::stats::{MIN_FOR_INTERVAL, median};
 use anyhow::{Context, Result, bail};
 use std::path::{Path, PathBuf};
@@ -99,7 +99,7 @@ impl EngineAb {
     /// interval when no look was taken.
     pub fn summary(&self, rule: Rule) -> RatioSummary {
         match &self.sequential {
-            None => summarize(&self.ratios(), rule),
+            None => summarize_at(&self.ratios(), rule, looks::ALPHA),
             Some(outcome) => outcome.looks.last().map_or(
                 RatioSummary {
                     median: median(&self.ratios()),
@@ -353,6 +353,7 @@ pub fn exit_code(options: &AbOptions, results: &[EngineAb]) -> u8 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bench::verdict::summarize;
 
     #[test]
     fn verdicts_follow_the_whole_interval() {

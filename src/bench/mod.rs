@@ -291,17 +291,7 @@ pub fn run(args: &BenchOptions, progress: &Progress) -> Result<Outcome> {
     let runs = progress.steps(total, "runs");
     let mut records = Vec::new();
     for plan in &plans {
-        let engines = measure::measure(
-            &plan.pool,
-            &scene,
-            &plan.setup.settings,
-            &plan.engines,
-            args.lanes,
-            args.warmup,
-            args.runs,
-            &runs,
-            progress.notice,
-        );
+        let engines = measure::measure(plan, &scene, args, &runs, progress.notice);
         let record = BenchRecord {
             format: record::FORMAT,
             raywave: env!("CARGO_PKG_VERSION").to_string(),

@@ -130,23 +130,13 @@ pub fn of_records(before: &FigureSummary, after: &FigureSummary, threshold_pct: 
     else {
         return Verdict::Undecided;
     };
-    let apart_below = ah < bl;
-    let apart_above = al > bh;
-    if change < -threshold_pct {
-        if apart_below {
-            Verdict::Slower
-        } else {
-            Verdict::Undecided
-        }
-    } else if change > threshold_pct {
-        if apart_above {
-            Verdict::Faster
-        } else {
-            Verdict::Undecided
-        }
-    } else {
-        // Apart or not, the change is within what the threshold says matters.
-        Verdict::Within
+    // Past the threshold the intervals must be apart too; within it, apart or not, the change
+    // is within what the threshold says matters.
+    match (change < -threshold_pct, change > threshold_pct) {
+        (true, _) if ah < bl => Verdict::Slower,
+        (_, true) if al > bh => Verdict::Faster,
+        (false, false) => Verdict::Within,
+        _ => Verdict::Undecided,
     }
 }
 
@@ -164,8 +154,9 @@ pub struct RatioSummary {
 }
 
 /// Median, 95% interval and verdict of per-round ratios.
+#[cfg(test)]
 pub fn summarize(ratios: &[f64], rule: Rule) -> RatioSummary {
-    summarize_at(ratios, rule, 0.05)
+    summarize_at(ratios, rule, crate::stats::looks::ALPHA)
 }
 
 /// Median, (1 − `alpha`) interval and verdict of per-round ratios.
