@@ -123,7 +123,7 @@ fn check_executable(path: &Path) -> Result<()> {
         ))
     })?;
     if !meta.is_file() || meta.permissions().mode() & 0o111 == 0 {
-        return Err(UsageError(format!(
+        bail!(UsageError(format!(
             "--against {}: expected an executable raywave binary, found {}",
             path.display(),
             if meta.is_file() {
@@ -131,8 +131,7 @@ fn check_executable(path: &Path) -> Result<()> {
             } else {
                 "something that is not a regular file"
             }
-        ))
-        .into());
+        )));
     }
     Ok(())
 }
@@ -252,11 +251,10 @@ pub fn run(options: &AbOptions, progress: &Progress) -> Result<Vec<EngineAb>> {
         Some(budget) => ("--max-rounds", budget.max_rounds),
     };
     if timed.1 < MIN_ROUNDS {
-        return Err(UsageError(format!(
+        bail!(UsageError(format!(
             "{} {}: a 95% interval of the median needs at least {MIN_ROUNDS} rounds",
             timed.0, timed.1
-        ))
-        .into());
+        )));
     }
     check_executable(&options.other)?;
     let builds = Builds {

@@ -5,6 +5,7 @@
 
 use super::verdict::{Verdict, change_pct, of_records};
 use crate::output::bench_record::{BenchRecord, FigureSummary, Setup};
+use serde_json::Value;
 use std::fmt::Write;
 
 /// The fields in which two setups differ, as `path: X in the record, Y now` lines (empty if
@@ -15,45 +16,39 @@ pub fn setup_differences(before: &Setup, after: &Setup) -> Vec<String> {
 
 /// [`setup_differences`] with the two sides named (`in A`, `in B`).
 pub fn setup_differences_as(before: &Setup, after: &Setup, a: &str, b: &str) -> Vec<String> {
-    let va = serde_json::to_value(before).unwrap_or_default();
-    let vb = serde_json::to_value(after).unwrap_or_default();
     let mut out = Vec::new();
-    diff("", &va, &vb, &mut out);
-    out.into_iter()
-        .map(|(path, x, y)| format!("{path}: {x} {a}, {y} {b}"))
-        .collect()
+    let value = |s: &Setup| serde_json::to_value(s).unwrap_or_default();
+    diff("", &value(before), &value(after), &mut |path, x, y| {
+        out.push(format!("{path}: {x} {a}, {y} {b}"));
+    });
+    out
 }
 
-fn diff(
-    path: &str,
-    a: &serde_json::Value,
-    b: &serde_json::Value,
-    out: &mut Vec<(String, String, String)>,
-) {
-    use serde_json::Value::Object;
+/// Calls `found` with the path and both values of each leaf where `x` and `y` differ.
+fn diff(path: &str, x: &Value, y: &Value, found: &mut dyn FnMut(&str, &Value, &Value)) {
     // The scene's source is its name only: the text hash and counts decide.
     if path == "scene.source" {
         return;
     }
-    match (a, b) {
-        (Object(ma), Object(mb)) => {
-            let null = serde_json::Value::Null;
-            let keys: std::collections::BTreeSet<&String> = ma.keys().chain(mb.keys()).collect();
+    match (x, y) {
+        (Value::Object(mx), Value::Object(my)) => {
+            let keys: std::collections::BTreeSet<&String> = mx.keys().chain(my.keys()).collect();
             for k in keys {
                 let p = if path.is_empty() {
                     k.clone()
                 } else {
                     format!("{path}.{k}")
                 };
+                let null = &Value::Null;
                 diff(
                     &p,
-                    ma.get(k).unwrap_or(&null),
-                    mb.get(k).unwrap_or(&null),
-                    out,
+                    mx.get(k).unwrap_or(null),
+                    my.get(k).unwrap_or(null),
+                    found,
                 );
             }
         }
-        _ if a != b => out.push((path.to_string(), a.to_string(), b.to_string())),
+        _ if x != y => found(path, x, y),
         _ => {}
     }
 }

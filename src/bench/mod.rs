@@ -139,7 +139,7 @@ pub fn run(args: &BenchOptions, progress: &Progress) -> Result<Outcome> {
     // Everything that can fail cheaply happens before the timed part.
     let points = args.sweep.points();
     if points.len() > 1 && (args.compare.is_some() || args.json.is_some()) {
-        return Err(UsageError(format!(
+        bail!(UsageError(format!(
             "{} takes one point, but the sweep has {}: compare or write points one at a time \
              (`raywave bench compare A B` compares saved points; --export-json writes them all)",
             if args.compare.is_some() {
@@ -148,8 +148,7 @@ pub fn run(args: &BenchOptions, progress: &Progress) -> Result<Outcome> {
                 "--json"
             },
             points.len()
-        ))
-        .into());
+        )));
     }
     if let Some(p) = args.json.as_ref().filter(|p| p.as_os_str() != "-") {
         crate::output::image_file::check_output_dir(p)?;
@@ -228,13 +227,12 @@ pub fn run(args: &BenchOptions, progress: &Progress) -> Result<Outcome> {
                 bail!(incomparable(path, &problems));
             }
             if args.runs < crate::stats::MIN_FOR_INTERVAL as u32 {
-                return Err(UsageError(format!(
+                bail!(UsageError(format!(
                     "--compare needs --runs {} or more: with {} run(s) the median has no 95% \
                      interval, and the verdict needs one",
                     crate::stats::MIN_FOR_INTERVAL,
                     args.runs
-                ))
-                .into());
+                )));
             }
         }
         let save = args
