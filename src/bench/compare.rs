@@ -192,17 +192,15 @@ pub fn record_problems(record: &BenchRecord, engines: &[&str]) -> Vec<String> {
         out.push("it holds no engines".to_string());
     }
     let names: Vec<&str> = record.engines.iter().map(|e| e.engine.as_str()).collect();
-    for engine in engines {
-        if !names.contains(engine) {
-            out.push(format!(
-                "it has no figures for engine {engine} (it holds {})",
-                if names.is_empty() {
-                    "none".to_string()
-                } else {
-                    names.join(", ")
-                }
-            ));
-        }
+    let held = if names.is_empty() {
+        "none".to_string()
+    } else {
+        names.join(", ")
+    };
+    for engine in engines.iter().filter(|e| !names.contains(e)) {
+        out.push(format!(
+            "it has no figures for engine {engine} (it holds {held})"
+        ));
     }
     for e in record
         .engines
@@ -260,11 +258,18 @@ pub fn compare(
     if after.engines.is_empty() {
         problems.push("the newer record measured no engine".to_string());
     }
-    let mut rows = Vec::new();
+    let (mut rows, mut notes) = (Vec::new(), Vec::new());
     for a in &after.engines {
         let Some(b) = before.engines.iter().find(|b| b.engine == a.engine) else {
             continue;
         };
+        if b.median.rays.kinds.map(|k| k.rays) != a.median.rays.kinds.map(|k| k.rays) {
+            notes.push(format!(
+                "{}: ray counts differ ({} rays before, {} after): the engines no longer do \
+                 the same work",
+                a.engine, b.median.rays.total.rays, a.median.rays.total.rays
+            ));
+        }
         for fa in &a.summary {
             let Some(fb) = b.summary.iter().find(|fb| fb.figure == fa.figure) else {
                 problems.push(format!(
@@ -284,7 +289,6 @@ pub fn compare(
                 ));
                 continue;
             }
-            let change_pct = change_pct(fb.median, fa.median);
             // A figure of the newer run that is not a positive finite rate (with a positive one
             // before) fails: it is no evidence of speed.
             let verdict = if usable(fa.median) {
@@ -296,25 +300,13 @@ pub fn compare(
                 engine: a.engine.clone(),
                 before: fb.clone(),
                 after: fa.clone(),
-                change_pct,
+                change_pct: change_pct(fb.median, fa.median),
                 verdict,
             });
         }
     }
     if !problems.is_empty() {
         return Err(Refusal::Incomparable(problems));
-    }
-    let mut notes = Vec::new();
-    for a in &after.engines {
-        if let Some(b) = before.engines.iter().find(|b| b.engine == a.engine)
-            && b.median.rays.kinds.map(|k| k.rays) != a.median.rays.kinds.map(|k| k.rays)
-        {
-            notes.push(format!(
-                "{}: ray counts differ ({} rays before, {} after): the engines no longer do \
-                 the same work",
-                a.engine, b.median.rays.total.rays, a.median.rays.total.rays
-            ));
-        }
     }
     let (mb, ma) = (&before.machine, &after.machine);
     if (&mb.hostname, &mb.cpu, &before.simd) != (&ma.hostname, &ma.cpu, &after.simd) {

@@ -50,8 +50,7 @@ pub use report::report;
 pub const EXIT_REGRESSION: u8 = 3;
 
 /// Exit code of `raywave bench --against OTHER --until-decided` when no engine regressed but
-/// one was still undecided at the budget (`--max-rounds` or `--max-time`), in either
-/// `--verdict` form.
+/// one was still undecided at the budget (`--max-rounds` or `--max-time`).
 pub const EXIT_UNDECIDED: u8 = 4;
 
 /// Default `--threshold`, in percent: see docs/BENCHMARKING.md for the noise it is chosen from.
@@ -69,8 +68,7 @@ pub struct BenchOptions {
     /// Size, bounces, shadows and sampling, defaulted as for `raywave render` (a sweep's
     /// values replace size and shadow samples point by point).
     pub image: ImageOptions,
-    /// Swept sizes, shadow samples and thread counts (empty: not given; threads then all
-    /// cores).
+    /// Swept sizes, shadow samples and thread counts (empty: not given; threads: all cores).
     pub sweep: sweep::Sweep,
     /// The engines to time, in record order (reference, then wavefront).
     pub engines: Vec<Engine>,

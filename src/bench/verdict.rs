@@ -30,8 +30,7 @@ pub enum Verdict {
     NotSlower,
     /// The whole interval lies below 1 / (1 + t) (the three-way form).
     Faster,
-    /// The whole interval lies within [1 / (1 + t), 1 + t]: no change as large as t (the
-    /// three-way form).
+    /// The whole interval lies within [1 / (1 + t), 1 + t] (the three-way form).
     Within,
     /// The interval straddles a boundary: more rounds are needed to decide.
     Undecided,
@@ -61,8 +60,7 @@ impl Verdict {
 /// Which verdicts `--against` can reach (`--verdict`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum VerdictForm {
-    /// One-sided, a pull request's gate: slower by more than the threshold (a regression), or
-    /// not.
+    /// One-sided, a pull request's gate: slower by more than the threshold, or not.
     #[default]
     Regression,
     /// Slower, faster, or no change beyond the threshold.

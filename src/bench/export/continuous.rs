@@ -1,8 +1,7 @@
-//! What the exports for continuous-benchmarking services share, so that a CI job can track
-//! raywave's rays/s commit after commit: the name of each headline figure, for `--export-bmf` (Bencher Metric Format, for `bencher run --adapter
-//! json`) and `--export-github-action-benchmark` (the JSON of github-action-benchmark's
-//! `customBiggerIsBetter` tool). Each holds every headline figure of every point and engine:
-//! the median and the bounds of its 95% interval.
+//! What the exports for continuous-benchmarking services (`--export-bmf`,
+//! `--export-github-action-benchmark`) share, so that a CI job can track raywave's rays/s commit
+//! after commit: each headline figure's name. Each holds every headline figure of every point
+//! and engine: the median and the bounds of its 95% interval.
 //!
 //! ```text
 //! name     = SCENE WxH+sS+tT ENGINE FIGURE [@ HOST]    e.g. "cornell_box 512x512+s16+t2 wavefront total"

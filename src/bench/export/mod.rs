@@ -1,9 +1,6 @@
-//! `raywave bench`'s exports, one file per format behind [`Format`]: `--export-json` (the
-//! whole records), `--export-csv` and `--export-markdown` (every point's headline figures:
-//! median, its 95% interval, min, max), and for continuous-benchmarking services `--export-bmf`
-//! and `--export-github-action-benchmark` (their naming in continuous.rs). [`Exports`] writes
-//! the ones asked for, for `raywave bench` and `raywave bench merge` alike. A new format is a new
-//! file, a field of [`Exports`] and a line of [`FORMATS`].
+//! `raywave bench`'s exports, one file per format behind [`Format`] (each file says what it
+//! writes). [`Exports`] writes the ones asked for, for `raywave bench` and `raywave bench merge`
+//! alike. A new format is a new file, a field of [`Exports`] and a line of [`FORMATS`].
 
 mod bmf;
 mod continuous;
