@@ -93,7 +93,7 @@ impl Comparison {
 
     /// The table with the two columns named `a` and `b` (`raywave bench compare A B`).
     pub fn table_with(&self, a: &str, b: &str) -> String {
-        let mut s = String::new();
+        let (mut s, t) = (String::new(), self.threshold_pct);
         // In the unit the tables print: Mrays/s or Mrays/thread-s.
         let cell =
             |f: &FigureSummary| format!("{:.2} {}", f.median / 1e6, f.interval_text(1e-6, 2));
@@ -128,8 +128,7 @@ impl Comparison {
             s,
             "rule: SLOWER when the median fell by more than {t:.1}% and the 95% intervals do \
              not overlap ({b}'s high < {a}'s low); faster in the mirror case; undecided when \
-             the change passes {t:.1}% but the intervals overlap",
-            t = self.threshold_pct
+             the change passes {t:.1}% but the intervals overlap"
         );
         for n in &self.notes {
             let _ = writeln!(s, "note: {n}");
@@ -149,20 +148,12 @@ impl Comparison {
                 )
             })
             .collect();
-        if regressed.is_empty() {
-            let _ = writeln!(
-                s,
-                "verdict: no headline figure regressed (threshold {:.1}%)",
-                self.threshold_pct
-            );
+        let verdict = if regressed.is_empty() {
+            format!("no headline figure regressed (threshold {t:.1}%)")
         } else {
-            let _ = writeln!(
-                s,
-                "verdict: REGRESSION past {:.1}%: {}",
-                self.threshold_pct,
-                regressed.join(", ")
-            );
-        }
+            format!("REGRESSION past {t:.1}%: {}", regressed.join(", "))
+        };
+        let _ = writeln!(s, "verdict: {verdict}");
         s
     }
 }
