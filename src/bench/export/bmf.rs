@@ -22,10 +22,6 @@ struct Metric {
 pub(super) struct Bmf;
 
 impl Format for Bmf {
-    fn flag(&self) -> &'static str {
-        "--export-bmf"
-    }
-
     fn text(&self, records: &[BenchRecord], _labels: &[String], by_host: bool) -> Result<String> {
         let mut out = BTreeMap::new();
         for (name, _, f) in figures(records, by_host)? {

@@ -28,10 +28,6 @@ fn opt(x: Option<f64>) -> String {
 pub(super) struct Csv;
 
 impl Format for Csv {
-    fn flag(&self) -> &'static str {
-        "--export-csv"
-    }
-
     fn text(&self, records: &[BenchRecord], labels: &[String], by_host: bool) -> Result<String> {
         let host_column = if by_host { ",host" } else { "" };
         let mut out = format!("{CSV_HEADER}{host_column}\n");

@@ -23,10 +23,6 @@ struct Entry {
 pub(super) struct GithubActionBenchmark;
 
 impl Format for GithubActionBenchmark {
-    fn flag(&self) -> &'static str {
-        "--export-github-action-benchmark"
-    }
-
     fn text(&self, records: &[BenchRecord], _labels: &[String], by_host: bool) -> Result<String> {
         let mut out = Vec::new();
         for (name, r, f) in figures(records, by_host)? {

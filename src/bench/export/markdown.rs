@@ -10,10 +10,6 @@ use anyhow::Result;
 pub(super) struct Markdown;
 
 impl Format for Markdown {
-    fn flag(&self) -> &'static str {
-        "--export-markdown"
-    }
-
     fn text(&self, records: &[BenchRecord], labels: &[String], by_host: bool) -> Result<String> {
         let mut out = String::from(if by_host { "| host " } else { "" });
         out.push_str("| point | engine | figure | median | 95% interval | min | max | unit |\n");
