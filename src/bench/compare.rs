@@ -174,9 +174,8 @@ fn usable(rate: f64) -> bool {
 }
 
 /// What in `record` keeps it from being compared with a run of `engines`: an engine it lacks
-/// or that has no summary, a headline figure (an engine's total, a stage that handled rays)
-/// whose median is not a positive finite rate or that has no 95% interval (fewer than 6
-/// runs). Empty when it can be compared. Checked before anything is timed.
+/// or without a total, a headline figure whose median is not a positive finite rate or that has
+/// no 95% interval (fewer than 6 runs). Empty when it can be compared; checked before timing.
 pub fn record_problems(record: &BenchRecord, engines: &[&str]) -> Vec<String> {
     let mut out = Vec::new();
     if record.engines.is_empty() {

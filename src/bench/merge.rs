@@ -7,9 +7,8 @@
 //! records in sweep order (grouped by host with --across-machines); --save; the exports
 //! ```
 //!
-//! Rates measured on different machines are never compared as one machine's: a merge of parts
-//! from more than one host (host name and CPU) is refused unless `--across-machines` is given,
-//! and then every report, row and exported name carries its host, the points grouped by host.
+//! Rates measured on different machines are never compared as one machine's: with
+//! `--across-machines`, every report, row and exported name carries its host (name and CPU).
 
 use super::export::Exports;
 use super::running::sweep::{Point, record_name};
