@@ -12,40 +12,28 @@
 //!     each run: `BUILD render SCENE FLAGS --engine E --threads T -q -o tmp --stats-json tmp`,
 //!               its render seconds from the JSON (parsing and file writing excluded)
 //!     ratio_r = this_r / other_r
-//! per engine: median ratio, 95% interval of the median from order statistics (no resampling),
-//!             verdict against the threshold t (`Rule::judge`):
-//!     slower      when the whole interval lies above 1 + t          → exit 3 (both forms)
-//!     --verdict regression (the default), one-sided:
-//!     not slower  when the whole interval lies at or below 1 + t
-//!     --verdict three-way:
-//!     faster      when it lies below 1 / (1 + t)
-//!     within      when it lies inside [1 / (1 + t), 1 + t]
-//!     undecided otherwise (the interval straddles a boundary: more rounds narrow it)
+//! per engine: median ratio, its 95% interval (order statistics, no resampling; n ≥ 6:
+//!             `stats::median_interval_rank_at`) and the verdict against the threshold t
+//!             (`Rule::judge`; the words in verdict.rs). Slower → exit 3 in both forms
 //! ```
 //!
-//! The interval is distribution-free (`stats::median_interval_rank_at`): for n paired ratios
-//! sorted, the median lies between the k-th and the (n − k + 1)-th with probability ≥ 95%, k the
-//! largest with P(Binomial(n, ½) < k) ≤ 2.5%. It needs n ≥ 6.
-//!
 //! The default form asks a pull request's one question, "is this build slower than the other by
-//! more than t?", so a build faster than the other by about t is decided as soon as its
-//! interval's high end is at or below 1 + t; the three-way form must also place it on one side
-//! of 1 / (1 + t), and a build about t faster straddles that line for as long as the rounds go
-//! on. Both forms judge the same interval, and the regression boundary is the same test in both.
+//! more than t?", so a build about t faster is decided as soon as its interval's high end is at
+//! or below 1 + t; the three-way form must also place it on one side of 1 / (1 + t), which it
+//! straddles for as long as the rounds go on.
 //!
 //! With `--until-decided` the rounds go on until the verdict is decided, judged at planned
 //! looks with narrower levels (`sequential`), within `--max-rounds` and `--max-time`.
 
 use super::running::sequential::{self, Budget};
-use super::verdict::{RatioSummary, Rule, Verdict, summarize};
+use super::verdict::{RatioSummary, Rule, Verdict, summarize_at};
 use super::{EXIT_REGRESSION, EXIT_UNDECIDED};
 use crate::render::engine::Engine;
 use crate::render::error::UsageError;
 use crate::render::progress::{Progress, Steps};
-use crate::stats::looks::LookPlan;
+use crate::stats::looks::{self, LookPlan};
 use crate::stats::{MIN_FOR_INTERVAL, median};
 use anyhow::{Context, Result, bail};
-use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
@@ -111,7 +99,7 @@ impl EngineAb {
     /// interval when no look was taken.
     pub fn summary(&self, rule: Rule) -> RatioSummary {
         match &self.sequential {
-            None => summarize(&self.ratios(), rule),
+            None => summarize_at(&self.ratios(), rule, looks::ALPHA),
             Some(outcome) => outcome.looks.last().map_or(
                 RatioSummary {
                     median: median(&self.ratios()),
@@ -135,7 +123,7 @@ fn check_executable(path: &Path) -> Result<()> {
         ))
     })?;
     if !meta.is_file() || meta.permissions().mode() & 0o111 == 0 {
-        return Err(UsageError(format!(
+        bail!(UsageError(format!(
             "--against {}: expected an executable raywave binary, found {}",
             path.display(),
             if meta.is_file() {
@@ -143,8 +131,7 @@ fn check_executable(path: &Path) -> Result<()> {
             } else {
                 "something that is not a regular file"
             }
-        ))
-        .into());
+        )));
     }
     Ok(())
 }
@@ -176,16 +163,16 @@ fn time_one(
         .output()
         .with_context(|| format!("cannot run {}", binary.display()))?;
     if !out.status.success() {
-        let args: Vec<OsString> = cmd.get_args().map(OsString::from).collect();
+        let args: Vec<_> = cmd
+            .get_args()
+            .skip(1)
+            .map(|a| a.to_string_lossy())
+            .collect();
         bail!(
             "{} failed ({}) on `render {}`:\n{}",
             binary.display(),
             out.status,
-            args[1..]
-                .iter()
-                .map(|a| a.to_string_lossy())
-                .collect::<Vec<_>>()
-                .join(" "),
+            args.join(" "),
             String::from_utf8_lossy(&out.stderr).trim_end()
         );
     }
@@ -235,25 +222,22 @@ impl Builds<'_> {
         result: &mut EngineAb,
         runs: &Steps,
     ) -> Result<(f64, f64)> {
+        let run = |binary: &Path| -> Result<(f64, String)> {
+            let time = time_one(binary, self.options, engine, self.scratch.path())?;
+            runs.step();
+            Ok(time)
+        };
         // Alternate which build goes first, so that neither always runs on a warmer or cooler
         // machine.
-        let order = if round.is_multiple_of(2) {
-            [&self.this, &self.options.other]
-        } else {
-            [&self.options.other, &self.this]
-        };
-        let mut times = [(0.0, String::new()), (0.0, String::new())];
-        for (slot, binary) in order.into_iter().enumerate() {
-            times[slot] = time_one(binary, self.options, engine, self.scratch.path())?;
-            runs.step();
-        }
         let (mine, theirs) = if round.is_multiple_of(2) {
-            (&times[0], &times[1])
+            let mine = run(&self.this)?;
+            (mine, run(&self.options.other)?)
         } else {
-            (&times[1], &times[0])
+            let theirs = run(&self.options.other)?;
+            (run(&self.this)?, theirs)
         };
         if mine.1 != theirs.1 && result.different_work.is_none() {
-            result.different_work = Some((mine.1.clone(), theirs.1.clone()));
+            result.different_work = Some((mine.1.clone(), theirs.1));
         }
         Ok((mine.0, theirs.0))
     }
@@ -267,11 +251,10 @@ pub fn run(options: &AbOptions, progress: &Progress) -> Result<Vec<EngineAb>> {
         Some(budget) => ("--max-rounds", budget.max_rounds),
     };
     if timed.1 < MIN_ROUNDS {
-        return Err(UsageError(format!(
+        bail!(UsageError(format!(
             "{} {}: a 95% interval of the median needs at least {MIN_ROUNDS} rounds",
             timed.0, timed.1
-        ))
-        .into());
+        )));
     }
     check_executable(&options.other)?;
     let builds = Builds {
@@ -368,6 +351,7 @@ pub fn exit_code(options: &AbOptions, results: &[EngineAb]) -> u8 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bench::verdict::summarize;
 
     #[test]
     fn verdicts_follow_the_whole_interval() {

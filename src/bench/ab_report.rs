@@ -67,11 +67,8 @@ pub fn report(options: &AbOptions, results: &[EngineAb]) -> String {
             if xs.is_empty() {
                 return "no rounds".to_string();
             }
-            let (lo, hi) = xs
-                .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
-                    (a.min(x), b.max(x))
-                });
+            let lo = xs.iter().copied().fold(f64::INFINITY, f64::min);
+            let hi = xs.iter().copied().fold(f64::NEG_INFINITY, f64::max);
             format!("{:.4} s ({:.3}–{:.3})", median(xs), lo, hi)
         };
         let verdict = match (s.verdict, &r.sequential) {

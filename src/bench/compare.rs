@@ -5,6 +5,7 @@
 
 use super::verdict::{Verdict, change_pct, of_records};
 use crate::output::bench_record::{BenchRecord, FigureSummary, Setup};
+use serde_json::Value;
 use std::fmt::Write;
 
 /// The fields in which two setups differ, as `path: X in the record, Y now` lines (empty if
@@ -15,47 +16,39 @@ pub fn setup_differences(before: &Setup, after: &Setup) -> Vec<String> {
 
 /// [`setup_differences`] with the two sides named (`in A`, `in B`).
 pub fn setup_differences_as(before: &Setup, after: &Setup, a: &str, b: &str) -> Vec<String> {
-    let va = serde_json::to_value(before).unwrap_or_default();
-    let vb = serde_json::to_value(after).unwrap_or_default();
     let mut out = Vec::new();
-    diff("", &va, &vb, &mut out);
-    out.into_iter()
-        .map(|(path, x, y)| format!("{path}: {x} {a}, {y} {b}"))
-        .collect()
+    let value = |s: &Setup| serde_json::to_value(s).unwrap_or_default();
+    diff("", &value(before), &value(after), &mut |path, x, y| {
+        out.push(format!("{path}: {x} {a}, {y} {b}"));
+    });
+    out
 }
 
-fn diff(
-    path: &str,
-    a: &serde_json::Value,
-    b: &serde_json::Value,
-    out: &mut Vec<(String, String, String)>,
-) {
-    use serde_json::Value::Object;
+/// Calls `found` with the path and both values of each leaf where `x` and `y` differ.
+fn diff(path: &str, x: &Value, y: &Value, found: &mut dyn FnMut(&str, &Value, &Value)) {
     // The scene's source is its name only: the text hash and counts decide.
     if path == "scene.source" {
         return;
     }
-    match (a, b) {
-        (Object(ma), Object(mb)) => {
-            let mut keys: Vec<&String> = ma.keys().chain(mb.keys()).collect();
-            keys.sort();
-            keys.dedup();
+    match (x, y) {
+        (Value::Object(mx), Value::Object(my)) => {
+            let keys: std::collections::BTreeSet<&String> = mx.keys().chain(my.keys()).collect();
             for k in keys {
-                let null = serde_json::Value::Null;
                 let p = if path.is_empty() {
                     k.clone()
                 } else {
                     format!("{path}.{k}")
                 };
+                let null = &Value::Null;
                 diff(
                     &p,
-                    ma.get(k).unwrap_or(&null),
-                    mb.get(k).unwrap_or(&null),
-                    out,
+                    mx.get(k).unwrap_or(null),
+                    my.get(k).unwrap_or(null),
+                    found,
                 );
             }
         }
-        _ if a != b => out.push((path.to_string(), a.to_string(), b.to_string())),
+        _ if x != y => found(path, x, y),
         _ => {}
     }
 }
@@ -86,11 +79,6 @@ pub struct Comparison {
     pub notes: Vec<String>,
 }
 
-/// The figure in the unit the tables print (Mrays/s or Mrays/thread-s).
-fn mega(x: f64) -> f64 {
-    x / 1e6
-}
-
 impl Comparison {
     /// Whether any headline figure regressed.
     pub fn regressed(&self) -> bool {
@@ -105,9 +93,10 @@ impl Comparison {
 
     /// The table with the two columns named `a` and `b` (`raywave bench compare A B`).
     pub fn table_with(&self, a: &str, b: &str) -> String {
-        let mut s = String::new();
+        let (mut s, t) = (String::new(), self.threshold_pct);
+        // In the unit the tables print: Mrays/s or Mrays/thread-s.
         let cell =
-            |f: &FigureSummary| format!("{:.2} {}", mega(f.median), f.interval_text(1e-6, 2));
+            |f: &FigureSummary| format!("{:.2} {}", f.median / 1e6, f.interval_text(1e-6, 2));
         let _ = writeln!(
             s,
             "{:<10} {:<17} {:>26} {:>26} {:>8}  verdict",
@@ -139,8 +128,7 @@ impl Comparison {
             s,
             "rule: SLOWER when the median fell by more than {t:.1}% and the 95% intervals do \
              not overlap ({b}'s high < {a}'s low); faster in the mirror case; undecided when \
-             the change passes {t:.1}% but the intervals overlap",
-            t = self.threshold_pct
+             the change passes {t:.1}% but the intervals overlap"
         );
         for n in &self.notes {
             let _ = writeln!(s, "note: {n}");
@@ -160,20 +148,12 @@ impl Comparison {
                 )
             })
             .collect();
-        if regressed.is_empty() {
-            let _ = writeln!(
-                s,
-                "verdict: no headline figure regressed (threshold {:.1}%)",
-                self.threshold_pct
-            );
+        let verdict = if regressed.is_empty() {
+            format!("no headline figure regressed (threshold {t:.1}%)")
         } else {
-            let _ = writeln!(
-                s,
-                "verdict: REGRESSION past {:.1}%: {}",
-                self.threshold_pct,
-                regressed.join(", ")
-            );
-        }
+            format!("REGRESSION past {t:.1}%: {}", regressed.join(", "))
+        };
+        let _ = writeln!(s, "verdict: {verdict}");
         s
     }
 }
@@ -188,41 +168,29 @@ pub enum Refusal {
     Incomparable(Vec<String>),
 }
 
-impl Refusal {
-    /// The lines, whichever the kind.
-    pub fn lines(&self) -> &[String] {
-        match self {
-            Refusal::Setup(l) | Refusal::Incomparable(l) => l,
-        }
-    }
-}
-
 /// A headline rate that a verdict can rest on: finite and above zero.
 fn usable(rate: f64) -> bool {
     rate.is_finite() && rate > 0.0
 }
 
 /// What in `record` keeps it from being compared with a run of `engines`: an engine it lacks
-/// or that has no summary, a headline figure (an engine's total, a stage that handled rays)
-/// whose median is not a positive finite rate or that has no 95% interval (fewer than 6
-/// runs). Empty when it can be compared. Checked before anything is timed.
+/// or without a total, a headline figure whose median is not a positive finite rate or that has
+/// no 95% interval (fewer than 6 runs). Empty when it can be compared; checked before timing.
 pub fn record_problems(record: &BenchRecord, engines: &[&str]) -> Vec<String> {
     let mut out = Vec::new();
     if record.engines.is_empty() {
         out.push("it holds no engines".to_string());
     }
     let names: Vec<&str> = record.engines.iter().map(|e| e.engine.as_str()).collect();
-    for engine in engines {
-        if !names.contains(engine) {
-            out.push(format!(
-                "it has no figures for engine {engine} (it holds {})",
-                if names.is_empty() {
-                    "none".to_string()
-                } else {
-                    names.join(", ")
-                }
-            ));
-        }
+    let held = if names.is_empty() {
+        "none".to_string()
+    } else {
+        names.join(", ")
+    };
+    for engine in engines.iter().filter(|e| !names.contains(e)) {
+        out.push(format!(
+            "it has no figures for engine {engine} (it holds {held})"
+        ));
     }
     for e in record
         .engines
@@ -280,11 +248,18 @@ pub fn compare(
     if after.engines.is_empty() {
         problems.push("the newer record measured no engine".to_string());
     }
-    let mut rows = Vec::new();
+    let (mut rows, mut notes) = (Vec::new(), Vec::new());
     for a in &after.engines {
         let Some(b) = before.engines.iter().find(|b| b.engine == a.engine) else {
             continue;
         };
+        if b.median.rays.kinds.map(|k| k.rays) != a.median.rays.kinds.map(|k| k.rays) {
+            notes.push(format!(
+                "{}: ray counts differ ({} rays before, {} after): the engines no longer do \
+                 the same work",
+                a.engine, b.median.rays.total.rays, a.median.rays.total.rays
+            ));
+        }
         for fa in &a.summary {
             let Some(fb) = b.summary.iter().find(|fb| fb.figure == fa.figure) else {
                 problems.push(format!(
@@ -304,7 +279,6 @@ pub fn compare(
                 ));
                 continue;
             }
-            let change_pct = change_pct(fb.median, fa.median);
             // A figure of the newer run that is not a positive finite rate (with a positive one
             // before) fails: it is no evidence of speed.
             let verdict = if usable(fa.median) {
@@ -316,25 +290,13 @@ pub fn compare(
                 engine: a.engine.clone(),
                 before: fb.clone(),
                 after: fa.clone(),
-                change_pct,
+                change_pct: change_pct(fb.median, fa.median),
                 verdict,
             });
         }
     }
     if !problems.is_empty() {
         return Err(Refusal::Incomparable(problems));
-    }
-    let mut notes = Vec::new();
-    for a in &after.engines {
-        if let Some(b) = before.engines.iter().find(|b| b.engine == a.engine)
-            && b.median.rays.kinds.map(|k| k.rays) != a.median.rays.kinds.map(|k| k.rays)
-        {
-            notes.push(format!(
-                "{}: ray counts differ ({} rays before, {} after): the engines no longer do \
-                 the same work",
-                a.engine, b.median.rays.total.rays, a.median.rays.total.rays
-            ));
-        }
     }
     let (mb, ma) = (&before.machine, &after.machine);
     if (&mb.hostname, &mb.cpu, &before.simd) != (&ma.hostname, &ma.cpu, &after.simd) {

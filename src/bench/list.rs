@@ -5,19 +5,14 @@ use crate::output::bench_record::{self as record, BenchRecord};
 use anyhow::{Context, Result, bail};
 use std::path::{Path, PathBuf};
 
-/// Where `compare`'s argument lives: a path when it ends in `.json`, else a record name in
-/// `dir` (`record::record_path`).
-fn locate(dir: &Path, name: &str) -> Result<PathBuf> {
-    if name.ends_with(".json") {
-        Ok(PathBuf::from(name))
+/// Loads `compare`'s argument `name`: the file `name` when it ends in `.json`, else the record
+/// `name` in `dir` (`record::record_path`).
+fn load(dir: &Path, name: &str) -> Result<BenchRecord> {
+    let path = if name.ends_with(".json") {
+        PathBuf::from(name)
     } else {
-        record::record_path(dir, name)
-    }
-}
-
-/// Loads the record `name` (see [`locate`]).
-pub fn load(dir: &Path, name: &str) -> Result<BenchRecord> {
-    let path = locate(dir, name)?;
+        record::record_path(dir, name)?
+    };
     record::load(&path, name.trim_end_matches(".json"))
 }
 

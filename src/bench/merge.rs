@@ -7,16 +7,15 @@
 //! records in sweep order (grouped by host with --across-machines); --save; the exports
 //! ```
 //!
-//! Rates measured on different machines are never compared as one machine's: a merge of parts
-//! from more than one host (host name and CPU) is refused unless `--across-machines` is given,
-//! and then every report, row and exported name carries its host, the points grouped by host.
+//! Rates measured on different machines are never compared as one machine's: with
+//! `--across-machines`, every report, row and exported name carries its host (name and CPU).
 
 use super::export::Exports;
-use super::running::sweep::record_name;
+use super::running::sweep::{Point, record_name};
 use super::shard::SweepPoints;
 use crate::output::OutputPlan;
 use crate::output::bench_record::{self as record, BenchRecord};
-use crate::shard::{HostSummary, Machines};
+use crate::shard::Machines;
 use anyhow::Result;
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -64,35 +63,27 @@ pub fn merge(args: &MergeOptions) -> Result<Merged> {
     };
     let mut shards = crate::shard::merge::<SweepPoints>(&args.parts, machines)?;
     let by_host = args.across_machines;
-    let sweep = shards.identity().work.clone();
     // In sweep order, or grouped by host (hosts in the order of their first point, each
     // host's points in sweep order).
-    let mut order: Vec<usize> = (0..sweep.points.len()).collect();
-    if by_host {
-        order.sort_by_key(|&i| (shards.item_host[i], i));
-    }
-    let mut slots: Vec<Option<BenchRecord>> = std::mem::take(&mut shards.results)
+    let mut rows: Vec<(usize, BenchRecord)> = std::mem::take(&mut shards.results)
         .into_iter()
-        .map(Some)
+        .enumerate()
         .collect();
-    let mut records = Vec::new();
-    let mut labels = Vec::new();
-    let mut host_of = Vec::new();
-    for &i in &order {
-        records.extend(slots[i].take());
-        labels.push(sweep.points[i].label.clone());
-        host_of.push(shards.item_host[i]);
+    if by_host {
+        rows.sort_by_key(|&(i, _)| (shards.item_host[i], i));
     }
+    let points = &shards.identity().work.points;
+    let labels: Vec<String> = rows.iter().map(|(i, _)| points[*i].label.clone()).collect();
+    let host_of = rows.iter().map(|(i, _)| shards.item_host[*i]).collect();
+    let records: Vec<BenchRecord> = rows.into_iter().map(|(_, r)| r).collect();
 
     // Every output is checked against the parts and each other before anything is written.
     let mut to_save = Vec::new();
     if let Some(name) = &args.save {
         for label in &labels {
-            let point = super::running::sweep::Point {
-                size: None,
-                shadow_samples: None,
-                threads: None,
+            let point = Point {
                 label: label.clone(),
+                ..Point::default()
             };
             to_save.push(record::record_path(&args.dir, &record_name(name, &point))?);
         }
@@ -132,12 +123,8 @@ impl Merged {
             let mut host = None;
             for ((r, label), &h) in self.records.iter().zip(&self.labels).zip(&self.host_of) {
                 if self.by_host && host != Some(h) {
-                    let _ = writeln!(
-                        out,
-                        "\nhost    {} · {}",
-                        self.hosts()[h].hostname,
-                        self.hosts()[h].cpu
-                    );
+                    let (name, cpu) = (&self.shards.hosts[h].hostname, &self.shards.hosts[h].cpu);
+                    let _ = writeln!(out, "\nhost    {name} · {cpu}");
                     host = Some(h);
                 }
                 if !label.is_empty() {
@@ -155,7 +142,7 @@ impl Merged {
             "merged  {} shard(s), {} point(s) of one sweep, measured on {} host(s)",
             self.shards.parts.len(),
             self.records.len(),
-            self.hosts().len()
+            self.shards.hosts.len()
         );
         let sweep = &self.shards.identity().work;
         for (path, part) in &self.shards.parts {
@@ -164,24 +151,17 @@ impl Merged {
                 .iter()
                 .map(|&i| sweep.points[i].label.as_str())
                 .collect();
-            let points = if labels.is_empty() {
-                "no points".to_string()
-            } else if labels.iter().all(|l| l.is_empty()) {
-                format!("{} point(s)", labels.len())
-            } else {
-                labels.join(", ")
-            };
             let _ = writeln!(
                 out,
                 "  {} {}: {} on {}, {:.2} s",
                 part.shard,
                 path.display(),
-                points,
+                super::points_text(&labels, "no points"),
                 part.host.hostname,
                 part.host.seconds()
             );
         }
-        for h in self.hosts() {
+        for h in &self.shards.hosts {
             let _ = writeln!(out, "  host {}: {}", h.hostname, h.cpu);
         }
         let _ = writeln!(
@@ -192,10 +172,5 @@ impl Merged {
             self.shards.elapsed_seconds()
         );
         out
-    }
-
-    /// The machines that ran the shards, in the order of the first point each ran.
-    pub fn hosts(&self) -> &[HostSummary] {
-        &self.shards.hosts
     }
 }

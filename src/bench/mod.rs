@@ -35,6 +35,7 @@ use running::{measure, sweep};
 use crate::output::bench_record::{self as record, BenchRecord, SceneId, Setup};
 use crate::output::machine::Machine;
 use crate::render::engine::{Engine, thread_pool};
+use crate::render::error::UsageError;
 use crate::render::progress::Progress;
 use crate::render::scene::{SceneFile, load_scene};
 use crate::render::settings::options::ImageOptions;
@@ -49,8 +50,7 @@ pub use report::report;
 pub const EXIT_REGRESSION: u8 = 3;
 
 /// Exit code of `raywave bench --against OTHER --until-decided` when no engine regressed but
-/// one was still undecided at the budget (`--max-rounds` or `--max-time`), in either
-/// `--verdict` form.
+/// one was still undecided at the budget (`--max-rounds` or `--max-time`).
 pub const EXIT_UNDECIDED: u8 = 4;
 
 /// Default `--threshold`, in percent: see docs/BENCHMARKING.md for the noise it is chosen from.
@@ -68,8 +68,7 @@ pub struct BenchOptions {
     /// Size, bounces, shadows and sampling, defaulted as for `raywave render` (a sweep's
     /// values replace size and shadow samples point by point).
     pub image: ImageOptions,
-    /// Swept sizes, shadow samples and thread counts (empty: not given; threads then all
-    /// cores).
+    /// Swept sizes, shadow samples and thread counts (empty: not given; threads: all cores).
     pub sweep: sweep::Sweep,
     /// The engines to time, in record order (reference, then wavefront).
     pub engines: Vec<Engine>,
@@ -124,20 +123,9 @@ pub struct Outcome {
     pub part: Option<(PathBuf, crate::shard::Shard, usize)>,
 }
 
-impl Outcome {
-    /// The process exit code: [`EXIT_REGRESSION`] when the comparison regressed, else 0.
-    pub fn exit_code(&self) -> u8 {
-        match &self.comparison {
-            Some((c, _)) if c.regressed() => EXIT_REGRESSION,
-            _ => 0,
-        }
-    }
-}
-
 /// One point, ready to time: everything refusable was checked.
 struct Plan {
     point: sweep::Point,
-    settings: crate::render::settings::RenderSettings,
     pool: rayon::ThreadPool,
     setup: Setup,
     engines: Vec<Engine>,
@@ -149,7 +137,7 @@ pub fn run(args: &BenchOptions, progress: &Progress) -> Result<Outcome> {
     // Everything that can fail cheaply happens before the timed part.
     let points = args.sweep.points();
     if points.len() > 1 && (args.compare.is_some() || args.json.is_some()) {
-        return Err(crate::render::error::UsageError(format!(
+        bail!(UsageError(format!(
             "{} takes one point, but the sweep has {}: compare or write points one at a time \
              (`raywave bench compare A B` compares saved points; --export-json writes them all)",
             if args.compare.is_some() {
@@ -158,8 +146,7 @@ pub fn run(args: &BenchOptions, progress: &Progress) -> Result<Outcome> {
                 "--json"
             },
             points.len()
-        ))
-        .into());
+        )));
     }
     if let Some(p) = args.json.as_ref().filter(|p| p.as_os_str() != "-") {
         crate::output::image_file::check_output_dir(p)?;
@@ -206,7 +193,7 @@ pub fn run(args: &BenchOptions, progress: &Progress) -> Result<Outcome> {
         }
         settings
             .check_sampler()
-            .map_err(|e| crate::render::error::UsageError(e.to_string()))?;
+            .map_err(|e| UsageError(e.to_string()))?;
         let pool = thread_pool(threads)?;
         let setup = Setup {
             scene: SceneId {
@@ -216,7 +203,7 @@ pub fn run(args: &BenchOptions, progress: &Progress) -> Result<Outcome> {
                 spheres: scene.spheres.len(),
                 lights: scene.lights.len(),
             },
-            settings: settings.clone(),
+            settings,
             threads: pool.current_num_threads(),
             batch_size: DEFAULT_BATCH_SIZE,
         };
@@ -238,25 +225,21 @@ pub fn run(args: &BenchOptions, progress: &Progress) -> Result<Outcome> {
                 bail!(incomparable(path, &problems));
             }
             if args.runs < crate::stats::MIN_FOR_INTERVAL as u32 {
-                return Err(crate::render::error::UsageError(format!(
+                bail!(UsageError(format!(
                     "--compare needs --runs {} or more: with {} run(s) the median has no 95% \
                      interval, and the verdict needs one",
                     crate::stats::MIN_FOR_INTERVAL,
                     args.runs
-                ))
-                .into());
+                )));
             }
         }
-        let save = match &args.save {
-            Some(name) => Some(record::record_path(
-                &args.dir,
-                &sweep::record_name(name, &point),
-            )?),
-            None => None,
-        };
+        let save = args
+            .save
+            .as_ref()
+            .map(|name| record::record_path(&args.dir, &sweep::record_name(name, &point)))
+            .transpose()?;
         plans.push(Plan {
             point,
-            settings,
             pool,
             setup,
             engines,
@@ -268,33 +251,30 @@ pub fn run(args: &BenchOptions, progress: &Progress) -> Result<Outcome> {
     let build = crate::output::build_info::current();
     let simd = crate::simd_path_for(args.lanes).to_string();
     let sweep_points = plans.len();
-    let shard_run = match &args.shard {
-        Some((which, dir)) => {
-            let sweep = shard::SweepPoints {
-                engines: args.engines.iter().map(|e| e.name().to_string()).collect(),
-                runs: args.runs,
-                warmup: args.warmup,
-                points: plans
-                    .iter()
-                    .map(|p| shard::SweepPoint {
-                        label: p.point.label.clone(),
-                        setup: p.setup.clone(),
-                        cost: shard::cost(&p.setup, args.runs, args.warmup),
-                    })
-                    .collect(),
-            };
-            let identity = crate::shard::Identity::current(&simd, sweep);
-            let mine = which.items(&crate::shard::Work::costs(&identity.work));
-            plans = plans
-                .into_iter()
-                .enumerate()
-                .filter(|(i, _)| mine.contains(i))
-                .map(|(_, p)| p)
-                .collect();
-            Some((*which, dir, identity, mine))
-        }
-        None => None,
-    };
+    let shard_run = args.shard.as_ref().map(|(which, dir)| {
+        let sweep = shard::SweepPoints {
+            engines: args.engines.iter().map(|e| e.name().to_string()).collect(),
+            runs: args.runs,
+            warmup: args.warmup,
+            points: plans
+                .iter()
+                .map(|p| shard::SweepPoint {
+                    label: p.point.label.clone(),
+                    setup: p.setup.clone(),
+                    cost: shard::cost(&p.setup, args.runs, args.warmup),
+                })
+                .collect(),
+        };
+        let identity = crate::shard::Identity::current(&simd, sweep);
+        let mine = which.items(&crate::shard::Work::costs(&identity.work));
+        plans = std::mem::take(&mut plans)
+            .into_iter()
+            .enumerate()
+            .filter(|(i, _)| mine.contains(i))
+            .map(|(_, p)| p)
+            .collect();
+        (*which, dir, identity, mine)
+    });
     let host = crate::shard::Host::start(rayon::current_num_threads());
 
     if let Some(w) = report::load_warning() {
@@ -307,17 +287,7 @@ pub fn run(args: &BenchOptions, progress: &Progress) -> Result<Outcome> {
     let runs = progress.steps(total, "runs");
     let mut records = Vec::new();
     for plan in &plans {
-        let engines = measure::measure(
-            &plan.pool,
-            &scene,
-            &plan.settings,
-            &plan.engines,
-            args.lanes,
-            args.warmup,
-            args.runs,
-            &runs,
-            progress.notice,
-        );
+        let engines = measure::measure(plan, &scene, args, &runs, progress.notice);
         let record = BenchRecord {
             format: record::FORMAT,
             raywave: env!("CARGO_PKG_VERSION").to_string(),
@@ -325,13 +295,7 @@ pub fn run(args: &BenchOptions, progress: &Progress) -> Result<Outcome> {
             git_dirty: build.dirty,
             build: build.clone(),
             timestamp: record::now_utc(),
-            machine: Machine {
-                hostname: crate::output::machine::hostname(),
-                cpu: crate::output::machine::cpu_model(),
-                logical_cpus: crate::output::machine::logical_cpus(),
-                os: std::env::consts::OS.to_string(),
-                arch: std::env::consts::ARCH.to_string(),
-            },
+            machine: Machine::current(),
             simd: simd.clone(),
             setup: plan.setup.clone(),
             runs: args.runs,
@@ -386,21 +350,20 @@ pub fn run(args: &BenchOptions, progress: &Progress) -> Result<Outcome> {
         github_action_benchmark: args.export_github_action_benchmark.clone(),
     }
     .write(&records, &labels, false)?;
-    let part = match shard_run {
-        Some((which, dir, identity, points)) => {
+    let part = shard_run
+        .map(|(which, dir, identity, items)| -> Result<_> {
             let mut part = crate::shard::Part {
                 identity,
                 shard: which,
-                items: points,
+                items,
                 host,
                 extra: (),
                 results: records.clone(),
             };
             part.host.finish();
-            Some((crate::shard::write_part(dir, &part)?, which, sweep_points))
-        }
-        None => None,
-    };
+            Ok((crate::shard::write_part(dir, &part)?, which, sweep_points))
+        })
+        .transpose()?;
     Ok(Outcome {
         records,
         labels,
@@ -411,6 +374,14 @@ pub fn run(args: &BenchOptions, progress: &Progress) -> Result<Outcome> {
 }
 
 impl Outcome {
+    /// The process exit code: [`EXIT_REGRESSION`] when the comparison regressed, else 0.
+    pub fn exit_code(&self) -> u8 {
+        match &self.comparison {
+            Some((c, _)) if c.regressed() => EXIT_REGRESSION,
+            _ => 0,
+        }
+    }
+
     /// The text a run prints: each point's report (unless `quiet`), the records saved, then
     /// the comparison with the record named `compared_with`.
     pub fn text(&self, quiet: bool, compared_with: Option<&str>) -> String {
@@ -427,19 +398,10 @@ impl Outcome {
             }
         }
         if let (false, Some((path, which, of))) = (quiet, &self.part) {
-            let points = if self.labels.iter().all(|l| l.is_empty()) {
-                format!("{} point(s)", self.labels.len())
-            } else {
-                self.labels.join(", ")
-            };
             out.push_str(&format!(
                 "shard   {which}: {} of the sweep's {of} point(s), split by estimated cost\n\
                  wrote   {}\n",
-                if self.labels.is_empty() {
-                    "none".to_string()
-                } else {
-                    points
-                },
+                points_text(&self.labels, "none"),
                 path.display()
             ));
         }
@@ -456,6 +418,18 @@ impl Outcome {
             ));
         }
         out
+    }
+}
+
+/// Points by their labels, counted when a sweep of one point has none, `none` when there are
+/// no points.
+fn points_text<S: std::borrow::Borrow<str>>(labels: &[S], none: &str) -> String {
+    if labels.is_empty() {
+        none.to_string()
+    } else if labels.iter().all(|l| l.borrow().is_empty()) {
+        format!("{} point(s)", labels.len())
+    } else {
+        labels.join(", ")
     }
 }
 

@@ -130,14 +130,15 @@ pub fn report(r: &BenchRecord) -> String {
 }
 
 fn outlier_text(f: &FigureSummary) -> String {
-    if f.outliers.is_empty() {
+    let runs: Vec<String> = f
+        .outliers
+        .iter()
+        .map(|i| format!("run {}", i + 1))
+        .collect();
+    if runs.is_empty() {
         "-".to_string()
     } else {
-        f.outliers
-            .iter()
-            .map(|i| format!("run {}", i + 1))
-            .collect::<Vec<_>>()
-            .join(", ")
+        runs.join(", ")
     }
 }
 

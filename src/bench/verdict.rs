@@ -30,8 +30,7 @@ pub enum Verdict {
     NotSlower,
     /// The whole interval lies below 1 / (1 + t) (the three-way form).
     Faster,
-    /// The whole interval lies within [1 / (1 + t), 1 + t]: no change as large as t (the
-    /// three-way form).
+    /// The whole interval lies within [1 / (1 + t), 1 + t] (the three-way form).
     Within,
     /// The interval straddles a boundary: more rounds are needed to decide.
     Undecided,
@@ -61,8 +60,7 @@ impl Verdict {
 /// Which verdicts `--against` can reach (`--verdict`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum VerdictForm {
-    /// One-sided, a pull request's gate: slower by more than the threshold (a regression), or
-    /// not.
+    /// One-sided, a pull request's gate: slower by more than the threshold, or not.
     #[default]
     Regression,
     /// Slower, faster, or no change beyond the threshold.
@@ -78,7 +76,10 @@ pub struct Rule {
     pub form: VerdictForm,
 }
 
+#[cfg(test)]
 impl Rule {
+    // For the tests: the command line builds its `Rule` whole.
+
     /// The pull-request gate's rule at `threshold_pct`: one-sided, a regression or not.
     pub fn regression(threshold_pct: f64) -> Rule {
         Rule {
@@ -94,7 +95,9 @@ impl Rule {
             form: VerdictForm::ThreeWay,
         }
     }
+}
 
+impl Rule {
     /// The verdict of an interval [`low`, `high`] of the ratio this / other.
     ///
     /// "Slower by more than t" needs the whole interval above 1 + t (strictly: a low end at
@@ -125,23 +128,13 @@ pub fn of_records(before: &FigureSummary, after: &FigureSummary, threshold_pct: 
     else {
         return Verdict::Undecided;
     };
-    let apart_below = ah < bl;
-    let apart_above = al > bh;
-    if change < -threshold_pct {
-        if apart_below {
-            Verdict::Slower
-        } else {
-            Verdict::Undecided
-        }
-    } else if change > threshold_pct {
-        if apart_above {
-            Verdict::Faster
-        } else {
-            Verdict::Undecided
-        }
-    } else {
-        // Apart or not, the change is within what the threshold says matters.
-        Verdict::Within
+    // Past the threshold the intervals must be apart too; within it, apart or not, the change
+    // is within what the threshold says matters.
+    match (change < -threshold_pct, change > threshold_pct) {
+        (true, _) if ah < bl => Verdict::Slower,
+        (_, true) if al > bh => Verdict::Faster,
+        (false, false) => Verdict::Within,
+        _ => Verdict::Undecided,
     }
 }
 
@@ -159,8 +152,9 @@ pub struct RatioSummary {
 }
 
 /// Median, 95% interval and verdict of per-round ratios.
+#[cfg(test)]
 pub fn summarize(ratios: &[f64], rule: Rule) -> RatioSummary {
-    summarize_at(ratios, rule, 0.05)
+    summarize_at(ratios, rule, crate::stats::looks::ALPHA)
 }
 
 /// Median, (1 − `alpha`) interval and verdict of per-round ratios.

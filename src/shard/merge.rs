@@ -75,10 +75,7 @@ impl<W: Work> Merged<W> {
 
 /// Whether `a` and `b` name the same file (both resolved; false when either does not exist).
 pub(crate) fn same_file(a: &Path, b: &Path) -> bool {
-    match (a.canonicalize(), b.canonicalize()) {
-        (Ok(a), Ok(b)) => a == b,
-        _ => false,
-    }
+    matches!((a.canonicalize(), b.canonicalize()), (Ok(a), Ok(b)) if a == b)
 }
 
 /// The part files named by `inputs`: each file as given, and in each directory its
@@ -189,37 +186,27 @@ pub fn merge<W: Work>(inputs: &[PathBuf], machines: Machines) -> Result<Merged<W
             missing[0]
         );
     }
-    let mut parts: Vec<(PathBuf, Part<W>)> = {
-        let mut v: Vec<Option<(PathBuf, Part<W>)>> = parts.into_iter().map(Some).collect();
-        by_index
-            .iter()
-            .filter_map(|k| k.and_then(|k| v[k].take()))
-            .collect()
-    };
+    // Every shard is here exactly once now, so its index is its place.
+    let items = first.identity.work.costs().len();
+    parts.sort_by_key(|(_, p)| p.shard.index);
 
-    let items = first_items(&parts);
     let mut hosts: Vec<HostSummary> = Vec::new();
     let mut item_host = vec![usize::MAX; items];
     // Machines in the order of the first item each ran.
     let mut by_first: Vec<&(PathBuf, Part<W>)> = parts.iter().collect();
     by_first.sort_by_key(|(_, p)| p.items.first().copied().unwrap_or(usize::MAX));
     for (_, part) in by_first {
-        let at = match hosts
-            .iter()
-            .position(|h| (&h.hostname, &h.cpu) == (&part.host.hostname, &part.host.cpu))
-        {
-            Some(at) => at,
-            None => {
-                hosts.push(HostSummary {
-                    hostname: part.host.hostname.clone(),
-                    cpu: part.host.cpu.clone(),
-                    shards: 0,
-                    items: 0,
-                    seconds: 0.0,
-                });
-                hosts.len() - 1
-            }
-        };
+        let same = |h: &HostSummary| (&h.hostname, &h.cpu) == (&part.host.hostname, &part.host.cpu);
+        let at = hosts.iter().position(same).unwrap_or_else(|| {
+            hosts.push(HostSummary {
+                hostname: part.host.hostname.clone(),
+                cpu: part.host.cpu.clone(),
+                shards: 0,
+                items: 0,
+                seconds: 0.0,
+            });
+            hosts.len() - 1
+        });
         let h = &mut hosts[at];
         h.shards += 1;
         h.items += part.items.len();
@@ -261,13 +248,6 @@ pub fn merge<W: Work>(inputs: &[PathBuf], machines: Machines) -> Result<Merged<W
         hosts,
         item_host,
     })
-}
-
-/// How many items the run has (every part's identity agrees by now).
-fn first_items<W: Work>(parts: &[(PathBuf, Part<W>)]) -> usize {
-    parts
-        .first()
-        .map_or(0, |(_, p)| p.identity.work.costs().len())
 }
 
 #[cfg(test)]

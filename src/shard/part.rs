@@ -106,15 +106,6 @@ pub fn part_name<W: Work>(shard: Shard) -> String {
     format!("{}-shard-{}-of-{}.part", W::KIND, shard.index, shard.count)
 }
 
-/// The kind field of the header: `kind` NUL-padded to 8 bytes.
-fn kind_bytes(kind: &str) -> [u8; 8] {
-    let mut out = [0u8; 8];
-    for (o, b) in out.iter_mut().zip(kind.bytes()) {
-        *o = b;
-    }
-    out
-}
-
 /// Writes `part` to `dir`/[`part_name`] atomically (a temporary file renamed into place),
 /// creating `dir`; returns the path.
 pub fn write_part<W: Work>(dir: &Path, part: &Part<W>) -> Result<PathBuf> {
@@ -125,7 +116,12 @@ pub fn write_part<W: Work>(dir: &Path, part: &Part<W>) -> Result<PathBuf> {
     ciborium::into_writer(part, &mut payload).context("cannot encode the part")?;
     crate::output::image_file::write_atomically(&path, |w| {
         w.write_all(MAGIC)?;
-        w.write_all(&kind_bytes(W::KIND))?;
+        // The kind, NUL-padded to 8 bytes.
+        let mut kind = [0u8; 8];
+        kind.iter_mut()
+            .zip(W::KIND.bytes())
+            .for_each(|(k, b)| *k = b);
+        w.write_all(&kind)?;
         w.write_all(&(payload.len() as u64).to_le_bytes())?;
         w.write_all(&crate::render::digest::of(&payload).to_le_bytes())?;
         w.write_all(&payload)?;
@@ -154,9 +150,11 @@ pub fn read_part<W: Work>(path: &Path) -> Result<Part<W>> {
         std::fs::File::open(path).with_context(|| format!("cannot read the part {shown}"))?;
     // Enough to tell an earlier raywave's parts, the JSON of `{"format": "raywave-bench-shard"`
     // among them, from anything else.
-    let mut head = [0u8; 64];
-    let got = read_up_to(&mut file, &mut head).with_context(|| format!("cannot read {shown}"))?;
-    let head = &head[..got];
+    let mut head = Vec::new();
+    Read::by_ref(&mut file)
+        .take(64)
+        .read_to_end(&mut head)
+        .with_context(|| format!("cannot read {shown}"))?;
     let earlier = EARLIER_MAGICS.iter().any(|m| head.starts_with(*m))
         || (head.trim_ascii_start().starts_with(b"{")
             && head.windows(19).any(|w| w == b"raywave-bench-shard"));
@@ -166,7 +164,7 @@ pub fn read_part<W: Work>(path: &Path) -> Result<Part<W>> {
              run its shard again with this build"
         );
     }
-    if got < HEADER_LEN || &head[..8] != MAGIC {
+    if head.len() < HEADER_LEN || &head[..8] != MAGIC {
         bail!(
             "{shown}: not a raywave part (expected a file written by `{command}`, starting {:?})",
             String::from_utf8_lossy(MAGIC).trim_end()
@@ -211,20 +209,6 @@ pub fn read_part<W: Work>(path: &Path) -> Result<Part<W>> {
         bail!("{shown}: inconsistent part: {problem}");
     }
     Ok(part)
-}
-
-/// Fills `buf` from `r` as far as `r` goes; returns how many bytes were read.
-fn read_up_to(r: &mut impl Read, buf: &mut [u8]) -> std::io::Result<usize> {
-    let mut got = 0;
-    while got < buf.len() {
-        match r.read(&mut buf[got..]) {
-            Ok(0) => break,
-            Ok(n) => got += n,
-            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
-            Err(e) => return Err(e),
-        }
-    }
-    Ok(got)
 }
 
 /// The first way `part` contradicts itself, if any.

@@ -45,15 +45,15 @@ impl FromStr for Shard {
     /// Parses `I/N`: two plain decimal numbers, 0 ≤ I < N ≤ [`MAX_SHARDS`].
     fn from_str(s: &str) -> Result<Shard, String> {
         let expected = "expected I/N, shard I (0-based) of N shards with 0 <= I < N, e.g. 0/3";
+        // Digits only (no sign, no spaces); an empty or too long number does not parse.
         let number = |x: &str| -> Option<usize> {
-            (!x.is_empty() && x.bytes().all(|b| b.is_ascii_digit()))
-                .then(|| x.parse().ok())
-                .flatten()
+            x.bytes()
+                .all(|b| b.is_ascii_digit())
+                .then(|| x.parse().ok())?
         };
-        let Some((i, n)) = s.split_once('/') else {
-            return Err(format!("`{}`: {expected}", s.escape_debug()));
-        };
-        let (Some(index), Some(count)) = (number(i), number(n)) else {
+        let Some((Some(index), Some(count))) =
+            s.split_once('/').map(|(i, n)| (number(i), number(n)))
+        else {
             return Err(format!("`{}`: {expected}", s.escape_debug()));
         };
         if count == 0 {

@@ -30,23 +30,8 @@ pub fn bootstrap_interval(
     seed: u64,
     mut stat: impl FnMut(&[usize]) -> f64,
 ) -> Option<(f64, f64)> {
-    use rand::{RngExt, SeedableRng};
-    if n < 2 || resamples == 0 {
-        return None;
-    }
-    let mut rng = rand::rngs::Xoshiro256PlusPlus::seed_from_u64(seed);
-    let mut idx = vec![0usize; n];
-    let mut values = Vec::with_capacity(resamples);
-    for _ in 0..resamples {
-        for i in idx.iter_mut() {
-            *i = rng.random_range(0..n);
-        }
-        let v = stat(&idx);
-        if !v.is_nan() {
-            values.push(v);
-        }
-    }
-    percentile_interval(values)
+    // One group of `n`: the same draws, in the same order.
+    grouped_bootstrap_interval(&[n], resamples, seed, |idx| stat(&idx[0]))
 }
 
 /// [`bootstrap_interval`] over independent groups: each resample draws, within every group

@@ -48,9 +48,8 @@ pub struct LookPlan {
 }
 
 impl LookPlan {
-    /// The plan up to `max_rounds` (at least 6, the fewest rounds with one 95%
-    /// interval): the smallest split K of [`ALPHA`] whose geometric schedule, starting at the
-    /// fewest rounds with a (1 − ALPHA/K) interval, has at most K looks.
+    /// The plan up to `max_rounds` (at least 6, the fewest rounds with one 95% interval): the
+    /// module's schedule with the smallest split K of [`ALPHA`] that has at most K looks.
     pub fn new(max_rounds: u32) -> LookPlan {
         for split in 1..=max_rounds {
             let alpha = ALPHA / f64::from(split);

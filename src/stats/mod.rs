@@ -15,8 +15,6 @@ pub mod fit;
 pub mod looks;
 pub mod median;
 
-pub use bootstrap::{
-    BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, bootstrap_interval, grouped_bootstrap_interval,
-};
-pub use fit::{LogLogFit, loglog_fit};
+pub use bootstrap::*;
+pub use fit::*;
 pub use median::*;

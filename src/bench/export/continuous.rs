@@ -1,8 +1,7 @@
-//! What the exports for continuous-benchmarking services share, so that a CI job can track
-//! raywave's rays/s commit after commit: the name of each headline figure, for `--export-bmf` (Bencher Metric Format, for `bencher run --adapter
-//! json`) and `--export-github-action-benchmark` (the JSON of github-action-benchmark's
-//! `customBiggerIsBetter` tool). Each holds every headline figure of every point and engine:
-//! the median and the bounds of its 95% interval.
+//! What the exports for continuous-benchmarking services (`--export-bmf`,
+//! `--export-github-action-benchmark`) share, so that a CI job can track raywave's rays/s commit
+//! after commit: each headline figure's name. Each holds every headline figure of every point
+//! and engine: the median and the bounds of its 95% interval.
 //!
 //! ```text
 //! name     = SCENE WxH+sS+tT ENGINE FIGURE [@ HOST]    e.g. "cornell_box 512x512+s16+t2 wavefront total"
@@ -19,6 +18,7 @@
 
 use crate::output::bench_record::{BenchRecord, FigureSummary};
 use crate::render::settings::ShadowMode;
+use anyhow::{Result, bail};
 
 /// The scene's short name: a built-in scene's name, else the file name without extension.
 fn scene_name(source: &str) -> String {
@@ -54,20 +54,29 @@ fn figure_name(r: &BenchRecord, engine: &str, figure: &str, by_host: bool) -> St
     name
 }
 
-/// Every headline figure of every record, with its name.
+/// Every headline figure of every record, with its name; two figures with one name (two
+/// machines of one host name, say) are an error rather than one overwriting the other.
 pub(super) fn figures(
     records: &[BenchRecord],
     by_host: bool,
-) -> Vec<(String, &BenchRecord, &FigureSummary)> {
+) -> Result<Vec<(String, &BenchRecord, &FigureSummary)>> {
     let mut out = Vec::new();
+    let mut names = std::collections::HashSet::new();
     for r in records {
         for e in &r.engines {
             for f in &e.summary {
-                out.push((figure_name(r, &e.engine, &f.figure, by_host), r, f));
+                let name = figure_name(r, &e.engine, &f.figure, by_host);
+                if !names.insert(name.clone()) {
+                    bail!(
+                        "two figures share the benchmark name `{name}`: give each machine its own \
+                         host name"
+                    );
+                }
+                out.push((name, r, f));
             }
         }
     }
-    out
+    Ok(out)
 }
 
 #[cfg(test)]

@@ -4,19 +4,6 @@ use super::Format;
 use crate::output::bench_record::BenchRecord;
 use anyhow::Result;
 
-/// One row per point, engine and figure.
-pub(super) struct Csv;
-
-impl Format for Csv {
-    fn flag(&self) -> &'static str {
-        "--export-csv"
-    }
-
-    fn text(&self, records: &[BenchRecord], labels: &[String], by_host: bool) -> Result<String> {
-        Ok(csv(records, labels, by_host))
-    }
-}
-
 /// The CSV header (one row per point, engine and figure follows).
 const CSV_HEADER: &str = "point,scene,width,height,bounces,shadow_samples,threads,engine,\
                               figure,unit,runs,min,median,low,high,max,outliers";
@@ -38,42 +25,46 @@ fn opt(x: Option<f64>) -> String {
 /// `low` and `high` empty without an interval, `outliers` the outlier runs (1-based) joined by
 /// spaces. `labels[i]` names point i (empty for a single point). `by_host` adds a last column,
 /// `host`: the host name of the machine that measured the row.
-fn csv(records: &[BenchRecord], labels: &[String], by_host: bool) -> String {
-    let host_column = if by_host { ",host" } else { "" };
-    let mut out = format!("{CSV_HEADER}{host_column}\n");
-    for (r, label) in records.iter().zip(labels) {
-        let s = &r.setup.settings;
-        for e in &r.engines {
-            for f in &e.summary {
-                let outliers: Vec<String> =
-                    f.outliers.iter().map(|i| (i + 1).to_string()).collect();
-                let row = [
-                    field(label),
-                    field(&r.setup.scene.source),
-                    s.width.to_string(),
-                    s.height.to_string(),
-                    s.bounces.to_string(),
-                    s.shadow_samples.to_string(),
-                    r.setup.threads.to_string(),
-                    field(&e.engine),
-                    field(&f.figure),
-                    field(&f.unit),
-                    f.runs.to_string(),
-                    f.min.to_string(),
-                    f.median.to_string(),
-                    opt(f.low),
-                    opt(f.high),
-                    f.max.to_string(),
-                    outliers.join(" "),
-                ];
-                out.push_str(&row.join(","));
-                if by_host {
-                    out.push(',');
-                    out.push_str(&field(&r.machine.hostname));
+pub(super) struct Csv;
+
+impl Format for Csv {
+    fn text(&self, records: &[BenchRecord], labels: &[String], by_host: bool) -> Result<String> {
+        let host_column = if by_host { ",host" } else { "" };
+        let mut out = format!("{CSV_HEADER}{host_column}\n");
+        for (r, label) in records.iter().zip(labels) {
+            let s = &r.setup.settings;
+            for e in &r.engines {
+                for f in &e.summary {
+                    let outliers: Vec<String> =
+                        f.outliers.iter().map(|i| (i + 1).to_string()).collect();
+                    let row = [
+                        field(label),
+                        field(&r.setup.scene.source),
+                        s.width.to_string(),
+                        s.height.to_string(),
+                        s.bounces.to_string(),
+                        s.shadow_samples.to_string(),
+                        r.setup.threads.to_string(),
+                        field(&e.engine),
+                        field(&f.figure),
+                        field(&f.unit),
+                        f.runs.to_string(),
+                        f.min.to_string(),
+                        f.median.to_string(),
+                        opt(f.low),
+                        opt(f.high),
+                        f.max.to_string(),
+                        outliers.join(" "),
+                    ];
+                    out.push_str(&row.join(","));
+                    if by_host {
+                        out.push(',');
+                        out.push_str(&field(&r.machine.hostname));
+                    }
+                    out.push('\n');
                 }
-                out.push('\n');
             }
         }
+        Ok(out)
     }
-    out
 }

@@ -4,21 +4,8 @@
 use super::Format;
 use super::continuous::figures;
 use crate::output::bench_record::BenchRecord;
-use anyhow::{Result, bail};
+use anyhow::Result;
 use serde::Serialize;
-
-/// github-action-benchmark's custom JSON: rates, bigger is better.
-pub(super) struct GithubActionBenchmark;
-
-impl Format for GithubActionBenchmark {
-    fn flag(&self) -> &'static str {
-        "--export-github-action-benchmark"
-    }
-
-    fn text(&self, records: &[BenchRecord], _labels: &[String], by_host: bool) -> Result<String> {
-        github_action_benchmark(records, by_host)
-    }
-}
 
 /// One entry of github-action-benchmark's custom JSON.
 #[derive(Serialize)]
@@ -31,47 +18,45 @@ struct Entry {
     extra: String,
 }
 
-/// The records as github-action-benchmark's `customBiggerIsBetter` input (rates: bigger is
-/// better); one entry per headline figure, in record order.
-fn github_action_benchmark(records: &[BenchRecord], by_host: bool) -> Result<String> {
-    let mut out = Vec::new();
-    let mut names = std::collections::HashSet::new();
-    for (name, r, f) in figures(records, by_host) {
-        if !names.insert(name.clone()) {
-            bail!(
-                "two figures share the benchmark name `{name}`: give each machine its own host name"
-            );
-        }
-        let (range, interval) = match (f.low, f.high) {
-            (Some(low), Some(high)) => (
-                Some(format!("± {}", (high - f.median).max(f.median - low))),
-                format!("95% interval of the median: [{low}, {high}] {}", f.unit),
-            ),
-            _ => (
-                None,
-                format!(
-                    "no 95% interval of the median: {} run(s) < {}",
-                    f.runs,
-                    crate::stats::MIN_FOR_INTERVAL
+/// github-action-benchmark's `customBiggerIsBetter` input (rates: bigger is better); one entry
+/// per headline figure, in record order.
+pub(super) struct GithubActionBenchmark;
+
+impl Format for GithubActionBenchmark {
+    fn text(&self, records: &[BenchRecord], _labels: &[String], by_host: bool) -> Result<String> {
+        let mut out = Vec::new();
+        for (name, r, f) in figures(records, by_host)? {
+            let (range, interval) = match (f.low, f.high) {
+                (Some(low), Some(high)) => (
+                    Some(format!("± {}", (high - f.median).max(f.median - low))),
+                    format!("95% interval of the median: [{low}, {high}] {}", f.unit),
                 ),
-            ),
-        };
-        out.push(Entry {
-            name,
-            unit: f.unit.clone(),
-            value: f.median,
-            range,
-            extra: format!(
-                "{interval}\n{} runs, min {}, max {}\nhost {} ({})\nraywave {}, commit {}",
-                f.runs,
-                f.min,
-                f.max,
-                r.machine.hostname,
-                r.machine.cpu,
-                r.raywave,
-                r.build.short_commit()
-            ),
-        });
+                _ => (
+                    None,
+                    format!(
+                        "no 95% interval of the median: {} run(s) < {}",
+                        f.runs,
+                        crate::stats::MIN_FOR_INTERVAL
+                    ),
+                ),
+            };
+            out.push(Entry {
+                name,
+                unit: f.unit.clone(),
+                value: f.median,
+                range,
+                extra: format!(
+                    "{interval}\n{} runs, min {}, max {}\nhost {} ({})\nraywave {}, commit {}",
+                    f.runs,
+                    f.min,
+                    f.max,
+                    r.machine.hostname,
+                    r.machine.cpu,
+                    r.raywave,
+                    r.build.short_commit()
+                ),
+            });
+        }
+        Ok(format!("{}\n", serde_json::to_string_pretty(&out)?))
     }
-    Ok(format!("{}\n", serde_json::to_string_pretty(&out)?))
 }

@@ -8,10 +8,6 @@ use anyhow::Result;
 pub(super) struct Json;
 
 impl Format for Json {
-    fn flag(&self) -> &'static str {
-        "--export-json"
-    }
-
     fn text(&self, records: &[BenchRecord], _labels: &[String], _by_host: bool) -> Result<String> {
         Ok(format!("{}\n", serde_json::to_string_pretty(records)?))
     }

@@ -1,9 +1,6 @@
-//! `raywave bench`'s exports, one file per format behind [`Format`]: `--export-json` (the
-//! whole records), `--export-csv` and `--export-markdown` (every point's headline figures:
-//! median, its 95% interval, min, max), and for continuous-benchmarking services `--export-bmf`
-//! and `--export-github-action-benchmark` (their naming in continuous.rs). [`Exports`] writes
-//! the ones asked for, for `raywave bench` and `raywave bench merge` alike. A new format is a new
-//! file, a field of [`Exports`] and a line of [`FORMATS`].
+//! `raywave bench`'s exports, one file per format behind [`Format`] (each file says what it
+//! writes). [`Exports`] writes the ones asked for, for `raywave bench` and `raywave bench merge`
+//! alike. A new format is a new file, a field of [`Exports`] and a line of [`FORMATS`].
 
 mod bmf;
 mod continuous;
@@ -17,22 +14,23 @@ use anyhow::Result;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-/// One export format: the flag that asks for it and the file it writes.
+/// One export format: the file it writes.
 trait Format: Sync {
-    /// The flag, e.g. `--export-csv`.
-    fn flag(&self) -> &'static str;
     /// The file's text for every point's record; `labels[i]` names point i, `by_host` adds the
     /// host to every row and name.
     fn text(&self, records: &[BenchRecord], labels: &[String], by_host: bool) -> Result<String>;
 }
 
-/// Every format, in the order of [`Exports`]' fields.
-const FORMATS: [&dyn Format; 5] = [
-    &json::Json,
-    &csv::Csv,
-    &markdown::Markdown,
-    &bmf::Bmf,
-    &github_action_benchmark::GithubActionBenchmark,
+/// Every format and the flag that asks for it, in the order of [`Exports`]' fields.
+const FORMATS: [(&str, &dyn Format); 5] = [
+    ("--export-json", &json::Json),
+    ("--export-csv", &csv::Csv),
+    ("--export-markdown", &markdown::Markdown),
+    ("--export-bmf", &bmf::Bmf),
+    (
+        "--export-github-action-benchmark",
+        &github_action_benchmark::GithubActionBenchmark,
+    ),
 ];
 
 /// Where each export goes (`--export-*`; `-` is standard output), `None` when not asked for.
@@ -55,21 +53,21 @@ impl Exports {
     pub fn flags(&self) -> Vec<(&'static str, &Path)> {
         self.asked()
             .into_iter()
-            .map(|(format, path)| (format.flag(), path))
+            .map(|(flag, _, path)| (flag, path))
             .collect()
     }
 
     /// Writes every export asked for, each atomically. `labels[i]` names point i; `by_host`
     /// adds the host to every row and name (points measured on several machines).
     pub fn write(&self, records: &[BenchRecord], labels: &[String], by_host: bool) -> Result<()> {
-        for (format, path) in self.asked() {
+        for (_, format, path) in self.asked() {
             write(path, &format.text(records, labels, by_host)?)?;
         }
         Ok(())
     }
 
-    /// Each export asked for: its format and its path, in flag order.
-    fn asked(&self) -> Vec<(&'static dyn Format, &Path)> {
+    /// Each export asked for: its flag, its format and its path, in flag order.
+    fn asked(&self) -> Vec<(&'static str, &'static dyn Format, &Path)> {
         let paths = [
             &self.json,
             &self.csv,
@@ -80,7 +78,7 @@ impl Exports {
         FORMATS
             .into_iter()
             .zip(paths)
-            .filter_map(|(format, path)| Some((format, path.as_deref()?)))
+            .filter_map(|((flag, format), path)| Some((flag, format, path.as_deref()?)))
             .collect()
     }
 }

@@ -10,95 +10,72 @@
 //! per engine: medians of every figure, and the summary of the headline figures
 //! ```
 
+use crate::bench::{BenchOptions, Plan};
 use crate::output::bench_record::{EngineRecord, KindFigures, Measurement, summarise};
 use crate::render::engine::{Engine, Prepared, clamped_warning};
 use crate::render::film::Film;
 use crate::render::progress::{Progress, Steps};
 use crate::render::scene::Scene;
-use crate::render::settings::RenderSettings;
 use crate::render::wavefront::DEFAULT_BATCH_SIZE;
-use crate::render::wavefront::lanes::LaneWidth;
 use std::time::Instant;
 
-/// Warm-up and timed runs of `engines` on `pool`, the wavefront engine `lanes` wide; `runs_done`
-/// steps after each run (warm-up included), `notice` for a run that clamped pixels. Records
-/// come back in `engines`' order.
-// More than clippy's 7: the point's settings are the arguments' natural split (a struct for
-// them would only be unpacked again below), and the two reports are the caller's.
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn measure(
-    pool: &rayon::ThreadPool,
+/// Warm-up and timed runs of `plan`'s engines on its pool, with `args`' run counts and lane
+/// width; `runs_done` steps after each run (warm-up included), `notice` for a run that clamped
+/// pixels. Records come back in the plan's engine order.
+pub(in crate::bench) fn measure(
+    plan: &Plan,
     scene: &Scene,
-    settings: &RenderSettings,
-    engines: &[Engine],
-    lanes: LaneWidth,
-    warmup: u32,
-    runs: u32,
+    args: &BenchOptions,
     runs_done: &Steps,
     notice: &(dyn Fn(&str) + Sync),
 ) -> Vec<EngineRecord> {
-    pool.install(|| {
-        timed(
-            scene, settings, engines, lanes, warmup, runs, runs_done, notice,
-        )
-    })
-}
-
-#[allow(clippy::too_many_arguments)]
-fn timed(
-    scene: &Scene,
-    settings: &RenderSettings,
-    engines: &[Engine],
-    lanes: LaneWidth,
-    warmup: u32,
-    runs: u32,
-    runs_done: &Steps,
-    notice: &(dyn Fn(&str) + Sync),
-) -> Vec<EngineRecord> {
-    let prepared: Vec<Prepared> = engines
-        .iter()
-        .map(|engine| engine.prepare_lanes(scene, settings, DEFAULT_BATCH_SIZE, lanes))
-        .collect();
-    let time = |engine: &Prepared| {
-        let start = Instant::now();
-        let (film, stats) = engine.render(&Progress::SILENT);
-        let seconds = start.elapsed().as_secs_f64();
-        drop::<Film>(film);
-        if let Some(w) = clamped_warning(&stats) {
-            notice(&w);
-        }
-        let stages = match engine.engine() {
-            Engine::Wavefront => stats.stage_figures(),
-            Engine::Reference => Vec::new(),
+    plan.pool.install(|| {
+        let prepared: Vec<Prepared> = plan
+            .engines
+            .iter()
+            .map(|e| e.prepare_lanes(scene, &plan.setup.settings, DEFAULT_BATCH_SIZE, args.lanes))
+            .collect();
+        let time = |engine: &Prepared| {
+            let start = Instant::now();
+            let (film, stats) = engine.render(&Progress::SILENT);
+            let seconds = start.elapsed().as_secs_f64();
+            drop::<Film>(film);
+            if let Some(w) = clamped_warning(&stats) {
+                notice(&w);
+            }
+            let stages = match engine.engine() {
+                Engine::Wavefront => stats.stage_figures(),
+                Engine::Reference => Vec::new(),
+            };
+            Measurement {
+                rays: KindFigures::new(&stats, seconds),
+                stages,
+            }
         };
-        Measurement {
-            rays: KindFigures::new(&stats, seconds),
-            stages,
+        for _ in 0..args.warmup {
+            for engine in &prepared {
+                time(engine);
+                runs_done.step();
+            }
         }
-    };
-    for _ in 0..warmup {
-        for engine in &prepared {
-            time(engine);
-            runs_done.step();
+        let mut measured: Vec<Vec<Measurement>> = vec![Vec::new(); prepared.len()];
+        for round in 0..args.runs as usize {
+            for i in round_order(prepared.len(), round) {
+                measured[i].push(time(&prepared[i]));
+                runs_done.step();
+            }
         }
-    }
-    let mut measured: Vec<Vec<Measurement>> = vec![Vec::new(); prepared.len()];
-    for round in 0..runs as usize {
-        for i in round_order(prepared.len(), round) {
-            measured[i].push(time(&prepared[i]));
-            runs_done.step();
-        }
-    }
-    prepared
-        .iter()
-        .zip(measured)
-        .map(|(engine, runs)| EngineRecord {
-            engine: engine.engine().name().to_string(),
-            median: Measurement::median_of(&runs),
-            summary: summarise(&runs),
-            runs,
-        })
-        .collect()
+        prepared
+            .iter()
+            .zip(measured)
+            .map(|(engine, runs)| EngineRecord {
+                engine: engine.engine().name().to_string(),
+                median: Measurement::median_of(&runs),
+                summary: summarise(&runs),
+                runs,
+            })
+            .collect()
+    })
 }
 
 /// The order in which round `round` runs `n` engines: 0..n rotated by `round`, so each engine

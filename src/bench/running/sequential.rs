@@ -9,9 +9,8 @@
 //! noisy machine). So the looks are planned, and the 5% is split between them:
 //!
 //! ```text
-//! plan:  looks at n₁, ⌈1.5·n₁⌉, ⌈1.5·n₂⌉, ..., max-rounds (the last one capped): K looks,
-//!        each interval at level 1 − 5%/K, n₁ the fewest rounds that have such an interval
-//!        (K is the smallest split whose plan has at most K looks)
+//! plan:  K looks at geometrically growing rounds up to max-rounds, each interval at level
+//!        1 − 5%/K (`crate::stats::looks`: the schedule, and why the Bonferroni split holds)
 //! for each planned look n:
 //!     rounds up to n, unless the caller's budget says the look cannot be reached: stop there
 //!     the n ratios' median and its (1 − 5%/K) interval → verdict (`verdict::Rule::judge`)
@@ -19,19 +18,13 @@
 //! after the last look: undecided at max-rounds
 //! ```
 //!
-//! The plan and why its Bonferroni split holds are in `crate::stats::looks`.
-//!
-//! **The default question is one-sided**: is this build slower than the other by more than the
-//! threshold t? A look answers *slower* (a regression) when its interval lies above 1 + t and
-//! *not slower* when it lies at or below 1 + t, and nothing else ends the rounds; a build
-//! clearly faster is decided as soon as its interval's high end clears 1 + t, however close its
-//! median sits to 1 / (1 + t), the line the three-way form (`--verdict three-way`) must also
-//! clear. Each call errs only when the interval misses the median on one side: a false alarm
-//! (a build at most t slower called a regression) has probability at most 2.5%, and a miss (a
-//! build more than t slower called not slower) at most 2.5%. Exactly, on the default plan: a
-//! build exactly t slower, the worst case, is called a regression in 1.02% of runs, and a build
-//! just past t is missed in 1.02% (the sign walk in the tests, exact at every threshold for this
-//! rule, whose verdict depends only on how many ratios lie below 1 + t).
+//! In the default, one-sided form (ab.rs) each call errs only when the interval misses the
+//! median on one side: a false alarm (a build at most t slower called a regression) has
+//! probability at most 2.5%, and a miss (a build more than t slower called not slower) at most
+//! 2.5%. Exactly, on the default plan: a build exactly t slower, the worst case, is called a
+//! regression in 1.02% of runs, and a build just past t is missed in 1.02% (the sign walk in the
+//! tests, exact at every threshold for this rule, whose verdict depends only on how many ratios
+//! lie below 1 + t).
 //!
 //! Why not give the one-sided question the whole 5% (each end of the interval at 5%/K, a
 //! (1 − 10%/K) two-sided interval): on the simulated machine below it saves about a tenth of the
@@ -41,11 +34,9 @@
 //! side of a 95% interval; and both forms then judge the same interval at the same level: one
 //! plan, one printed interval.
 //!
-//! The line 1 + t itself belongs to "not slower": a median of exactly 1 + t is not *more* than
-//! t, and the interval's ends are observed ratios, so the boundary is the comparison `low >
-//! 1 + t` for a regression and `high <= 1 + t` for not one (tested on exact binary fractions in
-//! `ab`); a ratio of two measured times equal to 1 + t to the bit is rare enough that the
-//! choice matters for the statement, not for a run.
+//! The line 1 + t itself belongs to "not slower" (`Rule::judge` says why); a ratio of two
+//! measured times equal to 1 + t to the bit is rare enough that the choice matters for the
+//! statement, not for a run.
 
 use crate::bench::verdict::{RatioSummary, Rule, Verdict, summarize_at};
 use crate::stats::looks::LookPlan;
@@ -96,6 +87,7 @@ pub struct Outcome {
     pub stop: Stop,
 }
 
+#[cfg(test)]
 impl Outcome {
     /// The last look's verdict; undecided when no look was taken.
     pub fn verdict(&self) -> Verdict {
@@ -125,40 +117,34 @@ pub fn decide(
 ) -> Result<Outcome> {
     let mut ratios = Vec::new();
     let mut looks = Vec::new();
-    for &at in &plan.looks {
-        while (ratios.len() as u32) < at {
-            let progress = Progress {
-                rounds: ratios.len() as u32,
-                next_look: at,
-            };
-            match round(progress)? {
-                Some(ratio) => ratios.push(ratio),
-                None => {
-                    return Ok(Outcome {
-                        looks,
-                        rounds: progress.rounds,
-                        stop: Stop::Budget,
-                    });
-                }
+    let stop = 'looks: {
+        for &at in &plan.looks {
+            while (ratios.len() as u32) < at {
+                let progress = Progress {
+                    rounds: ratios.len() as u32,
+                    next_look: at,
+                };
+                let Some(ratio) = round(progress)? else {
+                    break 'looks Stop::Budget;
+                };
+                ratios.push(ratio);
+            }
+            let summary = summarize_at(&ratios, rule, plan.alpha);
+            looks.push(Look {
+                rounds: at,
+                summary,
+            });
+            if summary.verdict != Verdict::Undecided {
+                break 'looks Stop::Decided;
             }
         }
-        let summary = summarize_at(&ratios, rule, plan.alpha);
-        looks.push(Look {
-            rounds: at,
-            summary,
-        });
-        if summary.verdict != Verdict::Undecided {
-            return Ok(Outcome {
-                looks,
-                rounds: at,
-                stop: Stop::Decided,
-            });
-        }
-    }
+        Stop::MaxRounds
+    };
+    // However the rounds stopped, each one run gave a ratio.
     Ok(Outcome {
         looks,
         rounds: ratios.len() as u32,
-        stop: Stop::MaxRounds,
+        stop,
     })
 }
 

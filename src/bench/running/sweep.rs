@@ -15,7 +15,7 @@ pub struct Sweep {
 }
 
 /// One point of a sweep: `None` where the flag was not given.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Point {
     /// Image size.
     pub size: Option<[u32; 2]>,
