@@ -102,14 +102,14 @@ pub struct FigureSummary {
     pub min: f64,
     /// The median run.
     pub median: f64,
-    /// Lower end of the median's 95% interval (`statistics::median_with_interval`); null
+    /// Lower end of the median's 95% interval (`stats::median_with_interval`); null
     /// with fewer than 6 runs.
     pub low: Option<f64>,
     /// Upper end of that interval; null with fewer than 6 runs.
     pub high: Option<f64>,
     /// The fastest run.
     pub max: f64,
-    /// Runs (0-based) whose modified Z-score exceeds `statistics::OUTLIER_Z`.
+    /// Runs (0-based) whose modified Z-score exceeds `stats::OUTLIER_Z`.
     pub outliers: Vec<usize>,
 }
 

@@ -15,7 +15,7 @@
 //! slope of log MSE against log N over the noisy points      per sampler and region
 //! budget matching 150 random points                          per sampler and region
 //! 95% intervals: MSE, slope, efficiency, matching budget by bootstrap over seeds
-//!                (statistics::bootstrap_interval); time by the median's sign-test interval
+//!                (stats::bootstrap_interval); time by the median's sign-test interval
 //! ```
 
 pub mod command;

@@ -105,11 +105,12 @@ pub struct Run {
 pub fn run(dir: &Path, args: &[&str], stdin: Option<&[u8]>, timeout: Duration) -> Run {
     let dir_text = dir.to_string_lossy();
     let args: Vec<String> = args.iter().map(|a| a.replace("{dir}", &dir_text)).collect();
-    let out_path = dir.join("..").join(format!(
-        "stdout-{}",
-        dir.file_name().unwrap().to_string_lossy()
-    ));
-    let err_path = out_path.with_extension("err");
+    // Beside `dir`, named after it: the temp dir's name (`.tmpXXXXXX`) is its only unique
+    // part, so it is not an extension to replace (`with_extension` gave every run one stderr
+    // file, which parallel tests deleted under each other).
+    let name = dir.file_name().unwrap().to_string_lossy();
+    let out_path = dir.join("..").join(format!("stdout-{name}"));
+    let err_path = dir.join("..").join(format!("stderr-{name}"));
     let mut child = Command::new(env!("CARGO_BIN_EXE_raywave"))
         .args(&args)
         .current_dir(dir)

@@ -1,5 +1,5 @@
 //! What a study fits across budgets and samplers, each with a 95% interval by bootstrap over
-//! the seeds (`statistics::bootstrap_interval`; every statistic sees the same resamples): the
+//! the seeds (`stats::bootstrap_interval`; every statistic sees the same resamples): the
 //! slope of log MSE against log N, the budget matching the lab's 150 random points, and each
 //! sampler's error and efficiency relative to random.
 //!

@@ -5,7 +5,7 @@
 //! slope(sampler, region)        = mean over the cases of each case's fitted slope
 //! ratio(sampler, N, region)     = geometric mean over the cases of random's MSE / the sampler's
 //! 95% interval                  = bootstrap: every resample redraws each case's K seeds on its
-//!                                 own (statistics::grouped_bootstrap_interval), so the interval
+//!                                 own (stats::grouped_bootstrap_interval), so the interval
 //!                                 is the figure's uncertainty from seed noise, for these cases
 //! ```
 //!
