@@ -4,8 +4,10 @@
 //! (`layering`: only the lane layer names `wide`), the module map (`module_map`:
 //! docs/ARCHITECTURE.md's tree is `src/`) and the docs' budgets (`doc_budgets`: README.md,
 //! docs/PERFORMANCE.md and docs/BENCHMARKING.md within their line counts, docs/TESTING.md
-//! without a diary of CI timings).
+//! without a diary of CI timings) and the build's reuse (`build_reuse`: `cargo test` compiles no
+//! dependency again that `cargo run` compiled).
 
+mod build_reuse;
 mod doc_budgets;
 mod icount;
 mod layering;
