@@ -83,16 +83,26 @@ impl ShadowPath {
 
     /// The path's name, as `render --stats` and `--stats-json` give it.
     pub fn name(self) -> &'static str {
-        ["FusedSoft", "FusedHard", "QueuedPerHit"][self as usize]
+        match self {
+            ShadowPath::FusedSoft => "FusedSoft",
+            ShadowPath::FusedHard => "FusedHard",
+            ShadowPath::QueuedPerHit => "QueuedPerHit",
+        }
     }
 
     /// What the path does, in a few words, for `render --stats`.
     pub fn describe(self) -> &'static str {
-        [
-            "each block of N light points spawned, tested against the shadow casters and shaded in registers",
-            "one ray per light for N hits at a time, tested (against the casters, or each through the BVH) and shaded in registers",
-            "every hit's rays queued in (light, point) order, then tested and shaded from the queue",
-        ][self as usize]
+        match self {
+            ShadowPath::FusedSoft => {
+                "each block of N light points spawned, tested against the shadow casters and shaded in registers"
+            }
+            ShadowPath::FusedHard => {
+                "one ray per light for N hits at a time, tested (against the casters, or each through the BVH) and shaded in registers"
+            }
+            ShadowPath::QueuedPerHit => {
+                "every hit's rays queued in (light, point) order, then tested and shaded from the queue"
+            }
+        }
     }
 
     /// The fastest path `ctx` admits.
