@@ -15,6 +15,8 @@ pub mod fit;
 pub mod looks;
 pub mod median;
 
-pub use bootstrap::*;
-pub use fit::*;
+pub use bootstrap::{
+    BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, bootstrap_interval, grouped_bootstrap_interval,
+};
+pub use fit::{LogLogFit, loglog_fit};
 pub use median::*;

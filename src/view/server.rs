@@ -8,7 +8,8 @@
 //! SIGINT/SIGTERM -> stop accepting -> wait for the open connections (at most DRAIN_TIME) -> return
 //! ```
 //!
-//! So a slow client holds one thread for at most the request time and never blocks another's
+//! A thread per connection, bounded by the connection limit, and a deadline per request: so a
+//! slow client holds one thread for at most the request time and never blocks another's
 //! request. Rejected: tiny_http (a thread per connection without a bound, no read timeout) and an
 //! async server (a runtime in every build, for a page with a few requests a second).
 
