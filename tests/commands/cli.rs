@@ -572,8 +572,8 @@ fn stats_tables_give_each_kind_over_its_own_thread_time_the_total_over_the_wall_
         let rate: f64 = total[3].parse().unwrap();
         // Both are printed rounded (seconds to 0.001, the rate to 0.01): the rate must lie
         // between the rates of the seconds' rounding interval, give or take its own rounding.
-        let (fastest, slowest) = (rays / (seconds - 0.0005), rays / (seconds + 0.0005));
         if seconds > 0.0005 {
+            let (fastest, slowest) = (rays / (seconds - 0.0005), rays / (seconds + 0.0005));
             assert!(
                 (slowest / 1e6 - 0.005..=fastest / 1e6 + 0.005).contains(&rate),
                 "{text}"
