@@ -166,7 +166,6 @@ impl StudyArgs {
             cache: self.cache.clone(),
             no_cache: self.no_cache,
             cache_limit_mib: self.cache_limit,
-            clean_cache: false,
             light_model: self.light_model.into(),
             engine: self.engine.into(),
             quiet,

@@ -47,8 +47,6 @@ pub struct VarianceOptions {
     pub no_cache: bool,
     /// Bound on the cache's total size, in MiB: the least recently used entries go first.
     pub cache_limit_mib: u64,
-    /// Remove the cache's entries and stop, without running a study.
-    pub clean_cache: bool,
     /// How a light's colour reaches a point.
     pub light_model: LightModel,
     /// The engine that renders the images.
@@ -75,7 +73,6 @@ impl Default for VarianceOptions {
             cache: PathBuf::from(".raywave-cache"),
             no_cache: false,
             cache_limit_mib: super::study::cache::DEFAULT_LIMIT_MIB,
-            clean_cache: false,
             light_model: LightModel::Lab,
             engine: Engine::Wavefront,
             quiet: false,
