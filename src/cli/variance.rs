@@ -292,7 +292,7 @@ pub fn run(args: &VarianceArgs) -> Result<()> {
     let cached = outcome
         .results
         .iter()
-        .filter(|r| r.reference_cached)
+        .filter(|r| r.facts.reference_cached)
         .count();
     print(&format!(
         "{}\nconverged reference{}: {}\nwrote   {}\n",

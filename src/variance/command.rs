@@ -343,7 +343,7 @@ pub fn study(
                 &case.scene.source,
                 options.engine.name(),
                 threads,
-                &facts,
+                facts,
                 results,
             )
         })
@@ -382,7 +382,7 @@ pub(crate) fn write_report(
     for (name, result) in names.iter().zip(&results) {
         for region in [Region::Penumbra, Region::Lit] {
             let margin = result.reference_margin(region);
-            if result.region_pixels[region as usize] > 0 && margin < 10.0 {
+            if result.facts.region_pixels[region as usize] > 0 && margin < 10.0 {
                 let case = if results.len() > 1 {
                     format!("{name}: ")
                 } else {

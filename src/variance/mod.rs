@@ -304,12 +304,9 @@ pub struct StudyResult {
     pub engine: String,
     /// Worker threads the renders ran on.
     pub threads: usize,
-    /// Pixels in each region.
-    pub region_pixels: [usize; 3],
-    /// Mean error variance of the reference per region (its own MSE).
-    pub reference_mse: [f64; 3],
-    /// True when the reference came from the cache.
-    pub reference_cached: bool,
+    /// Pixels per region, the reference's own MSE per region, and whether it was cached.
+    #[serde(flatten)]
+    pub facts: jobs::CaseFacts,
     /// One row per (sampler, N, region).
     pub rows: Vec<Row>,
     /// One slope per (sampler, region).
@@ -348,7 +345,7 @@ pub fn run_study(
         &scene.source,
         engine,
         rayon::current_num_threads(),
-        &setup.facts(),
+        setup.facts(),
         results,
     ))
 }
@@ -362,6 +359,6 @@ impl StudyResult {
             .filter(|r| r.region == region && r.stats.mse > 0.0)
             .map(|r| r.stats.mse)
             .fold(f64::INFINITY, f64::min);
-        smallest / self.reference_mse[region as usize].max(1e-30)
+        smallest / self.facts.reference_mse[region as usize].max(1e-30)
     }
 }
