@@ -294,7 +294,6 @@ fn sampler_name<'de, D: serde::Deserializer<'de>>(d: D) -> Result<&'static str, 
 }
 
 /// Everything a study found.
-#[derive(Serialize)]
 pub struct StudyResult {
     /// The configuration.
     pub config: StudyConfig,
@@ -305,7 +304,6 @@ pub struct StudyResult {
     /// Worker threads the renders ran on.
     pub threads: usize,
     /// Pixels per region, the reference's own MSE per region, and whether it was cached.
-    #[serde(flatten)]
     pub facts: jobs::CaseFacts,
     /// One row per (sampler, N, region).
     pub rows: Vec<Row>,
@@ -313,11 +311,9 @@ pub struct StudyResult {
     pub slopes: Vec<Slope>,
     /// One per (sampler other than random, region), when random was studied.
     pub matching: Vec<Matching>,
-    /// Per-sampler per-pixel MSE at `heatmap_n` (not serialised).
-    #[serde(skip)]
+    /// Per-sampler per-pixel MSE at `heatmap_n`.
     pub heatmaps: Vec<(LightSampler, Vec<f32>)>,
     /// Per (sampler, N): the warm-up render (seed 0), tone-mapped, for the contact sheet.
-    #[serde(skip)]
     pub thumbnails: Vec<(LightSampler, u32, image::RgbImage)>,
 }
 
