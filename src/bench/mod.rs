@@ -88,16 +88,8 @@ pub struct BenchOptions {
     pub threshold: f64,
     /// Also write the record as JSON to this file (`-` for stdout); one point only.
     pub json: Option<PathBuf>,
-    /// Write every point's record as a JSON array to this file.
-    pub export_json: Option<PathBuf>,
-    /// Write every point's headline figures as CSV to this file.
-    pub export_csv: Option<PathBuf>,
-    /// Write every point's headline figures as a Markdown table to this file.
-    pub export_markdown: Option<PathBuf>,
-    /// Write every point's headline figures in Bencher Metric Format to this file.
-    pub export_bmf: Option<PathBuf>,
-    /// Write every point's headline figures as github-action-benchmark's JSON to this file.
-    pub export_github_action_benchmark: Option<PathBuf>,
+    /// The `--export-*` files.
+    pub exports: export::Exports,
     /// Time only this shard's points and write them to a part file in this directory.
     pub shard: Option<(crate::shard::Shard, PathBuf)>,
     /// The flags given on the command line (clap ids: `size`, `threads`, `engine`, ...):
@@ -342,14 +334,7 @@ pub fn run(args: &BenchOptions, progress: &Progress) -> Result<Outcome> {
         export::write(p, &format!("{}\n", serde_json::to_string_pretty(record)?))?;
     }
     let labels: Vec<String> = plans.iter().map(|p| p.point.label.clone()).collect();
-    export::Exports {
-        json: args.export_json.clone(),
-        csv: args.export_csv.clone(),
-        markdown: args.export_markdown.clone(),
-        bmf: args.export_bmf.clone(),
-        github_action_benchmark: args.export_github_action_benchmark.clone(),
-    }
-    .write(&records, &labels, false)?;
+    args.exports.write(&records, &labels, false)?;
     let part = shard_run
         .map(|(which, dir, identity, items)| -> Result<_> {
             let mut part = crate::shard::Part {

@@ -166,7 +166,6 @@ impl StudyArgs {
             cache: self.cache.clone(),
             no_cache: self.no_cache,
             cache_limit_mib: self.cache_limit,
-            clean_cache: false,
             light_model: self.light_model.into(),
             engine: self.engine.into(),
             quiet,
@@ -293,7 +292,7 @@ pub fn run(args: &VarianceArgs) -> Result<()> {
     let cached = outcome
         .results
         .iter()
-        .filter(|r| r.reference_cached)
+        .filter(|r| r.facts.reference_cached)
         .count();
     print(&format!(
         "{}\nconverged reference{}: {}\nwrote   {}\n",

@@ -47,8 +47,6 @@ pub struct VarianceOptions {
     pub no_cache: bool,
     /// Bound on the cache's total size, in MiB: the least recently used entries go first.
     pub cache_limit_mib: u64,
-    /// Remove the cache's entries and stop, without running a study.
-    pub clean_cache: bool,
     /// How a light's colour reaches a point.
     pub light_model: LightModel,
     /// The engine that renders the images.
@@ -75,7 +73,6 @@ impl Default for VarianceOptions {
             cache: PathBuf::from(".raywave-cache"),
             no_cache: false,
             cache_limit_mib: super::study::cache::DEFAULT_LIMIT_MIB,
-            clean_cache: false,
             light_model: LightModel::Lab,
             engine: Engine::Wavefront,
             quiet: false,
@@ -346,7 +343,7 @@ pub fn study(
                 &case.scene.source,
                 options.engine.name(),
                 threads,
-                &facts,
+                facts,
                 results,
             )
         })
@@ -385,7 +382,7 @@ pub(crate) fn write_report(
     for (name, result) in names.iter().zip(&results) {
         for region in [Region::Penumbra, Region::Lit] {
             let margin = result.reference_margin(region);
-            if result.region_pixels[region as usize] > 0 && margin < 10.0 {
+            if result.facts.region_pixels[region as usize] > 0 && margin < 10.0 {
                 let case = if results.len() > 1 {
                     format!("{name}: ")
                 } else {

@@ -143,7 +143,7 @@ pub fn merge(inputs: &[PathBuf], out: &Path, notice: &(dyn Fn(&str) + Sync)) -> 
             source,
             &study.engine,
             *threads,
-            f,
+            f.clone(),
             jobs,
         ));
     }

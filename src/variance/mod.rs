@@ -294,7 +294,6 @@ fn sampler_name<'de, D: serde::Deserializer<'de>>(d: D) -> Result<&'static str, 
 }
 
 /// Everything a study found.
-#[derive(Serialize)]
 pub struct StudyResult {
     /// The configuration.
     pub config: StudyConfig,
@@ -304,23 +303,17 @@ pub struct StudyResult {
     pub engine: String,
     /// Worker threads the renders ran on.
     pub threads: usize,
-    /// Pixels in each region.
-    pub region_pixels: [usize; 3],
-    /// Mean error variance of the reference per region (its own MSE).
-    pub reference_mse: [f64; 3],
-    /// True when the reference came from the cache.
-    pub reference_cached: bool,
+    /// Pixels per region, the reference's own MSE per region, and whether it was cached.
+    pub facts: jobs::CaseFacts,
     /// One row per (sampler, N, region).
     pub rows: Vec<Row>,
     /// One slope per (sampler, region).
     pub slopes: Vec<Slope>,
     /// One per (sampler other than random, region), when random was studied.
     pub matching: Vec<Matching>,
-    /// Per-sampler per-pixel MSE at `heatmap_n` (not serialised).
-    #[serde(skip)]
+    /// Per-sampler per-pixel MSE at `heatmap_n`.
     pub heatmaps: Vec<(LightSampler, Vec<f32>)>,
     /// Per (sampler, N): the warm-up render (seed 0), tone-mapped, for the contact sheet.
-    #[serde(skip)]
     pub thumbnails: Vec<(LightSampler, u32, image::RgbImage)>,
 }
 
@@ -348,7 +341,7 @@ pub fn run_study(
         &scene.source,
         engine,
         rayon::current_num_threads(),
-        &setup.facts(),
+        setup.facts(),
         results,
     ))
 }
@@ -362,6 +355,6 @@ impl StudyResult {
             .filter(|r| r.region == region && r.stats.mse > 0.0)
             .map(|r| r.stats.mse)
             .fold(f64::INFINITY, f64::min);
-        smallest / self.reference_mse[region as usize].max(1e-30)
+        smallest / self.facts.reference_mse[region as usize].max(1e-30)
     }
 }

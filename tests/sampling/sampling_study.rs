@@ -355,9 +355,9 @@ fn the_study_meets_its_floor_and_writes_its_outputs() {
         );
     }
     assert!(
-        result.region_pixels[1] > 100,
+        result.facts.region_pixels[1] > 100,
         "penumbra too small: {:?}",
-        result.region_pixels
+        result.facts.region_pixels
     );
 
     let dir = tempfile::tempdir().unwrap();

@@ -234,7 +234,11 @@ fn the_study_flags_biased_samplers_and_only_them() {
         &Progress::SILENT,
     )
     .unwrap();
-    assert!(result.region_pixels[1] > 200, "{:?}", result.region_pixels);
+    assert!(
+        result.facts.region_pixels[1] > 200,
+        "{:?}",
+        result.facts.region_pixels
+    );
     for r in &result.rows {
         let s = &r.stats;
         println!(

@@ -39,7 +39,7 @@ impl StudyResult {
             LOWPASS_SIGMAS[0], LOWPASS_SIGMAS[1]
         );
         for region in REGIONS {
-            if self.region_pixels[region as usize] == 0 {
+            if self.facts.region_pixels[region as usize] == 0 {
                 continue;
             }
             let _ = writeln!(s, "\n{}", region.name());

@@ -95,7 +95,7 @@ fn panel(
         Axis::Budget => ("MSE against N", "light samples N"),
         Axis::Time => ("MSE against time", "ms per image (median)"),
     };
-    let pixels = result.region_pixels[region as usize];
+    let pixels = result.facts.region_pixels[region as usize];
     let title = format!("{}: {what} ({pixels} px)", region.name());
     let mut chart = ChartBuilder::on(area)
         .caption(title, ("sans-serif", 20))

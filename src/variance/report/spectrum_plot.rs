@@ -57,7 +57,7 @@ fn panel(
     let title = format!(
         "{}: error spectrum at N = {n} ({} px)",
         region.name(),
-        result.region_pixels[region as usize]
+        result.facts.region_pixels[region as usize]
     );
     let curves: Vec<Curve> = result
         .config

@@ -273,7 +273,7 @@ impl StudyResult {
             );
         }
         for (i, region) in Region::ALL.iter().enumerate() {
-            if self.region_pixels[i] == 0 {
+            if self.facts.region_pixels[i] == 0 {
                 let _ = writeln!(
                     s,
                     "\n{}: no pixels in this region, nothing measured",
@@ -285,8 +285,8 @@ impl StudyResult {
                 s,
                 "\n{} ({} pixels; reference MSE {:.2e}, {:.0}× below the smallest measured)",
                 region.name(),
-                self.region_pixels[i],
-                self.reference_mse[i],
+                self.facts.region_pixels[i],
+                self.facts.reference_mse[i],
                 self.reference_margin(*region)
             );
             let _ = writeln!(
@@ -482,9 +482,9 @@ impl StudyResult {
                     unit: "seed: one resample draws K seeds with replacement, the same for every sampler, budget and region",
                 },
             },
-            region_pixels: by_region(self.region_pixels),
-            reference_mse: by_region(self.reference_mse),
-            reference_cached: self.reference_cached,
+            region_pixels: by_region(self.facts.region_pixels),
+            reference_mse: by_region(self.facts.reference_mse),
+            reference_cached: self.facts.reference_cached,
             rows: &self.rows,
             slopes: &self.slopes,
             matching: &self.matching,

@@ -276,7 +276,7 @@ pub fn assemble(
     scene: &str,
     engine: &str,
     threads: usize,
-    facts: &CaseFacts,
+    facts: CaseFacts,
     mut results: Vec<JobResult>,
 ) -> StudyResult {
     let samplers = &config.samplers;
@@ -306,9 +306,7 @@ pub fn assemble(
         scene: scene.to_string(),
         engine: engine.to_string(),
         threads,
-        region_pixels: facts.region_pixels,
-        reference_mse: facts.reference_mse,
-        reference_cached: facts.reference_cached,
+        facts,
         rows,
         slopes,
         matching,
