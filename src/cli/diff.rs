@@ -130,19 +130,13 @@ pub fn run(args: &DiffArgs) -> Result<u8> {
             }
         );
     }
-    let mut plan = OutputPlan::new().input("A", &args.a).input("B", &args.b);
-    if let Some(mask) = args.mask_file() {
-        plan = plan.input("--mask", mask);
-    }
-    if let (true, Some(scene)) = (args.penumbra(), &args.scene) {
-        plan = plan.input("--scene", scene);
-    }
-    if let Some(out) = &args.out {
-        plan = plan.output("--out", out);
-    }
-    if let Some(json) = &args.json {
-        plan = plan.output("--json", json);
-    }
+    let plan = OutputPlan::new()
+        .input("A", &args.a)
+        .input("B", &args.b)
+        .input_if("--mask", args.mask_file())
+        .input_if("--scene", args.scene.as_deref().filter(|_| args.penumbra()))
+        .output_if("--out", args.out.as_deref())
+        .output_if("--json", args.json.as_deref());
     plan.check()?;
     plan.refuse_binary_on_terminal(&["--out"])?;
 

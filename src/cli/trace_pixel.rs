@@ -239,14 +239,8 @@ pub fn meaningless(args: &TracePixelArgs) -> Vec<String> {
 
 /// The scene (an input) and the outputs, checked before any work.
 fn output_plan(args: &TracePixelArgs) -> OutputPlan {
-    let mut plan = OutputPlan::new();
-    if let Some(scene) = &args.scene {
-        plan = plan.input("SCENE", scene);
-    }
-    for (flag, path) in args.outputs() {
-        if let Some(p) = path {
-            plan = plan.output(flag, p);
-        }
-    }
-    plan
+    (args.outputs().into_iter()).fold(
+        OutputPlan::new().input_if("SCENE", args.scene.as_deref()),
+        |plan, (flag, path)| plan.output_if(flag, path.as_deref()),
+    )
 }
