@@ -7,7 +7,7 @@ use super::values::{ToneMapArg, float};
 use anyhow::{Context, Result};
 use clap::Args;
 use raywave::frame::scene_and_settings;
-use raywave::output::image_file::ldr_format;
+use raywave::output::image_file::{ldr_format, write_json};
 use raywave::output::terminal::with_bar;
 use raywave::output::{OutputPlan, write_output};
 use raywave::render::camera::CameraRays;
@@ -16,7 +16,6 @@ use raywave::render::error::UsageError;
 use raywave::trace::draw::{Overlay, depth_buffer};
 use raywave::trace::view::ViewPlacement;
 use raywave::trace::{check_pixel, mesh, obj, ply, scene_bounds, summary, trace_pixel};
-use std::io::Write;
 use std::path::PathBuf;
 
 /// `raywave trace-pixel` flags.
@@ -129,10 +128,7 @@ pub fn run(args: &TracePixelArgs) -> Result<()> {
         args.x, args.y, scene.source
     );
     if let Some(path) = &args.json {
-        write_output(path, |w| {
-            serde_json::to_writer_pretty(&mut *w, &tree)?;
-            Ok(writeln!(w)?)
-        })?;
+        write_json(path, &tree)?;
     }
     if args.obj.is_some() || args.ply.is_some() {
         let groups = mesh::groups(&scene, &tree);
