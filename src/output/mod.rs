@@ -287,10 +287,7 @@ fn check_writable(out: &Named) -> Result<()> {
         if out.creates_dir {
             // The nearest existing ancestor is where the new directories will be made.
             while !dir.exists() {
-                match dir.parent() {
-                    Some(p) if !p.as_os_str().is_empty() => dir = p.to_path_buf(),
-                    _ => dir = PathBuf::from("."),
-                }
+                dir = write::parent_dir(&dir).to_path_buf();
             }
         }
         if !dir.exists() {
