@@ -6,7 +6,7 @@ use super::values::{DefaultsArg, MetricArg, float};
 use anyhow::{Result, bail};
 use clap::Args;
 use raywave::diff::{self, Comparison, EXIT_FAILED, FileInfo, Image, Metric, Region, read_image};
-use raywave::output::image_file::{ldr_format, write_atomically};
+use raywave::output::image_file::{ldr_format, write_json};
 use raywave::output::terminal::print;
 use raywave::output::{OutputPlan, is_stdio};
 use raywave::render::error::UsageError;
@@ -14,7 +14,6 @@ use raywave::render::sampling::LightSampler;
 use raywave::render::scene::load_scene;
 use raywave::render::settings::options::ImageOptions;
 use serde::Serialize;
-use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 /// Flags of `raywave diff`.
@@ -130,19 +129,13 @@ pub fn run(args: &DiffArgs) -> Result<u8> {
             }
         );
     }
-    let mut plan = OutputPlan::new().input("A", &args.a).input("B", &args.b);
-    if let Some(mask) = args.mask_file() {
-        plan = plan.input("--mask", mask);
-    }
-    if let (true, Some(scene)) = (args.penumbra(), &args.scene) {
-        plan = plan.input("--scene", scene);
-    }
-    if let Some(out) = &args.out {
-        plan = plan.output("--out", out);
-    }
-    if let Some(json) = &args.json {
-        plan = plan.output("--json", json);
-    }
+    let plan = OutputPlan::new()
+        .input("A", &args.a)
+        .input("B", &args.b)
+        .input_if("--mask", args.mask_file())
+        .input_if("--scene", args.scene.as_deref().filter(|_| args.penumbra()))
+        .output_if("--out", args.out.as_deref())
+        .output_if("--json", args.json.as_deref());
     plan.check()?;
     plan.refuse_binary_on_terminal(&["--out"])?;
 
@@ -211,11 +204,8 @@ pub fn run(args: &DiffArgs) -> Result<u8> {
             fail_above: args.fail_above,
             failed,
         };
-        let value = serde_json::to_value(&record)?;
-        write_atomically(json, |w| {
-            serde_json::to_writer_pretty(&mut *w, &value)?;
-            Ok(writeln!(w)?)
-        })?;
+        // Through a `Value`, whose keys are sorted.
+        write_json(json, &serde_json::to_value(&record)?)?;
     }
     if let (Some(threshold), Some(v)) = (args.fail_above, value) {
         let (verdict, relation) = match (failed, metric) {

@@ -147,25 +147,12 @@ pub fn run(args: &RenderArgs) -> Result<()> {
 
 /// The scene (an input) and every output of a render, for the checks before any work.
 fn output_plan(args: &RenderArgs) -> OutputPlan {
-    let mut plan = OutputPlan::new();
-    if let Some(scene) = &args.scene {
-        plan = plan.input("SCENE", scene);
-    }
-    if let Some(input) = &args.input {
-        plan = plan.input("-input", input);
-    }
-    plan = plan.output("-o", &args.output);
-    if let Some(hdr) = &args.hdr {
-        plan = plan.output("--hdr", hdr);
-    }
-    if let Some(json) = &args.stats_json {
-        plan = plan.output("--stats-json", json);
-    }
-    if let Some(map) = &args.cost_map {
-        plan = plan.output("--cost-map", map);
-    }
-    if let Some(reference) = &args.mse_reference {
-        plan = plan.input("--mse-reference", reference);
-    }
-    plan
+    OutputPlan::new()
+        .input_if("SCENE", args.scene.as_deref())
+        .input_if("-input", args.input.as_deref())
+        .output("-o", &args.output)
+        .output_if("--hdr", args.hdr.as_deref())
+        .output_if("--stats-json", args.stats_json.as_deref())
+        .output_if("--cost-map", args.cost_map.as_deref())
+        .input_if("--mse-reference", args.mse_reference.as_deref())
 }

@@ -7,7 +7,7 @@ use super::values::{ToneMapArg, float};
 use anyhow::{Context, Result};
 use clap::Args;
 use raywave::frame::scene_and_settings;
-use raywave::output::image_file::ldr_format;
+use raywave::output::image_file::{ldr_format, write_json};
 use raywave::output::terminal::with_bar;
 use raywave::output::{OutputPlan, write_output};
 use raywave::render::camera::CameraRays;
@@ -16,7 +16,6 @@ use raywave::render::error::UsageError;
 use raywave::trace::draw::{Overlay, depth_buffer};
 use raywave::trace::view::ViewPlacement;
 use raywave::trace::{check_pixel, mesh, obj, ply, scene_bounds, summary, trace_pixel};
-use std::io::Write;
 use std::path::PathBuf;
 
 /// `raywave trace-pixel` flags.
@@ -129,10 +128,7 @@ pub fn run(args: &TracePixelArgs) -> Result<()> {
         args.x, args.y, scene.source
     );
     if let Some(path) = &args.json {
-        write_output(path, |w| {
-            serde_json::to_writer_pretty(&mut *w, &tree)?;
-            Ok(writeln!(w)?)
-        })?;
+        write_json(path, &tree)?;
     }
     if args.obj.is_some() || args.ply.is_some() {
         let groups = mesh::groups(&scene, &tree);
@@ -239,14 +235,8 @@ pub fn meaningless(args: &TracePixelArgs) -> Vec<String> {
 
 /// The scene (an input) and the outputs, checked before any work.
 fn output_plan(args: &TracePixelArgs) -> OutputPlan {
-    let mut plan = OutputPlan::new();
-    if let Some(scene) = &args.scene {
-        plan = plan.input("SCENE", scene);
-    }
-    for (flag, path) in args.outputs() {
-        if let Some(p) = path {
-            plan = plan.output(flag, p);
-        }
-    }
-    plan
+    (args.outputs().into_iter()).fold(
+        OutputPlan::new().input_if("SCENE", args.scene.as_deref()),
+        |plan, (flag, path)| plan.output_if(flag, path.as_deref()),
+    )
 }

@@ -152,10 +152,20 @@ impl OutputPlan {
         self
     }
 
+    /// [`OutputPlan::input`] when the flag was given.
+    pub fn input_if(self, flag: &str, path: Option<&Path>) -> OutputPlan {
+        path.into_iter().fold(self, |plan, p| plan.input(flag, p))
+    }
+
     /// An output file whose directory must already exist.
     pub fn output(mut self, flag: &str, path: &Path) -> OutputPlan {
         self.outputs.push(Named::new(flag, path, false));
         self
+    }
+
+    /// [`OutputPlan::output`] when the flag was given.
+    pub fn output_if(self, flag: &str, path: Option<&Path>) -> OutputPlan {
+        path.into_iter().fold(self, |plan, p| plan.output(flag, p))
     }
 
     /// An output file in a directory the command creates if it is missing.
@@ -277,10 +287,7 @@ fn check_writable(out: &Named) -> Result<()> {
         if out.creates_dir {
             // The nearest existing ancestor is where the new directories will be made.
             while !dir.exists() {
-                match dir.parent() {
-                    Some(p) if !p.as_os_str().is_empty() => dir = p.to_path_buf(),
-                    _ => dir = PathBuf::from("."),
-                }
+                dir = write::parent_dir(&dir).to_path_buf();
             }
         }
         if !dir.exists() {

@@ -289,7 +289,14 @@ pub fn write_output_now(
                 .with_context(|| format!("cannot open {} for writing", path.display()))?;
             write_direct(&mut file, &path.display().to_string(), fill)
         }
-        Target::Regular(real) => write_atomically(path, &real, fill),
+        Target::Regular(real) => {
+            let tmp = write_temporary(path, &real, fill)?;
+            // Renamed under the lock: a signal now waits for the rename, and finds nothing to
+            // remove.
+            outputs()
+                .persist(tmp, &real)
+                .with_context(|| format!("cannot move the finished file to {}", path.display()))
+        }
     }
 }
 
@@ -337,20 +344,6 @@ fn write_direct(
     fill(&mut w).with_context(|| format!("cannot write {name}"))?;
     w.flush().with_context(|| format!("cannot write {name}"))?;
     Ok(())
-}
-
-/// Writes into a temporary file beside `real` (the symlink-free target of `path`), then
-/// renames it over `real`.
-fn write_atomically(
-    path: &Path,
-    real: &Path,
-    fill: impl FnOnce(&mut BufWriter<&mut File>) -> Result<()>,
-) -> Result<()> {
-    let tmp = write_temporary(path, real, fill)?;
-    // Renamed under the lock: a signal now waits for the rename, and finds nothing to remove.
-    outputs()
-        .persist(tmp, real)
-        .with_context(|| format!("cannot move the finished file to {}", path.display()))
 }
 
 /// The temporary file beside `real`, filled through `fill`, flushed, with the mode of the

@@ -72,6 +72,14 @@ pub enum TraceError {
 /// settings, is checked before tracing, so a huge request is refused instead of filling memory.
 const MAX_SEGMENTS: u64 = 1_000_000;
 
+/// The most segments one pixel's tree can have: per camera sample, a camera or mirror ray at
+/// each depth, each followed by its shadow rays.
+pub(crate) fn max_segments(scene: &Scene, settings: &RenderSettings) -> u64 {
+    u64::from(settings.aa_samples.max(1))
+        .saturating_mul(u64::from(settings.bounces) + 1)
+        .saturating_mul(1 + scene.lights.len() as u64 * u64::from(settings.points_per_light()))
+}
+
 /// Traces pixel (x, y) (from the top-left) of `scene` rendered with `settings` and records its
 /// ray tree; errors when the pixel is outside the image.
 pub fn trace_pixel(
@@ -89,18 +97,14 @@ pub fn trace_pixel(
         });
     }
     let aa = settings.aa_samples.max(1);
-    let paths = u64::from(settings.bounces) + 1;
-    let points = settings.points_per_light();
-    let bound = u64::from(aa)
-        .saturating_mul(paths)
-        .saturating_mul(1 + scene.lights.len() as u64 * u64::from(points));
+    let bound = max_segments(scene, settings);
     if bound > MAX_SEGMENTS {
         return Err(TraceError::TooLarge {
             bound,
             aa,
-            paths,
+            paths: u64::from(settings.bounces) + 1,
             lights: scene.lights.len(),
-            points,
+            points: settings.points_per_light(),
         });
     }
     let pixel = y * settings.width + x;

@@ -6,18 +6,12 @@ use super::http::ApiError;
 use crate::render::scene::Scene;
 use crate::render::settings::RenderSettings;
 use crate::trace::palette::{self, Rgb};
+use crate::trace::tracer::max_segments;
 use crate::trace::{RayTree, TraceError, check_pixel, trace_pixel};
 
 /// The most segments a tree may have before it is traced (its JSON is about 1 KB a segment, and
 /// the page draws and lists each one).
 const MAX_TREE_SEGMENTS: u64 = 50_000;
-
-/// The most segments one pixel's tree can have: per camera sample, a camera or mirror ray at
-/// each depth, each followed by its shadow rays.
-fn max_segments(scene: &Scene, settings: &RenderSettings) -> u64 {
-    let per_hit = 1 + scene.lights.len() as u64 * settings.points_per_light() as u64;
-    settings.aa_samples.max(1) as u64 * (settings.bounces as u64 + 1) * per_hit
-}
 
 /// The ray tree of pixel (x, y) (from the top-left), with `check` filled in; a pixel outside
 /// the image, or settings whose tree could pass [`MAX_TREE_SEGMENTS`], are a 400.
