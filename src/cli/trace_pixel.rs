@@ -235,8 +235,8 @@ pub fn meaningless(args: &TracePixelArgs) -> Vec<String> {
 
 /// The scene (an input) and the outputs, checked before any work.
 fn output_plan(args: &TracePixelArgs) -> OutputPlan {
-    (args.outputs().into_iter()).fold(
-        OutputPlan::new().input_if("SCENE", args.scene.as_deref()),
-        |plan, (flag, path)| plan.output_if(flag, path.as_deref()),
-    )
+    let plan = OutputPlan::new().input_if("SCENE", args.scene.as_deref());
+    args.outputs().into_iter().fold(plan, |plan, (flag, path)| {
+        plan.output_if(flag, path.as_deref())
+    })
 }
