@@ -18,11 +18,11 @@ use serde_json::Value;
 use std::path::{Path, PathBuf};
 
 fn manifest() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/scaling/variance-job.yaml")
+    Path::new(env!("RAYWAVE_REPO")).join("docs/scaling/variance-job.yaml")
 }
 
 fn schema() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/commands/k8s/job-batch-v1.json")
+    Path::new(env!("RAYWAVE_REPO")).join("tests/commands/k8s/job-batch-v1.json")
 }
 
 /// Reads YAML documents from stdin and prints `{"docs": [...], "violations": [...]}`: each

@@ -17,7 +17,7 @@ use common::skip::skip_or_fail;
 fn a_study_sharded_four_ways_by_gnu_parallel_merges_into_the_single_process_report() {
     let dir = study_dir();
     let d = dir.path();
-    let exe = env!("CARGO_BIN_EXE_raywave");
+    let exe = crate::common::bin::exe();
     single_and_prepared(d);
     let template = format!(
         "{exe} variance --study study.toml --shard {{}}/4 --cache cache --out parts --threads 1 -q"

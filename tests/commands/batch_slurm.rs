@@ -42,7 +42,7 @@ fn script(tmp: &Path, name: &str, body: &str) -> (PathBuf, PathBuf) {
 /// The array script of a study's shards: task I runs shard I/4 of `study.toml` in its working
 /// directory, on the cache the shards share; with `die_at`, that task exits 7 first.
 fn shards_script(tmp: &Path, name: &str, die_at: Option<u32>) -> (PathBuf, PathBuf) {
-    let exe = env!("CARGO_BIN_EXE_raywave");
+    let exe = crate::common::bin::exe();
     let die = die_at.map_or(String::new(), |i| {
         format!("[ \"$SLURM_ARRAY_TASK_ID\" = {i} ] && exit 7\n")
     });

@@ -269,7 +269,7 @@ fn until_decided_ends_undecided_at_the_budget_with_exit_4() {
 #[test]
 fn until_decided_against_itself_reports_its_rounds_and_a_documented_code() {
     let dir = tempfile::tempdir().unwrap();
-    let this = Path::new(env!("CARGO_BIN_EXE_raywave"));
+    let this = Path::new(crate::common::bin::exe());
     let out = until_decided(dir.path(), this, &["--max-rounds", "9"]);
     let table = stdout(&out);
     let expected = if table.contains("slower by more than 5%: a regression") {
@@ -290,7 +290,7 @@ fn until_decided_against_itself_reports_its_rounds_and_a_documented_code() {
 #[test]
 fn until_decided_flags_are_checked() {
     let dir = tempfile::tempdir().unwrap();
-    let this = env!("CARGO_BIN_EXE_raywave");
+    let this = crate::common::bin::exe();
     for (args, says) in [
         (
             &["--against", this, "--until-decided", "--max-rounds", "5"][..],

@@ -11,7 +11,7 @@ use std::path::Path;
 /// The mesh scene (684 triangles: the mesh BVH), small, on several tiles, soft shadows and a
 /// bounce, with `threads` rayon threads.
 fn cost_map(dir: &Path, threads: &str, map: &str, extra: &[&str]) -> Vec<u8> {
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_raywave"))
+    let out = std::process::Command::new(crate::common::bin::exe())
         .args([
             "render",
             "mesh_spheres_small.obj",

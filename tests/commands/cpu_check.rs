@@ -91,7 +91,7 @@ fn a_build_the_cpu_cannot_run_exits_2_under_valgrind_naming_the_features_the_cpu
         return skip_or_fail("valgrind is missing (.ci/run installs it)");
     };
     let out = Command::new(valgrind)
-        .args(["--tool=none", "-q", env!("CARGO_BIN_EXE_raywave"), "info"])
+        .args(["--tool=none", "-q", crate::common::bin::exe(), "info"])
         .output()
         .expect("run valgrind");
     let lacks = refused_or_ran(&out, "==");
@@ -107,7 +107,7 @@ fn a_build_the_cpu_cannot_run_exits_2_under_qemu_as_haswell() {
         return skip_or_fail("qemu-x86_64 is missing (.ci/run installs qemu-user)");
     };
     let out = Command::new(qemu)
-        .args(["-cpu", "Haswell", env!("CARGO_BIN_EXE_raywave"), "info"])
+        .args(["-cpu", "Haswell", crate::common::bin::exe(), "info"])
         .output()
         .expect("run qemu-x86_64");
     // QEMU warns about the Haswell features its emulator leaves out.

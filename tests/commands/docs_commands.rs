@@ -10,7 +10,7 @@ use common::docs::{
 };
 use std::path::Path;
 
-const ROOT: &str = env!("CARGO_MANIFEST_DIR");
+const ROOT: &str = env!("RAYWAVE_REPO");
 
 /// `raywave view` serves until stopped; tests/commands/view_http.rs and view_browser.rs run it.
 const VIEW: &str =
@@ -214,7 +214,7 @@ fn the_shortening_replaces_adds_and_keeps_sweep_points_apart() {
     assert_eq!(
         out[1..]
             .join(" ")
-            .replace(env!("CARGO_BIN_EXE_raywave"), "THIS"),
+            .replace(crate::common::bin::exe(), "THIS"),
         "--against THIS --until-decided --max-rounds 6 --warmup 0 --size 24 24 \
          --shadow-samples 4"
     );

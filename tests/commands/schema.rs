@@ -14,7 +14,7 @@ use serde_json::{Value, json};
 use std::path::{Path, PathBuf};
 
 fn schema_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/schema")
+    Path::new(env!("RAYWAVE_REPO")).join("docs/schema")
 }
 
 /// The checked-in schema `name`, parsed.

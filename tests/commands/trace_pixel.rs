@@ -349,7 +349,7 @@ fn the_summary_names_every_segment_and_the_check() {
 /// it after changing the types.
 #[test]
 fn the_checked_in_schema_matches_the_types() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/schema/ray-tree.schema.json");
+    let path = Path::new(env!("RAYWAVE_REPO")).join("docs/schema/ray-tree.schema.json");
     let schema = schemars::schema_for!(RayTree);
     let generated = serde_json::to_string_pretty(&schema).unwrap() + "\n";
     if std::env::var_os("RAYWAVE_BLESS").is_some() {
@@ -509,7 +509,7 @@ fn bad_input_is_a_usage_error_and_writes_nothing() {
 /// The `raywave` commands of the ```sh blocks in docs/TRACE.md and README's debug view (with
 /// `\` continuations joined).
 fn documented_commands() -> Vec<String> {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let root = Path::new(env!("RAYWAVE_REPO"));
     let trace = std::fs::read_to_string(root.join("docs/TRACE.md")).unwrap();
     let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
     let start = readme.find("### The debug view").unwrap();

@@ -483,7 +483,7 @@ fn concurrent_shards_render_a_shared_reference_once_and_prepare_renders_it_ahead
     };
     let children: Vec<_> = (0..4)
         .map(|i| {
-            std::process::Command::new(env!("CARGO_BIN_EXE_raywave"))
+            std::process::Command::new(crate::common::bin::exe())
                 .args(args(&format!("{i}/4")))
                 .current_dir(d)
                 .stdout(std::process::Stdio::piped())

@@ -10,7 +10,7 @@ use std::process::Command;
 
 #[test]
 fn the_page_modules_pass_their_node_tests() {
-    let root = env!("CARGO_MANIFEST_DIR");
+    let root = env!("RAYWAVE_REPO");
     let run = Command::new("node")
         .args(["--test", "--test-reporter=tap", "tests/js/"])
         .current_dir(root)

@@ -181,7 +181,7 @@ fn a_token_can_be_fixed_by_flag_or_variable_and_checked() {
     drop(server);
 
     // --help does not show the variable's value.
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_raywave"))
+    let out = std::process::Command::new(crate::common::bin::exe())
         .args(["view", "--help"])
         .env("RAYWAVE_VIEW_TOKEN", T)
         .output()
@@ -283,7 +283,7 @@ struct Route {
 /// what makes a route added there a route this file requests; a pattern it cannot read fails
 /// the test, naming it.
 fn routing_table() -> Vec<Route> {
-    let source = include_str!(concat!(env!("CARGO_MANIFEST_DIR"), "/src/view/routes.rs"));
+    let source = include_str!(concat!(env!("RAYWAVE_REPO"), "/src/view/routes.rs"));
     let (_, table) = source.split_once("match segments.as_slice() {").expect(
         "src/view/routes.rs: no `match segments.as_slice()` in `route`: update routing_table()",
     );
@@ -401,7 +401,7 @@ fn every_route_refuses_a_missing_or_wrong_token() {
     // Every URL the server serves: the page, each file under assets/ (the directory listed, so
     // a new file is covered), the API, and every image, as the server's own answers name them.
     let mut urls: Vec<String> = vec!["/".into(), "/index.html".into(), "/api/scene".into()];
-    let assets = concat!(env!("CARGO_MANIFEST_DIR"), "/src/view/assets");
+    let assets = concat!(env!("RAYWAVE_REPO"), "/src/view/assets");
     let mut files: Vec<String> = std::fs::read_dir(assets)
         .unwrap()
         .map(|e| e.unwrap().file_name().into_string().unwrap())

@@ -15,7 +15,7 @@ use super::bin::{raywave, scenes, stderr, stdout};
 use std::collections::BTreeSet;
 use std::path::Path;
 
-const ROOT: &str = env!("CARGO_MANIFEST_DIR");
+const ROOT: &str = env!("RAYWAVE_REPO");
 
 /// How to shorten one subcommand's runs: (subcommand, flag, values). A flag the command gives
 /// is replaced, one it lacks is added.
@@ -103,7 +103,7 @@ pub fn shorten(args: &[&str], quick: &Quick) -> Vec<String> {
         return out;
     }
     if let Some(i) = out.iter().position(|w| w == "--against") {
-        out[i + 1] = env!("CARGO_BIN_EXE_raywave").to_string();
+        out[i + 1] = crate::common::bin::exe().to_string();
         let rounds = if out.iter().any(|w| w == "--until-decided") {
             "--max-rounds"
         } else {
@@ -230,33 +230,36 @@ pub fn stale_manual(page: &Page) -> Vec<String> {
         .collect()
 }
 
-/// The targets of one kind (`bench` or `test`) declared in Cargo.toml: name and path (the path
-/// empty when the table gives none).
+/// The targets of one kind (`bench` or `test`) declared in the two manifests (the top one and
+/// tests/Cargo.toml's): name and path from the top folder (empty when the table gives none).
 fn targets(kind: &str) -> Vec<(String, String)> {
-    let toml = std::fs::read_to_string(Path::new(ROOT).join("Cargo.toml")).unwrap();
     let header = format!("[[{kind}]]");
     let mut out: Vec<(String, String)> = Vec::new();
-    let mut inside = false;
-    for line in toml.lines().map(str::trim) {
-        if line.starts_with('[') {
-            inside = line == header;
-            if inside {
-                out.push((String::new(), String::new()));
+    for folder in ["", "tests/"] {
+        let toml =
+            std::fs::read_to_string(Path::new(ROOT).join(folder).join("Cargo.toml")).unwrap();
+        let mut inside = false;
+        for line in toml.lines().map(str::trim) {
+            if line.starts_with('[') {
+                inside = line == header;
+                if inside {
+                    out.push((String::new(), String::new()));
+                }
+                continue;
             }
-            continue;
-        }
-        let Some(last) = out.last_mut().filter(|_| inside) else {
-            continue;
-        };
-        let value = |v: &str| {
-            v.trim_start_matches([' ', '='])
-                .trim_matches('"')
-                .to_string()
-        };
-        if let Some(v) = line.strip_prefix("name") {
-            last.0 = value(v);
-        } else if let Some(v) = line.strip_prefix("path") {
-            last.1 = value(v);
+            let Some(last) = out.last_mut().filter(|_| inside) else {
+                continue;
+            };
+            let value = |v: &str| {
+                v.trim_start_matches([' ', '='])
+                    .trim_matches('"')
+                    .to_string()
+            };
+            if let Some(v) = line.strip_prefix("name") {
+                last.0 = value(v);
+            } else if let Some(v) = line.strip_prefix("path") {
+                last.1 = format!("{folder}{}", value(v));
+            }
         }
     }
     out

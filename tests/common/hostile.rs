@@ -111,7 +111,7 @@ pub fn run(dir: &Path, args: &[&str], stdin: Option<&[u8]>, timeout: Duration) -
     let name = dir.file_name().unwrap().to_string_lossy();
     let out_path = dir.join("..").join(format!("stdout-{name}"));
     let err_path = dir.join("..").join(format!("stderr-{name}"));
-    let mut child = Command::new(env!("CARGO_BIN_EXE_raywave"))
+    let mut child = Command::new(crate::common::bin::exe())
         .args(&args)
         .current_dir(dir)
         .stdin(if stdin.is_some() {

@@ -61,7 +61,7 @@ pub fn rpi_scenes() -> Vec<(String, Scene)> {
 
 /// The `.obj` files of the repository's folder `dir`, parsed, by file name in name order.
 fn scenes_in(dir: &str) -> Vec<(String, Scene)> {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(dir);
+    let dir = std::path::Path::new(env!("RAYWAVE_REPO")).join(dir);
     let mut paths: Vec<_> = std::fs::read_dir(&dir)
         .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
         .map(|e| e.expect("dir entry").path())

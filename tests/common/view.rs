@@ -59,7 +59,7 @@ impl ViewServer {
 
     /// Starts `raywave view ARGS --port 0` with extra environment variables.
     pub fn start_with(args: &[&str], env: &[(&str, &str)]) -> ViewServer {
-        let mut child = Command::new(env!("CARGO_BIN_EXE_raywave"))
+        let mut child = Command::new(crate::common::bin::exe())
             .arg("view")
             .args(args)
             .args(["--port", "0"])

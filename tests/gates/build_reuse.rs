@@ -27,7 +27,7 @@ fn features(with_dev: bool) -> BTreeMap<String, String> {
             "-e",
             edges,
         ])
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .current_dir(env!("RAYWAVE_REPO"))
         .output()
         .expect("run cargo tree");
     assert!(

@@ -56,7 +56,7 @@ const DIARY_PHRASES: [&str; 7] = [
 ];
 
 fn read(path: &str) -> String {
-    let full = Path::new(env!("CARGO_MANIFEST_DIR")).join(path);
+    let full = Path::new(env!("RAYWAVE_REPO")).join(path);
     std::fs::read_to_string(&full).unwrap_or_else(|e| panic!("cannot read {}: {e}", full.display()))
 }
 

@@ -32,7 +32,7 @@ use std::process::Command;
 /// capture, chiefly glibc's `memset`/`memcpy`/`malloc`, which are picked per CPU at run time.
 const THRESHOLD: f64 = 0.01;
 /// The committed baselines.
-const RECORD: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/benches/baselines/icount.json");
+const RECORD: &str = concat!(env!("RAYWAVE_REPO"), "/benches/baselines/icount.json");
 /// The one command that re-records this machine's baselines.
 const RECORD_COMMAND: &str = "RAYWAVE_RECORD=1 cargo test --release --test gates icount";
 /// The regions, in the order the child runs them (the dumps come in this order).
@@ -134,7 +134,7 @@ fn measure(exe: &Path) -> Result<Measured, String> {
 const FIXED_TARGET: &str = "x86-64-v3";
 /// Where the child is built: its own target directory, so that building it does not wait on
 /// the lock of the `cargo test` that runs this, and its flags do not rebuild the test build.
-const FIXED_TARGET_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/target/icount-x86-64-v3");
+const FIXED_TARGET_DIR: &str = concat!(env!("RAYWAVE_REPO"), "/target/icount-x86-64-v3");
 /// The child's binary target (Cargo.toml) and the crate name its symbols carry.
 const CHILD_BIN: &str = "raywave-icount-child";
 const CHILD_CRATE: &str = "raywave_icount_child";
@@ -150,6 +150,8 @@ fn fixed_target_child() -> Result<PathBuf, String> {
         .args([
             "build",
             "--release",
+            "--package",
+            "raywave",
             "--no-default-features",
             "--features",
             "icount-child",
@@ -157,7 +159,7 @@ fn fixed_target_child() -> Result<PathBuf, String> {
             CHILD_BIN,
             "--message-format=json",
         ])
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .current_dir(env!("RAYWAVE_REPO"))
         .env("RUSTFLAGS", format!("-C target-cpu={FIXED_TARGET}"))
         .env("CARGO_TARGET_DIR", FIXED_TARGET_DIR)
         .output()

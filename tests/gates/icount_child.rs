@@ -206,7 +206,7 @@ fn workloads() {
     let mut out = vec![glam::Vec3::ZERO; REFERENCE_PIXELS as usize];
     icount_region_reference(&reference, &mut out);
 
-    let mesh_path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/mesh_spheres_small.obj");
+    let mesh_path = concat!(env!("RAYWAVE_REPO"), "/scenes/mesh_spheres_small.obj");
     let mesh = Scene::load(Path::new(mesh_path)).expect("scenes/mesh_spheres_small.obj");
     let mesh_ctx = Context::new(&mesh, &settings);
     assert!(

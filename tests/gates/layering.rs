@@ -20,7 +20,7 @@ fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
 
 #[test]
 fn only_the_lane_layer_names_wide_or_bytemuck() {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let src = Path::new(env!("RAYWAVE_REPO")).join("src");
     let lanes = src.join("render").join("wavefront").join("lanes.rs");
     let mut files = Vec::new();
     rust_files(&src, &mut files);
@@ -77,7 +77,7 @@ const TOOLS: [&str; 6] = ["bench", "diff", "frame", "trace", "variance", "view"]
 /// sharding layer names no tool; the statistics name no other module.
 #[test]
 fn each_layer_names_only_the_layers_above_it() {
-    let src = Path::new("src");
+    let src = &Path::new(env!("RAYWAVE_REPO")).join("src");
     let mut offenders = uses_of(
         &src.join("render"),
         &[&["output", "shard"][..], &TOOLS].concat(),
@@ -103,5 +103,11 @@ fn each_layer_names_only_the_layers_above_it() {
 /// The check sees a use: the view names the trace module.
 #[test]
 fn a_use_across_layers_is_seen() {
-    assert!(!uses_of(&Path::new("src").join("view"), &["trace"]).is_empty());
+    assert!(
+        !uses_of(
+            &Path::new(env!("RAYWAVE_REPO")).join("src/view"),
+            &["trace"]
+        )
+        .is_empty()
+    );
 }

@@ -163,9 +163,9 @@ fn problems_of(doc: &str, src: &Path) -> Vec<String> {
 
 #[test]
 fn the_module_map_is_the_source_tree() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let root = Path::new(env!("RAYWAVE_REPO"));
     let doc = std::fs::read_to_string(root.join("docs/ARCHITECTURE.md")).unwrap();
-    let problems = problems_of(&doc, Path::new("src"));
+    let problems = problems_of(&doc, &root.join("src"));
     assert!(
         problems.is_empty(),
         "docs/ARCHITECTURE.md's module map and src/ disagree:\n{}",
@@ -177,9 +177,9 @@ fn the_module_map_is_the_source_tree() {
 /// paragraph that forgets a file are each caught.
 #[test]
 fn a_stale_map_is_caught() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let root = Path::new(env!("RAYWAVE_REPO"));
     let doc = std::fs::read_to_string(root.join("docs/ARCHITECTURE.md")).unwrap();
-    let src = Path::new("src");
+    let src = &Path::new(env!("RAYWAVE_REPO")).join("src");
     let missing = doc.replacen("    camera.rs ", "    ", 1);
     assert!(
         problems_of(&missing, src)

@@ -463,7 +463,7 @@ fn light_model_and_ambient_match_the_oracle() {
 #[test]
 fn the_mirror_sphere_speckle_pixel_matches_the_oracle() {
     let scene = Scene::load(std::path::Path::new(concat!(
-        env!("CARGO_MANIFEST_DIR"),
+        env!("RAYWAVE_REPO"),
         "/scenes/cornell_box_reflective_spheres.obj"
     )))
     .unwrap();

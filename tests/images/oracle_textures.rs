@@ -83,7 +83,7 @@ fn the_oracle_reads_and_looks_up_texels_the_right_way_up() {
     assert!((srgb_to_linear(0.5) - 0.214_041_140).abs() < 1e-9);
     assert!((srgb_to_linear(0.04045) - 0.003_130_805).abs() < 1e-9);
     assert_eq!(srgb_to_linear(1.0), 1.0);
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/textures/asymmetric.ppm");
+    let path = Path::new(env!("RAYWAVE_REPO")).join("scenes/textures/asymmetric.ppm");
     let tex = Image::read(&path).unwrap();
     assert_eq!((tex.width, tex.height), (4, 3));
     // (i/4, j/3) is texel (i, j) exactly: t = 0 is the file's last row.
@@ -229,7 +229,7 @@ fn a_flipped_or_transposed_lookup_fails_against_the_oracle() {
 /// with s = 0 at every corner (exactly 0 in any arithmetic).
 #[test]
 fn a_face_at_a_whole_coordinate_is_flagged_everywhere() {
-    let texture = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/textures/asymmetric.ppm");
+    let texture = Path::new(env!("RAYWAVE_REPO")).join("scenes/textures/asymmetric.ppm");
     let dir = tempfile::tempdir().unwrap();
     let settings = RenderSettings {
         width: 48,

@@ -323,7 +323,7 @@ fn check_mesh_occlusion<V: Lanes>(rng: &mut TestRng, scene: &Scene, len: usize, 
 
 #[test]
 fn mesh_occlusion_in_registers_equals_the_queue_s() {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/mesh_spheres_small.obj");
+    let path = concat!(env!("RAYWAVE_REPO"), "/scenes/mesh_spheres_small.obj");
     let scene = Scene::load(std::path::Path::new(path)).expect("scenes/mesh_spheres_small.obj");
     let mut rng: TestRng = seeded(0x3e5b);
     for len in [0, 1, 7, 8, 9, 17, 300] {

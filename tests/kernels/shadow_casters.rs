@@ -14,12 +14,7 @@ use std::fmt::Write;
 use std::path::Path;
 
 fn scene(name: &str) -> Scene {
-    Scene::load(
-        &Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("scenes")
-            .join(name),
-    )
-    .unwrap()
+    Scene::load(&Path::new(env!("RAYWAVE_REPO")).join("scenes").join(name)).unwrap()
 }
 
 /// Blocked with every triangle tested: what the engines did before culling.

@@ -8,8 +8,8 @@
 #   RAYWAVE_MUTANT_TESTS="sampling" tests/mutants/run.sh P.patch   other tests than the patch's
 #
 # A patch is `git diff` output after two header lines, "Mutant: what changed" and "Tests:
-# test binaries" (the [[test]] names of Cargo.toml, one per kind, so `kernels` runs every file
-# of tests/kernels/; `lib` for the unit tests in src/), which `git apply` skips. Run it from a
+# test binaries" (the [[test]] names of the two Cargo.tomls, one per kind, so `kernels` runs
+# every file of tests/kernels/; `lib` for the unit tests in src/), which `git apply` skips. Run it from a
 # clean work tree: it refuses to start when src/ has uncommitted changes, and it always reverts
 # what it applied. Each mutant rebuilds the library in release: about a minute on 2 cores.
 set -u
@@ -34,8 +34,9 @@ for patch in "$@"; do
     for t in $tests; do
         if [ "$t" = lib ]; then args="$args --lib"; else args="$args --test $t"; fi
     done
+    # The binary too: the tests that run it (tests/Cargo.toml's) do not build it.
     # shellcheck disable=SC2086 # one argument per word on purpose
-    if ! cargo test --release --no-fail-fast $args --no-run >"$log" 2>&1; then
+    if ! { cargo build --release && cargo test --release --no-fail-fast $args --no-run; } >"$log" 2>&1; then
         result="NO-BUILD  $name"
     elif cargo test --release --no-fail-fast $args >"$log" 2>&1; then
         result="SURVIVED  $name  [$tests]"

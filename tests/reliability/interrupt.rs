@@ -12,7 +12,7 @@ const OLD: &[u8] = b"the old output";
 fn start(dir: &Path, size: &str, slow: bool) -> Child {
     std::fs::write(dir.join("out.png"), OLD).unwrap();
     std::fs::write(dir.join("out.exr"), OLD).unwrap();
-    Command::new(env!("CARGO_BIN_EXE_raywave"))
+    Command::new(crate::common::bin::exe())
         .args(["render", "--size", size, size, "-q"])
         .args(if slow {
             [

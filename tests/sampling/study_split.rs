@@ -93,7 +93,7 @@ fn traced(scene: &Scene, config: &StudyConfig) -> Vec<(Job, f64, u64)> {
 }
 
 fn scenes() -> Vec<(&'static str, Scene)> {
-    let two = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/two_lights.obj");
+    let two = std::path::Path::new(env!("RAYWAVE_REPO")).join("scenes/two_lights.obj");
     let two_lights = Scene::load(&two).unwrap();
     assert_eq!(two_lights.lights.len(), 2);
     vec![

@@ -19,7 +19,7 @@ const SEED_COUNTS: &[(&str, usize, usize, usize, usize)] = &[
 ];
 
 fn manifest_dir() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+    PathBuf::from(env!("RAYWAVE_REPO"))
 }
 
 fn check_counts(dir: &Path) {

@@ -29,7 +29,7 @@ fn cli_render(width: u32, height: u32, flags: &[&str]) -> image::RgbImage {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("render.png");
     let (w, h) = (width.to_string(), height.to_string());
-    let run = Command::new(env!("CARGO_BIN_EXE_raywave"))
+    let run = Command::new(crate::common::bin::exe())
         .args(["render", "--size", &w, &h, "-q", "--output"])
         .arg(&out)
         .args(flags)
