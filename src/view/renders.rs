@@ -16,13 +16,13 @@
 //! ```
 
 use crate::output::bench_record::KindFigures;
-use crate::output::cost_map::{CostInput, overlay};
+use crate::output::cost_map::{CostInput, Count, overlay};
 use crate::output::image_file::png_bytes;
 use crate::render::engine::{Engine, Prepared, clamp_to_finite};
 use crate::render::film::ToneMap;
 use crate::render::progress::Progress;
 use crate::render::scene::{Camera, Scene};
-use crate::view::request::{CostMeasureView, CostOverlay, Resolved, ViewSettings};
+use crate::view::request::{CostOverlay, Resolved, ViewSettings};
 use crate::view::scene_json::CameraFrame;
 use crate::view::{CountedRender, keep, lock};
 use serde::Serialize;
@@ -85,7 +85,7 @@ pub(crate) struct CostLegend {
     /// The rays counted.
     pub kind: CostOverlay,
     /// The count shown.
-    pub measure: CostMeasureView,
+    pub measure: Count,
     /// The top of the linear scale (the scale starts at 0), per pixel and camera sample.
     pub high: f64,
     /// The largest value of the map.
@@ -463,7 +463,7 @@ fn render_levels(
                             totals: &costs.totals,
                             rays: &stats.counts,
                         };
-                        overlay(&input, kind, job.resolved.cost_measure.count())
+                        overlay(&input, kind, job.resolved.cost_measure)
                     });
                     (film, stats, overlay)
                 }),
@@ -527,7 +527,7 @@ mod tests {
             engine: Engine::Wavefront,
             camera: Scene::builtin_default().camera,
             cost_map: CostOverlay::Off,
-            cost_measure: CostMeasureView::Nodes,
+            cost_measure: Count::Nodes,
         }
     }
 
