@@ -159,24 +159,20 @@ pub fn trace_settings(s: &RenderSettings) -> TraceSettings {
 
 /// The primitive behind a global id.
 pub fn primitive_ref(scene: &Scene, prim: u32) -> PrimitiveRef {
-    match scene.triangles.get(prim as usize) {
-        Some(t) => PrimitiveRef {
-            id: prim,
-            shape: PrimitiveShape::Triangle,
-            index: prim,
-            face: Some(t.face),
-            material: t.material,
-        },
+    let (shape, index, face, material) = match scene.triangles.get(prim as usize) {
+        Some(t) => (PrimitiveShape::Triangle, prim, Some(t.face), t.material),
         None => {
             let index = prim - scene.triangles.len() as u32;
-            PrimitiveRef {
-                id: prim,
-                shape: PrimitiveShape::Sphere,
-                index,
-                face: None,
-                material: scene.spheres[index as usize].material,
-            }
+            let material = scene.spheres[index as usize].material;
+            (PrimitiveShape::Sphere, index, None, material)
         }
+    };
+    PrimitiveRef {
+        id: prim,
+        shape,
+        index,
+        face,
+        material,
     }
 }
 
