@@ -97,17 +97,12 @@ pub(crate) struct Estimate {
 }
 
 impl Estimate {
+    /// Of two or more values (a request asks for at least two seeds); NaN for fewer.
     fn of(values: &[f64]) -> Estimate {
-        let k = values.len() as f64;
-        let mean = values.iter().sum::<f64>() / k.max(1.0);
-        let var = if values.len() > 1 {
-            values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (k - 1.0)
-        } else {
-            0.0
-        };
+        use statrs::statistics::Statistics;
         Estimate {
-            mean,
-            se: (var / k.max(1.0)).sqrt(),
+            mean: values.mean(),
+            se: values.std_dev() / (values.len() as f64).sqrt(),
         }
     }
 }
@@ -235,7 +230,7 @@ impl Comparisons {
         let mut pngs = vec![("reference".to_string(), film_png(&reference.film)?)];
         let mut maps = Vec::new();
         let mut sides = Vec::new();
-        for (i, &sampler) in request.samplers.iter().enumerate() {
+        for (&sampler, side_name) in request.samplers.iter().zip(["a", "b"]) {
             let mut films = Vec::new();
             let mut times = Vec::new();
             for k in 1..=request.seeds {
@@ -254,7 +249,6 @@ impl Comparisons {
                 Estimate::of(&v)
             };
             let all = error_stats(&images, &reference.film.pixels, &reference.noise, &whole);
-            let side_name = if i == 0 { "a" } else { "b" };
             pngs.push((format!("image-{side_name}"), film_png(&films[0])?));
             maps.push(pixel_mse(&images, &reference.film.pixels));
             let perceived = perceived::measure(
