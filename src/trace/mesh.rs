@@ -14,7 +14,6 @@
 
 use super::draw::MARKER_SIZE;
 use super::palette::{MAIN_CAMERA, Rgb, Style};
-use super::scene_view::scene_bounds;
 use super::tree::RayTree;
 use super::view::camera_marker;
 use crate::render::scene::Scene;
@@ -63,6 +62,28 @@ impl Group {
 fn rgb8(c: Vec3) -> Rgb {
     let c = c.clamp(Vec3::ZERO, Vec3::ONE) * 255.0;
     [c.x.round() as u8, c.y.round() as u8, c.z.round() as u8]
+}
+
+/// The axis-aligned bounds of every triangle corner and sphere: (min, max); the origin for an
+/// empty scene.
+pub fn scene_bounds(scene: &Scene) -> (Vec3, Vec3) {
+    let mut lo = Vec3::splat(f32::INFINITY);
+    let mut hi = Vec3::splat(f32::NEG_INFINITY);
+    for t in &scene.triangles {
+        for c in [t.v0, t.v0 + t.e1, t.v0 + t.e2] {
+            lo = lo.min(c);
+            hi = hi.max(c);
+        }
+    }
+    for s in &scene.spheres {
+        lo = lo.min(s.center - s.radius);
+        hi = hi.max(s.center + s.radius);
+    }
+    if lo.cmple(hi).all() {
+        (lo, hi)
+    } else {
+        (Vec3::ZERO, Vec3::ZERO)
+    }
 }
 
 /// The groups of a scene and a tree.

@@ -108,7 +108,7 @@ pub fn trace_pixel(
         });
     }
     let pixel = y * settings.width + x;
-    let (lo, hi) = super::scene_view::scene_bounds(scene);
+    let (lo, hi) = super::mesh::scene_bounds(scene);
     let diagonal = (hi - lo).length();
     let miss_length = Some(diagonal)
         .filter(|d| d.is_finite() && *d > 0.0)
