@@ -418,8 +418,8 @@ pub(crate) fn with_camera<'a>(scene: &'a Scene, camera: &Camera) -> Cow<'a, Scen
 impl Renderer {
     /// Renders every level; false when superseded before the last was finished.
     fn render_levels(&self, job: &RenderJob) -> anyhow::Result<bool> {
-        let (pool, counted) = (&self.pool, self.counted);
-        let scene = with_camera(&self.scene, &job.resolved.camera);
+        let r = &job.resolved;
+        let scene = with_camera(&self.scene, &r.camera);
         for &[width, height] in &job.sizes {
             if job.cancel.load(Ordering::Relaxed) {
                 return Ok(false);
@@ -427,13 +427,10 @@ impl Renderer {
             let settings = crate::render::settings::RenderSettings {
                 width,
                 height,
-                ..job.resolved.settings.clone()
+                ..r.settings.clone()
             };
             let start = Instant::now();
-            let prepared = job
-                .resolved
-                .engine
-                .prepare(&scene, &settings, self.batch_size);
+            let prepared = r.engine.prepare(&scene, &settings, self.batch_size);
             // Steps come from every worker: the count only grows within a level.
             let report = |done, total, _: &str| {
                 job.total_units.store(total, Ordering::Relaxed);
@@ -446,9 +443,8 @@ impl Renderer {
                 report: &report,
                 ..Progress::SILENT
             };
-            let rendered = match (&prepared, job.resolved.cost_map.kind()) {
-                (Prepared::Wavefront(w), Some(kind)) => pool
-                    .install(|| counted(w, &progress, &job.cancel))
+            let rendered = self.pool.install(|| match (&prepared, r.cost_map.kind()) {
+                (Prepared::Wavefront(w), Some(kind)) => (self.counted)(w, &progress, &job.cancel)
                     .map(|(mut film, stats, costs)| {
                         clamp_to_finite(&mut film);
                         let overlay = costs.pixels.as_ref().map(|pixels| {
@@ -460,14 +456,14 @@ impl Renderer {
                                 totals: &costs.totals,
                                 rays: &stats.counts,
                             };
-                            overlay(&input, kind, job.resolved.cost_measure)
+                            overlay(&input, kind, r.cost_measure)
                         });
                         (film, stats, overlay)
                     }),
-                _ => pool
-                    .install(|| prepared.render_until(&progress, &job.cancel))
+                _ => prepared
+                    .render_until(&progress, &job.cancel)
                     .map(|(film, stats)| (film, stats, None)),
-            };
+            });
             let Some((film, stats, overlay)) = rendered else {
                 return Ok(false);
             };
@@ -476,8 +472,8 @@ impl Renderer {
             let (cost, cost_png) = match overlay {
                 Some(map) => (
                     Some(CostLegend {
-                        kind: job.resolved.cost_map,
-                        measure: job.resolved.cost_measure,
+                        kind: r.cost_map,
+                        measure: r.cost_measure,
                         high: map.scale.high,
                         largest: map.largest,
                         per_ray: map.per_ray,
