@@ -213,6 +213,7 @@ impl Comparisons {
             heatmap_n: request.n,
             ..StudyConfig::standard(base_settings)
         };
+        let (wc, hc) = (config.base.width, config.base.height);
         let render = |s: &Scene, settings: &crate::render::settings::RenderSettings| {
             pool.install(|| resolved.engine.image(s, settings))
         };
@@ -251,13 +252,8 @@ impl Comparisons {
             let all = error_stats(&images, &reference.film.pixels, &reference.noise, &whole);
             pngs.push((format!("image-{side_name}"), film_png(&films[0])?));
             maps.push(pixel_mse(&images, &reference.film.pixels));
-            let perceived = perceived::measure(
-                &images,
-                &reference.film.pixels,
-                config.base.width as usize,
-                config.base.height as usize,
-                &whole,
-            );
+            let (wu, hu) = (wc as usize, hc as usize);
+            let perceived = perceived::measure(&images, &reference.film.pixels, wu, hu, &whole);
             sides.push(Side {
                 sampler,
                 image: url(&format!("image-{side_name}")),
@@ -270,7 +266,6 @@ impl Comparisons {
             });
         }
         let map_refs: Vec<&[f32]> = maps.iter().map(Vec::as_slice).collect();
-        let (wc, hc) = (config.base.width, config.base.height);
         let (heat_imgs, heat_scale) = match heat_images(&map_refs, wc, hc) {
             Some((imgs, scale)) => (imgs, Some(scale)),
             None => (vec![image::RgbImage::new(wc, hc); 2], None),
