@@ -4,11 +4,12 @@
 use super::compare::{CompareRequest, Comparisons, KEPT};
 use super::http::{ApiError, Reply, number, query};
 use super::renders::{
-    ENGINES, KEPT_RENDERS, RENDER_BURST, RENDER_RATE, RenderJob, Renders, Status, with_camera,
+    KEPT_RENDERS, RENDER_BURST, RENDER_RATE, RenderJob, Renders, Status, with_camera,
 };
 use super::request::{Resolved, ViewSettings, parse_json};
 use super::scene_json::SceneJson;
 use super::tree;
+use crate::render::engine::Engine;
 use crate::render::quote::quote;
 use crate::render::sampling::LightSampler;
 use crate::render::scene::Scene;
@@ -55,7 +56,7 @@ pub(crate) fn scene_json(scene: &Scene, base: &Resolved) -> Vec<u8> {
         scene: SceneJson::new(scene),
         settings: base.to_json(),
         samplers: LightSampler::ALL.iter().map(|s| s.name()).collect(),
-        engines: ENGINES.iter().map(|e| e.name()).collect(),
+        engines: vec![Engine::Wavefront.name(), Engine::Reference.name()],
         simd: crate::simd_path(),
         palette: tree::PALETTE,
     })

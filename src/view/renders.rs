@@ -18,7 +18,7 @@
 use crate::output::bench_record::KindFigures;
 use crate::output::cost_map::{CostInput, Count, overlay};
 use crate::output::image_file::png_bytes;
-use crate::render::engine::{Engine, Prepared, clamp_to_finite};
+use crate::render::engine::{Prepared, clamp_to_finite};
 use crate::render::film::ToneMap;
 use crate::render::progress::Progress;
 use crate::render::scene::{Camera, Scene};
@@ -496,12 +496,10 @@ impl Renderer {
     }
 }
 
-/// Engines by name, for the page's menu.
-pub(crate) const ENGINES: [Engine; 2] = [Engine::Wavefront, Engine::Reference];
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::render::engine::Engine;
     use std::time::Duration;
 
     #[test]
