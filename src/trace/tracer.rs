@@ -327,29 +327,23 @@ impl TraceLog for Recorder<'_> {
         blocked: Option<bool>,
         term: Vec3,
     ) {
+        let beta = Vec3::from_array(self.at(key).segment.throughput);
         // Which primitive blocks it: the nearest hit in (0, tmax). `blocked` is the render's
         // own test; this only names the blocker.
-        let blocker = (blocked == Some(true))
-            .then(|| {
-                let h = self
-                    .accel
-                    .closest(self.scene, &shadow.ray, shadow.tmax, self.two_sided);
-                h.is_hit().then(|| BlockerInfo {
-                    primitive: primitive_ref(self.scene, h.prim),
-                    t: h.t,
-                    point: (shadow.ray.origin + h.t * shadow.ray.direction).to_array(),
-                })
-            })
-            .flatten();
-        let per_sample = self.per_sample;
-        let record = self.at(key);
-        let beta = Vec3::from_array(record.segment.throughput);
-        let contribution = if blocked == Some(true) {
-            Vec3::ZERO
+        let (blocker, contribution) = if blocked == Some(true) {
+            let h = self
+                .accel
+                .closest(self.scene, &shadow.ray, shadow.tmax, self.two_sided);
+            let blocker = h.is_hit().then(|| BlockerInfo {
+                primitive: primitive_ref(self.scene, h.prim),
+                t: h.t,
+                point: (shadow.ray.origin + h.t * shadow.ray.direction).to_array(),
+            });
+            (blocker, Vec3::ZERO)
         } else {
-            beta * term * per_sample
+            (None, beta * term * self.per_sample)
         };
-        record.shadows.push(Segment {
+        self.at(key).shadows.push(Segment {
             id: 0,
             parent: None,
             sample: key.sample,
