@@ -469,19 +469,16 @@ impl Renderer {
             };
             let seconds = start.elapsed().as_secs_f64();
             let png = png_bytes(&film.to_rgb8(ToneMap::Clamp))?;
-            let (cost, cost_png) = match overlay {
-                Some(map) => (
-                    Some(CostLegend {
-                        kind: r.cost_map,
-                        measure: r.cost_measure,
-                        high: map.scale.high,
-                        largest: map.largest,
-                        per_ray: map.per_ray,
-                    }),
-                    Some(Arc::new(png_bytes(&map.image(width, height))?)),
-                ),
-                None => (None, None),
-            };
+            let cost = overlay.as_ref().map(|map| CostLegend {
+                kind: r.cost_map,
+                measure: r.cost_measure,
+                high: map.scale.high,
+                largest: map.largest,
+                per_ray: map.per_ray,
+            });
+            let cost_png = overlay
+                .map(|map| png_bytes(&map.image(width, height)))
+                .transpose()?;
             let mut state = lock(&job.state);
             state.levels.push(Level {
                 width,
@@ -490,7 +487,7 @@ impl Renderer {
                 cost,
             });
             state.pngs.push(Arc::new(png));
-            state.cost_pngs.push(cost_png);
+            state.cost_pngs.push(cost_png.map(Arc::new));
         }
         Ok(true)
     }
