@@ -25,6 +25,7 @@ use crate::variance::report::{plot::heat_images, spectrum_plot};
 use crate::variance::{StudyConfig, converged_reference, error_stats, penumbra_mask, pixel_mse};
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
+use statrs::statistics::Statistics;
 use std::collections::VecDeque;
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
@@ -99,7 +100,6 @@ pub(crate) struct Estimate {
 impl Estimate {
     /// Of two or more values (a request asks for at least two seeds); NaN for fewer.
     fn of(values: &[f64]) -> Estimate {
-        use statrs::statistics::Statistics;
         Estimate {
             mean: values.mean(),
             se: values.std_dev() / (values.len() as f64).sqrt(),
@@ -278,8 +278,7 @@ impl Comparisons {
         let spectrum =
             spectrum_plot::comparison_image(&spectra, request.n, (640, 400)).map_err(internal)?;
         pngs.push(("spectrum".to_string(), encode(&spectrum)?));
-        let noise = reference.noise.iter().map(|&v| v as f64).sum::<f64>()
-            / reference.noise.len().max(1) as f64;
+        let noise = reference.noise.iter().map(|&v| f64::from(v)).mean();
         keep(&self.kept, (id, pngs), KEPT);
         Ok(Comparison {
             id,
