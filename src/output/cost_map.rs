@@ -63,9 +63,11 @@ pub enum CostMeasure {
 }
 
 /// One count a map shows: a panel of the figure, or the viewer's overlay.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum Count {
     /// BVH nodes visited.
+    #[default]
     Nodes,
     /// Primitives tested.
     Tests,

@@ -14,7 +14,6 @@
 
 use super::draw::MARKER_SIZE;
 use super::palette::{MAIN_CAMERA, Rgb, Style};
-use super::scene_view::scene_bounds;
 use super::tree::RayTree;
 use super::view::camera_marker;
 use crate::render::scene::Scene;
@@ -65,27 +64,43 @@ fn rgb8(c: Vec3) -> Rgb {
     [c.x.round() as u8, c.y.round() as u8, c.z.round() as u8]
 }
 
+/// The axis-aligned bounds of every triangle corner and sphere: (min, max); the origin for an
+/// empty scene.
+pub fn scene_bounds(scene: &Scene) -> (Vec3, Vec3) {
+    let mut lo = Vec3::splat(f32::INFINITY);
+    let mut hi = Vec3::splat(f32::NEG_INFINITY);
+    for t in &scene.triangles {
+        for c in [t.v0, t.v0 + t.e1, t.v0 + t.e2] {
+            lo = lo.min(c);
+            hi = hi.max(c);
+        }
+    }
+    for s in &scene.spheres {
+        lo = lo.min(s.center - s.radius);
+        hi = hi.max(s.center + s.radius);
+    }
+    if lo.cmple(hi).all() {
+        (lo, hi)
+    } else {
+        (Vec3::ZERO, Vec3::ZERO)
+    }
+}
+
 /// The groups of a scene and a tree.
 pub fn groups(scene: &Scene, tree: &RayTree) -> Vec<Group> {
-    let mut out = Vec::new();
-    let mut faces = Group::new("scene");
-    let mut lights: Vec<Group> = (0..scene.lights.len())
-        .map(|k| Group::new(&format!("light_{k}")))
+    // The faces that are not lights, then light k's at k + 1.
+    let mut out: Vec<Group> = std::iter::once(Group::new("scene"))
+        .chain((0..scene.lights.len()).map(|k| Group::new(&format!("light_{k}"))))
         .collect();
     for t in &scene.triangles {
         let material = &scene.materials[t.material as usize];
-        let light = scene.lights.iter().position(|l| l.face == t.face);
-        let (group, colour) = match light {
-            Some(k) => (&mut lights[k], rgb8(material.emitted)),
-            None => (&mut faces, rgb8(material.diffuse)),
+        let (group, colour) = match scene.lights.iter().position(|l| l.face == t.face) {
+            Some(k) => (&mut out[k + 1], rgb8(material.emitted)),
+            None => (&mut out[0], rgb8(material.diffuse)),
         };
-        let a = group.vertex(t.v0, colour);
-        let b = group.vertex(t.v0 + t.e1, colour);
-        let c = group.vertex(t.v0 + t.e2, colour);
-        group.triangles.push([a, b, c]);
+        let corners = [t.v0, t.v0 + t.e1, t.v0 + t.e2].map(|p| group.vertex(p, colour));
+        group.triangles.push(corners);
     }
-    out.push(faces);
-    out.extend(lights);
     for (k, s) in scene.spheres.iter().enumerate() {
         let material = &scene.materials[s.material as usize];
         let colour = rgb8(material.diffuse.max(material.reflective));

@@ -108,7 +108,7 @@ pub fn trace_pixel(
         });
     }
     let pixel = y * settings.width + x;
-    let (lo, hi) = super::scene_view::scene_bounds(scene);
+    let (lo, hi) = super::mesh::scene_bounds(scene);
     let diagonal = (hi - lo).length();
     let miss_length = Some(diagonal)
         .filter(|d| d.is_finite() && *d > 0.0)
@@ -159,24 +159,20 @@ pub fn trace_settings(s: &RenderSettings) -> TraceSettings {
 
 /// The primitive behind a global id.
 pub fn primitive_ref(scene: &Scene, prim: u32) -> PrimitiveRef {
-    match scene.triangles.get(prim as usize) {
-        Some(t) => PrimitiveRef {
-            id: prim,
-            shape: PrimitiveShape::Triangle,
-            index: prim,
-            face: Some(t.face),
-            material: t.material,
-        },
+    let (shape, index, face, material) = match scene.triangles.get(prim as usize) {
+        Some(t) => (PrimitiveShape::Triangle, prim, Some(t.face), t.material),
         None => {
             let index = prim - scene.triangles.len() as u32;
-            PrimitiveRef {
-                id: prim,
-                shape: PrimitiveShape::Sphere,
-                index,
-                face: None,
-                material: scene.spheres[index as usize].material,
-            }
+            let material = scene.spheres[index as usize].material;
+            (PrimitiveShape::Sphere, index, None, material)
         }
+    };
+    PrimitiveRef {
+        id: prim,
+        shape,
+        index,
+        face,
+        material,
     }
 }
 
@@ -331,29 +327,23 @@ impl TraceLog for Recorder<'_> {
         blocked: Option<bool>,
         term: Vec3,
     ) {
+        let beta = Vec3::from_array(self.at(key).segment.throughput);
         // Which primitive blocks it: the nearest hit in (0, tmax). `blocked` is the render's
         // own test; this only names the blocker.
-        let blocker = (blocked == Some(true))
-            .then(|| {
-                let h = self
-                    .accel
-                    .closest(self.scene, &shadow.ray, shadow.tmax, self.two_sided);
-                h.is_hit().then(|| BlockerInfo {
-                    primitive: primitive_ref(self.scene, h.prim),
-                    t: h.t,
-                    point: (shadow.ray.origin + h.t * shadow.ray.direction).to_array(),
-                })
-            })
-            .flatten();
-        let per_sample = self.per_sample;
-        let record = self.at(key);
-        let beta = Vec3::from_array(record.segment.throughput);
-        let contribution = if blocked == Some(true) {
-            Vec3::ZERO
+        let (blocker, contribution) = if blocked == Some(true) {
+            let h = self
+                .accel
+                .closest(self.scene, &shadow.ray, shadow.tmax, self.two_sided);
+            let blocker = h.is_hit().then(|| BlockerInfo {
+                primitive: primitive_ref(self.scene, h.prim),
+                t: h.t,
+                point: (shadow.ray.origin + h.t * shadow.ray.direction).to_array(),
+            });
+            (blocker, Vec3::ZERO)
         } else {
-            beta * term * per_sample
+            (None, beta * term * self.per_sample)
         };
-        record.shadows.push(Segment {
+        self.at(key).shadows.push(Segment {
             id: 0,
             parent: None,
             sample: key.sample,

@@ -94,6 +94,18 @@ pub struct CameraInfo {
     pub fov_degrees: f32,
 }
 
+impl CameraInfo {
+    /// The scene camera as plain values.
+    pub fn of(camera: &crate::render::scene::Camera) -> CameraInfo {
+        CameraInfo {
+            position: camera.position.to_array(),
+            look_at: camera.point_of_interest.to_array(),
+            up: camera.up.to_array(),
+            fov_degrees: camera.fov.to_degrees(),
+        }
+    }
+}
+
 /// What a segment is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "lowercase")]

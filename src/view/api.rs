@@ -1,14 +1,15 @@
 //! The API's handlers: each takes the shared [`State`] and the request's parts, and returns a
 //! reply or an [`ApiError`] (a 4xx naming what was wrong with the request).
 
-use super::compare::{CompareRequest, Comparisons};
+use super::compare::{CompareRequest, Comparisons, KEPT};
 use super::http::{ApiError, Reply, number, query};
 use super::renders::{
-    ENGINES, KEPT_RENDERS, RENDER_BURST, RENDER_RATE, RenderJob, Renders, Status, with_camera,
+    KEPT_RENDERS, RENDER_BURST, RENDER_RATE, RenderJob, Renders, Status, with_camera,
 };
 use super::request::{Resolved, ViewSettings, parse_json};
 use super::scene_json::SceneJson;
 use super::tree;
+use crate::render::engine::Engine;
 use crate::render::quote::quote;
 use crate::render::sampling::LightSampler;
 use crate::render::scene::Scene;
@@ -55,7 +56,7 @@ pub(crate) fn scene_json(scene: &Scene, base: &Resolved) -> Vec<u8> {
         scene: SceneJson::new(scene),
         settings: base.to_json(),
         samplers: LightSampler::ALL.iter().map(|s| s.name()).collect(),
-        engines: ENGINES.iter().map(|e| e.name()).collect(),
+        engines: vec![Engine::Wavefront.name(), Engine::Reference.name()],
         simd: crate::simd_path(),
         palette: tree::PALETTE,
     })
@@ -90,8 +91,7 @@ fn path_number(text: &str, what: &str) -> Result<u64, ApiError> {
 fn job_by_id(state: &State, id: u64) -> Result<Arc<RenderJob>, ApiError> {
     state.jobs.get(id).ok_or_else(|| {
         ApiError::not_found(format!(
-            "no render job {id}: only the last {} are kept",
-            KEPT_RENDERS
+            "no render job {id}: only the last {KEPT_RENDERS} are kept"
         ))
     })
 }
@@ -105,6 +105,7 @@ pub(crate) fn render_status(state: &State, job: &str) -> Result<Reply, ApiError>
 /// `GET /api/render/{job}/{level}.png`, and `{level}.cost.png`: the level's cost-map overlay.
 pub(crate) fn render_png(state: &State, job: &str, level: &str) -> Result<Reply, ApiError> {
     let job = job_by_id(state, path_number(job, "a job number")?)?;
+    let (id, levels) = (job.id, job.sizes.len());
     let (k, cost) = match level.strip_suffix(".cost.png") {
         Some(k) => (k, true),
         None => (level.strip_suffix(".png").unwrap_or(""), false),
@@ -115,24 +116,18 @@ pub(crate) fn render_png(state: &State, job: &str, level: &str) -> Result<Reply,
             quote(level)
         ))
     })?;
-    if k >= job.sizes.len() {
+    if k >= levels {
         return Err(ApiError::not_found(format!(
-            "job {} has levels 0..{}, not {k}",
-            job.id,
-            job.sizes.len()
+            "job {id} has levels 0..{levels}, not {k}"
         )));
     }
     let png = if cost {
         job.cost_png(k).ok_or_else(|| format!(
-            "level {k} of job {} has no cost map: ask for one with cost_map in the settings (the level may not be rendered yet: see GET /api/render/{})",
-            job.id, job.id
+            "level {k} of job {id} has no cost map: ask for one with cost_map in the settings (the level may not be rendered yet: see GET /api/render/{id})"
         ))
     } else {
         job.png(k).ok_or_else(|| {
-            format!(
-                "level {k} of job {} is not rendered (yet): see GET /api/render/{}",
-                job.id, job.id
-            )
+            format!("level {k} of job {id} is not rendered (yet): see GET /api/render/{id}")
         })
     };
     let png = png.map_err(ApiError::not_found)?;
@@ -145,7 +140,7 @@ pub(crate) fn render_png(state: &State, job: &str, level: &str) -> Result<Reply,
 pub(crate) fn pixel(state: &State, q: &str) -> Result<Reply, ApiError> {
     let pairs = query(q, &["job", "x", "y"])?;
     let job = job_by_id(state, number(&pairs, "job")?)?;
-    let newest = state.jobs.newest();
+    let (id, newest) = (job.id, state.jobs.newest());
     let gone = match job.state() {
         Status::Superseded => {
             let by = job.superseded_by().unwrap_or(newest);
@@ -155,19 +150,17 @@ pub(crate) fn pixel(state: &State, q: &str) -> Result<Reply, ApiError> {
                 format!("ask for the newest job's pixels, job {newest}")
             };
             Some(format!(
-                "job {} was superseded by job {by} before its image was finished: {ask}",
-                job.id
+                "job {id} was superseded by job {by} before its image was finished: {ask}"
             ))
         }
         Status::Failed(error) => {
-            let ask = if newest == job.id {
+            let ask = if newest == id {
                 "start a new render and ask for its pixels".to_string()
             } else {
                 format!("ask for job {newest}'s pixels")
             };
             Some(format!(
-                "job {} failed before its image was finished ({error}): {ask}",
-                job.id
+                "job {id} failed before its image was finished ({error}): {ask}"
             ))
         }
         Status::Queued | Status::Running | Status::Done => None,
@@ -198,9 +191,8 @@ pub(crate) fn compare_png(state: &State, id: &str, name: &str) -> Result<Reply, 
         .and_then(|name| state.comparisons.png(n, name))
         .ok_or_else(|| {
             ApiError::not_found(format!(
-                "no image `{}` in comparison {n} (only the last {} are kept)",
-                quote(name),
-                super::compare::KEPT
+                "no image `{}` in comparison {n} (only the last {KEPT} are kept)",
+                quote(name)
             ))
         })?;
     Ok(Reply::bytes("image/png", png.as_ref().clone()))

@@ -25,6 +25,7 @@ use crate::variance::report::{plot::heat_images, spectrum_plot};
 use crate::variance::{StudyConfig, converged_reference, error_stats, penumbra_mask, pixel_mse};
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
+use statrs::statistics::Statistics;
 use std::collections::VecDeque;
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
@@ -97,17 +98,11 @@ pub(crate) struct Estimate {
 }
 
 impl Estimate {
+    /// Of two or more values (a request asks for at least two seeds); NaN for fewer.
     fn of(values: &[f64]) -> Estimate {
-        let k = values.len() as f64;
-        let mean = values.iter().sum::<f64>() / k.max(1.0);
-        let var = if values.len() > 1 {
-            values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (k - 1.0)
-        } else {
-            0.0
-        };
         Estimate {
-            mean,
-            se: (var / k.max(1.0)).sqrt(),
+            mean: values.mean(),
+            se: values.std_dev() / (values.len() as f64).sqrt(),
         }
     }
 }
@@ -218,6 +213,7 @@ impl Comparisons {
             heatmap_n: request.n,
             ..StudyConfig::standard(base_settings)
         };
+        let (wc, hc) = (config.base.width, config.base.height);
         let render = |s: &Scene, settings: &crate::render::settings::RenderSettings| {
             pool.install(|| resolved.engine.image(s, settings))
         };
@@ -235,7 +231,7 @@ impl Comparisons {
         let mut pngs = vec![("reference".to_string(), film_png(&reference.film)?)];
         let mut maps = Vec::new();
         let mut sides = Vec::new();
-        for (i, &sampler) in request.samplers.iter().enumerate() {
+        for (&sampler, side_name) in request.samplers.iter().zip(["a", "b"]) {
             let mut films = Vec::new();
             let mut times = Vec::new();
             for k in 1..=request.seeds {
@@ -254,16 +250,10 @@ impl Comparisons {
                 Estimate::of(&v)
             };
             let all = error_stats(&images, &reference.film.pixels, &reference.noise, &whole);
-            let side_name = if i == 0 { "a" } else { "b" };
             pngs.push((format!("image-{side_name}"), film_png(&films[0])?));
             maps.push(pixel_mse(&images, &reference.film.pixels));
-            let perceived = perceived::measure(
-                &images,
-                &reference.film.pixels,
-                config.base.width as usize,
-                config.base.height as usize,
-                &whole,
-            );
+            let (wu, hu) = (wc as usize, hc as usize);
+            let perceived = perceived::measure(&images, &reference.film.pixels, wu, hu, &whole);
             sides.push(Side {
                 sampler,
                 image: url(&format!("image-{side_name}")),
@@ -276,7 +266,6 @@ impl Comparisons {
             });
         }
         let map_refs: Vec<&[f32]> = maps.iter().map(Vec::as_slice).collect();
-        let (wc, hc) = (config.base.width, config.base.height);
         let (heat_imgs, heat_scale) = match heat_images(&map_refs, wc, hc) {
             Some((imgs, scale)) => (imgs, Some(scale)),
             None => (vec![image::RgbImage::new(wc, hc); 2], None),
@@ -289,8 +278,7 @@ impl Comparisons {
         let spectrum =
             spectrum_plot::comparison_image(&spectra, request.n, (640, 400)).map_err(internal)?;
         pngs.push(("spectrum".to_string(), encode(&spectrum)?));
-        let noise = reference.noise.iter().map(|&v| v as f64).sum::<f64>()
-            / reference.noise.len().max(1) as f64;
+        let noise = reference.noise.iter().map(|&v| f64::from(v)).mean();
         keep(&self.kept, (id, pngs), KEPT);
         Ok(Comparison {
             id,

@@ -48,8 +48,7 @@ impl Request {
     pub(crate) fn all(&self, name: &str) -> Vec<&str> {
         self.headers
             .iter()
-            .filter(|(n, _)| n == name)
-            .map(|(_, v)| v.as_str())
+            .filter_map(|(n, v)| (n == name).then_some(v.as_str()))
             .collect()
     }
 

@@ -140,8 +140,7 @@ pub(crate) fn number<T: std::str::FromStr>(
 ) -> Result<T, ApiError> {
     let value = pairs
         .iter()
-        .find(|(n, _)| *n == name)
-        .map(|(_, v)| *v)
+        .find_map(|&(n, v)| (n == name).then_some(v))
         .ok_or_else(|| ApiError::bad(format!("missing query parameter `{name}`")))?;
     value.parse().map_err(|_| {
         ApiError::bad(format!(

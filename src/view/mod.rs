@@ -77,12 +77,12 @@ pub fn run(options: ViewOptions, say: &dyn Fn(&str) -> Result<()>) -> Result<i32
     let server = server::Server::bind(options.bind, options.port)?;
     let pool = Arc::new(crate::render::engine::thread_pool(options.threads)?);
     let scene = Arc::new(options.scene);
-    let jobs = renders::Renders::start(
-        scene.clone(),
-        pool.clone(),
-        options.batch_size,
-        options.counted,
-    )
+    let jobs = renders::Renders::start(renders::Renderer {
+        scene: scene.clone(),
+        pool: pool.clone(),
+        batch_size: options.batch_size,
+        counted: options.counted,
+    })
     .map_err(|e| anyhow::anyhow!("cannot start the render thread: {e}"))?;
     let state = Arc::new(api::State {
         scene_json: api::scene_json(&scene, &options.base),

@@ -16,13 +16,13 @@
 //! ```
 
 use crate::output::bench_record::KindFigures;
-use crate::output::cost_map::{CostInput, overlay};
+use crate::output::cost_map::{CostInput, Count, overlay};
 use crate::output::image_file::png_bytes;
-use crate::render::engine::{Engine, Prepared, clamp_to_finite};
+use crate::render::engine::{Prepared, clamp_to_finite};
 use crate::render::film::ToneMap;
 use crate::render::progress::Progress;
 use crate::render::scene::{Camera, Scene};
-use crate::view::request::{CostMeasureView, CostOverlay, Resolved, ViewSettings};
+use crate::view::request::{CostOverlay, Resolved, ViewSettings};
 use crate::view::scene_json::CameraFrame;
 use crate::view::{CountedRender, keep, lock};
 use serde::Serialize;
@@ -85,7 +85,7 @@ pub(crate) struct CostLegend {
     /// The rays counted.
     pub kind: CostOverlay,
     /// The count shown.
-    pub measure: CostMeasureView,
+    pub measure: Count,
     /// The top of the linear scale (the scale starts at 0), per pixel and camera sample.
     pub high: f64,
     /// The largest value of the map.
@@ -278,20 +278,24 @@ pub(crate) struct Renders {
     bucket: Mutex<TokenBucket>,
 }
 
+/// What the render thread renders with.
+pub(crate) struct Renderer {
+    pub scene: Arc<Scene>,
+    /// The worker threads.
+    pub pool: Arc<rayon::ThreadPool>,
+    /// The wavefront engine's camera samples per tile.
+    pub batch_size: usize,
+    pub counted: CountedRender,
+}
+
 impl Renders {
-    /// Starts the render thread, which renders on `pool` with `batch_size` (the wavefront
-    /// engine's tile) and reads `scene`.
-    pub(crate) fn start(
-        scene: Arc<Scene>,
-        pool: Arc<rayon::ThreadPool>,
-        batch_size: usize,
-        counted: CountedRender,
-    ) -> std::io::Result<Arc<Renders>> {
+    /// Starts the render thread.
+    pub(crate) fn start(renderer: Renderer) -> std::io::Result<Arc<Renders>> {
         let queue = Arc::new(Queue::default());
         let inbox = queue.clone();
         std::thread::Builder::new()
             .name("render".into())
-            .spawn(move || render_thread(&inbox, &scene, &pool, batch_size, counted))?;
+            .spawn(move || render_thread(&inbox, &renderer))?;
         Ok(Arc::new(Renders {
             next: AtomicU64::new(1),
             kept: Mutex::new(VecDeque::new()),
@@ -361,13 +365,7 @@ impl Drop for CloseOnExit<'_> {
     }
 }
 
-fn render_thread(
-    queue: &Queue,
-    scene: &Scene,
-    pool: &rayon::ThreadPool,
-    batch_size: usize,
-    counted: CountedRender,
-) {
+fn render_thread(queue: &Queue, renderer: &Renderer) {
     let _close = CloseOnExit(queue);
     loop {
         let job = {
@@ -386,7 +384,7 @@ fn render_thread(
         job.set_status(Status::Running);
         // A panic in an engine must not take the viewer down: the job fails with the message.
         let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-            render_levels(&job, scene, pool, batch_size, counted)
+            renderer.render_levels(&job)
         }));
         let status = match outcome {
             Ok(Ok(true)) => Status::Done,
@@ -417,97 +415,88 @@ pub(crate) fn with_camera<'a>(scene: &'a Scene, camera: &Camera) -> Cow<'a, Scen
     }
 }
 
-/// Renders every level; false when superseded before the last was finished.
-fn render_levels(
-    job: &RenderJob,
-    scene: &Scene,
-    pool: &rayon::ThreadPool,
-    batch_size: usize,
-    counted: CountedRender,
-) -> anyhow::Result<bool> {
-    let scene = with_camera(scene, &job.resolved.camera);
-    for &[width, height] in &job.sizes {
-        if job.cancel.load(Ordering::Relaxed) {
-            return Ok(false);
-        }
-        let settings = crate::render::settings::RenderSettings {
-            width,
-            height,
-            ..job.resolved.settings.clone()
-        };
-        let start = Instant::now();
-        let prepared = job.resolved.engine.prepare(&scene, &settings, batch_size);
-        // Steps come from every worker: the count only grows within a level.
-        let report = |done, total, _: &str| {
-            job.total_units.store(total, Ordering::Relaxed);
-            match done {
-                0 => job.done_units.store(0, Ordering::Relaxed),
-                _ => _ = job.done_units.fetch_max(done, Ordering::Relaxed),
+impl Renderer {
+    /// Renders every level; false when superseded before the last was finished.
+    fn render_levels(&self, job: &RenderJob) -> anyhow::Result<bool> {
+        let r = &job.resolved;
+        let scene = with_camera(&self.scene, &r.camera);
+        for &[width, height] in &job.sizes {
+            if job.cancel.load(Ordering::Relaxed) {
+                return Ok(false);
             }
-        };
-        let progress = Progress {
-            report: &report,
-            ..Progress::SILENT
-        };
-        let rendered = match (&prepared, job.resolved.cost_map.kind()) {
-            (Prepared::Wavefront(w), Some(kind)) => pool
-                .install(|| counted(w, &progress, &job.cancel))
-                .map(|(mut film, stats, costs)| {
-                    clamp_to_finite(&mut film);
-                    let overlay = costs.pixels.as_ref().map(|pixels| {
-                        let input = CostInput {
-                            pixels,
-                            width,
-                            height,
-                            aa_samples: settings.aa_samples,
-                            totals: &costs.totals,
-                            rays: &stats.counts,
-                        };
-                        overlay(&input, kind, job.resolved.cost_measure.count())
-                    });
-                    (film, stats, overlay)
-                }),
-            _ => pool
-                .install(|| prepared.render_until(&progress, &job.cancel))
-                .map(|(film, stats)| (film, stats, None)),
-        };
-        let Some((film, stats, overlay)) = rendered else {
-            return Ok(false);
-        };
-        let seconds = start.elapsed().as_secs_f64();
-        let png = png_bytes(&film.to_rgb8(ToneMap::Clamp))?;
-        let (cost, cost_png) = match overlay {
-            Some(map) => (
-                Some(CostLegend {
-                    kind: job.resolved.cost_map,
-                    measure: job.resolved.cost_measure,
-                    high: map.scale.high,
-                    largest: map.largest,
-                    per_ray: map.per_ray,
-                }),
-                Some(Arc::new(png_bytes(&map.image(width, height))?)),
-            ),
-            None => (None, None),
-        };
-        let mut state = lock(&job.state);
-        state.levels.push(Level {
-            width,
-            height,
-            rays: KindFigures::new(&stats, seconds),
-            cost,
-        });
-        state.pngs.push(Arc::new(png));
-        state.cost_pngs.push(cost_png);
+            let settings = crate::render::settings::RenderSettings {
+                width,
+                height,
+                ..r.settings.clone()
+            };
+            let start = Instant::now();
+            let prepared = r.engine.prepare(&scene, &settings, self.batch_size);
+            // Steps come from every worker: the count only grows within a level.
+            let report = |done, total, _: &str| {
+                job.total_units.store(total, Ordering::Relaxed);
+                match done {
+                    0 => job.done_units.store(0, Ordering::Relaxed),
+                    _ => _ = job.done_units.fetch_max(done, Ordering::Relaxed),
+                }
+            };
+            let progress = Progress {
+                report: &report,
+                ..Progress::SILENT
+            };
+            let rendered = self.pool.install(|| match (&prepared, r.cost_map.kind()) {
+                (Prepared::Wavefront(w), Some(kind)) => (self.counted)(w, &progress, &job.cancel)
+                    .map(|(mut film, stats, costs)| {
+                        clamp_to_finite(&mut film);
+                        let overlay = costs.pixels.as_ref().map(|pixels| {
+                            let input = CostInput {
+                                pixels,
+                                width,
+                                height,
+                                aa_samples: settings.aa_samples,
+                                totals: &costs.totals,
+                                rays: &stats.counts,
+                            };
+                            overlay(&input, kind, r.cost_measure)
+                        });
+                        (film, stats, overlay)
+                    }),
+                _ => prepared
+                    .render_until(&progress, &job.cancel)
+                    .map(|(film, stats)| (film, stats, None)),
+            });
+            let Some((film, stats, overlay)) = rendered else {
+                return Ok(false);
+            };
+            let seconds = start.elapsed().as_secs_f64();
+            let png = png_bytes(&film.to_rgb8(ToneMap::Clamp))?;
+            let cost = overlay.as_ref().map(|map| CostLegend {
+                kind: r.cost_map,
+                measure: r.cost_measure,
+                high: map.scale.high,
+                largest: map.largest,
+                per_ray: map.per_ray,
+            });
+            let cost_png = overlay
+                .map(|map| png_bytes(&map.image(width, height)))
+                .transpose()?;
+            let mut state = lock(&job.state);
+            state.levels.push(Level {
+                width,
+                height,
+                rays: KindFigures::new(&stats, seconds),
+                cost,
+            });
+            state.pngs.push(Arc::new(png));
+            state.cost_pngs.push(cost_png.map(Arc::new));
+        }
+        Ok(true)
     }
-    Ok(true)
 }
-
-/// Engines by name, for the page's menu.
-pub(crate) const ENGINES: [Engine; 2] = [Engine::Wavefront, Engine::Reference];
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::render::engine::Engine;
     use std::time::Duration;
 
     #[test]
@@ -527,7 +516,7 @@ mod tests {
             engine: Engine::Wavefront,
             camera: Scene::builtin_default().camera,
             cost_map: CostOverlay::Off,
-            cost_measure: CostMeasureView::Nodes,
+            cost_measure: Count::Nodes,
         }
     }
 

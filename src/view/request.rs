@@ -4,6 +4,7 @@
 //! render that cannot finish.
 
 use super::http::ApiError;
+use crate::output::cost_map::{CostKind, Count};
 use crate::render::engine::Engine;
 use crate::render::quote::quote;
 use crate::render::sampling::LightSampler;
@@ -106,35 +107,13 @@ pub enum CostOverlay {
 
 impl CostOverlay {
     /// The cost map's kind, or `None` for no overlay.
-    pub(crate) fn kind(self) -> Option<crate::output::cost_map::CostKind> {
-        use crate::output::cost_map::CostKind;
+    pub(crate) fn kind(self) -> Option<CostKind> {
         match self {
             CostOverlay::Off => None,
             CostOverlay::Camera => Some(CostKind::Camera),
             CostOverlay::Shadow => Some(CostKind::Shadow),
             CostOverlay::Reflection => Some(CostKind::Reflection),
             CostOverlay::All => Some(CostKind::All),
-        }
-    }
-}
-
-/// What the cost-map overlay shows (`render --cost-measure`, one count at a time).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum CostMeasureView {
-    /// BVH nodes visited.
-    #[default]
-    Nodes,
-    /// Primitives tested.
-    Tests,
-}
-
-impl CostMeasureView {
-    /// The cost map's count.
-    pub(crate) fn count(self) -> crate::output::cost_map::Count {
-        match self {
-            CostMeasureView::Nodes => crate::output::cost_map::Count::Nodes,
-            CostMeasureView::Tests => crate::output::cost_map::Count::Tests,
         }
     }
 }
@@ -168,7 +147,7 @@ pub struct ViewSettings {
     /// The cost-map overlay: off, camera, shadow, reflection or all (wavefront engine only).
     pub cost_map: Option<CostOverlay>,
     /// What the overlay shows: nodes or tests.
-    pub cost_measure: Option<CostMeasureView>,
+    pub cost_measure: Option<Count>,
 }
 
 /// Settings checked and filled in: what a render job or a ray tree is computed with.
@@ -183,7 +162,7 @@ pub struct Resolved {
     /// The cost-map overlay (off: the render is not counted).
     pub cost_map: CostOverlay,
     /// What the overlay shows.
-    pub cost_measure: CostMeasureView,
+    pub cost_measure: Count,
 }
 
 /// `v`, or a 400 saying `name` must be in `lo..=hi`.
@@ -301,7 +280,7 @@ mod tests {
             engine: Engine::Wavefront,
             camera: Camera::default(),
             cost_map: CostOverlay::Off,
-            cost_measure: CostMeasureView::Nodes,
+            cost_measure: Count::Nodes,
         }
     }
 
@@ -328,7 +307,7 @@ mod tests {
         let r = parse(body).unwrap().resolve(&base()).unwrap();
         assert_eq!(
             (r.cost_map, r.cost_measure),
-            (CostOverlay::Shadow, CostMeasureView::Tests)
+            (CostOverlay::Shadow, Count::Tests)
         );
         assert_eq!(r.to_json().resolve(&base()).unwrap(), r);
     }

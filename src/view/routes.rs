@@ -58,8 +58,8 @@ fn check(request: &Request, gate: &Gate) -> Result<Option<String>, ApiError> {
     gate.access.check(request, gate.port)
 }
 
-/// The routing table. tests/commands/view_token.rs reads its arms from this source: each arm's
-/// body, on lines of its own, calls `get()` or `post()`.
+/// The routing table: each arm checks the method with `get()` or `post()`, then calls its
+/// handler. tests/commands/view_token.rs reads the arms from this source.
 fn route(request: &Request, path: &str, query: &str, state: &State) -> Result<Reply, ApiError> {
     let method = request.method.as_str();
     let segments: Vec<&str> = path.split('/').skip(1).collect();
@@ -71,42 +71,15 @@ fn route(request: &Request, path: &str, query: &str, state: &State) -> Result<Re
     let (get, post) = (|| allow("GET"), || allow("POST"));
     let body = &request.body;
     match segments.as_slice() {
-        [""] | ["index.html"] => {
-            get()?;
-            assets::page()
-        }
-        ["assets", name] => {
-            get()?;
-            assets::asset(name)
-        }
-        ["api", "scene"] => {
-            get()?;
-            Ok(api::scene(state))
-        }
-        ["api", "render"] => {
-            post()?;
-            api::render(state, body)
-        }
-        ["api", "render", job] => {
-            get()?;
-            api::render_status(state, job)
-        }
-        ["api", "render", job, level] => {
-            get()?;
-            api::render_png(state, job, level)
-        }
-        ["api", "pixel"] => {
-            get()?;
-            api::pixel(state, query)
-        }
-        ["api", "compare"] => {
-            post()?;
-            api::compare(state, body)
-        }
-        ["api", "compare", id, name] => {
-            get()?;
-            api::compare_png(state, id, name)
-        }
+        [""] | ["index.html"] => get().and_then(|()| assets::page()),
+        ["assets", name] => get().and_then(|()| assets::asset(name)),
+        ["api", "scene"] => get().map(|()| api::scene(state)),
+        ["api", "render"] => post().and_then(|()| api::render(state, body)),
+        ["api", "render", job] => get().and_then(|()| api::render_status(state, job)),
+        ["api", "render", job, level] => get().and_then(|()| api::render_png(state, job, level)),
+        ["api", "pixel"] => get().and_then(|()| api::pixel(state, query)),
+        ["api", "compare"] => post().and_then(|()| api::compare(state, body)),
+        ["api", "compare", id, name] => get().and_then(|()| api::compare_png(state, id, name)),
         _ => Err(ApiError::not_found(format!(
             "no such path: {} (the page is at /, the API under /api/)",
             quote(path)

@@ -114,9 +114,7 @@ impl Access {
             .all("cookie")
             .into_iter()
             .flat_map(|header| header.split(';'))
-            .filter_map(|pair| pair.trim().split_once('='))
-            .filter(|(n, _)| *n == name)
-            .map(|(_, v)| v)
+            .filter_map(|pair| pair.trim().strip_prefix(name.as_str())?.strip_prefix('='))
             .collect();
         if in_query.is_some_and(|t| token.matches(t)) {
             // Keeps the token for the page's later requests.

@@ -294,8 +294,8 @@ fn routing_table() -> Vec<Route> {
     for line in table.lines() {
         let trimmed = line.trim();
         match trimmed.split_once("=>") {
-            Some((pattern, _)) if trimmed.starts_with('[') => {
-                arms.push((pattern.trim().to_string(), String::new()))
+            Some((pattern, body)) if trimmed.starts_with('[') => {
+                arms.push((pattern.trim().to_string(), body.to_string()))
             }
             _ => {
                 if let Some((_, body)) = arms.last_mut() {
