@@ -93,19 +93,17 @@ pub fn run(args: &DiffArgs) -> Result<u8> {
     let metric = Metric::from(args.metric);
     let want_flip = args.flip || metric == Metric::Flip;
     if want_flip && !diff::FLIP_AVAILABLE {
-        return Err(UsageError(
+        bail!(UsageError(
             "--flip and --metric flip need raywave built with the `flip` feature (on by default; it needs a C++ compiler)".into(),
-        )
-        .into());
+        ));
     }
     if let Some(out) = &args.out
         && ldr_format(out).is_err()
     {
-        return Err(UsageError(format!(
+        bail!(UsageError(format!(
             "--out {}: expected a figure file ending in .png or .ppm",
             out.display()
-        ))
-        .into());
+        )));
     }
     let scene_flags: Vec<&str> = [
         ("--scene", args.scene.is_some()),

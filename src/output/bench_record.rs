@@ -320,13 +320,12 @@ pub fn record_path(dir: &Path, name: &str) -> Result<std::path::PathBuf> {
             .chars()
             .all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.' | '+'));
     if !plain {
-        return Err(crate::render::error::UsageError(format!(
+        bail!(crate::render::error::UsageError(format!(
             "bench record name `{}` is not usable: expected a plain name like `before` \
              (letters, digits, - _ . +; no path separators, not starting with '.' or '-'); \
              use --dir to choose the directory",
             name.escape_debug()
-        ))
-        .into());
+        )));
     }
     Ok(dir.join(format!("{name}.json")))
 }
