@@ -12,7 +12,7 @@ pub mod report;
 use crate::diff::{Image, read_image};
 use crate::output::OutputPlan;
 use crate::output::cost_map::{self, CostInput, CostKind, CostMeasure};
-use crate::output::image_file::{OutputFormat, check_hdr_path, ldr_format, output_format};
+use crate::output::image_file::{OutputFormat, hdr_format, ldr_format, output_format};
 use crate::output::memory::{self, RenderFootprint};
 use crate::output::render_record::TraversalFigures;
 use crate::render::camera::CameraRays;
@@ -293,7 +293,7 @@ pub fn run(
 fn check_outputs(options: &FrameOptions) -> Result<OutputFormat> {
     let format = output_format(&options.output).map_err(|e| UsageError::from_error(&e))?;
     if let Some(hdr) = &options.hdr {
-        check_hdr_path(hdr).map_err(|e| UsageError::from_error(&e))?;
+        hdr_format(hdr).map_err(|e| UsageError::from_error(&e))?;
     }
     if let Some((map, _, _)) = &options.cost_map {
         if ldr_format(map).is_err() {

@@ -2,11 +2,11 @@
 //! formats by extension, and the atomic writer every command's files go through
 //! (`output::write`: each file whole or not at all).
 
-use crate::output::{Target, target};
+use crate::output::{OutputPlan, Target, target, write_output};
 use crate::render::film::{Film, ToneMap};
 use anyhow::{Context, Result, bail};
 use glam::Vec3;
-use std::io::{BufWriter, Write};
+use std::io::Write;
 use std::path::Path;
 
 impl Film {
@@ -79,8 +79,8 @@ impl Film {
     /// Writes linear floats: `.pfm` (portable float map) or `.exr`; PFM to standard output
     /// (`-`), a device or a FIFO whose name has neither extension.
     pub fn write_hdr(&self, path: &Path) -> Result<()> {
-        match hdr_extension(path)? {
-            HdrFormat::Pfm => write_atomically(path, |w| {
+        match hdr_format(path)? {
+            HdrFormat::Pfm => write_output(path, |w| {
                 write!(w, "PF\n{} {}\n-1.0\n", self.width, self.height)?;
                 // PFM stores rows bottom to top, little-endian (the negative scale says so).
                 for row in self.pixels.chunks(self.width as usize).rev() {
@@ -97,9 +97,9 @@ impl Film {
                     // EXR seeks back to its offset table: a pipe needs the file in memory.
                     let mut bytes = std::io::Cursor::new(Vec::new());
                     self.write_exr(&mut bytes)?;
-                    write_atomically(path, |w| Ok(w.write_all(bytes.get_ref())?))
+                    write_output(path, |w| Ok(w.write_all(bytes.get_ref())?))
                 } else {
-                    write_atomically(path, |w| self.write_exr(w))
+                    write_output(path, |w| self.write_exr(w))
                 }
             }
         }
@@ -141,7 +141,7 @@ pub enum LdrFormat {
 
 /// A linear float format raywave writes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum HdrFormat {
+pub enum HdrFormat {
     /// Portable float map, written here.
     Pfm,
     /// OpenEXR, through the `exr` crate.
@@ -230,8 +230,8 @@ pub fn png_bytes(img: &image::RgbImage) -> Result<Vec<u8>> {
 /// Writes an 8-bit image whole or not at all; the format follows the extension (png, ppm).
 pub fn write_rgb8(img: &image::RgbImage, path: &Path) -> Result<()> {
     match ldr_format(path)? {
-        LdrFormat::Png => write_atomically(path, |w| write_png(img, w)),
-        LdrFormat::Ppm => write_atomically(path, |w| {
+        LdrFormat::Png => write_output(path, |w| write_png(img, w)),
+        LdrFormat::Ppm => write_output(path, |w| {
             // Netpbm's binary pixmap: magic, width, height, maxval, one whitespace byte, then
             // the RGB bytes row by row from the top.
             write!(w, "P6\n{} {}\n255\n", img.width(), img.height())?;
@@ -241,12 +241,8 @@ pub fn write_rgb8(img: &image::RgbImage, path: &Path) -> Result<()> {
     }
 }
 
-/// Checks that an `--hdr` path has a float format's extension.
-pub fn check_hdr_path(path: &Path) -> Result<()> {
-    hdr_extension(path).map(|_| ())
-}
-
-fn hdr_extension(path: &Path) -> Result<HdrFormat> {
+/// The float format for an `--hdr` path, or an error naming the extensions accepted.
+pub fn hdr_format(path: &Path) -> Result<HdrFormat> {
     let pick = |f| match f {
         Format::Hdr(f) => Some(f),
         Format::Ldr(_) => None,
@@ -255,38 +251,16 @@ fn hdr_extension(path: &Path) -> Result<HdrFormat> {
     format_for(path, pick, HdrFormat::Pfm, expected)
 }
 
-/// Checks, before a long render, that the directory of `path` exists and `path` is not a
-/// directory itself.
+/// Checks, before a long render, that `path` can be written (as [`OutputPlan::check`] checks
+/// an output): a directory named like an image is otherwise found out only by the final
+/// rename, after the whole render.
 pub fn check_output_dir(path: &Path) -> Result<()> {
-    let dir = crate::output::write::parent_dir(path);
-    if !dir.is_dir() {
-        bail!(
-            "cannot write {}: directory {} does not exist",
-            path.display(),
-            dir.display()
-        );
-    }
-    // Without this, a directory named like an image was found out only by the final rename,
-    // after the whole render.
-    if path.is_dir() {
-        bail!("cannot write {}: it is a directory", path.display());
-    }
-    Ok(())
+    OutputPlan::new().output("", path).check()
 }
 
-/// Writes through `fill` into a temporary file beside `path` (beside the file a symlink points
-/// to), then renames it into place; standard output (`-`), devices and FIFOs are written
-/// directly (see `output::write`).
-pub fn write_atomically(
-    path: &Path,
-    fill: impl FnOnce(&mut BufWriter<&mut std::fs::File>) -> Result<()>,
-) -> Result<()> {
-    crate::output::write_output(path, fill)
-}
-
-/// Writes `value` as pretty JSON with a final newline, through [`write_atomically`].
+/// Writes `value` as pretty JSON with a final newline, through [`write_output`].
 pub fn write_json(path: &Path, value: &impl serde::Serialize) -> Result<()> {
-    write_atomically(path, |w| {
+    write_output(path, |w| {
         serde_json::to_writer_pretty(&mut *w, value)?;
         Ok(writeln!(w)?)
     })
