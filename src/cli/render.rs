@@ -6,7 +6,6 @@ use super::values::{CostKindArg, CostMeasureArg, EngineArg, LanesArg, ToneMapArg
 use anyhow::Result;
 use clap::Args;
 use raywave::frame::phases::Phases;
-use raywave::frame::report::{stats_table, summary};
 use raywave::frame::{self, FrameOptions};
 use raywave::output::OutputPlan;
 use raywave::output::terminal::with_bar;
@@ -126,17 +125,12 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             .collect();
         say(&format!(
             "{}wrote   {}{extra}\n",
-            summary(
-                &outcome.scene,
-                &outcome.effective,
-                &outcome.run,
-                &outcome.report
-            ),
+            outcome.summary(),
             args.output.display()
         ))?;
     }
     if args.stats {
-        say(&stats_table(&outcome.run, &outcome.report))?;
+        say(&outcome.stats_table())?;
         say(&phases.table("tables, BVH, progress bar"))?;
     }
     if let Some(text) = &outcome.reference_error {

@@ -23,7 +23,7 @@ use crate::render::progress::Progress;
 use crate::render::scene::{Scene, load_scene};
 use crate::render::settings::options::{Effective, ImageOptions};
 use crate::render::wavefront::lanes::LaneWidth;
-use anyhow::Result;
+use anyhow::{Result, bail};
 use phases::Phases;
 use report::{Report, RunInfo};
 use std::path::{Path, PathBuf};
@@ -109,7 +109,8 @@ pub fn run(
     progress: &Progress,
     phases: &mut Phases,
 ) -> Result<Outcome> {
-    let format = check_outputs(options)?;
+    // An 8-bit image is made unless `-o` names a float format.
+    let rgb8 = matches!(check_outputs(options)?, OutputFormat::Ldr(_));
     let (scene, effective) = scene_and_settings(
         options.scene.as_deref(),
         &options.image,
@@ -121,11 +122,10 @@ pub fn run(
     if let Some([x, y]) = options.debug_pixel
         && (x >= settings.width || y >= settings.height)
     {
-        return Err(UsageError(format!(
+        bail!(UsageError(format!(
             "--debug-pixel {x} {y} is outside the {}×{} image",
             settings.width, settings.height
-        ))
-        .into());
+        )));
     }
     let reference = match &options.mse_reference {
         Some(path) => Some((path, read_reference(path, settings.width, settings.height)?)),
@@ -143,7 +143,7 @@ pub fn run(
             primitives: (scene.triangles.len() + scene.spheres.len()) as u64,
             threads: threads as u64,
             batch_size: options.batch_size as u64,
-            rgb8: matches!(format, OutputFormat::Ldr(_)),
+            rgb8,
             exr_in_memory: exr_to_stream(&options.output)
                 || options.hdr.as_ref().is_some_and(exr_to_stream),
             cost_map: options.cost_map.is_some(),
@@ -170,10 +170,7 @@ pub fn run(
     if let Some(w) = clamped_warning(&stats) {
         (progress.notice)(&w);
     }
-    let mut img = match format {
-        OutputFormat::Ldr(_) => Some(film.to_rgb8(options.tonemap)),
-        OutputFormat::Linear => None,
-    };
+    let mut img = rgb8.then(|| film.to_rgb8(options.tonemap));
     let mut pixel_rays = None;
     if let Some([x, y]) = options.debug_pixel {
         // The tree both engines trace for the pixel (crate::trace), checked against both.
@@ -255,13 +252,6 @@ pub fn run(
             counted_seconds,
         ));
     }
-    let report = Report {
-        stats,
-        seconds,
-        bvh: engine.bvh_build_seconds(),
-        instrumented_seconds,
-        traversal,
-    };
     let run = RunInfo {
         engine: options.engine,
         simd: engine.simd_path(),
@@ -269,23 +259,30 @@ pub fn run(
         batch_size: options.batch_size,
         shadow_path: engine.shadow_path(),
     };
+    let report = Report {
+        stats,
+        seconds,
+        bvh: engine.bvh_build_seconds(),
+        instrumented_seconds,
+        traversal,
+    };
     drop(engine);
-    if let Some(path) = &options.stats_json {
-        let extra = reference_error
-            .as_ref()
-            .map(|(_, json)| ("mse_reference", json.clone()));
-        report::record(&scene, &effective, &run, &report).write(path, extra)?;
-    }
-    // Every output in place before the summary says it was written.
-    crate::output::commit_outputs()?;
-    Ok(Outcome {
+    let (reference_error, reference_json) = reference_error.unzip();
+    let outcome = Outcome {
         scene,
         effective,
         run,
         report,
         pixel_rays,
-        reference_error: reference_error.map(|(text, _)| text),
-    })
+        reference_error,
+    };
+    if let Some(path) = &options.stats_json {
+        let extra = reference_json.map(|json| ("mse_reference", json));
+        outcome.record().write(path, extra)?;
+    }
+    // Every output in place before the summary says it was written.
+    crate::output::commit_outputs()?;
+    Ok(outcome)
 }
 
 /// The checks of the outputs' names and of the plan, before the scene is read; returns the
@@ -297,17 +294,15 @@ fn check_outputs(options: &FrameOptions) -> Result<OutputFormat> {
     }
     if let Some((map, _, _)) = &options.cost_map {
         if ldr_format(map).is_err() {
-            return Err(UsageError(format!(
+            bail!(UsageError(format!(
                 "--cost-map {}: expected a file ending in .png or .ppm (an 8-bit figure)",
                 map.display()
-            ))
-            .into());
+            )));
         }
         if options.engine == Engine::Reference {
-            return Err(UsageError(
+            bail!(UsageError(
                 "--cost-map counts the wavefront engine's traversal: expected --engine wavefront (the default), not --engine reference".into(),
-            )
-            .into());
+            ));
         }
     }
     options.plan.check()?;
@@ -321,13 +316,12 @@ fn check_outputs(options: &FrameOptions) -> Result<OutputFormat> {
 fn read_reference(path: &Path, width: u32, height: u32) -> Result<Image> {
     let image = read_image(path)?;
     if (image.film.width, image.film.height) != (width, height) {
-        return Err(UsageError(format!(
+        bail!(UsageError(format!(
             "--mse-reference {} is {}×{} but the render is {width}×{height}: expected a reference of the render's size",
             path.display(),
             image.film.width,
             image.film.height,
-        ))
-        .into());
+        )));
     }
     Ok(image)
 }
