@@ -118,9 +118,12 @@ pub fn commit_outputs() -> Result<()> {
     };
     // Without the lock: a FIFO may wait for its reader, and the signal handler must still be
     // able to remove the held temporary files meanwhile.
-    let copied = direct
-        .into_iter()
-        .try_for_each(|mut held| copy_direct(&mut held.bytes, &held.shown));
+    let copied = direct.into_iter().try_for_each(|mut held| {
+        held.bytes.rewind()?;
+        write_output_now(&held.shown, |w| {
+            Ok(std::io::copy(&mut held.bytes, w).map(drop)?)
+        })
+    });
     let mut state = outputs();
     if let Err(e) = copied {
         state.drop_renames(renames);
@@ -157,15 +160,6 @@ pub fn discard_outputs() {
     state.direct.clear();
     let renames = std::mem::take(&mut state.renames);
     state.drop_renames(renames);
-}
-
-/// Copies a held direct output to its target.
-fn copy_direct(bytes: &mut File, shown: &Path) -> Result<()> {
-    bytes.rewind()?;
-    write_output_now(shown, |w| {
-        std::io::copy(bytes, w)?;
-        Ok(())
-    })
 }
 
 /// What writing to a path means.
