@@ -6,9 +6,8 @@ use super::values::{DefaultsArg, MetricArg, float};
 use anyhow::{Result, bail};
 use clap::Args;
 use raywave::diff::{self, Comparison, EXIT_FAILED, FileInfo, Image, Metric, Region, read_image};
+use raywave::output::OutputPlan;
 use raywave::output::image_file::{ldr_format, write_json};
-use raywave::output::terminal::print;
-use raywave::output::{OutputPlan, is_stdio};
 use raywave::render::error::UsageError;
 use raywave::render::sampling::LightSampler;
 use raywave::render::scene::load_scene;
@@ -163,10 +162,8 @@ pub fn run(args: &DiffArgs) -> Result<u8> {
     text.push_str(&diff::text::table(&comparison));
 
     let value = comparison.value(metric);
-    let failed = match (args.fail_above, value) {
-        (Some(threshold), Some(v)) => metric.fails(v, threshold),
-        _ => false,
-    };
+    let failed =
+        (args.fail_above.zip(value)).is_some_and(|(threshold, v)| metric.fails(v, threshold));
     if let Some(out) = &args.out {
         let errors = match (&flip_map, metric) {
             (Some(map), Metric::Flip) => map.clone(),
@@ -221,11 +218,7 @@ pub fn run(args: &DiffArgs) -> Result<u8> {
             metric.name()
         ));
     }
-    if args.json.as_deref().is_some_and(is_stdio) {
-        eprint!("{text}");
-    } else {
-        print(&text)?;
-    }
+    super::image::say(&plan, &text)?;
     Ok(if failed { EXIT_FAILED } else { 0 })
 }
 
