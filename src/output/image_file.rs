@@ -28,33 +28,23 @@ impl Film {
         let bytes =
             std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?;
         let bad = || anyhow::anyhow!("{}: not a little-endian colour PFM", path.display());
-        // Header: "PF", width height, scale; each ends at a newline.
-        let mut fields = Vec::new();
-        let mut at = 0;
-        for _ in 0..3 {
-            let end = bytes[at..]
-                .iter()
-                .position(|&b| b == b'\n')
-                .ok_or_else(bad)?
-                + at;
-            fields.push(
-                std::str::from_utf8(&bytes[at..end])
-                    .map_err(|_| bad())?
-                    .trim()
-                    .to_string(),
-            );
-            at = end + 1;
-        }
-        let dims: Vec<u32> = fields[1]
+        // Header: "PF", width height, scale; each ends at a newline. Then the floats.
+        let mut parts = bytes.splitn(4, |&b| b == b'\n');
+        let mut field = || -> Result<&str> {
+            let part = parts.next().ok_or_else(bad)?;
+            Ok(std::str::from_utf8(part).map_err(|_| bad())?.trim())
+        };
+        let (magic, dims, scale) = (field()?, field()?, field()?);
+        let dims: Vec<u32> = dims
             .split_whitespace()
             .filter_map(|t| t.parse().ok())
             .collect();
-        let scale: f32 = fields[2].parse().map_err(|_| bad())?;
-        if fields[0] != "PF" || dims.len() != 2 || scale >= 0.0 {
+        let scale: f32 = scale.parse().map_err(|_| bad())?;
+        let floats = parts.next().ok_or_else(bad)?;
+        if magic != "PF" || dims.len() != 2 || scale >= 0.0 {
             return Err(bad());
         }
         let (width, height) = (dims[0], dims[1]);
-        let floats = &bytes[at..];
         // A zero dimension would make the row split below panic ("chunk size must be
         // non-zero"); an empty image is not a PFM this program writes.
         let expected = (width as u64) * (height as u64) * 12;
@@ -83,12 +73,9 @@ impl Film {
             HdrFormat::Pfm => write_output(path, |w| {
                 write!(w, "PF\n{} {}\n-1.0\n", self.width, self.height)?;
                 // PFM stores rows bottom to top, little-endian (the negative scale says so).
-                for row in self.pixels.chunks(self.width as usize).rev() {
-                    for c in row {
-                        for x in c.to_array() {
-                            w.write_all(&x.to_le_bytes())?;
-                        }
-                    }
+                let rows = self.pixels.chunks(self.width as usize).rev();
+                for x in rows.flatten().flat_map(|c| c.to_array()) {
+                    w.write_all(&x.to_le_bytes())?;
                 }
                 Ok(())
             }),
