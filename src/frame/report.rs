@@ -204,7 +204,7 @@ impl Outcome {
                 let _ = writeln!(
                     out,
                     "kinds timed by a second pass with timers: {pass:.3} s against the render's \
-                 {:.3} s ({:+.1}%); the render itself had no timers",
+                     {:.3} s ({:+.1}%); the render itself had no timers",
                     report.seconds,
                     (pass / report.seconds.max(1e-9) - 1.0) * 100.0
                 );
@@ -213,7 +213,7 @@ impl Outcome {
                 let _ = writeln!(
                     out,
                     "kinds timed by the stage timers: camera = generate + intersect of camera rays, \
-                 reflection = reflect + intersect of mirror rays, shadow = shadow; film in none"
+                     reflection = reflect + intersect of mirror rays, shadow = shadow; film in none"
                 );
             }
         }
@@ -243,7 +243,7 @@ impl Outcome {
             let _ = writeln!(
                 out,
                 "traversal counted by a second pass: {:.3} s; the render timed above counted nothing \
-             (tests: triangles of the leaves visited, spheres, and without a BVH every primitive)",
+                 (tests: triangles of the leaves visited, spheres, and without a BVH every primitive)",
                 t.counted_seconds
             );
         }
