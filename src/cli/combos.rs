@@ -24,8 +24,7 @@ pub fn meaningless(command: &Command, typed: &dyn Fn(&str) -> String) -> Vec<Str
                 && matches!(output_format(&args.output), Ok(OutputFormat::Linear))
             {
                 out.push(format!(
-                    "{} has no effect: {} {} is a linear float image, not tone mapped",
-                    "--tonemap exp",
+                    "--tonemap exp has no effect: {} {} is a linear float image, not tone mapped",
                     typed("--output"),
                     raywave::render::quote::quote(&args.output.display().to_string())
                 ));

@@ -13,6 +13,7 @@ use raywave::output::{OutputPlan, write_output};
 use raywave::render::camera::CameraRays;
 use raywave::render::engine::{Engine, clamped_warning, thread_pool};
 use raywave::render::error::UsageError;
+use raywave::render::wavefront::DEFAULT_BATCH_SIZE;
 use raywave::trace::draw::{Overlay, depth_buffer};
 use raywave::trace::view::ViewPlacement;
 use raywave::trace::{check_pixel, mesh, obj, ply, scene_bounds, summary, trace_pixel};
@@ -106,10 +107,7 @@ pub fn run(args: &TracePixelArgs) -> Result<()> {
     let mut tree =
         trace_pixel(&scene, &settings, args.x, args.y).map_err(|e| UsageError(e.to_string()))?;
     let placement = ViewPlacement {
-        from: args
-            .view_from
-            .as_ref()
-            .map(|v| glam::Vec3::new(v[0], v[1], v[2])),
+        from: args.view_from.as_deref().map(glam::Vec3::from_slice),
         orbit_degrees: args.orbit.unwrap_or(if args.view_from.is_some() {
             0.0
         } else {
@@ -150,11 +148,7 @@ pub fn run(args: &TracePixelArgs) -> Result<()> {
             ..settings.clone()
         };
         let pool = thread_pool(args.workers.threads)?;
-        let engine = Engine::Wavefront.prepare(
-            &view_scene,
-            &view_settings,
-            raywave::render::wavefront::DEFAULT_BATCH_SIZE,
-        );
+        let engine = Engine::Wavefront.prepare(&view_scene, &view_settings, DEFAULT_BATCH_SIZE);
         let template = "{spinner} rendering the debug view [{bar:40}] {pos}/{len} {msg}";
         let (film, depth) = with_bar(template, false, |progress| {
             pool.install(|| {

@@ -23,9 +23,10 @@ use crate::render::progress::Progress;
 use crate::render::scene::{Scene, load_scene};
 use crate::render::settings::options::{Effective, ImageOptions};
 use crate::render::wavefront::lanes::LaneWidth;
+use crate::render::wavefront::shadow::ShadowPath;
+use crate::render::wavefront::stats::RenderStats;
 use anyhow::{Result, bail};
 use phases::Phases;
-use report::{Report, RunInfo};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -69,10 +70,28 @@ pub struct Outcome {
     pub scene: Scene,
     /// The settings it was rendered with, and where each came from.
     pub effective: Effective,
-    /// How it ran.
-    pub run: RunInfo,
-    /// What it measured.
-    pub report: Report,
+    /// The engine that rendered.
+    pub engine: Engine,
+    /// The SIMD path the engine ran on (`Prepared::simd_path`).
+    pub simd: &'static str,
+    /// Worker threads.
+    pub threads: usize,
+    /// Camera samples per wavefront tile.
+    pub batch_size: u32,
+    /// How the wavefront engine's shadow stage ran; `None` for the reference.
+    pub shadow_path: Option<ShadowPath>,
+    /// Ray counts, and each kind's thread-time when measured.
+    pub stats: RenderStats,
+    /// Wall-clock seconds of the render (for the reference, its set-up included).
+    pub seconds: f64,
+    /// Wavefront only (its stages are in `stats`): the BVH build time if a BVH was used.
+    pub bvh: Option<Option<f64>>,
+    /// Reference only, with --stats or --stats-json: the wall-clock seconds of the second,
+    /// instrumented pass that timed the kinds.
+    pub instrumented_seconds: Option<f64>,
+    /// Wavefront only, with --stats, --stats-json or --cost-map: the traversal counters of a
+    /// second, counted pass.
+    pub traversal: Option<TraversalFigures>,
     /// With a debug pixel: the rays traced for it.
     pub pixel_rays: Option<String>,
     /// With a reference: the error table.
@@ -252,27 +271,26 @@ pub fn run(
             counted_seconds,
         ));
     }
-    let run = RunInfo {
-        engine: options.engine,
-        simd: engine.simd_path(),
-        threads,
-        batch_size: options.batch_size,
-        shadow_path: engine.shadow_path(),
-    };
-    let report = Report {
-        stats,
-        seconds,
-        bvh: engine.bvh_build_seconds(),
-        instrumented_seconds,
-        traversal,
-    };
+    let (simd, shadow_path, bvh) = (
+        engine.simd_path(),
+        engine.shadow_path(),
+        engine.bvh_build_seconds(),
+    );
     drop(engine);
     let (reference_error, reference_json) = reference_error.unzip();
     let outcome = Outcome {
         scene,
         effective,
-        run,
-        report,
+        engine: options.engine,
+        simd,
+        threads,
+        batch_size: options.batch_size,
+        shadow_path,
+        stats,
+        seconds,
+        bvh,
+        instrumented_seconds,
+        traversal,
         pixel_rays,
         reference_error,
     };

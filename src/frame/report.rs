@@ -1,70 +1,32 @@
 //! What a render prints and records once the frame is rendered: the summary, the
 //! `--stats` tables and the `--stats-json` record, from what the render measured.
 
+use super::Outcome;
 use crate::diff::{self, Encoding, FileInfo, Image, Region};
 use crate::output::bench_record::KindFigures;
 use crate::output::machine::Machine;
-use crate::output::render_record::{
-    DefaultsUsed, KindTiming, RenderRecord, SceneFigures, TraversalFigures,
-};
-use crate::render::engine::Engine;
+use crate::output::render_record::{DefaultsUsed, KindTiming, RenderRecord, SceneFigures};
 use crate::render::film::{Film, ToneMap};
 use crate::render::quote::escape;
-
-use super::Outcome;
 use crate::render::settings::options::BackgroundSource;
 use crate::render::settings::{LightModel, ShadowMode};
 use crate::render::wavefront::shadow::ShadowPath;
-use crate::render::wavefront::stats::RenderStats;
 use anyhow::Result;
 use image::RgbImage;
 use std::fmt::Write as _;
 use std::path::Path;
 
-/// How the render ran, for the summary and the JSON.
-pub struct RunInfo {
-    /// The engine that rendered.
-    pub engine: Engine,
-    /// The SIMD path the engine ran on (`Prepared::simd_path`).
-    pub simd: &'static str,
-    /// Worker threads.
-    pub threads: usize,
-    /// Camera samples per wavefront tile.
-    pub batch_size: u32,
-    /// How the wavefront engine's shadow stage ran; `None` for the reference.
-    pub shadow_path: Option<ShadowPath>,
-}
-
-/// What a render measured.
-pub struct Report {
-    /// Ray counts, and each kind's thread-time when measured.
-    pub stats: RenderStats,
-    /// Wall-clock seconds of the render (for the reference, its set-up included).
-    pub seconds: f64,
-    /// Wavefront only (its stages are in `stats`): the BVH build time if a BVH was used.
-    pub bvh: Option<Option<f64>>,
-    /// Reference only, with --stats or --stats-json: the wall-clock seconds of the second,
-    /// instrumented pass that timed the kinds.
-    pub instrumented_seconds: Option<f64>,
-    /// Wavefront only, with --stats, --stats-json or --cost-map: the traversal counters of a
-    /// second, counted pass.
-    pub traversal: Option<TraversalFigures>,
-}
-
-impl Report {
+impl Outcome {
     /// Rays by kind, each kind per thread-second of its work, the total per wall-clock second,
     /// as the JSON gives them.
     pub fn kinds(&self) -> KindFigures {
         KindFigures::new(&self.stats, self.seconds)
     }
-}
 
-impl Outcome {
     /// The summary printed after a render: engine, scene, settings, rays and time.
     pub fn summary(&self) -> String {
         let mut out = String::new();
-        let (scene, effective, run, report) =
-            (&self.scene, &self.effective, &self.run, &self.report);
+        let (scene, effective) = (&self.scene, &self.effective);
         let s = &effective.settings;
         let shadows = match s.shadows {
             ShadowMode::Off => "off (every light visible)".to_string(),
@@ -79,9 +41,9 @@ impl Outcome {
             out,
             "raywave {} · engine {} · simd {} · {} thread(s)",
             env!("CARGO_PKG_VERSION"),
-            run.engine.name(),
-            run.simd,
-            run.threads
+            self.engine.name(),
+            self.simd,
+            self.threads
         );
         let rings = match scene.ring_count {
             0 => String::new(),
@@ -156,7 +118,7 @@ impl Outcome {
             )
         };
         let _ = writeln!(out, "default {defaulted}");
-        let counts = &report.stats.counts;
+        let counts = &self.stats.counts;
         let _ = writeln!(
             out,
             "rays    {} total: {} camera, {} shadow, {} reflection",
@@ -168,8 +130,8 @@ impl Outcome {
         let _ = writeln!(
             out,
             "time    {:.3} s, {:.2} Mrays/s",
-            report.seconds,
-            report.kinds().total.rays_per_second / 1e6
+            self.seconds,
+            self.kinds().total.rays_per_second / 1e6
         );
         out
     }
@@ -178,8 +140,7 @@ impl Outcome {
     /// total over the wall clock), then (wavefront) the BVH build and each stage.
     pub fn stats_table(&self) -> String {
         let mut out = String::new();
-        let (run, report) = (&self.run, &self.report);
-        let kinds = report.kinds();
+        let kinds = self.kinds();
         // A row of the kind and stage tables: name, rays, seconds, rate.
         let row = |out: &mut String, cells: [&dyn std::fmt::Display; 4]| {
             let [name, rays, seconds, rate] = cells;
@@ -199,14 +160,14 @@ impl Outcome {
         let seconds = format!("{:.3}", total.seconds);
         let rate = format!("{:.2}", total.rays_per_second / 1e6);
         row(&mut out, [&"total", &total.rays, &seconds, &rate]);
-        match report.instrumented_seconds {
+        match self.instrumented_seconds {
             Some(pass) => {
                 let _ = writeln!(
                     out,
                     "kinds timed by a second pass with timers: {pass:.3} s against the render's \
                      {:.3} s ({:+.1}%); the render itself had no timers",
-                    report.seconds,
-                    (pass / report.seconds.max(1e-9) - 1.0) * 100.0
+                    self.seconds,
+                    (pass / self.seconds.max(1e-9) - 1.0) * 100.0
                 );
             }
             None => {
@@ -217,13 +178,13 @@ impl Outcome {
                 );
             }
         }
-        if let Some(Some(build)) = report.bvh {
+        if let Some(Some(build)) = self.bvh {
             let _ = writeln!(out, "bvh build {build:.3} s");
         }
-        if let Some(path) = run.shadow_path {
+        if let Some(path) = self.shadow_path {
             let _ = writeln!(out, "shadow path {}: {}", path.name(), path.describe());
         }
-        if let Some(t) = &report.traversal {
+        if let Some(t) = &self.traversal {
             let _ = writeln!(
                 out,
                 "{:<12} {:>14} {:>14} {:>14} {:>14}",
@@ -247,12 +208,12 @@ impl Outcome {
                 t.counted_seconds
             );
         }
-        if report.bvh.is_some() {
+        if self.bvh.is_some() {
             row(
                 &mut out,
                 [&"stage", &"rays", &"thread-s", &"Mrays/thread-s"],
             );
-            for stage in report.stats.stage_figures() {
+            for stage in self.stats.stage_figures() {
                 let seconds = format!("{:.4}", stage.thread_seconds);
                 let rate = format!("{:.2}", stage.rays_per_thread_second / 1e6);
                 row(&mut out, [&stage.stage, &stage.rays, &seconds, &rate]);
@@ -263,8 +224,7 @@ impl Outcome {
 
     /// The `--stats-json` record of a render.
     pub(super) fn record(&self) -> RenderRecord {
-        let (scene, effective, run, report) =
-            (&self.scene, &self.effective, &self.run, &self.report);
+        let (scene, effective) = (&self.scene, &self.effective);
         RenderRecord {
             format: crate::output::bench_record::FORMAT,
             raywave: env!("CARGO_PKG_VERSION"),
@@ -273,33 +233,33 @@ impl Outcome {
                 hostname: String::new(),
                 ..Machine::current()
             },
-            simd: run.simd,
-            threads: run.threads,
-            engine: run.engine,
-            batch_size: run.batch_size,
-            shadow_path: run.shadow_path.map(ShadowPath::name),
+            simd: self.simd,
+            threads: self.threads,
+            engine: self.engine,
+            batch_size: self.batch_size,
+            shadow_path: self.shadow_path.map(ShadowPath::name),
             scene: SceneFigures {
                 source: scene.source.clone(),
                 triangles: scene.triangles.len(),
                 spheres: scene.spheres.len(),
                 lights: scene.lights.len(),
-                bvh: report.bvh.map(|b| b.is_some()),
-                bvh_build_seconds: report.bvh.flatten(),
+                bvh: self.bvh.map(|b| b.is_some()),
+                bvh_build_seconds: self.bvh.flatten(),
             },
             settings: effective.settings.clone(),
             defaults: DefaultsUsed {
                 from: effective.defaults.name(),
                 settings: effective.defaulted.clone(),
             },
-            seconds: report.seconds,
-            rays: report.kinds(),
-            kinds_timed_by: match report.instrumented_seconds {
+            seconds: self.seconds,
+            rays: self.kinds(),
+            kinds_timed_by: match self.instrumented_seconds {
                 Some(_) => KindTiming::InstrumentedPass,
                 None => KindTiming::StageTimers,
             },
-            instrumented_seconds: report.instrumented_seconds,
-            stages: report.bvh.map(|_| report.stats.stage_figures()),
-            traversal: report.traversal,
+            instrumented_seconds: self.instrumented_seconds,
+            stages: self.bvh.map(|_| self.stats.stage_figures()),
+            traversal: self.traversal,
         }
     }
 }
