@@ -152,14 +152,8 @@ fn foreign(arg: &str) -> Option<(&'static ForeignFlag, Option<Defaults>)> {
         None => (arg.strip_prefix('-')?, false),
     };
     let flag = (FOREIGN_FLAGS.iter()).find(|f| f.0 == name && (!double || f.1 == Both))?;
-    let dialect = if RAYWAVE_SPELLINGS.contains(&arg) {
-        None
-    } else if double {
-        Some(Defaults::Rpi)
-    } else {
-        Some(Defaults::Lab)
-    };
-    Some((flag, dialect))
+    let dialect = if double { Defaults::Rpi } else { Defaults::Lab };
+    Some((flag, (!RAYWAVE_SPELLINGS.contains(&arg)).then_some(dialect)))
 }
 
 /// Reads the values of `spelling` from `rest`, checking each one.
@@ -295,9 +289,9 @@ pub fn normalize_args(args: impl IntoIterator<Item = OsString>) -> Result<Normal
         };
         let Some((&(_, _, kinds, meaning), _)) = foreign(text) else {
             claim(text, text)?;
+            // A single dash and a letter: `-x`, not `--x` nor `-1`.
             if text.len() > 2
                 && text.starts_with('-')
-                && !text.starts_with("--")
                 && text[1..].starts_with(|c: char| c.is_ascii_alphabetic())
             {
                 return Err(UsageError(format!(
