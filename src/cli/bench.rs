@@ -301,10 +301,8 @@ const AB_THRESHOLD_PCT: f64 = 5.0;
 /// `--json` and the exports (outputs). `--save` may name the `--compare` record (see below), no
 /// other input. Names `record_path` refuses are left to the bench, which reports them.
 fn output_plan(args: &BenchArgs, points: &[raywave::bench::running::sweep::Point]) -> OutputPlan {
-    let mut plan = OutputPlan::new();
-    if let Some(scene) = args.scene.as_ref().or(args.input.as_ref()) {
-        plan = plan.input("SCENE", scene);
-    }
+    let scene = args.scene.as_deref().or(args.input.as_deref());
+    let mut plan = OutputPlan::new().input_if("SCENE", scene);
     // `--compare X --save X` is the rolling baseline, by design: X is read whole before any
     // timing, and replaced only when this run did not regress against it.
     if let Some(Ok(path)) = args
@@ -322,9 +320,7 @@ fn output_plan(args: &BenchArgs, points: &[raywave::bench::running::sweep::Point
             }
         }
     }
-    if let Some(json) = &args.json {
-        plan = plan.output("--json", json);
-    }
+    plan = plan.output_if("--json", args.json.as_deref());
     for (flag, path) in args.exports.exports().flags() {
         plan = plan.output(flag, path);
     }
