@@ -111,19 +111,18 @@ pub fn run(args: &DiffArgs) -> Result<u8> {
         ("--ring-segments", args.ring_segments.is_some()),
         ("--two-sided", args.two_sided),
     ]
-    .iter()
-    .filter(|(_, given)| *given)
-    .map(|(flag, _)| *flag)
+    .into_iter()
+    .filter_map(|(flag, given)| given.then_some(flag))
     .collect();
     if !scene_flags.is_empty() && !args.penumbra() {
+        let verb = if scene_flags.len() == 1 {
+            "has"
+        } else {
+            "have"
+        };
         eprintln!(
-            "warning: {} {} no effect without --mask penumbra",
-            scene_flags.join(", "),
-            if scene_flags.len() == 1 {
-                "has"
-            } else {
-                "have"
-            }
+            "warning: {} {verb} no effect without --mask penumbra",
+            scene_flags.join(", ")
         );
     }
     let plan = OutputPlan::new()
@@ -138,10 +137,8 @@ pub fn run(args: &DiffArgs) -> Result<u8> {
 
     let a = read_image(&args.a)?;
     let b = read_image(&args.b)?;
-    let (a_name, b_name) = (
-        format!("A {}", args.a.display()),
-        format!("B {}", args.b.display()),
-    );
+    let a_name = format!("A {}", args.a.display());
+    let b_name = format!("B {}", args.b.display());
     diff::check_same_size(&a, &a_name, &b, &b_name).map_err(|e| UsageError::from_error(&e))?;
     let (a_info, b_info) = (FileInfo::of(&args.a, &a), FileInfo::of(&args.b, &b));
     let mut text = format!(
