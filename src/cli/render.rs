@@ -106,7 +106,15 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             .map(|path| (path, args.cost_kind.into(), args.cost_measure.into())),
         max_memory: args.max_memory,
         mse_reference: args.mse_reference.clone(),
-        plan: output_plan(args),
+        // The scene (an input) and every output of a render, checked before any work.
+        plan: OutputPlan::new()
+            .input_if("SCENE", args.scene.as_deref())
+            .input_if("-input", args.input.as_deref())
+            .output("-o", &args.output)
+            .output_if("--hdr", args.hdr.as_deref())
+            .output_if("--stats-json", args.stats_json.as_deref())
+            .output_if("--cost-map", args.cost_map.as_deref())
+            .input_if("--mse-reference", args.mse_reference.as_deref()),
     };
     let pool = thread_pool(args.workers.threads)?;
     let template = "{spinner} {msg} [{bar:40}] {pos}/{len}, {elapsed} (eta {eta})";
@@ -137,16 +145,4 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         say(text)?;
     }
     Ok(())
-}
-
-/// The scene (an input) and every output of a render, for the checks before any work.
-fn output_plan(args: &RenderArgs) -> OutputPlan {
-    OutputPlan::new()
-        .input_if("SCENE", args.scene.as_deref())
-        .input_if("-input", args.input.as_deref())
-        .output("-o", &args.output)
-        .output_if("--hdr", args.hdr.as_deref())
-        .output_if("--stats-json", args.stats_json.as_deref())
-        .output_if("--cost-map", args.cost_map.as_deref())
-        .input_if("--mse-reference", args.mse_reference.as_deref())
 }

@@ -93,7 +93,11 @@ pub fn run(args: &TracePixelArgs) -> Result<()> {
     if let Some(png) = &args.png {
         ldr_format(png).map_err(|e| UsageError::from_error(&e))?;
     }
-    let plan = output_plan(args);
+    // The scene (an input) and the outputs, checked before any work.
+    let plan = OutputPlan::new().input_if("SCENE", args.scene.as_deref());
+    let plan = (args.outputs().into_iter()).fold(plan, |plan, (flag, path)| {
+        plan.output_if(flag, path.as_deref())
+    });
     plan.check()?;
     plan.refuse_binary_on_terminal(&["--png"])?;
 
@@ -225,12 +229,4 @@ pub fn meaningless(args: &TracePixelArgs) -> Vec<String> {
             format!("{flag} has no effect without --png (it shapes the debug camera's image only)")
         })
         .collect()
-}
-
-/// The scene (an input) and the outputs, checked before any work.
-fn output_plan(args: &TracePixelArgs) -> OutputPlan {
-    let plan = OutputPlan::new().input_if("SCENE", args.scene.as_deref());
-    args.outputs().into_iter().fold(plan, |plan, (flag, path)| {
-        plan.output_if(flag, path.as_deref())
-    })
 }
