@@ -21,7 +21,7 @@ pub fn meaningless(command: &Command, typed: &dyn Fn(&str) -> String) -> Vec<Str
         Command::Render(args) => {
             image(&args.image, typed, &mut out);
             if args.tonemap == ToneMapArg::Exp
-                && matches!(output_format(&args.output), Ok(OutputFormat::Linear))
+                && matches!(output_format(&args.output), Ok(OutputFormat::Linear(_)))
             {
                 out.push(format!(
                     "--tonemap exp has no effect: {} {} is a linear float image, not tone mapped",

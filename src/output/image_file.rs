@@ -135,19 +135,23 @@ pub enum HdrFormat {
     Exr,
 }
 
-/// Every image format raywave writes, by its file extension (lower case): the one table that
-/// `-o`, `--hdr` and every figure consult.
+/// An image format raywave writes, and what `-o FILE` makes of it: an 8-bit image, or (for
+/// `.pfm` and `.exr`) only the linear floats.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Format {
+pub enum OutputFormat {
+    /// A tone-mapped 8-bit image.
     Ldr(LdrFormat),
-    Hdr(HdrFormat),
+    /// Linear floats, and no 8-bit image beside them.
+    Linear(HdrFormat),
 }
 
-const FORMATS: [(&str, Format); 4] = [
-    ("png", Format::Ldr(LdrFormat::Png)),
-    ("ppm", Format::Ldr(LdrFormat::Ppm)),
-    ("pfm", Format::Hdr(HdrFormat::Pfm)),
-    ("exr", Format::Hdr(HdrFormat::Exr)),
+/// Every image format raywave writes, by its file extension (lower case): the one table that
+/// `-o`, `--hdr` and every figure consult.
+const FORMATS: [(&str, OutputFormat); 4] = [
+    ("png", OutputFormat::Ldr(LdrFormat::Png)),
+    ("ppm", OutputFormat::Ldr(LdrFormat::Ppm)),
+    ("pfm", OutputFormat::Linear(HdrFormat::Pfm)),
+    ("exr", OutputFormat::Linear(HdrFormat::Exr)),
 ];
 
 /// What `pick` makes of the format `path`'s extension names; for a path without one to go by
@@ -155,7 +159,7 @@ const FORMATS: [(&str, Format); 4] = [
 /// error saying what was `expected`.
 fn format_for<T>(
     path: &Path,
-    pick: impl Fn(Format) -> Option<T>,
+    pick: impl Fn(OutputFormat) -> Option<T>,
     stream: T,
     expected: &str,
 ) -> Result<T> {
@@ -173,31 +177,18 @@ fn format_for<T>(
 /// The 8-bit format for an output path, or an error naming what is accepted.
 pub fn ldr_format(path: &Path) -> Result<LdrFormat> {
     let pick = |f| match f {
-        Format::Ldr(f) => Some(f),
-        Format::Hdr(_) => None,
+        OutputFormat::Ldr(f) => Some(f),
+        OutputFormat::Linear(_) => None,
     };
     let expected = "an output file ending in .png or .ppm (use --hdr for .pfm or .exr)";
     format_for(path, pick, LdrFormat::Png, expected)
 }
 
-/// What `-o FILE` writes: an 8-bit image, or (for `.pfm` and `.exr`) only the linear floats.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum OutputFormat {
-    /// A tone-mapped 8-bit image.
-    Ldr(LdrFormat),
-    /// Linear floats, and no 8-bit image beside them.
-    Linear,
-}
-
 /// The format of an `-o` path, or an error naming the extensions accepted.
 pub fn output_format(path: &Path) -> Result<OutputFormat> {
-    let pick = |f| match f {
-        Format::Ldr(f) => Some(OutputFormat::Ldr(f)),
-        Format::Hdr(_) => Some(OutputFormat::Linear),
-    };
     let expected =
         "an output file ending in .png or .ppm (8-bit), or .pfm or .exr (linear floats only)";
-    format_for(path, pick, OutputFormat::Ldr(LdrFormat::Png), expected)
+    format_for(path, Some, OutputFormat::Ldr(LdrFormat::Png), expected)
 }
 
 /// Encodes an 8-bit image as PNG into `w`: the one PNG encoder of every output (files, figures
@@ -231,8 +222,8 @@ pub fn write_rgb8(img: &image::RgbImage, path: &Path) -> Result<()> {
 /// The float format for an `--hdr` path, or an error naming the extensions accepted.
 pub fn hdr_format(path: &Path) -> Result<HdrFormat> {
     let pick = |f| match f {
-        Format::Hdr(f) => Some(f),
-        Format::Ldr(_) => None,
+        OutputFormat::Linear(f) => Some(f),
+        OutputFormat::Ldr(_) => None,
     };
     let expected = "an --hdr file ending in .pfm or .exr";
     format_for(path, pick, HdrFormat::Pfm, expected)
