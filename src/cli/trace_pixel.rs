@@ -153,6 +153,7 @@ pub fn run(args: &TracePixelArgs) -> Result<()> {
         };
         let pool = thread_pool(args.workers.threads)?;
         let engine = Engine::Wavefront.prepare(&view_scene, &view_settings, DEFAULT_BATCH_SIZE);
+        let rays = CameraRays::new(&camera, width, height);
         let template = "{spinner} rendering the debug view [{bar:40}] {pos}/{len} {msg}";
         let (film, depth) = with_bar(template, false, |progress| {
             pool.install(|| {
@@ -160,14 +161,13 @@ pub fn run(args: &TracePixelArgs) -> Result<()> {
                 if let Some(w) = clamped_warning(&stats) {
                     (progress.notice)(&w);
                 }
-                let rays = CameraRays::new(&camera, width, height);
                 (film, depth_buffer(&view_scene, &rays, settings.two_sided))
             })
         });
         let mut img = film.to_rgb8(args.tonemap.into());
         let (lo, hi) = scene_bounds(&scene);
         Overlay {
-            camera: CameraRays::new(&camera, width, height),
+            camera: rays,
             depth: &depth,
             diagonal: (hi - lo).length(),
         }
