@@ -3,7 +3,7 @@
 
 use super::image::{ImageArgs, say};
 use super::values::{EngineArg, float};
-use anyhow::Result;
+use anyhow::{Result, bail};
 use clap::parser::ValueSource;
 use clap::{ArgAction, ArgMatches, Args, Subcommand};
 use raywave::bench::ab::{self, AbOptions, MIN_ROUNDS};
@@ -15,12 +15,12 @@ use raywave::bench::shard::SweepPoints;
 use raywave::bench::{BenchOptions, DEFAULT_RUNS, DEFAULT_THRESHOLD_PCT, EXIT_REGRESSION, list};
 use raywave::output::OutputPlan;
 use raywave::output::bench_record::record_path;
+use raywave::output::machine::logical_cpus;
 use raywave::output::memory::{self, RenderFootprint};
 use raywave::output::terminal::with_bar;
 use raywave::render::engine::Engine;
 use raywave::render::error::UsageError;
-use raywave::shard::Shard;
-use raywave::shard::part_name;
+use raywave::shard::{Shard, part_name};
 use std::path::PathBuf;
 
 /// Flags of `raywave bench`. A scene file literally named `compare` or `list` is given as
@@ -204,19 +204,6 @@ pub struct MergeArgs {
     pub quiet: bool,
 }
 
-impl MergeArgs {
-    /// The flags as the library's options.
-    fn options(&self) -> MergeOptions {
-        MergeOptions {
-            parts: self.parts.clone(),
-            exports: self.exports.exports(),
-            save: self.save.clone(),
-            dir: self.dir.clone(),
-            across_machines: self.across_machines,
-        }
-    }
-}
-
 /// Flags of `raywave bench compare`.
 #[derive(Args, Debug, Clone)]
 pub(crate) struct CompareArgs {
@@ -271,23 +258,20 @@ impl BenchArgs {
     /// list and which flags were given).
     pub fn options(&self, matches: Option<&ArgMatches>) -> BenchOptions {
         let sizes = self.image.size.as_deref().unwrap_or_default();
-        let mut sweep = Sweep {
+        let sweep = Sweep {
             sizes: sizes.chunks_exact(2).map(|c| [c[0], c[1]]).collect(),
-            shadow_samples: Vec::new(),
+            shadow_samples: (matches.and_then(|m| m.get_many::<u32>("shadow_samples")))
+                .map_or_else(Vec::new, |v| v.copied().collect()),
             threads: self.threads.clone(),
         };
-        let mut explicit = Vec::new();
-        if let Some(m) = matches {
-            sweep.shadow_samples = m
-                .get_many::<u32>("shadow_samples")
-                .map(|v| v.copied().collect())
-                .unwrap_or_default();
-            explicit = ADOPTABLE
-                .iter()
-                .filter(|id| m.value_source(id) == Some(ValueSource::CommandLine))
-                .map(|id| id.to_string())
-                .collect();
-        }
+        let given = |id: &&str| {
+            matches.is_some_and(|m| m.value_source(id) == Some(ValueSource::CommandLine))
+        };
+        let explicit = ADOPTABLE
+            .into_iter()
+            .filter(given)
+            .map(|id| id.to_string())
+            .collect();
         let sweep_points = sweep.points();
         BenchOptions {
             scene: self.scene.clone().or_else(|| self.input.clone()),
@@ -317,10 +301,8 @@ const AB_THRESHOLD_PCT: f64 = 5.0;
 /// `--json` and the exports (outputs). `--save` may name the `--compare` record (see below), no
 /// other input. Names `record_path` refuses are left to the bench, which reports them.
 fn output_plan(args: &BenchArgs, points: &[raywave::bench::running::sweep::Point]) -> OutputPlan {
-    let mut plan = OutputPlan::new();
-    if let Some(scene) = args.scene.as_ref().or(args.input.as_ref()) {
-        plan = plan.input("SCENE", scene);
-    }
+    let scene = args.scene.as_deref().or(args.input.as_deref());
+    let mut plan = OutputPlan::new().input_if("SCENE", scene);
     // `--compare X --save X` is the rolling baseline, by design: X is read whole before any
     // timing, and replaced only when this run did not regress against it.
     if let Some(Ok(path)) = args
@@ -338,9 +320,7 @@ fn output_plan(args: &BenchArgs, points: &[raywave::bench::running::sweep::Point
             }
         }
     }
-    if let Some(json) = &args.json {
-        plan = plan.output("--json", json);
-    }
+    plan = plan.output_if("--json", args.json.as_deref());
     for (flag, path) in args.exports.exports().flags() {
         plan = plan.output(flag, path);
     }
@@ -368,7 +348,13 @@ pub fn run(args: &BenchArgs, matches: Option<&ArgMatches>) -> Result<u8> {
             return Ok(0);
         }
         Some(BenchAction::Merge(m)) => {
-            let options = m.options();
+            let options = MergeOptions {
+                parts: m.parts.clone(),
+                exports: m.exports.exports(),
+                save: m.save.clone(),
+                dir: m.dir.clone(),
+                across_machines: m.across_machines,
+            };
             let text = merge::merge(&options)?.text(m.quiet);
             let plan = (options.exports.flags().into_iter())
                 .fold(OutputPlan::new(), |plan, (flag, p)| plan.output(flag, p));
@@ -380,22 +366,16 @@ pub fn run(args: &BenchArgs, matches: Option<&ArgMatches>) -> Result<u8> {
     let options = args.options(matches);
     options.plan.check()?;
     // Each timed run holds one film; refuse a size the machine cannot hold before any timing.
-    let largest = options
-        .sweep
-        .sizes
-        .iter()
-        .map(|[w, h]| u64::from(*w) * u64::from(*h))
-        .max();
     let settings = args.image.options().resolve(None).settings;
-    let threads = options.sweep.threads.iter().max().map_or_else(
-        || std::thread::available_parallelism().map_or(1, |n| n.get() as u64),
-        |t| u64::from(*t),
-    );
+    let pixels = (options.sweep.sizes.iter())
+        .map(|&[w, h]| u64::from(w) * u64::from(h))
+        .max();
+    let threads = options.sweep.threads.iter().max();
     memory::check(
         &RenderFootprint {
-            pixels: largest.unwrap_or(settings.width as u64 * settings.height as u64),
+            pixels: pixels.unwrap_or(settings.width as u64 * settings.height as u64),
             primitives: 0,
-            threads,
+            threads: threads.map_or(logical_cpus() as u64, |&t| t.into()),
             batch_size: raywave::render::wavefront::DEFAULT_BATCH_SIZE as u64,
             rgb8: false,
             exr_in_memory: false,
@@ -410,16 +390,15 @@ pub fn run(args: &BenchArgs, matches: Option<&ArgMatches>) -> Result<u8> {
             |progress| raywave::bench::run(&options, progress),
         )?;
         let text = outcome.text(args.quiet, options.compare.as_deref());
-        say(&output_plan(args, &[]), &text)?;
+        say(&options.plan, &text)?;
         return Ok(outcome.exit_code());
     };
     let points = options.sweep.points().len();
     if points > 1 || options.sweep.threads.len() > 1 {
-        return Err(UsageError(format!(
+        bail!(UsageError(format!(
             "--against times one point, but the flags sweep {points}: give one --size, one \
              --shadow-samples and one --threads"
-        ))
-        .into());
+        )));
     }
     let options = AbOptions {
         other: other.clone(),

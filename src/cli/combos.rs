@@ -21,11 +21,10 @@ pub fn meaningless(command: &Command, typed: &dyn Fn(&str) -> String) -> Vec<Str
         Command::Render(args) => {
             image(&args.image, typed, &mut out);
             if args.tonemap == ToneMapArg::Exp
-                && matches!(output_format(&args.output), Ok(OutputFormat::Linear))
+                && matches!(output_format(&args.output), Ok(OutputFormat::Linear(_)))
             {
                 out.push(format!(
-                    "{} has no effect: {} {} is a linear float image, not tone mapped",
-                    "--tonemap exp",
+                    "--tonemap exp has no effect: {} {} is a linear float image, not tone mapped",
                     typed("--output"),
                     raywave::render::quote::quote(&args.output.display().to_string())
                 ));

@@ -6,9 +6,8 @@ use super::values::{DefaultsArg, MetricArg, float};
 use anyhow::{Result, bail};
 use clap::Args;
 use raywave::diff::{self, Comparison, EXIT_FAILED, FileInfo, Image, Metric, Region, read_image};
+use raywave::output::OutputPlan;
 use raywave::output::image_file::{ldr_format, write_json};
-use raywave::output::terminal::print;
-use raywave::output::{OutputPlan, is_stdio};
 use raywave::render::error::UsageError;
 use raywave::render::sampling::LightSampler;
 use raywave::render::scene::load_scene;
@@ -93,19 +92,17 @@ pub fn run(args: &DiffArgs) -> Result<u8> {
     let metric = Metric::from(args.metric);
     let want_flip = args.flip || metric == Metric::Flip;
     if want_flip && !diff::FLIP_AVAILABLE {
-        return Err(UsageError(
+        bail!(UsageError(
             "--flip and --metric flip need raywave built with the `flip` feature (on by default; it needs a C++ compiler)".into(),
-        )
-        .into());
+        ));
     }
     if let Some(out) = &args.out
         && ldr_format(out).is_err()
     {
-        return Err(UsageError(format!(
+        bail!(UsageError(format!(
             "--out {}: expected a figure file ending in .png or .ppm",
             out.display()
-        ))
-        .into());
+        )));
     }
     let scene_flags: Vec<&str> = [
         ("--scene", args.scene.is_some()),
@@ -114,19 +111,18 @@ pub fn run(args: &DiffArgs) -> Result<u8> {
         ("--ring-segments", args.ring_segments.is_some()),
         ("--two-sided", args.two_sided),
     ]
-    .iter()
-    .filter(|(_, given)| *given)
-    .map(|(flag, _)| *flag)
+    .into_iter()
+    .filter_map(|(flag, given)| given.then_some(flag))
     .collect();
     if !scene_flags.is_empty() && !args.penumbra() {
+        let verb = if scene_flags.len() == 1 {
+            "has"
+        } else {
+            "have"
+        };
         eprintln!(
-            "warning: {} {} no effect without --mask penumbra",
-            scene_flags.join(", "),
-            if scene_flags.len() == 1 {
-                "has"
-            } else {
-                "have"
-            }
+            "warning: {} {verb} no effect without --mask penumbra",
+            scene_flags.join(", ")
         );
     }
     let plan = OutputPlan::new()
@@ -141,10 +137,8 @@ pub fn run(args: &DiffArgs) -> Result<u8> {
 
     let a = read_image(&args.a)?;
     let b = read_image(&args.b)?;
-    let (a_name, b_name) = (
-        format!("A {}", args.a.display()),
-        format!("B {}", args.b.display()),
-    );
+    let a_name = format!("A {}", args.a.display());
+    let b_name = format!("B {}", args.b.display());
     diff::check_same_size(&a, &a_name, &b, &b_name).map_err(|e| UsageError::from_error(&e))?;
     let (a_info, b_info) = (FileInfo::of(&args.a, &a), FileInfo::of(&args.b, &b));
     let mut text = format!(
@@ -165,10 +159,8 @@ pub fn run(args: &DiffArgs) -> Result<u8> {
     text.push_str(&diff::text::table(&comparison));
 
     let value = comparison.value(metric);
-    let failed = match (args.fail_above, value) {
-        (Some(threshold), Some(v)) => metric.fails(v, threshold),
-        _ => false,
-    };
+    let failed =
+        (args.fail_above.zip(value)).is_some_and(|(threshold, v)| metric.fails(v, threshold));
     if let Some(out) = &args.out {
         let errors = match (&flip_map, metric) {
             (Some(map), Metric::Flip) => map.clone(),
@@ -223,11 +215,7 @@ pub fn run(args: &DiffArgs) -> Result<u8> {
             metric.name()
         ));
     }
-    if args.json.as_deref().is_some_and(is_stdio) {
-        eprint!("{text}");
-    } else {
-        print(&text)?;
-    }
+    super::image::say(&plan, &text)?;
     Ok(if failed { EXIT_FAILED } else { 0 })
 }
 

@@ -43,29 +43,9 @@ enum Dashes {
     Both,
 }
 
-/// One flag of the lab's or RPI's ArgParser.
-struct ForeignFlag {
-    /// The name without its dashes.
-    name: &'static str,
-    dashes: Dashes,
-    /// The values that follow it.
-    values: &'static [Value],
-    meaning: Meaning,
-}
-
-const fn flag(
-    name: &'static str,
-    dashes: Dashes,
-    values: &'static [Value],
-    meaning: Meaning,
-) -> ForeignFlag {
-    ForeignFlag {
-        name,
-        dashes,
-        values,
-        meaning,
-    }
-}
+/// One flag of the lab's or RPI's ArgParser: its name without the dashes, the dashes it is
+/// spelled with, the values that follow it, and what it does in raywave.
+type ForeignFlag = (&'static str, Dashes, &'static [Value], Meaning);
 
 const RADIOSITY: &str = "raywave has no radiosity solver";
 const PHOTONS: &str = "raywave has no photon mapping; indirect light stays the ambient term";
@@ -84,23 +64,23 @@ use Value::{Count, Number, Text};
 /// single-dash spelling of `-o`, kept for lab-style lines.
 #[rustfmt::skip]
 const FOREIGN_FLAGS: &[ForeignFlag] = &[
-    flag("input",                       Both, &[Text],                   Flag("--input")),
-    flag("i",                           One,  &[Text],                   Flag("--input")),
-    flag("output",                      One,  &[Text],                   Flag("--output")),
-    flag("size",                        Both, &[Count, Count],           Flag("--size")),
-    flag("num_bounces",                 Both, &[Count],                  Flag("--bounces")),
-    flag("num_shadow_samples",          Both, &[Count],                  ShadowSamples),
-    flag("soft_shadow",                 One,  &[],                       Tokens(&["--shadows", "soft"])),
-    flag("background_color",            One,  &[Number, Number, Number], Flag("--background")),
-    flag("num_antialias_samples",       Both, &[Count],                  Flag("--aa")),
-    flag("ambient_light",               Both, &[Number, Number, Number], Flag("--ambient")),
-    flag("cylinder_ring_rasterization", Both, &[Count],                  Flag("--ring-segments")),
-    flag("sphere_rasterization",        Both, &[Count, Count],           NoEffect(SPHERES)),
-    flag("num_glossy_samples",          Both, &[Count],                  NoEffect(GLOSSY)),
-    flag("num_form_factor_samples",     Both, &[Count],                  NoEffect(RADIOSITY)),
-    flag("num_photons_to_shoot",        Both, &[Count],                  NoEffect(PHOTONS)),
-    flag("num_photons_to_collect",      Both, &[Count],                  NoEffect(PHOTONS)),
-    flag("gather_indirect",             Both, &[],                       NoEffect(PHOTONS)),
+    ("input",                       Both, &[Text],                   Flag("--input")),
+    ("i",                           One,  &[Text],                   Flag("--input")),
+    ("output",                      One,  &[Text],                   Flag("--output")),
+    ("size",                        Both, &[Count, Count],           Flag("--size")),
+    ("num_bounces",                 Both, &[Count],                  Flag("--bounces")),
+    ("num_shadow_samples",          Both, &[Count],                  ShadowSamples),
+    ("soft_shadow",                 One,  &[],                       Tokens(&["--shadows", "soft"])),
+    ("background_color",            One,  &[Number, Number, Number], Flag("--background")),
+    ("num_antialias_samples",       Both, &[Count],                  Flag("--aa")),
+    ("ambient_light",               Both, &[Number, Number, Number], Flag("--ambient")),
+    ("cylinder_ring_rasterization", Both, &[Count],                  Flag("--ring-segments")),
+    ("sphere_rasterization",        Both, &[Count, Count],           NoEffect(SPHERES)),
+    ("num_glossy_samples",          Both, &[Count],                  NoEffect(GLOSSY)),
+    ("num_form_factor_samples",     Both, &[Count],                  NoEffect(RADIOSITY)),
+    ("num_photons_to_shoot",        Both, &[Count],                  NoEffect(PHOTONS)),
+    ("num_photons_to_collect",      Both, &[Count],                  NoEffect(PHOTONS)),
+    ("gather_indirect",             Both, &[],                       NoEffect(PHOTONS)),
 ];
 
 /// Spellings in the table that are also raywave's own: they do not choose whose defaults apply.
@@ -171,17 +151,9 @@ fn foreign(arg: &str) -> Option<(&'static ForeignFlag, Option<Defaults>)> {
         Some(name) => (name, true),
         None => (arg.strip_prefix('-')?, false),
     };
-    let flag = FOREIGN_FLAGS
-        .iter()
-        .find(|f| f.name == name && (!double || f.dashes == Both))?;
-    let dialect = if RAYWAVE_SPELLINGS.contains(&arg) {
-        None
-    } else if double {
-        Some(Defaults::Rpi)
-    } else {
-        Some(Defaults::Lab)
-    };
-    Some((flag, dialect))
+    let flag = (FOREIGN_FLAGS.iter()).find(|f| f.0 == name && (!double || f.1 == Both))?;
+    let dialect = if double { Defaults::Rpi } else { Defaults::Lab };
+    Some((flag, (!RAYWAVE_SPELLINGS.contains(&arg)).then_some(dialect)))
 }
 
 /// Reads the values of `spelling` from `rest`, checking each one.
@@ -315,18 +287,18 @@ pub fn normalize_args(args: impl IntoIterator<Item = OsString>) -> Result<Normal
             out.push(arg.clone());
             continue;
         };
-        let Some((flag, _)) = foreign(text) else {
+        let Some((&(_, _, kinds, meaning), _)) = foreign(text) else {
             claim(text, text)?;
+            // A single dash and a letter: `-x`, not `--x` nor `-1`.
             if text.len() > 2
                 && text.starts_with('-')
-                && !text.starts_with("--")
                 && text[1..].starts_with(|c: char| c.is_ascii_alphabetic())
             {
                 return Err(UsageError(format!(
                     "unknown flag `{text}`: expected one of raywave's flags (--help lists them), or one of the lab's or RPI's: {}",
                     FOREIGN_FLAGS
                         .iter()
-                        .map(|f| format!("-{}", f.name))
+                        .map(|f| format!("-{}", f.0))
                         .collect::<Vec<_>>()
                         .join(", ")
                 )));
@@ -334,9 +306,9 @@ pub fn normalize_args(args: impl IntoIterator<Item = OsString>) -> Result<Normal
             out.push(arg.clone());
             continue;
         };
-        let values = take_values(text, flag.values, &mut rest)?;
+        let values = take_values(text, kinds, &mut rest)?;
         // The raywave flag it stands for, and the values that follow that flag.
-        let (target, values) = match flag.meaning {
+        let (target, values) = match meaning {
             Meaning::Flag(target) => (target, values),
             Meaning::Tokens(args) => (args[0], args[1..].iter().map(|a| a.to_string()).collect()),
             Meaning::ShadowSamples if values[0] != "0" => ("--shadow-samples", values),

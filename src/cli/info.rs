@@ -37,15 +37,8 @@ fn cpu_lines() -> String {
     let has = |f: &cpu::Feature| here.has(f);
     let needed: Vec<&cpu::Feature> = FEATURES.iter().filter(|f| f.compiled).collect();
     let lacks = cpu::missing(FEATURES, has);
-    let listed: Vec<String> = needed
-        .iter()
-        .map(|f| {
-            if has(f) {
-                f.name.to_string()
-            } else {
-                format!("{} (absent)", f.name)
-            }
-        })
+    let listed: Vec<String> = (needed.iter())
+        .map(|f| format!("{}{}", f.name, if has(f) { "" } else { " (absent)" }))
         .collect();
     let verdict = if lacks.is_empty() {
         "this CPU has every one".to_string()

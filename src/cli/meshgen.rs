@@ -25,9 +25,7 @@ pub fn run(args: &MeshgenArgs) -> Result<()> {
     plan.check()?;
     let bands = bands_for(args.triangles as usize);
     let text = cornell_box_mesh_spheres(bands);
-    raywave::output::image_file::write_atomically(&args.output, |w| {
-        Ok(w.write_all(text.as_bytes())?)
-    })?;
+    raywave::output::write_output(&args.output, |w| Ok(w.write_all(text.as_bytes())?))?;
     let text = format!(
         "wrote   {}: {} triangles ({bands} latitude bands per sphere)\n",
         args.output.display(),

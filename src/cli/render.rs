@@ -6,7 +6,6 @@ use super::values::{CostKindArg, CostMeasureArg, EngineArg, LanesArg, ToneMapArg
 use anyhow::Result;
 use clap::Args;
 use raywave::frame::phases::Phases;
-use raywave::frame::report::{stats_table, summary};
 use raywave::frame::{self, FrameOptions};
 use raywave::output::OutputPlan;
 use raywave::output::terminal::with_bar;
@@ -107,7 +106,15 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             .map(|path| (path, args.cost_kind.into(), args.cost_measure.into())),
         max_memory: args.max_memory,
         mse_reference: args.mse_reference.clone(),
-        plan: output_plan(args),
+        // The scene (an input) and every output of a render, checked before any work.
+        plan: OutputPlan::new()
+            .input_if("SCENE", args.scene.as_deref())
+            .input_if("-input", args.input.as_deref())
+            .output("-o", &args.output)
+            .output_if("--hdr", args.hdr.as_deref())
+            .output_if("--stats-json", args.stats_json.as_deref())
+            .output_if("--cost-map", args.cost_map.as_deref())
+            .input_if("--mse-reference", args.mse_reference.as_deref()),
     };
     let pool = thread_pool(args.workers.threads)?;
     let template = "{spinner} {msg} [{bar:40}] {pos}/{len}, {elapsed} (eta {eta})";
@@ -126,33 +133,16 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             .collect();
         say(&format!(
             "{}wrote   {}{extra}\n",
-            summary(
-                &outcome.scene,
-                &outcome.effective,
-                &outcome.run,
-                &outcome.report
-            ),
+            outcome.summary(),
             args.output.display()
         ))?;
     }
     if args.stats {
-        say(&stats_table(&outcome.run, &outcome.report))?;
+        say(&outcome.stats_table())?;
         say(&phases.table("tables, BVH, progress bar"))?;
     }
     if let Some(text) = &outcome.reference_error {
         say(text)?;
     }
     Ok(())
-}
-
-/// The scene (an input) and every output of a render, for the checks before any work.
-fn output_plan(args: &RenderArgs) -> OutputPlan {
-    OutputPlan::new()
-        .input_if("SCENE", args.scene.as_deref())
-        .input_if("-input", args.input.as_deref())
-        .output("-o", &args.output)
-        .output_if("--hdr", args.hdr.as_deref())
-        .output_if("--stats-json", args.stats_json.as_deref())
-        .output_if("--cost-map", args.cost_map.as_deref())
-        .input_if("--mse-reference", args.mse_reference.as_deref())
 }

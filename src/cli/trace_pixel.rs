@@ -13,6 +13,7 @@ use raywave::output::{OutputPlan, write_output};
 use raywave::render::camera::CameraRays;
 use raywave::render::engine::{Engine, clamped_warning, thread_pool};
 use raywave::render::error::UsageError;
+use raywave::render::wavefront::DEFAULT_BATCH_SIZE;
 use raywave::trace::draw::{Overlay, depth_buffer};
 use raywave::trace::view::ViewPlacement;
 use raywave::trace::{check_pixel, mesh, obj, ply, scene_bounds, summary, trace_pixel};
@@ -92,7 +93,11 @@ pub fn run(args: &TracePixelArgs) -> Result<()> {
     if let Some(png) = &args.png {
         ldr_format(png).map_err(|e| UsageError::from_error(&e))?;
     }
-    let plan = output_plan(args);
+    // The scene (an input) and the outputs, checked before any work.
+    let plan = OutputPlan::new().input_if("SCENE", args.scene.as_deref());
+    let plan = (args.outputs().into_iter()).fold(plan, |plan, (flag, path)| {
+        plan.output_if(flag, path.as_deref())
+    });
     plan.check()?;
     plan.refuse_binary_on_terminal(&["--png"])?;
 
@@ -106,10 +111,7 @@ pub fn run(args: &TracePixelArgs) -> Result<()> {
     let mut tree =
         trace_pixel(&scene, &settings, args.x, args.y).map_err(|e| UsageError(e.to_string()))?;
     let placement = ViewPlacement {
-        from: args
-            .view_from
-            .as_ref()
-            .map(|v| glam::Vec3::new(v[0], v[1], v[2])),
+        from: args.view_from.as_deref().map(glam::Vec3::from_slice),
         orbit_degrees: args.orbit.unwrap_or(if args.view_from.is_some() {
             0.0
         } else {
@@ -150,11 +152,8 @@ pub fn run(args: &TracePixelArgs) -> Result<()> {
             ..settings.clone()
         };
         let pool = thread_pool(args.workers.threads)?;
-        let engine = Engine::Wavefront.prepare(
-            &view_scene,
-            &view_settings,
-            raywave::render::wavefront::DEFAULT_BATCH_SIZE,
-        );
+        let engine = Engine::Wavefront.prepare(&view_scene, &view_settings, DEFAULT_BATCH_SIZE);
+        let rays = CameraRays::new(&camera, width, height);
         let template = "{spinner} rendering the debug view [{bar:40}] {pos}/{len} {msg}";
         let (film, depth) = with_bar(template, false, |progress| {
             pool.install(|| {
@@ -162,14 +161,13 @@ pub fn run(args: &TracePixelArgs) -> Result<()> {
                 if let Some(w) = clamped_warning(&stats) {
                     (progress.notice)(&w);
                 }
-                let rays = CameraRays::new(&camera, width, height);
                 (film, depth_buffer(&view_scene, &rays, settings.two_sided))
             })
         });
         let mut img = film.to_rgb8(args.tonemap.into());
         let (lo, hi) = scene_bounds(&scene);
         Overlay {
-            camera: CameraRays::new(&camera, width, height),
+            camera: rays,
             depth: &depth,
             diagonal: (hi - lo).length(),
         }
@@ -231,12 +229,4 @@ pub fn meaningless(args: &TracePixelArgs) -> Vec<String> {
             format!("{flag} has no effect without --png (it shapes the debug camera's image only)")
         })
         .collect()
-}
-
-/// The scene (an input) and the outputs, checked before any work.
-fn output_plan(args: &TracePixelArgs) -> OutputPlan {
-    let plan = OutputPlan::new().input_if("SCENE", args.scene.as_deref());
-    args.outputs().into_iter().fold(plan, |plan, (flag, path)| {
-        plan.output_if(flag, path.as_deref())
-    })
 }

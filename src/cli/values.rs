@@ -68,9 +68,12 @@ pub fn colour_component() -> impl TypedValueParser<Value = f32> {
     })
 }
 
-/// Declares a clap value enum and its conversion into the library's enum of the same variants.
+/// Declares clap value enums, each with its conversion into the library's enum of the same
+/// variants.
 macro_rules! mirror {
-    ($(#[$doc:meta])* $name:ident => $lib:ident { $($(#[$vdoc:meta])* $variant:ident,)+ }) => {
+    ($(
+        $(#[$doc:meta])* $name:ident => $lib:ident { $($(#[$vdoc:meta])* $variant:ident,)+ }
+    )+) => {$(
         $(#[$doc])*
         #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
         pub enum $name {
@@ -84,7 +87,7 @@ macro_rules! mirror {
                 }
             }
         }
-    };
+    )+};
 }
 
 mirror! {
@@ -95,9 +98,7 @@ mirror! {
         /// The scalar recursive renderer, one ray at a time: the whole-image twin.
         Reference,
     }
-}
 
-mirror! {
     /// Which verdicts `bench --against` can reach.
     VerdictArg => VerdictForm {
         /// One-sided, a pull request's gate: slower by more than --threshold (a regression,
@@ -107,9 +108,7 @@ mirror! {
         /// beyond it (exit 0).
         ThreeWay,
     }
-}
 
-mirror! {
     /// How many lanes the wavefront engine's brute-force, light and shading kernels run
     /// (speed only: every width gives the same image; the mesh BVH is 8-wide either way).
     LanesArg => LaneWidth {
@@ -122,9 +121,7 @@ mirror! {
         #[value(name = "16")]
         Sixteen,
     }
-}
 
-mirror! {
     /// `--metric` of `raywave diff`.
     MetricArg => Metric {
         /// Mean squared error.
@@ -138,9 +135,7 @@ mirror! {
         /// FLIP's mean (needs the `flip` feature).
         Flip,
     }
-}
 
-mirror! {
     /// Which rays a cost map counts.
     CostKindArg => CostKind {
         /// Camera rays' closest hits.
@@ -152,9 +147,7 @@ mirror! {
         /// Every ray.
         All,
     }
-}
 
-mirror! {
     /// What a cost map shows.
     CostMeasureArg => CostMeasure {
         /// BVH nodes visited (each an 8-wide test of child boxes).
@@ -164,9 +157,7 @@ mirror! {
         /// Both figures, side by side.
         Both,
     }
-}
 
-mirror! {
     /// How linear values become 8-bit pixels.
     ToneMapArg => ToneMap {
         /// The lab's look: clamp to [0, 1], no gamma.
@@ -174,9 +165,7 @@ mirror! {
         /// The lab's key 'h': 1 − exp(−3x).
         Exp,
     }
-}
 
-mirror! {
     /// How shadows are computed.
     ShadowArg => ShadowMode {
         /// The lab's starting point: every light counts as visible (no shadow rays).
@@ -186,9 +175,7 @@ mirror! {
         /// `shadow_samples` shadow rays per light, to points chosen by `sampler`.
         Soft,
     }
-}
 
-mirror! {
     /// How a light's colour reaches a shaded point.
     LightModelArg => LightModel {
         /// The lab's: Lc = 0.2·ke·area, with no fall-off with distance.
@@ -197,9 +184,7 @@ mirror! {
         /// the distance to the light point (docs/SHADING.md).
         Rpi,
     }
-}
 
-mirror! {
     /// How points are chosen on an area light.
     SamplerArg => LightSampler {
         /// N independent uniform points on the light.
@@ -224,9 +209,7 @@ mirror! {
         /// Heitz et al.'s 2019 blue-noise tables: aa samples × points ≤ 256.
         Bluenoise,
     }
-}
 
-mirror! {
     /// Whose defaults fill the settings that no flag sets.
     DefaultsArg => Defaults {
         /// raywave's own, the lab's third run line: 512×512, 5 bounces, soft shadows (16 points).

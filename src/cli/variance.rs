@@ -175,18 +175,6 @@ impl StudyArgs {
         }
         Ok(options)
     }
-
-    /// The inputs: the scene files and the study file.
-    fn inputs(&self, options: &VarianceOptions) -> OutputPlan {
-        let mut plan = OutputPlan::new();
-        if let Some(file) = &self.study {
-            plan = plan.input("--study", file);
-        }
-        for scene in options.scenes.iter().flatten() {
-            plan = plan.input("SCENE", scene);
-        }
-        plan
-    }
 }
 
 /// Loads the cases, printing the scenes' warnings and the heat-map note.
@@ -228,8 +216,9 @@ fn with_progress<T>(
     })
 }
 
-/// No output of `plan` is a texture one of the cases' scenes read.
-fn check_textures(plan: &OutputPlan, cases: &[Case]) -> Result<()> {
+/// Checks `plan`, and that none of its outputs is a texture one of the cases' scenes read.
+fn check(plan: &OutputPlan, cases: &[Case]) -> Result<()> {
+    plan.check()?;
     cases
         .iter()
         .try_for_each(|case| plan.check_scene_files(&format!("case {}", case.name), &case.scene))
@@ -262,13 +251,13 @@ pub fn run(args: &VarianceArgs) -> Result<()> {
     }
     let cases = cases(&options)?;
     let pool = thread_pool(args.workers.threads)?;
-    let plan = args.study.inputs(&options);
+    let plan = OutputPlan::new().input_if("--study", args.study.study.as_deref());
+    let plan = (options.scenes.iter().flatten()).fold(plan, |plan, s| plan.input("SCENE", s));
     let work = identity(&cases, options.engine.name()).work;
     if let Some(shard) = args.shard {
         let part = options.out.join(raywave::shard::part_name::<Study>(shard));
         let plan = plan.output_in_new_dir("--out", &part);
-        plan.check()?;
-        check_textures(&plan, &cases)?;
+        check(&plan, &cases)?;
         let jobs = work.assignment(shard.count)[shard.index].len();
         let prefix = format!("variance shard {shard}, {jobs} jobs");
         let (path, jobs) = with_progress(&options, prefix, |render, progress| {
@@ -283,8 +272,7 @@ pub fn run(args: &VarianceArgs) -> Result<()> {
     let plan = (report_files(&options, &cases).into_iter()).fold(plan, |plan, name| {
         plan.output_in_new_dir("--out", &options.out.join(name))
     });
-    plan.check()?;
-    check_textures(&plan, &cases)?;
+    check(&plan, &cases)?;
     let prefix = format!("variance, {} jobs", work.jobs().len());
     let outcome = with_progress(&options, prefix, |render, progress| {
         pool.install(|| study(&options, &cases, render, progress))

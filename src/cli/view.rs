@@ -2,7 +2,7 @@
 
 use super::image::{ImageArgs, SeedArgs, ThreadsArg};
 use super::values::EngineArg;
-use anyhow::Result;
+use anyhow::{Result, bail};
 use clap::Args;
 use raywave::frame::scene_and_settings;
 use raywave::render::engine::Engine;
@@ -69,18 +69,16 @@ pub fn run(args: &ViewArgs) -> Result<u8> {
     )?;
     let settings = effective.settings;
     if settings.width > MAX_SIDE || settings.height > MAX_SIDE {
-        return Err(UsageError(format!(
+        bail!(UsageError(format!(
             "--size {} {}: the viewer renders at most {MAX_SIDE} pixels a side",
             settings.width, settings.height
-        ))
-        .into());
+        )));
     }
     let samples = settings.width as u64 * settings.height as u64 * settings.aa_samples as u64;
     if samples > MAX_CAMERA_SAMPLES {
-        return Err(UsageError(format!(
+        bail!(UsageError(format!(
             "--size × --aa is {samples} camera samples: the viewer renders at most {MAX_CAMERA_SAMPLES}"
-        ))
-        .into());
+        )));
     }
     let base = Resolved {
         camera: scene.camera,
@@ -117,12 +115,11 @@ pub fn run(args: &ViewArgs) -> Result<u8> {
 fn access(args: &ViewArgs) -> Result<Access> {
     let loopback = args.bind.is_loopback();
     if args.no_token && !loopback {
-        return Err(UsageError(format!(
+        bail!(UsageError(format!(
             "--bind {} --no-token: a server on an address other than loopback needs its token \
              (leave out --no-token)",
             args.bind
-        ))
-        .into());
+        )));
     }
     if !loopback {
         let whom = if args.bind.is_unspecified() {

@@ -386,17 +386,10 @@ pub fn pixel_errors(a: &Image, b: &Image, region: &Region, metric: Metric) -> Ve
                 return f32::NAN;
             }
             let d = |c: usize| pa[c] as f64 - pb[c] as f64;
+            let r = |c: usize| pb[c] as f64 + RELATIVE_EPSILON;
             let v = match metric {
                 Metric::Max => (0..3).map(|c| d(c).abs()).fold(0.0, f64::max),
-                Metric::Relmse => {
-                    (0..3)
-                        .map(|c| {
-                            let r = pb[c] as f64 + RELATIVE_EPSILON;
-                            d(c) * d(c) / (r * r)
-                        })
-                        .sum::<f64>()
-                        / 3.0
-                }
+                Metric::Relmse => (0..3).map(|c| d(c) * d(c) / (r(c) * r(c))).sum::<f64>() / 3.0,
                 _ => (0..3).map(|c| d(c) * d(c)).sum::<f64>() / 3.0,
             };
             v as f32

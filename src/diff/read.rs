@@ -9,7 +9,6 @@ use anyhow::{Context, Result, bail};
 use glam::Vec3;
 use image::{ColorType, ImageFormat, ImageReader};
 use std::io::Read;
-use std::os::unix::fs::FileTypeExt;
 use std::path::Path;
 
 /// Reads `path` as an image; every error names the file and what was expected.
@@ -23,7 +22,7 @@ pub fn read_image(path: &Path) -> Result<Image> {
             path.display()
         );
     }
-    if kind.is_char_device() || kind.is_block_device() || kind.is_fifo() || kind.is_socket() {
+    if !kind.is_file() {
         bail!(
             "cannot read {}: expected a regular image file (PNG, PPM, PFM or EXR), found a device, FIFO or socket",
             path.display()

@@ -12,7 +12,7 @@ pub mod report;
 use crate::diff::{Image, read_image};
 use crate::output::OutputPlan;
 use crate::output::cost_map::{self, CostInput, CostKind, CostMeasure};
-use crate::output::image_file::{OutputFormat, check_hdr_path, ldr_format, output_format};
+use crate::output::image_file::{OutputFormat, hdr_format, ldr_format, output_format};
 use crate::output::memory::{self, RenderFootprint};
 use crate::output::render_record::TraversalFigures;
 use crate::render::camera::CameraRays;
@@ -23,9 +23,10 @@ use crate::render::progress::Progress;
 use crate::render::scene::{Scene, load_scene};
 use crate::render::settings::options::{Effective, ImageOptions};
 use crate::render::wavefront::lanes::LaneWidth;
-use anyhow::Result;
+use crate::render::wavefront::shadow::ShadowPath;
+use crate::render::wavefront::stats::RenderStats;
+use anyhow::{Result, bail};
 use phases::Phases;
-use report::{Report, RunInfo};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -69,10 +70,28 @@ pub struct Outcome {
     pub scene: Scene,
     /// The settings it was rendered with, and where each came from.
     pub effective: Effective,
-    /// How it ran.
-    pub run: RunInfo,
-    /// What it measured.
-    pub report: Report,
+    /// The engine that rendered.
+    pub engine: Engine,
+    /// The SIMD path the engine ran on (`Prepared::simd_path`).
+    pub simd: &'static str,
+    /// Worker threads.
+    pub threads: usize,
+    /// Camera samples per wavefront tile.
+    pub batch_size: u32,
+    /// How the wavefront engine's shadow stage ran; `None` for the reference.
+    pub shadow_path: Option<ShadowPath>,
+    /// Ray counts, and each kind's thread-time when measured.
+    pub stats: RenderStats,
+    /// Wall-clock seconds of the render (for the reference, its set-up included).
+    pub seconds: f64,
+    /// Wavefront only (its stages are in `stats`): the BVH build time if a BVH was used.
+    pub bvh: Option<Option<f64>>,
+    /// Reference only, with --stats or --stats-json: the wall-clock seconds of the second,
+    /// instrumented pass that timed the kinds.
+    pub instrumented_seconds: Option<f64>,
+    /// Wavefront only, with --stats, --stats-json or --cost-map: the traversal counters of a
+    /// second, counted pass.
+    pub traversal: Option<TraversalFigures>,
     /// With a debug pixel: the rays traced for it.
     pub pixel_rays: Option<String>,
     /// With a reference: the error table.
@@ -109,7 +128,8 @@ pub fn run(
     progress: &Progress,
     phases: &mut Phases,
 ) -> Result<Outcome> {
-    let format = check_outputs(options)?;
+    // An 8-bit image is made unless `-o` names a float format.
+    let rgb8 = matches!(check_outputs(options)?, OutputFormat::Ldr(_));
     let (scene, effective) = scene_and_settings(
         options.scene.as_deref(),
         &options.image,
@@ -121,11 +141,10 @@ pub fn run(
     if let Some([x, y]) = options.debug_pixel
         && (x >= settings.width || y >= settings.height)
     {
-        return Err(UsageError(format!(
+        bail!(UsageError(format!(
             "--debug-pixel {x} {y} is outside the {}×{} image",
             settings.width, settings.height
-        ))
-        .into());
+        )));
     }
     let reference = match &options.mse_reference {
         Some(path) => Some((path, read_reference(path, settings.width, settings.height)?)),
@@ -143,7 +162,7 @@ pub fn run(
             primitives: (scene.triangles.len() + scene.spheres.len()) as u64,
             threads: threads as u64,
             batch_size: options.batch_size as u64,
-            rgb8: matches!(format, OutputFormat::Ldr(_)),
+            rgb8,
             exr_in_memory: exr_to_stream(&options.output)
                 || options.hdr.as_ref().is_some_and(exr_to_stream),
             cost_map: options.cost_map.is_some(),
@@ -170,10 +189,7 @@ pub fn run(
     if let Some(w) = clamped_warning(&stats) {
         (progress.notice)(&w);
     }
-    let mut img = match format {
-        OutputFormat::Ldr(_) => Some(film.to_rgb8(options.tonemap)),
-        OutputFormat::Linear => None,
-    };
+    let mut img = rgb8.then(|| film.to_rgb8(options.tonemap));
     let mut pixel_rays = None;
     if let Some([x, y]) = options.debug_pixel {
         // The tree both engines trace for the pixel (crate::trace), checked against both.
@@ -255,37 +271,36 @@ pub fn run(
             counted_seconds,
         ));
     }
-    let report = Report {
-        stats,
-        seconds,
-        bvh: engine.bvh_build_seconds(),
-        instrumented_seconds,
-        traversal,
-    };
-    let run = RunInfo {
+    let (simd, shadow_path, bvh) = (
+        engine.simd_path(),
+        engine.shadow_path(),
+        engine.bvh_build_seconds(),
+    );
+    drop(engine);
+    let (reference_error, reference_json) = reference_error.unzip();
+    let outcome = Outcome {
+        scene,
+        effective,
         engine: options.engine,
-        simd: engine.simd_path(),
+        simd,
         threads,
         batch_size: options.batch_size,
-        shadow_path: engine.shadow_path(),
+        shadow_path,
+        stats,
+        seconds,
+        bvh,
+        instrumented_seconds,
+        traversal,
+        pixel_rays,
+        reference_error,
     };
-    drop(engine);
     if let Some(path) = &options.stats_json {
-        let extra = reference_error
-            .as_ref()
-            .map(|(_, json)| ("mse_reference", json.clone()));
-        report::record(&scene, &effective, &run, &report).write(path, extra)?;
+        let extra = reference_json.map(|json| ("mse_reference", json));
+        outcome.record().write(path, extra)?;
     }
     // Every output in place before the summary says it was written.
     crate::output::commit_outputs()?;
-    Ok(Outcome {
-        scene,
-        effective,
-        run,
-        report,
-        pixel_rays,
-        reference_error: reference_error.map(|(text, _)| text),
-    })
+    Ok(outcome)
 }
 
 /// The checks of the outputs' names and of the plan, before the scene is read; returns the
@@ -293,21 +308,19 @@ pub fn run(
 fn check_outputs(options: &FrameOptions) -> Result<OutputFormat> {
     let format = output_format(&options.output).map_err(|e| UsageError::from_error(&e))?;
     if let Some(hdr) = &options.hdr {
-        check_hdr_path(hdr).map_err(|e| UsageError::from_error(&e))?;
+        hdr_format(hdr).map_err(|e| UsageError::from_error(&e))?;
     }
     if let Some((map, _, _)) = &options.cost_map {
         if ldr_format(map).is_err() {
-            return Err(UsageError(format!(
+            bail!(UsageError(format!(
                 "--cost-map {}: expected a file ending in .png or .ppm (an 8-bit figure)",
                 map.display()
-            ))
-            .into());
+            )));
         }
         if options.engine == Engine::Reference {
-            return Err(UsageError(
+            bail!(UsageError(
                 "--cost-map counts the wavefront engine's traversal: expected --engine wavefront (the default), not --engine reference".into(),
-            )
-            .into());
+            ));
         }
     }
     options.plan.check()?;
@@ -321,13 +334,12 @@ fn check_outputs(options: &FrameOptions) -> Result<OutputFormat> {
 fn read_reference(path: &Path, width: u32, height: u32) -> Result<Image> {
     let image = read_image(path)?;
     if (image.film.width, image.film.height) != (width, height) {
-        return Err(UsageError(format!(
+        bail!(UsageError(format!(
             "--mse-reference {} is {}×{} but the render is {width}×{height}: expected a reference of the render's size",
             path.display(),
             image.film.width,
             image.film.height,
-        ))
-        .into());
+        )));
     }
     Ok(image)
 }

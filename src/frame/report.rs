@@ -1,303 +1,266 @@
 //! What a render prints and records once the frame is rendered: the summary, the
 //! `--stats` tables and the `--stats-json` record, from what the render measured.
 
+use super::Outcome;
 use crate::diff::{self, Encoding, FileInfo, Image, Region};
 use crate::output::bench_record::KindFigures;
 use crate::output::machine::Machine;
-use crate::output::render_record::{
-    DefaultsUsed, KindTiming, RenderRecord, SceneFigures, TraversalFigures,
-};
-use crate::render::engine::Engine;
+use crate::output::render_record::{DefaultsUsed, KindTiming, RenderRecord, SceneFigures};
 use crate::render::film::{Film, ToneMap};
 use crate::render::quote::escape;
-use crate::render::scene::Scene;
-use crate::render::settings::options::{BackgroundSource, Effective};
+use crate::render::settings::options::BackgroundSource;
 use crate::render::settings::{LightModel, ShadowMode};
 use crate::render::wavefront::shadow::ShadowPath;
-use crate::render::wavefront::stats::RenderStats;
 use anyhow::Result;
 use image::RgbImage;
 use std::fmt::Write as _;
 use std::path::Path;
 
-/// The summary printed after a render: engine, scene, settings, rays and time.
-pub fn summary(scene: &Scene, effective: &Effective, run: &RunInfo, report: &Report) -> String {
-    let mut out = String::new();
-    let s = &effective.settings;
-    let shadows = match s.shadows {
-        ShadowMode::Off => "off (every light visible)".to_string(),
-        ShadowMode::Hard => "hard (light centroids)".to_string(),
-        ShadowMode::Soft => format!(
-            "soft, {} {} points per light",
-            s.shadow_samples,
-            s.sampler.name()
-        ),
-    };
-    let _ = writeln!(
-        out,
-        "raywave {} · engine {} · simd {} · {} thread(s)",
-        env!("CARGO_PKG_VERSION"),
-        run.engine.name(),
-        run.simd,
-        run.threads
-    );
-    let rings = match scene.ring_count {
-        0 => String::new(),
-        n => format!("; {n} ring(s) cut into faces"),
-    };
-    let _ = writeln!(
-        out,
-        "scene   {}: {} faces ({} triangles{rings}), {} spheres, {} light(s), {} camera",
-        scene.source,
-        scene.face_count,
-        scene.triangles.len(),
-        scene.spheres.len(),
-        scene.lights.len(),
-        if scene.camera_from_file {
-            "file"
-        } else {
-            "lab default"
-        }
-    );
-    for t in &scene.textures {
-        let outside = if t.outside_folder {
-            " (outside the scene file's folder)"
-        } else {
-            ""
-        };
-        let _ = writeln!(
-            out,
-            "texture {}: {}×{} texels from {}{outside}",
-            escape(&t.name),
-            t.width,
-            t.height,
-            escape(&t.path.display().to_string())
-        );
-    }
-    let _ = writeln!(
-        out,
-        "render  {}×{}, {} bounces, shadows {shadows}, {} aa sample(s), seed {}, {} faces",
-        s.width,
-        s.height,
-        s.bounces,
-        s.aa_samples,
-        s.seed,
-        if s.two_sided {
-            "two-sided"
-        } else {
-            "one-sided"
-        }
-    );
-    let model = match s.light_model {
-        LightModel::Lab => "lab (no fall-off)",
-        LightModel::Rpi => "rpi (divided by π·d²)",
-    };
-    let background = match effective.background {
-        BackgroundSource::Flag => "flag",
-        BackgroundSource::Scene => "scene",
-        BackgroundSource::Defaults => "default",
-    };
-    let [r, g, b] = s.background;
-    let [ar, ag, ab] = s.ambient;
-    let _ = writeln!(
-        out,
-        "light   model {model}, ambient {ar} {ag} {ab}, background {r} {g} {b} ({background})"
-    );
-    let defaulted = if effective.defaulted.is_empty() {
-        "none needed: flags set every setting".to_string()
-    } else {
-        format!(
-            "{} (--defaults {}) for {}",
-            effective.defaults.owner(),
-            effective.defaults.name(),
-            effective.defaulted.join(", ")
-        )
-    };
-    let _ = writeln!(out, "default {defaulted}");
-    let counts = &report.stats.counts;
-    let _ = writeln!(
-        out,
-        "rays    {} total: {} camera, {} shadow, {} reflection",
-        counts.total(),
-        counts.camera,
-        counts.shadow,
-        counts.reflection
-    );
-    let _ = writeln!(
-        out,
-        "time    {:.3} s, {:.2} Mrays/s",
-        report.seconds,
-        report.kinds().total.rays_per_second / 1e6
-    );
-    out
-}
-
-/// How the render ran, for the summary and the JSON.
-pub struct RunInfo {
-    /// The engine that rendered.
-    pub engine: Engine,
-    /// The SIMD path the engine ran on (`Prepared::simd_path`).
-    pub simd: &'static str,
-    /// Worker threads.
-    pub threads: usize,
-    /// Camera samples per wavefront tile.
-    pub batch_size: u32,
-    /// How the wavefront engine's shadow stage ran; `None` for the reference.
-    pub shadow_path: Option<ShadowPath>,
-}
-
-/// What a render measured.
-pub struct Report {
-    /// Ray counts, and each kind's thread-time when measured.
-    pub stats: RenderStats,
-    /// Wall-clock seconds of the render (for the reference, its set-up included).
-    pub seconds: f64,
-    /// Wavefront only (its stages are in `stats`): the BVH build time if a BVH was used.
-    pub bvh: Option<Option<f64>>,
-    /// Reference only, with --stats or --stats-json: the wall-clock seconds of the second,
-    /// instrumented pass that timed the kinds.
-    pub instrumented_seconds: Option<f64>,
-    /// Wavefront only, with --stats, --stats-json or --cost-map: the traversal counters of a
-    /// second, counted pass.
-    pub traversal: Option<TraversalFigures>,
-}
-
-impl Report {
+impl Outcome {
     /// Rays by kind, each kind per thread-second of its work, the total per wall-clock second,
     /// as the JSON gives them.
     pub fn kinds(&self) -> KindFigures {
         KindFigures::new(&self.stats, self.seconds)
     }
-}
 
-/// The `--stats` tables: rays by kind (each kind over the thread-time of its own work, the
-/// total over the wall clock), then (wavefront) the BVH build and each stage.
-pub fn stats_table(run: &RunInfo, report: &Report) -> String {
-    let mut out = String::new();
-    let kinds = report.kinds();
-    // A row of the kind and stage tables: name, rays, seconds, rate.
-    let row = |out: &mut String, cells: [&dyn std::fmt::Display; 4]| {
-        let [name, rays, seconds, rate] = cells;
-        let _ = writeln!(out, "{name:<12} {rays:>14} {seconds:>14} {rate:>20}");
-    };
-    let or_dash = |x: Option<f64>, scale: f64, digits: usize| {
-        x.map_or("-".to_string(), |x| format!("{:.digits$}", x * scale))
-    };
-    row(&mut out, [&"kind", &"rays", &"thread-s", &"Mrays/thread-s"]);
-    for (kind, figure) in kinds.kinds.iter() {
-        let seconds = or_dash(figure.thread_seconds, 1.0, 4);
-        let rate = or_dash(figure.rays_per_thread_second, 1e-6, 2);
-        row(&mut out, [&kind.name(), &figure.rays, &seconds, &rate]);
-    }
-    let total = kinds.total;
-    row(&mut out, [&"", &"", &"wall s", &"Mrays/s"]);
-    let seconds = format!("{:.3}", total.seconds);
-    let rate = format!("{:.2}", total.rays_per_second / 1e6);
-    row(&mut out, [&"total", &total.rays, &seconds, &rate]);
-    match report.instrumented_seconds {
-        Some(pass) => {
-            let _ = writeln!(
-                out,
-                "kinds timed by a second pass with timers: {pass:.3} s against the render's \
-                 {:.3} s ({:+.1}%); the render itself had no timers",
-                report.seconds,
-                (pass / report.seconds.max(1e-9) - 1.0) * 100.0
-            );
-        }
-        None => {
-            let _ = writeln!(
-                out,
-                "kinds timed by the stage timers: camera = generate + intersect of camera rays, \
-                 reflection = reflect + intersect of mirror rays, shadow = shadow; film in none"
-            );
-        }
-    }
-    if let Some(Some(build)) = report.bvh {
-        let _ = writeln!(out, "bvh build {build:.3} s");
-    }
-    if let Some(path) = run.shadow_path {
-        let _ = writeln!(out, "shadow path {}: {}", path.name(), path.describe());
-    }
-    if let Some(t) = &report.traversal {
+    /// The summary printed after a render: engine, scene, settings, rays and time.
+    pub fn summary(&self) -> String {
+        let mut out = String::new();
+        let (scene, effective) = (&self.scene, &self.effective);
+        let s = &effective.settings;
+        let shadows = match s.shadows {
+            ShadowMode::Off => "off (every light visible)".to_string(),
+            ShadowMode::Hard => "hard (light centroids)".to_string(),
+            ShadowMode::Soft => format!(
+                "soft, {} {} points per light",
+                s.shadow_samples,
+                s.sampler.name()
+            ),
+        };
         let _ = writeln!(
             out,
-            "{:<12} {:>14} {:>14} {:>14} {:>14}",
-            "traversal", "rays", "nodes/ray", "leaves/ray", "tests/ray"
+            "raywave {} · engine {} · simd {} · {} thread(s)",
+            env!("CARGO_PKG_VERSION"),
+            self.engine.name(),
+            self.simd,
+            self.threads
         );
-        for (kind, f) in t.kinds.iter() {
+        let rings = match scene.ring_count {
+            0 => String::new(),
+            n => format!("; {n} ring(s) cut into faces"),
+        };
+        let _ = writeln!(
+            out,
+            "scene   {}: {} faces ({} triangles{rings}), {} spheres, {} light(s), {} camera",
+            scene.source,
+            scene.face_count,
+            scene.triangles.len(),
+            scene.spheres.len(),
+            scene.lights.len(),
+            if scene.camera_from_file {
+                "file"
+            } else {
+                "lab default"
+            }
+        );
+        for t in &scene.textures {
+            let outside = if t.outside_folder {
+                " (outside the scene file's folder)"
+            } else {
+                ""
+            };
+            let _ = writeln!(
+                out,
+                "texture {}: {}×{} texels from {}{outside}",
+                escape(&t.name),
+                t.width,
+                t.height,
+                escape(&t.path.display().to_string())
+            );
+        }
+        let _ = writeln!(
+            out,
+            "render  {}×{}, {} bounces, shadows {shadows}, {} aa sample(s), seed {}, {} faces",
+            s.width,
+            s.height,
+            s.bounces,
+            s.aa_samples,
+            s.seed,
+            if s.two_sided {
+                "two-sided"
+            } else {
+                "one-sided"
+            }
+        );
+        let model = match s.light_model {
+            LightModel::Lab => "lab (no fall-off)",
+            LightModel::Rpi => "rpi (divided by π·d²)",
+        };
+        let background = match effective.background {
+            BackgroundSource::Flag => "flag",
+            BackgroundSource::Scene => "scene",
+            BackgroundSource::Defaults => "default",
+        };
+        let [r, g, b] = s.background;
+        let [ar, ag, ab] = s.ambient;
+        let _ = writeln!(
+            out,
+            "light   model {model}, ambient {ar} {ag} {ab}, background {r} {g} {b} ({background})"
+        );
+        let defaulted = if effective.defaulted.is_empty() {
+            "none needed: flags set every setting".to_string()
+        } else {
+            format!(
+                "{} (--defaults {}) for {}",
+                effective.defaults.owner(),
+                effective.defaults.name(),
+                effective.defaulted.join(", ")
+            )
+        };
+        let _ = writeln!(out, "default {defaulted}");
+        let counts = &self.stats.counts;
+        let _ = writeln!(
+            out,
+            "rays    {} total: {} camera, {} shadow, {} reflection",
+            counts.total(),
+            counts.camera,
+            counts.shadow,
+            counts.reflection
+        );
+        let _ = writeln!(
+            out,
+            "time    {:.3} s, {:.2} Mrays/s",
+            self.seconds,
+            self.kinds().total.rays_per_second / 1e6
+        );
+        out
+    }
+
+    /// The `--stats` tables: rays by kind (each kind over the thread-time of its own work, the
+    /// total over the wall clock), then (wavefront) the BVH build and each stage.
+    pub fn stats_table(&self) -> String {
+        let mut out = String::new();
+        let kinds = self.kinds();
+        // A row of the kind and stage tables: name, rays, seconds, rate.
+        let row = |out: &mut String, cells: [&dyn std::fmt::Display; 4]| {
+            let [name, rays, seconds, rate] = cells;
+            let _ = writeln!(out, "{name:<12} {rays:>14} {seconds:>14} {rate:>20}");
+        };
+        let or_dash = |x: Option<f64>, scale: f64, digits: usize| {
+            x.map_or("-".to_string(), |x| format!("{:.digits$}", x * scale))
+        };
+        row(&mut out, [&"kind", &"rays", &"thread-s", &"Mrays/thread-s"]);
+        for (kind, figure) in kinds.kinds.iter() {
+            let seconds = or_dash(figure.thread_seconds, 1.0, 4);
+            let rate = or_dash(figure.rays_per_thread_second, 1e-6, 2);
+            row(&mut out, [&kind.name(), &figure.rays, &seconds, &rate]);
+        }
+        let total = kinds.total;
+        row(&mut out, [&"", &"", &"wall s", &"Mrays/s"]);
+        let seconds = format!("{:.3}", total.seconds);
+        let rate = format!("{:.2}", total.rays_per_second / 1e6);
+        row(&mut out, [&"total", &total.rays, &seconds, &rate]);
+        match self.instrumented_seconds {
+            Some(pass) => {
+                let _ = writeln!(
+                    out,
+                    "kinds timed by a second pass with timers: {pass:.3} s against the render's \
+                     {:.3} s ({:+.1}%); the render itself had no timers",
+                    self.seconds,
+                    (pass / self.seconds.max(1e-9) - 1.0) * 100.0
+                );
+            }
+            None => {
+                let _ = writeln!(
+                    out,
+                    "kinds timed by the stage timers: camera = generate + intersect of camera rays, \
+                     reflection = reflect + intersect of mirror rays, shadow = shadow; film in none"
+                );
+            }
+        }
+        if let Some(Some(build)) = self.bvh {
+            let _ = writeln!(out, "bvh build {build:.3} s");
+        }
+        if let Some(path) = self.shadow_path {
+            let _ = writeln!(out, "shadow path {}: {}", path.name(), path.describe());
+        }
+        if let Some(t) = &self.traversal {
             let _ = writeln!(
                 out,
                 "{:<12} {:>14} {:>14} {:>14} {:>14}",
-                kind.name(),
-                f.rays,
-                or_dash(f.nodes_per_ray, 1.0, 2),
-                or_dash(f.leaves_per_ray, 1.0, 2),
-                or_dash(f.primitive_tests_per_ray, 1.0, 2)
+                "traversal", "rays", "nodes/ray", "leaves/ray", "tests/ray"
+            );
+            for (kind, f) in t.kinds.iter() {
+                let _ = writeln!(
+                    out,
+                    "{:<12} {:>14} {:>14} {:>14} {:>14}",
+                    kind.name(),
+                    f.rays,
+                    or_dash(f.nodes_per_ray, 1.0, 2),
+                    or_dash(f.leaves_per_ray, 1.0, 2),
+                    or_dash(f.primitive_tests_per_ray, 1.0, 2)
+                );
+            }
+            let _ = writeln!(
+                out,
+                "traversal counted by a second pass: {:.3} s; the render timed above counted nothing \
+                 (tests: triangles of the leaves visited, spheres, and without a BVH every primitive)",
+                t.counted_seconds
             );
         }
-        let _ = writeln!(
-            out,
-            "traversal counted by a second pass: {:.3} s; the render timed above counted nothing \
-             (tests: triangles of the leaves visited, spheres, and without a BVH every primitive)",
-            t.counted_seconds
-        );
-    }
-    if report.bvh.is_some() {
-        row(
-            &mut out,
-            [&"stage", &"rays", &"thread-s", &"Mrays/thread-s"],
-        );
-        for stage in report.stats.stage_figures() {
-            let seconds = format!("{:.4}", stage.thread_seconds);
-            let rate = format!("{:.2}", stage.rays_per_thread_second / 1e6);
-            row(&mut out, [&stage.stage, &stage.rays, &seconds, &rate]);
+        if self.bvh.is_some() {
+            row(
+                &mut out,
+                [&"stage", &"rays", &"thread-s", &"Mrays/thread-s"],
+            );
+            for stage in self.stats.stage_figures() {
+                let seconds = format!("{:.4}", stage.thread_seconds);
+                let rate = format!("{:.2}", stage.rays_per_thread_second / 1e6);
+                row(&mut out, [&stage.stage, &stage.rays, &seconds, &rate]);
+            }
         }
+        out
     }
-    out
-}
 
-/// The `--stats-json` record of a render.
-pub fn record(
-    scene: &Scene,
-    effective: &Effective,
-    run: &RunInfo,
-    report: &Report,
-) -> RenderRecord {
-    RenderRecord {
-        format: crate::output::bench_record::FORMAT,
-        raywave: env!("CARGO_PKG_VERSION"),
-        // The record has never named the host.
-        machine: Machine {
-            hostname: String::new(),
-            ..Machine::current()
-        },
-        simd: run.simd,
-        threads: run.threads,
-        engine: run.engine,
-        batch_size: run.batch_size,
-        shadow_path: run.shadow_path.map(ShadowPath::name),
-        scene: SceneFigures {
-            source: scene.source.clone(),
-            triangles: scene.triangles.len(),
-            spheres: scene.spheres.len(),
-            lights: scene.lights.len(),
-            bvh: report.bvh.map(|b| b.is_some()),
-            bvh_build_seconds: report.bvh.flatten(),
-        },
-        settings: effective.settings.clone(),
-        defaults: DefaultsUsed {
-            from: effective.defaults.name(),
-            settings: effective.defaulted.clone(),
-        },
-        seconds: report.seconds,
-        rays: report.kinds(),
-        kinds_timed_by: match report.instrumented_seconds {
-            Some(_) => KindTiming::InstrumentedPass,
-            None => KindTiming::StageTimers,
-        },
-        instrumented_seconds: report.instrumented_seconds,
-        stages: report.bvh.map(|_| report.stats.stage_figures()),
-        traversal: report.traversal,
+    /// The `--stats-json` record of a render.
+    pub(super) fn record(&self) -> RenderRecord {
+        let (scene, effective) = (&self.scene, &self.effective);
+        RenderRecord {
+            format: crate::output::bench_record::FORMAT,
+            raywave: env!("CARGO_PKG_VERSION"),
+            // The record has never named the host.
+            machine: Machine {
+                hostname: String::new(),
+                ..Machine::current()
+            },
+            simd: self.simd,
+            threads: self.threads,
+            engine: self.engine,
+            batch_size: self.batch_size,
+            shadow_path: self.shadow_path.map(ShadowPath::name),
+            scene: SceneFigures {
+                source: scene.source.clone(),
+                triangles: scene.triangles.len(),
+                spheres: scene.spheres.len(),
+                lights: scene.lights.len(),
+                bvh: self.bvh.map(|b| b.is_some()),
+                bvh_build_seconds: self.bvh.flatten(),
+            },
+            settings: effective.settings.clone(),
+            defaults: DefaultsUsed {
+                from: effective.defaults.name(),
+                settings: effective.defaulted.clone(),
+            },
+            seconds: self.seconds,
+            rays: self.kinds(),
+            kinds_timed_by: match self.instrumented_seconds {
+                Some(_) => KindTiming::InstrumentedPass,
+                None => KindTiming::StageTimers,
+            },
+            instrumented_seconds: self.instrumented_seconds,
+            stages: self.bvh.map(|_| self.stats.stage_figures()),
+            traversal: self.traversal,
+        }
     }
 }
 

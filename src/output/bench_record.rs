@@ -280,25 +280,18 @@ impl Measurement {
         let Some(first) = runs.first() else {
             return Measurement::default();
         };
-        let stages = first
-            .stages
-            .iter()
-            .enumerate()
+        let stages = (first.stages.iter().enumerate())
             .map(|(i, s)| {
-                let col = |f: &dyn Fn(&StageFigure) -> f64| {
-                    median(
-                        &runs
-                            .iter()
-                            .filter_map(|r| r.stages.get(i))
-                            .map(f)
-                            .collect::<Vec<_>>(),
-                    )
+                let of_runs: Vec<&StageFigure> =
+                    runs.iter().filter_map(|r| r.stages.get(i)).collect();
+                let col = |f: fn(&StageFigure) -> f64| {
+                    median(&of_runs.iter().map(|s| f(s)).collect::<Vec<_>>())
                 };
                 StageFigure {
                     stage: s.stage.clone(),
                     rays: s.rays,
-                    thread_seconds: col(&|s| s.thread_seconds),
-                    rays_per_thread_second: col(&|s| s.rays_per_thread_second),
+                    thread_seconds: col(|s| s.thread_seconds),
+                    rays_per_thread_second: col(|s| s.rays_per_thread_second),
                 }
             })
             .collect();
@@ -320,13 +313,12 @@ pub fn record_path(dir: &Path, name: &str) -> Result<std::path::PathBuf> {
             .chars()
             .all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.' | '+'));
     if !plain {
-        return Err(crate::render::error::UsageError(format!(
+        bail!(crate::render::error::UsageError(format!(
             "bench record name `{}` is not usable: expected a plain name like `before` \
              (letters, digits, - _ . +; no path separators, not starting with '.' or '-'); \
              use --dir to choose the directory",
             name.escape_debug()
-        ))
-        .into());
+        )));
     }
     Ok(dir.join(format!("{name}.json")))
 }

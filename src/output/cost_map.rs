@@ -162,21 +162,12 @@ impl Overlay {
 
 /// `kind`'s `one` count per pixel and camera sample, its scale and its legend's figures.
 pub fn overlay(input: &CostInput, kind: CostKind, one: Count) -> Overlay {
-    let per_sample = input.aa_samples.max(1) as f32;
-    let values: Vec<f32> = input
-        .pixels
-        .iter()
-        .map(|p| {
-            let sum: u64 = kind.kinds().iter().map(|&k| one.of(&p[k]) as u64).sum();
-            sum as f32 / per_sample
-        })
+    let (kinds, per_sample) = (kind.kinds(), input.aa_samples.max(1) as f32);
+    let values: Vec<f32> = (input.pixels.iter())
+        .map(|p| kinds.iter().map(|&k| one.of(&p[k]) as u64).sum::<u64>() as f32 / per_sample)
         .collect();
-    let rays: u64 = kind.kinds().iter().map(|&k| input.rays[k]).sum();
-    let work: u64 = kind
-        .kinds()
-        .iter()
-        .map(|&k| one.of_sum(&input.totals[k]))
-        .sum();
+    let rays: u64 = kinds.iter().map(|&k| input.rays[k]).sum();
+    let work: u64 = kinds.iter().map(|&k| one.of_sum(&input.totals[k])).sum();
     Overlay {
         scale: scale_of(&values),
         largest: values.iter().copied().fold(0.0f32, f32::max),

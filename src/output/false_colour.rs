@@ -171,14 +171,12 @@ pub fn figure(
         let i = ((y * fw + x) * 3) as usize;
         buffer[i..i + 3].copy_from_slice(&c);
     };
+    let bar_x = MARGIN + mw + MARGIN;
     for y in 0..mh {
         for x in 0..mw {
             let v = values[((y / factor) * width + x / factor) as usize];
             put(MARGIN + x, TITLE_HEIGHT + y, inferno(scale.position(v)));
         }
-    }
-    let bar_x = MARGIN + mw + MARGIN;
-    for y in 0..mh {
         let t = 1.0 - y as f32 / (mh - 1).max(1) as f32;
         for x in 0..BAR_WIDTH {
             put(bar_x + x, TITLE_HEIGHT + y, inferno(t));

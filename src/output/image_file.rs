@@ -2,11 +2,11 @@
 //! formats by extension, and the atomic writer every command's files go through
 //! (`output::write`: each file whole or not at all).
 
-use crate::output::{Target, target};
+use crate::output::{OutputPlan, Target, target, write_output};
 use crate::render::film::{Film, ToneMap};
 use anyhow::{Context, Result, bail};
 use glam::Vec3;
-use std::io::{BufWriter, Write};
+use std::io::Write;
 use std::path::Path;
 
 impl Film {
@@ -28,33 +28,23 @@ impl Film {
         let bytes =
             std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?;
         let bad = || anyhow::anyhow!("{}: not a little-endian colour PFM", path.display());
-        // Header: "PF", width height, scale; each ends at a newline.
-        let mut fields = Vec::new();
-        let mut at = 0;
-        for _ in 0..3 {
-            let end = bytes[at..]
-                .iter()
-                .position(|&b| b == b'\n')
-                .ok_or_else(bad)?
-                + at;
-            fields.push(
-                std::str::from_utf8(&bytes[at..end])
-                    .map_err(|_| bad())?
-                    .trim()
-                    .to_string(),
-            );
-            at = end + 1;
-        }
-        let dims: Vec<u32> = fields[1]
+        // Header: "PF", width height, scale; each ends at a newline. Then the floats.
+        let mut parts = bytes.splitn(4, |&b| b == b'\n');
+        let mut field = || -> Result<&str> {
+            let part = parts.next().ok_or_else(bad)?;
+            Ok(std::str::from_utf8(part).map_err(|_| bad())?.trim())
+        };
+        let (magic, dims, scale) = (field()?, field()?, field()?);
+        let dims: Vec<u32> = dims
             .split_whitespace()
             .filter_map(|t| t.parse().ok())
             .collect();
-        let scale: f32 = fields[2].parse().map_err(|_| bad())?;
-        if fields[0] != "PF" || dims.len() != 2 || scale >= 0.0 {
+        let scale: f32 = scale.parse().map_err(|_| bad())?;
+        let floats = parts.next().ok_or_else(bad)?;
+        if magic != "PF" || dims.len() != 2 || scale >= 0.0 {
             return Err(bad());
         }
         let (width, height) = (dims[0], dims[1]);
-        let floats = &bytes[at..];
         // A zero dimension would make the row split below panic ("chunk size must be
         // non-zero"); an empty image is not a PFM this program writes.
         let expected = (width as u64) * (height as u64) * 12;
@@ -79,16 +69,13 @@ impl Film {
     /// Writes linear floats: `.pfm` (portable float map) or `.exr`; PFM to standard output
     /// (`-`), a device or a FIFO whose name has neither extension.
     pub fn write_hdr(&self, path: &Path) -> Result<()> {
-        match hdr_extension(path)? {
-            HdrFormat::Pfm => write_atomically(path, |w| {
+        match hdr_format(path)? {
+            HdrFormat::Pfm => write_output(path, |w| {
                 write!(w, "PF\n{} {}\n-1.0\n", self.width, self.height)?;
                 // PFM stores rows bottom to top, little-endian (the negative scale says so).
-                for row in self.pixels.chunks(self.width as usize).rev() {
-                    for c in row {
-                        for x in c.to_array() {
-                            w.write_all(&x.to_le_bytes())?;
-                        }
-                    }
+                let rows = self.pixels.chunks(self.width as usize).rev();
+                for x in rows.flatten().flat_map(|c| c.to_array()) {
+                    w.write_all(&x.to_le_bytes())?;
                 }
                 Ok(())
             }),
@@ -97,9 +84,9 @@ impl Film {
                     // EXR seeks back to its offset table: a pipe needs the file in memory.
                     let mut bytes = std::io::Cursor::new(Vec::new());
                     self.write_exr(&mut bytes)?;
-                    write_atomically(path, |w| Ok(w.write_all(bytes.get_ref())?))
+                    write_output(path, |w| Ok(w.write_all(bytes.get_ref())?))
                 } else {
-                    write_atomically(path, |w| self.write_exr(w))
+                    write_output(path, |w| self.write_exr(w))
                 }
             }
         }
@@ -141,26 +128,30 @@ pub enum LdrFormat {
 
 /// A linear float format raywave writes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum HdrFormat {
+pub enum HdrFormat {
     /// Portable float map, written here.
     Pfm,
     /// OpenEXR, through the `exr` crate.
     Exr,
 }
 
-/// Every image format raywave writes, by its file extension (lower case): the one table that
-/// `-o`, `--hdr` and every figure consult.
+/// An image format raywave writes, and what `-o FILE` makes of it: an 8-bit image, or (for
+/// `.pfm` and `.exr`) only the linear floats.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Format {
+pub enum OutputFormat {
+    /// A tone-mapped 8-bit image.
     Ldr(LdrFormat),
-    Hdr(HdrFormat),
+    /// Linear floats, and no 8-bit image beside them.
+    Linear(HdrFormat),
 }
 
-const FORMATS: [(&str, Format); 4] = [
-    ("png", Format::Ldr(LdrFormat::Png)),
-    ("ppm", Format::Ldr(LdrFormat::Ppm)),
-    ("pfm", Format::Hdr(HdrFormat::Pfm)),
-    ("exr", Format::Hdr(HdrFormat::Exr)),
+/// Every image format raywave writes, by its file extension (lower case): the one table that
+/// `-o`, `--hdr` and every figure consult.
+const FORMATS: [(&str, OutputFormat); 4] = [
+    ("png", OutputFormat::Ldr(LdrFormat::Png)),
+    ("ppm", OutputFormat::Ldr(LdrFormat::Ppm)),
+    ("pfm", OutputFormat::Linear(HdrFormat::Pfm)),
+    ("exr", OutputFormat::Linear(HdrFormat::Exr)),
 ];
 
 /// What `pick` makes of the format `path`'s extension names; for a path without one to go by
@@ -168,7 +159,7 @@ const FORMATS: [(&str, Format); 4] = [
 /// error saying what was `expected`.
 fn format_for<T>(
     path: &Path,
-    pick: impl Fn(Format) -> Option<T>,
+    pick: impl Fn(OutputFormat) -> Option<T>,
     stream: T,
     expected: &str,
 ) -> Result<T> {
@@ -186,31 +177,18 @@ fn format_for<T>(
 /// The 8-bit format for an output path, or an error naming what is accepted.
 pub fn ldr_format(path: &Path) -> Result<LdrFormat> {
     let pick = |f| match f {
-        Format::Ldr(f) => Some(f),
-        Format::Hdr(_) => None,
+        OutputFormat::Ldr(f) => Some(f),
+        OutputFormat::Linear(_) => None,
     };
     let expected = "an output file ending in .png or .ppm (use --hdr for .pfm or .exr)";
     format_for(path, pick, LdrFormat::Png, expected)
 }
 
-/// What `-o FILE` writes: an 8-bit image, or (for `.pfm` and `.exr`) only the linear floats.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum OutputFormat {
-    /// A tone-mapped 8-bit image.
-    Ldr(LdrFormat),
-    /// Linear floats, and no 8-bit image beside them.
-    Linear,
-}
-
 /// The format of an `-o` path, or an error naming the extensions accepted.
 pub fn output_format(path: &Path) -> Result<OutputFormat> {
-    let pick = |f| match f {
-        Format::Ldr(f) => Some(OutputFormat::Ldr(f)),
-        Format::Hdr(_) => Some(OutputFormat::Linear),
-    };
     let expected =
         "an output file ending in .png or .ppm (8-bit), or .pfm or .exr (linear floats only)";
-    format_for(path, pick, OutputFormat::Ldr(LdrFormat::Png), expected)
+    format_for(path, Some, OutputFormat::Ldr(LdrFormat::Png), expected)
 }
 
 /// Encodes an 8-bit image as PNG into `w`: the one PNG encoder of every output (files, figures
@@ -230,8 +208,8 @@ pub fn png_bytes(img: &image::RgbImage) -> Result<Vec<u8>> {
 /// Writes an 8-bit image whole or not at all; the format follows the extension (png, ppm).
 pub fn write_rgb8(img: &image::RgbImage, path: &Path) -> Result<()> {
     match ldr_format(path)? {
-        LdrFormat::Png => write_atomically(path, |w| write_png(img, w)),
-        LdrFormat::Ppm => write_atomically(path, |w| {
+        LdrFormat::Png => write_output(path, |w| write_png(img, w)),
+        LdrFormat::Ppm => write_output(path, |w| {
             // Netpbm's binary pixmap: magic, width, height, maxval, one whitespace byte, then
             // the RGB bytes row by row from the top.
             write!(w, "P6\n{} {}\n255\n", img.width(), img.height())?;
@@ -241,52 +219,26 @@ pub fn write_rgb8(img: &image::RgbImage, path: &Path) -> Result<()> {
     }
 }
 
-/// Checks that an `--hdr` path has a float format's extension.
-pub fn check_hdr_path(path: &Path) -> Result<()> {
-    hdr_extension(path).map(|_| ())
-}
-
-fn hdr_extension(path: &Path) -> Result<HdrFormat> {
+/// The float format for an `--hdr` path, or an error naming the extensions accepted.
+pub fn hdr_format(path: &Path) -> Result<HdrFormat> {
     let pick = |f| match f {
-        Format::Hdr(f) => Some(f),
-        Format::Ldr(_) => None,
+        OutputFormat::Linear(f) => Some(f),
+        OutputFormat::Ldr(_) => None,
     };
     let expected = "an --hdr file ending in .pfm or .exr";
     format_for(path, pick, HdrFormat::Pfm, expected)
 }
 
-/// Checks, before a long render, that the directory of `path` exists and `path` is not a
-/// directory itself.
+/// Checks, before a long render, that `path` can be written (as [`OutputPlan::check`] checks
+/// an output): a directory named like an image is otherwise found out only by the final
+/// rename, after the whole render.
 pub fn check_output_dir(path: &Path) -> Result<()> {
-    let dir = crate::output::write::parent_dir(path);
-    if !dir.is_dir() {
-        bail!(
-            "cannot write {}: directory {} does not exist",
-            path.display(),
-            dir.display()
-        );
-    }
-    // Without this, a directory named like an image was found out only by the final rename,
-    // after the whole render.
-    if path.is_dir() {
-        bail!("cannot write {}: it is a directory", path.display());
-    }
-    Ok(())
+    OutputPlan::new().output("", path).check()
 }
 
-/// Writes through `fill` into a temporary file beside `path` (beside the file a symlink points
-/// to), then renames it into place; standard output (`-`), devices and FIFOs are written
-/// directly (see `output::write`).
-pub fn write_atomically(
-    path: &Path,
-    fill: impl FnOnce(&mut BufWriter<&mut std::fs::File>) -> Result<()>,
-) -> Result<()> {
-    crate::output::write_output(path, fill)
-}
-
-/// Writes `value` as pretty JSON with a final newline, through [`write_atomically`].
+/// Writes `value` as pretty JSON with a final newline, through [`write_output`].
 pub fn write_json(path: &Path, value: &impl serde::Serialize) -> Result<()> {
-    write_atomically(path, |w| {
+    write_output(path, |w| {
         serde_json::to_writer_pretty(&mut *w, value)?;
         Ok(writeln!(w)?)
     })

@@ -28,9 +28,7 @@ pub fn hostname() -> String {
 
 /// Logical CPUs the process may use.
 pub fn logical_cpus() -> usize {
-    std::thread::available_parallelism()
-        .map(|n| n.get())
-        .unwrap_or(1)
+    std::thread::available_parallelism().map_or(1, |n| n.get())
 }
 
 /// The machine a measurement ran on, as `--stats-json` files and bench records name it.

@@ -61,17 +61,13 @@ impl Identity {
                 canonical: PathBuf::from("<stdout>"),
             };
         }
-        match dev_ino(path) {
-            Some(dev_ino) => Identity {
-                dev_ino: Some(dev_ino),
-                canonical: std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf()),
-            },
+        let dev_ino = dev_ino(path);
+        let canonical = match dev_ino {
+            Some(_) => std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf()),
             // A new file, or one a dangling symlink would create.
-            None => Identity {
-                dev_ino: None,
-                canonical: canonical_new(&write::resolve_symlinks(path)),
-            },
-        }
+            None => canonical_new(&write::resolve_symlinks(path)),
+        };
+        Identity { dev_ino, canonical }
     }
 
     /// True for `/dev/null` under any name (also standard output sent there).
@@ -190,11 +186,10 @@ impl OutputPlan {
             .find(|o| is_stdout(&o.path) && flags.contains(&o.flag.as_str()))
             && std::io::stdout().is_terminal()
         {
-            return Err(UsageError(format!(
+            bail!(UsageError(format!(
                 "{} would write an image to the terminal: expected standard output redirected to a file or a pipe",
                 o.describe()
-            ))
-            .into());
+            )));
         }
         Ok(())
     }
@@ -237,23 +232,21 @@ impl OutputPlan {
         for (i, (out, id)) in outputs.iter().enumerate() {
             for (input, input_id) in &inputs {
                 if id.same(input_id) {
-                    return Err(UsageError(format!(
+                    bail!(UsageError(format!(
                         "{} is the same file as the input {}: expected an output that is not an input (it would be overwritten)",
                         out.describe(),
                         input.describe()
-                    ))
-                    .into());
+                    )));
                 }
             }
             for (other, other_id) in &outputs[..i] {
                 // Any number of outputs may be thrown away.
                 if id.same(other_id) && !id.is_null() {
-                    return Err(UsageError(format!(
+                    bail!(UsageError(format!(
                         "{} and {} are the same file: expected a different file for each output",
                         other.describe(),
                         out.describe()
-                    ))
-                    .into());
+                    )));
                 }
             }
         }

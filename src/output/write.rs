@@ -30,6 +30,11 @@ use std::os::unix::fs::FileTypeExt;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
+/// What writes an output: it fills the buffered file it is given, whatever file that is.
+pub trait Fill: FnOnce(&mut BufWriter<&mut File>) -> Result<()> {}
+
+impl<F: FnOnce(&mut BufWriter<&mut File>) -> Result<()>> Fill for F {}
+
 /// A regular output written in full to its temporary file, renamed over `real` at the commit.
 struct HeldRename {
     tmp: tempfile::NamedTempFile,
@@ -118,9 +123,12 @@ pub fn commit_outputs() -> Result<()> {
     };
     // Without the lock: a FIFO may wait for its reader, and the signal handler must still be
     // able to remove the held temporary files meanwhile.
-    let copied = direct
-        .into_iter()
-        .try_for_each(|mut held| copy_direct(&mut held.bytes, &held.shown));
+    let copied = direct.into_iter().try_for_each(|mut held| {
+        held.bytes.rewind()?;
+        write_output_now(&held.shown, |w| {
+            Ok(std::io::copy(&mut held.bytes, w).map(drop)?)
+        })
+    });
     let mut state = outputs();
     if let Err(e) = copied {
         state.drop_renames(renames);
@@ -157,15 +165,6 @@ pub fn discard_outputs() {
     state.direct.clear();
     let renames = std::mem::take(&mut state.renames);
     state.drop_renames(renames);
-}
-
-/// Copies a held direct output to its target.
-fn copy_direct(bytes: &mut File, shown: &Path) -> Result<()> {
-    bytes.rewind()?;
-    write_output_now(shown, |w| {
-        std::io::copy(bytes, w)?;
-        Ok(())
-    })
 }
 
 /// What writing to a path means.
@@ -240,10 +239,7 @@ pub(crate) fn may_write_in(dir: &Path) -> bool {
 
 /// Writes through `fill`: atomically to a regular target, directly to anything else; held
 /// until [`commit_outputs`] after [`hold_outputs`].
-pub fn write_output(
-    path: &Path,
-    fill: impl FnOnce(&mut BufWriter<&mut File>) -> Result<()>,
-) -> Result<()> {
+pub fn write_output(path: &Path, fill: impl Fill) -> Result<()> {
     if !outputs().holding {
         return write_output_now(path, fill);
     }
@@ -271,10 +267,7 @@ pub fn write_output(
 
 /// Writes through `fill` at once, held or not: for files the run reads back (the variance
 /// study's cache), which are not outputs to commit together.
-pub fn write_output_now(
-    path: &Path,
-    fill: impl FnOnce(&mut BufWriter<&mut File>) -> Result<()>,
-) -> Result<()> {
+pub fn write_output_now(path: &Path, fill: impl Fill) -> Result<()> {
     match target(path) {
         Target::Stdout => {
             use std::os::fd::AsFd;
@@ -335,11 +328,7 @@ fn open_special(path: &Path) -> std::io::Result<File> {
 }
 
 /// Fills `file` through `fill` and flushes it; errors name the file as `name`.
-fn write_direct(
-    file: &mut File,
-    name: &str,
-    fill: impl FnOnce(&mut BufWriter<&mut File>) -> Result<()>,
-) -> Result<()> {
+fn write_direct(file: &mut File, name: &str, fill: impl Fill) -> Result<()> {
     let mut w = BufWriter::new(file);
     fill(&mut w).with_context(|| format!("cannot write {name}"))?;
     w.flush().with_context(|| format!("cannot write {name}"))?;
@@ -348,11 +337,7 @@ fn write_direct(
 
 /// The temporary file beside `real`, filled through `fill`, flushed, with the mode of the
 /// file it replaces; registered for the signal handler until it is renamed or dropped.
-fn write_temporary(
-    path: &Path,
-    real: &Path,
-    fill: impl FnOnce(&mut BufWriter<&mut File>) -> Result<()>,
-) -> Result<tempfile::NamedTempFile> {
+fn write_temporary(path: &Path, real: &Path, fill: impl Fill) -> Result<tempfile::NamedTempFile> {
     let dir = parent_dir(real);
     // Created and registered under the lock, so that the signal handler sees every
     // temporary file that exists.

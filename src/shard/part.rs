@@ -114,7 +114,7 @@ pub fn write_part<W: Work>(dir: &Path, part: &Part<W>) -> Result<PathBuf> {
     let path = dir.join(part_name::<W>(part.shard));
     let mut payload = Vec::new();
     ciborium::into_writer(part, &mut payload).context("cannot encode the part")?;
-    crate::output::image_file::write_atomically(&path, |w| {
+    crate::output::write_output(&path, |w| {
         w.write_all(MAGIC)?;
         // The kind, NUL-padded to 8 bytes.
         let mut kind = [0u8; 8];

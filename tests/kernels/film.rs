@@ -2,7 +2,8 @@
 //! files written whole or not at all.
 
 use glam::Vec3;
-use raywave::output::image_file::{check_output_dir, ldr_format, write_atomically, write_rgb8};
+use raywave::output::image_file::{check_output_dir, ldr_format, write_rgb8};
+use raywave::output::write_output;
 use raywave::render::film::{Film, ToneMap};
 use std::io::Write;
 
@@ -109,7 +110,7 @@ fn png_round_trips() {
 fn a_failed_write_leaves_nothing_behind_and_keeps_the_old_file() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("out.png");
-    let result = write_atomically(&path, |w| {
+    let result = write_output(&path, |w| {
         w.write_all(b"half an image")?;
         anyhow::bail!("the encoder failed")
     });
@@ -120,12 +121,12 @@ fn a_failed_write_leaves_nothing_behind_and_keeps_the_old_file() {
         files_in(dir.path())
     );
     std::fs::write(&path, b"old").unwrap();
-    let result = write_atomically(&path, |_| anyhow::bail!("failed again"));
+    let result = write_output(&path, |_| anyhow::bail!("failed again"));
     assert!(result.is_err());
     assert_eq!(std::fs::read(&path).unwrap(), b"old");
     assert_eq!(files_in(dir.path()), ["out.png"]);
     // A successful write replaces it whole.
-    write_atomically(&path, |w| Ok(w.write_all(b"new")?)).unwrap();
+    write_output(&path, |w| Ok(w.write_all(b"new")?)).unwrap();
     assert_eq!(std::fs::read(&path).unwrap(), b"new");
     assert_eq!(files_in(dir.path()), ["out.png"]);
 }

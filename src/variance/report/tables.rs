@@ -106,7 +106,7 @@ pub fn file_names(samplers: &[LightSampler], budgets: &[u32], heatmap_n: u32) ->
 
 /// Writes `body` to `path` atomically; returns the path.
 pub(crate) fn write_text(path: &Path, body: &str) -> Result<PathBuf> {
-    crate::output::image_file::write_atomically(path, |w| {
+    crate::output::write_output(path, |w| {
         std::io::Write::write_all(w, body.as_bytes())?;
         Ok(())
     })?;
