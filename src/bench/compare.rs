@@ -5,6 +5,7 @@
 
 use super::verdict::{Verdict, change_pct, of_records};
 use crate::output::bench_record::{BenchRecord, FigureSummary, Setup};
+use crate::output::terminal::table_line;
 use serde_json::Value;
 use std::fmt::Write;
 
@@ -39,13 +40,8 @@ fn diff(path: &str, x: &Value, y: &Value, found: &mut dyn FnMut(&str, &Value, &V
                 } else {
                     format!("{path}.{k}")
                 };
-                let null = &Value::Null;
-                diff(
-                    &p,
-                    mx.get(k).unwrap_or(null),
-                    my.get(k).unwrap_or(null),
-                    found,
-                );
+                let [x, y] = [mx, my].map(|m| m.get(k).unwrap_or(&Value::Null));
+                diff(&p, x, y, found);
             }
         }
         _ if x != y => found(path, x, y),
@@ -97,26 +93,15 @@ impl Comparison {
         // In the unit the tables print: Mrays/s or Mrays/thread-s.
         let cell =
             |f: &FigureSummary| format!("{:.2} {}", f.median / 1e6, f.interval_text(1e-6, 2));
-        let _ = writeln!(
-            s,
-            "{:<10} {:<17} {:>26} {:>26} {:>8}  verdict",
-            "engine",
-            "figure",
-            format!("{a} [95% interval]"),
-            format!("{b} [95% interval]"),
-            "change"
-        );
+        let line = |cells: [&str; 5]| table_line(&[-10, -17, 26, 26, 8], cells);
+        let (ha, hb) = (format!("{a} [95% interval]"), format!("{b} [95% interval]"));
+        let header = line(["engine", "figure", &ha, &hb, "change"]);
+        let _ = writeln!(s, "{header}  verdict");
         for r in &self.rows {
-            let _ = writeln!(
-                s,
-                "{:<10} {:<17} {:>26} {:>26} {:>+7.1}%  {}",
-                r.engine,
-                r.after.figure,
-                cell(&r.before),
-                cell(&r.after),
-                r.change_pct,
-                r.verdict.label()
-            );
+            let change = format!("{:+.1}%", r.change_pct);
+            let [before, after] = [&r.before, &r.after].map(cell);
+            let row = line([&r.engine, &r.after.figure, &before, &after, &change]);
+            let _ = writeln!(s, "{row}  {}", r.verdict.label());
         }
         let _ = writeln!(
             s,
