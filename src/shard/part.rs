@@ -118,9 +118,7 @@ pub fn write_part<W: Work>(dir: &Path, part: &Part<W>) -> Result<PathBuf> {
         w.write_all(MAGIC)?;
         // The kind, NUL-padded to 8 bytes.
         let mut kind = [0u8; 8];
-        kind.iter_mut()
-            .zip(W::KIND.bytes())
-            .for_each(|(k, b)| *k = b);
+        kind[..W::KIND.len()].copy_from_slice(W::KIND.as_bytes());
         w.write_all(&kind)?;
         w.write_all(&(payload.len() as u64).to_le_bytes())?;
         w.write_all(&crate::render::digest::of(&payload).to_le_bytes())?;
