@@ -158,6 +158,14 @@ fn usable(rate: f64) -> bool {
     rate.is_finite() && rate > 0.0
 }
 
+/// That figure `f` of `engine` (`whose`: which record's, or "") has no 95% interval.
+fn no_interval(engine: &str, f: &FigureSummary, whose: &str) -> String {
+    let (figure, runs, min) = (&f.figure, f.runs, crate::stats::MIN_FOR_INTERVAL);
+    format!(
+        "engine {engine} {figure}{whose}: no 95% interval ({runs} run(s); at least {min} needed)"
+    )
+}
+
 /// What in `record` keeps it from being compared with a run of `engines`: an engine it lacks
 /// or without a total, a headline figure whose median is not a positive finite rate or that has
 /// no 95% interval (fewer than 6 runs). Empty when it can be compared; checked before timing.
@@ -203,13 +211,7 @@ pub fn record_problems(record: &BenchRecord, engines: &[&str]) -> Vec<String> {
                     "engine {} {}: interval [{l}, {h}] does not hold its median {}",
                     e.engine, f.figure, f.median
                 )),
-                _ => out.push(format!(
-                    "engine {} {}: no 95% interval ({} run(s); at least {} needed)",
-                    e.engine,
-                    f.figure,
-                    f.runs,
-                    crate::stats::MIN_FOR_INTERVAL
-                )),
+                _ => out.push(no_interval(&e.engine, f, "")),
             }
         }
     }
@@ -254,14 +256,7 @@ pub fn compare(
                 continue;
             };
             if fa.low.is_none() || fa.high.is_none() {
-                problems.push(format!(
-                    "engine {} {} of the newer run: no 95% interval ({} run(s); at least {} \
-                     needed)",
-                    a.engine,
-                    fa.figure,
-                    fa.runs,
-                    crate::stats::MIN_FOR_INTERVAL
-                ));
+                problems.push(no_interval(&a.engine, fa, " of the newer run"));
                 continue;
             }
             // A figure of the newer run that is not a positive finite rate (with a positive one
