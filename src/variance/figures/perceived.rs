@@ -85,8 +85,6 @@ pub fn measure(
         low_band_interval: interval(k, |idx| mean_at(&seed_low_band, Some(idx))),
         low_band_share: mean_at(&seed_share, None),
         low_band_share_interval: interval(k, |idx| mean_at(&seed_share, Some(idx))),
-        low_band_vs_random: None,
-        low_band_vs_random_interval: None,
         spectrum: (0..RINGS).map(|i| mean_at(&ring(i), None)).collect(),
         spectrum_interval: (0..RINGS)
             .map(|i| {
@@ -96,6 +94,7 @@ pub fn measure(
             .collect(),
         seed_low_band,
         seed_lowpass,
+        ..Perceived::default()
     }
 }
 
