@@ -38,9 +38,6 @@ pub struct Perceived {
     /// Per seed: low-band power.
     #[serde(skip)]
     pub seed_low_band: Vec<f64>,
-    /// Per seed: low-pass MSE at each σ.
-    #[serde(skip)]
-    pub seed_lowpass: [Vec<f64>; 2],
 }
 
 /// The error image of `image` against `reference`: the mean of the three channels' difference.
@@ -93,7 +90,6 @@ pub fn measure(
             })
             .collect(),
         seed_low_band,
-        seed_lowpass,
         ..Perceived::default()
     }
 }
