@@ -12,7 +12,6 @@ pub struct JobRecord {
     rows: Vec<RowRecord>,
     heatmap: Option<Vec<f32>>,
     thumbnail: Thumbnail,
-    host: String,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -42,7 +41,6 @@ impl From<JobResult> for JobRecord {
             rows,
             heatmap: r.heatmap,
             thumbnail: r.thumbnail,
-            host: r.host,
         }
     }
 }
@@ -66,7 +64,6 @@ impl From<JobRecord> for JobResult {
             rows,
             heatmap: r.heatmap,
             thumbnail: r.thumbnail,
-            host: r.host,
         }
     }
 }

@@ -135,8 +135,6 @@ pub struct JobResult {
     pub heatmap: Option<Vec<f32>>,
     /// The warm-up render (seed 0).
     pub thumbnail: Thumbnail,
-    /// The host whose clock timed the renders.
-    pub host: String,
 }
 
 /// The rows of `job` from its timed images: their seconds each, and rays per image.
@@ -254,7 +252,6 @@ pub fn run_jobs(
                 rows,
                 heatmap,
                 thumbnail,
-                host: host.to_string(),
             });
         }
     }
