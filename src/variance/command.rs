@@ -313,15 +313,8 @@ pub fn study(
     let results = ran
         .into_iter()
         .map(|(c, facts, results)| {
-            let case = &cases[c];
-            jobs::assemble(
-                &case.config,
-                &case.scene.source,
-                engine,
-                threads,
-                facts,
-                results,
-            )
+            let (config, source) = (&cases[c].config, &cases[c].scene.source);
+            jobs::assemble(config, source, engine, threads, facts, results)
         })
         .collect::<Vec<_>>();
     let names: Vec<String> = cases.iter().map(|c| c.name.clone()).collect();

@@ -137,14 +137,8 @@ pub fn merge(inputs: &[PathBuf], out: &Path, notice: &(dyn Fn(&str) + Sync)) -> 
         let Some((f, source, threads, _)) = facts else {
             bail!("no part holds the setup of case {}", case.name);
         };
-        studies.push(jobs::assemble(
-            &case.config,
-            &source,
-            &study.engine,
-            threads,
-            f,
-            jobs,
-        ));
+        let result = jobs::assemble(&case.config, &source, &study.engine, threads, f, jobs);
+        studies.push(result);
     }
     let names: Vec<String> = study.cases.iter().map(|c| c.name.clone()).collect();
     let outcome = write_report(&names, studies, out, notice)?;

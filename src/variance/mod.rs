@@ -323,15 +323,9 @@ pub fn run_study(
     let progress = |done: f64, label: &str| rays.advance(done as u64, label);
     let host = crate::output::machine::hostname();
     let results = jobs::run_jobs(scene, config, &setup, &all, render, &host, &progress);
-    let threads = rayon::current_num_threads();
-    Ok(jobs::assemble(
-        config,
-        &scene.source,
-        engine,
-        threads,
-        setup.facts(),
-        results,
-    ))
+    let (threads, facts) = (rayon::current_num_threads(), setup.facts());
+    let study = jobs::assemble(config, &scene.source, engine, threads, facts, results);
+    Ok(study)
 }
 
 impl StudyResult {
