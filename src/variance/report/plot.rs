@@ -232,22 +232,15 @@ pub(crate) fn heatmaps(result: &StudyResult, dir: &Path) -> Result<Vec<PathBuf>>
         return Ok(Vec::new());
     };
     let (w, h) = (result.config.base.width, result.config.base.height);
-    let n = result.config.heatmap_n;
+    let (n, seeds) = (result.config.heatmap_n, result.config.seeds);
+    let bar = "MSE per pixel, mean of R, G, B; one scale for all samplers";
     let mut written = Vec::new();
     for (sampler, map) in &result.heatmaps {
         let title = format!(
-            "{}, N = {n}: per-pixel MSE over {} seeds",
-            sampler.name(),
-            result.config.seeds
+            "{}, N = {n}: per-pixel MSE over {seeds} seeds",
+            sampler.name()
         );
-        let img = figure(
-            map,
-            w,
-            h,
-            &scale,
-            &title,
-            "MSE per pixel, mean of R, G, B; one scale for all samplers",
-        )?;
+        let img = figure(map, w, h, &scale, &title, bar)?;
         let path = dir.join(format!("heat_{}_N{n}.png", sampler.name()));
         write_rgb8(&img, &path)?;
         written.push(path);
