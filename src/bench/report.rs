@@ -13,18 +13,12 @@ const NOISY_WIDTH_PCT: f64 = 10.0;
 /// The printed report of one record: header, then per engine its kinds and stages, then the
 /// headline figures.
 pub fn report(r: &BenchRecord) -> String {
-    let s = &r.setup.settings;
+    let (s, b, commit) = (&r.setup.settings, &r.build, r.build.short_commit());
     let mut out = String::new();
     let _ = writeln!(
         out,
-        "raywave {} · commit {} · {} {} · simd {} · {} thread(s) · {}",
-        r.raywave,
-        r.build.short_commit(),
-        r.build.profile,
-        r.build.target,
-        r.simd,
-        r.setup.threads,
-        r.machine.cpu
+        "raywave {} · commit {commit} · {} {} · simd {} · {} thread(s) · {}",
+        r.raywave, b.profile, b.target, r.simd, r.setup.threads, r.machine.cpu
     );
     let shadows = match s.shadows {
         ShadowMode::Soft => format!("soft, {} {} points", s.shadow_samples, s.sampler.name()),

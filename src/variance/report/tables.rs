@@ -255,17 +255,11 @@ impl StudyResult {
     /// A readable report: one table per region, the slopes and matching budgets with their
     /// 95% intervals, and the checks.
     pub fn table(&self) -> String {
-        let mut s = String::new();
+        let (mut s, base, seeds) = (String::new(), &self.config.base, self.config.seeds);
         let _ = writeln!(
             s,
-            "variance study: {} at {}×{}, {} bounces, {} seeds per point, engine {}, {} threads",
-            self.scene,
-            self.config.base.width,
-            self.config.base.height,
-            self.config.base.bounces,
-            self.config.seeds,
-            self.engine,
-            self.threads
+            "variance study: {} at {}×{}, {} bounces, {seeds} seeds per point, engine {}, {} threads",
+            self.scene, base.width, base.height, base.bounces, self.engine, self.threads
         );
         let _ = writeln!(
             s,
@@ -411,16 +405,11 @@ impl StudyResult {
     fn seeds_csv(&self) -> String {
         let mut s = String::from("sampler,n,region,seed,mse,bias,seconds\n");
         for r in self.seed_rows() {
+            let region = r.region.name();
             let _ = writeln!(
                 s,
-                "{},{},{},{},{:e},{:e},{:e}",
-                r.sampler,
-                r.n,
-                r.region.name(),
-                r.seed,
-                r.mse,
-                r.bias,
-                r.seconds
+                "{},{},{region},{},{:e},{:e},{:e}",
+                r.sampler, r.n, r.seed, r.mse, r.bias, r.seconds
             );
         }
         s
