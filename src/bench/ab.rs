@@ -159,9 +159,10 @@ fn time_one(
     if let Some(t) = options.threads {
         cmd.args(["--threads", &t.to_string()]);
     }
+    let shown = binary.display();
     let out = cmd
         .output()
-        .with_context(|| format!("cannot run {}", binary.display()))?;
+        .with_context(|| format!("cannot run {shown}"))?;
     if !out.status.success() {
         let args: Vec<_> = cmd
             .get_args()
@@ -169,30 +170,19 @@ fn time_one(
             .map(|a| a.to_string_lossy())
             .collect();
         bail!(
-            "{} failed ({}) on `render {}`:\n{}",
-            binary.display(),
+            "{shown} failed ({}) on `render {}`:\n{}",
             out.status,
             args.join(" "),
             String::from_utf8_lossy(&out.stderr).trim_end()
         );
     }
-    let text = std::fs::read_to_string(&json)
-        .with_context(|| format!("{} wrote no --stats-json", binary.display()))?;
-    let value: serde_json::Value = serde_json::from_str(&text).with_context(|| {
-        format!(
-            "{}'s --stats-json is not JSON: is it a raywave binary?",
-            binary.display()
-        )
+    let text =
+        std::fs::read_to_string(&json).with_context(|| format!("{shown} wrote no --stats-json"))?;
+    let value: serde_json::Value = serde_json::from_str(&text)
+        .with_context(|| format!("{shown}'s --stats-json is not JSON: is it a raywave binary?"))?;
+    let seconds = (value["seconds"].as_f64().filter(|s| *s > 0.0)).with_context(|| {
+        format!("{shown}'s --stats-json has no positive `seconds`: is it a raywave binary?")
     })?;
-    let seconds = value["seconds"]
-        .as_f64()
-        .filter(|s| *s > 0.0)
-        .with_context(|| {
-            format!(
-                "{}'s --stats-json has no positive `seconds`: is it a raywave binary?",
-                binary.display()
-            )
-        })?;
     // The ray counts by kind, without the rates (which differ from run to run).
     let counts = ["camera", "shadow", "reflection", "total"]
         .map(|kind| {

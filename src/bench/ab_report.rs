@@ -4,6 +4,7 @@
 use super::ab::{AbOptions, EngineAb};
 use super::running::sequential::{self, Budget, Stop};
 use super::verdict::{Verdict, VerdictForm};
+use crate::output::terminal::table_line;
 use crate::stats::looks::{self, LookPlan};
 use crate::stats::median;
 use std::time::Duration;
@@ -24,7 +25,7 @@ pub fn report(options: &AbOptions, results: &[EngineAb]) -> String {
         None => (
             format!("{} rounds", options.rounds),
             String::new(),
-            "95% interval".to_string(),
+            "95% interval",
         ),
         Some(budget) => {
             let plan = LookPlan::new(budget.max_rounds);
@@ -45,21 +46,18 @@ pub fn report(options: &AbOptions, results: &[EngineAb]) -> String {
                     looks::ALPHA * 100.0,
                     plan.split,
                 ),
-                "interval".to_string(),
+                "interval",
             )
         }
     };
+    let columns = [-10, 25, 25, 8, 18];
+    let header = format!("engine|this: median (min–max)|other: median (min–max)|ratio|{level}");
     let mut out = format!(
         "this build / {} · {rounds} after {} warm-up, alternating · threshold {t}%, \
-         {form}{plan}\n\
-         {:<10} {:>25} {:>25} {:>8} {:>18}  verdict\n",
+         {form}{plan}\n{}  verdict\n",
         options.other.display(),
         options.warmup,
-        "engine",
-        "this: median (min–max)",
-        "other: median (min–max)",
-        "ratio",
-        level,
+        table_line(&columns, header.split('|')),
     );
     for r in results {
         let s = r.summary(options.rule);
@@ -81,14 +79,13 @@ pub fn report(options: &AbOptions, results: &[EngineAb]) -> String {
             }
             (Verdict::Undecided, Some(_)) => "undecided at the budget".to_string(),
         };
-        out += &format!(
-            "{:<10} {:>25} {:>25} {:>8.4} {:>18}  {verdict}\n",
-            r.engine.name(),
-            spread(&r.this),
-            spread(&r.other),
-            s.median,
+        let [this, other] = [&r.this, &r.other].map(|xs| spread(xs));
+        let (median, interval) = (
+            format!("{:.4}", s.median),
             format!("[{:.4}, {:.4}]", s.low, s.high),
         );
+        let cells = [r.engine.name(), &this, &other, &median, &interval];
+        out += &format!("{}  {verdict}\n", table_line(&columns, cells));
         if let (Some(outcome), Some(budget)) = (&r.sequential, options.until_decided) {
             out += &format!("  {}\n", looks_line(outcome, budget));
         }

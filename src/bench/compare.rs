@@ -5,6 +5,7 @@
 
 use super::verdict::{Verdict, change_pct, of_records};
 use crate::output::bench_record::{BenchRecord, FigureSummary, Setup};
+use crate::output::terminal::table_line;
 use serde_json::Value;
 use std::fmt::Write;
 
@@ -39,13 +40,8 @@ fn diff(path: &str, x: &Value, y: &Value, found: &mut dyn FnMut(&str, &Value, &V
                 } else {
                     format!("{path}.{k}")
                 };
-                let null = &Value::Null;
-                diff(
-                    &p,
-                    mx.get(k).unwrap_or(null),
-                    my.get(k).unwrap_or(null),
-                    found,
-                );
+                let [x, y] = [mx, my].map(|m| m.get(k).unwrap_or(&Value::Null));
+                diff(&p, x, y, found);
             }
         }
         _ if x != y => found(path, x, y),
@@ -97,26 +93,15 @@ impl Comparison {
         // In the unit the tables print: Mrays/s or Mrays/thread-s.
         let cell =
             |f: &FigureSummary| format!("{:.2} {}", f.median / 1e6, f.interval_text(1e-6, 2));
-        let _ = writeln!(
-            s,
-            "{:<10} {:<17} {:>26} {:>26} {:>8}  verdict",
-            "engine",
-            "figure",
-            format!("{a} [95% interval]"),
-            format!("{b} [95% interval]"),
-            "change"
-        );
+        let line = |cells: [&str; 5]| table_line(&[-10, -17, 26, 26, 8], cells);
+        let (ha, hb) = (format!("{a} [95% interval]"), format!("{b} [95% interval]"));
+        let header = line(["engine", "figure", &ha, &hb, "change"]);
+        let _ = writeln!(s, "{header}  verdict");
         for r in &self.rows {
-            let _ = writeln!(
-                s,
-                "{:<10} {:<17} {:>26} {:>26} {:>+7.1}%  {}",
-                r.engine,
-                r.after.figure,
-                cell(&r.before),
-                cell(&r.after),
-                r.change_pct,
-                r.verdict.label()
-            );
+            let change = format!("{:+.1}%", r.change_pct);
+            let [before, after] = [&r.before, &r.after].map(cell);
+            let row = line([&r.engine, &r.after.figure, &before, &after, &change]);
+            let _ = writeln!(s, "{row}  {}", r.verdict.label());
         }
         let _ = writeln!(
             s,
@@ -173,6 +158,14 @@ fn usable(rate: f64) -> bool {
     rate.is_finite() && rate > 0.0
 }
 
+/// That figure `f` of `engine` (`whose`: which record's, or "") has no 95% interval.
+fn no_interval(engine: &str, f: &FigureSummary, whose: &str) -> String {
+    let (figure, runs, min) = (&f.figure, f.runs, crate::stats::MIN_FOR_INTERVAL);
+    format!(
+        "engine {engine} {figure}{whose}: no 95% interval ({runs} run(s); at least {min} needed)"
+    )
+}
+
 /// What in `record` keeps it from being compared with a run of `engines`: an engine it lacks
 /// or without a total, a headline figure whose median is not a positive finite rate or that has
 /// no 95% interval (fewer than 6 runs). Empty when it can be compared; checked before timing.
@@ -218,13 +211,7 @@ pub fn record_problems(record: &BenchRecord, engines: &[&str]) -> Vec<String> {
                     "engine {} {}: interval [{l}, {h}] does not hold its median {}",
                     e.engine, f.figure, f.median
                 )),
-                _ => out.push(format!(
-                    "engine {} {}: no 95% interval ({} run(s); at least {} needed)",
-                    e.engine,
-                    f.figure,
-                    f.runs,
-                    crate::stats::MIN_FOR_INTERVAL
-                )),
+                _ => out.push(no_interval(&e.engine, f, "")),
             }
         }
     }
@@ -269,14 +256,7 @@ pub fn compare(
                 continue;
             };
             if fa.low.is_none() || fa.high.is_none() {
-                problems.push(format!(
-                    "engine {} {} of the newer run: no 95% interval ({} run(s); at least {} \
-                     needed)",
-                    a.engine,
-                    fa.figure,
-                    fa.runs,
-                    crate::stats::MIN_FOR_INTERVAL
-                ));
+                problems.push(no_interval(&a.engine, fa, " of the newer run"));
                 continue;
             }
             // A figure of the newer run that is not a positive finite rate (with a positive one

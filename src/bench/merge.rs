@@ -88,16 +88,10 @@ pub fn merge(args: &MergeOptions) -> Result<Merged> {
             to_save.push(record::record_path(&args.dir, &record_name(name, &point))?);
         }
     }
-    let mut plan = OutputPlan::new();
-    for (p, _) in &shards.parts {
-        plan = plan.input("PARTS", p);
-    }
-    for p in &to_save {
-        plan = plan.output_in_new_dir("--save", p);
-    }
-    for (flag, p) in args.exports.flags() {
-        plan = plan.output(flag, p);
-    }
+    let plan = (shards.parts.iter()).fold(OutputPlan::new(), |plan, (p, _)| plan.input("PARTS", p));
+    let plan = (to_save.iter()).fold(plan, |plan, p| plan.output_in_new_dir("--save", p));
+    let plan =
+        (args.exports.flags().into_iter()).fold(plan, |plan, (flag, p)| plan.output(flag, p));
     plan.check()?;
     for (path, r) in to_save.iter().zip(&records) {
         record::save(path, r)?;

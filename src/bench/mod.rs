@@ -132,11 +132,7 @@ pub fn run(args: &BenchOptions, progress: &Progress) -> Result<Outcome> {
         bail!(UsageError(format!(
             "{} takes one point, but the sweep has {}: compare or write points one at a time \
              (`raywave bench compare A B` compares saved points; --export-json writes them all)",
-            if args.compare.is_some() {
-                "--compare"
-            } else {
-                "--json"
-            },
+            args.compare.as_ref().map_or("--json", |_| "--compare"),
             points.len()
         )));
     }
@@ -152,8 +148,7 @@ pub fn run(args: &BenchOptions, progress: &Progress) -> Result<Outcome> {
     let baseline = match &args.compare {
         Some(name) => {
             let path = record::record_path(&args.dir, name)?;
-            let before = record::load(&path, name)?;
-            Some((path, before))
+            Some((record::load(&path, name)?, path))
         }
         None => None,
     };
@@ -168,7 +163,7 @@ pub fn run(args: &BenchOptions, progress: &Progress) -> Result<Outcome> {
             .settings;
         let mut threads = point.threads;
         let mut engines = args.engines.clone();
-        if let Some((_, before)) = &baseline {
+        if let Some((before, _)) = &baseline {
             settings = adopt::adopt_settings(&settings, &before.setup.settings, &args.explicit);
             if !given("threads") {
                 threads = u32::try_from(before.setup.threads).ok();
@@ -199,7 +194,7 @@ pub fn run(args: &BenchOptions, progress: &Progress) -> Result<Outcome> {
             threads: pool.current_num_threads(),
             batch_size: DEFAULT_BATCH_SIZE,
         };
-        if let Some((path, before)) = &baseline {
+        if let Some((before, path)) = &baseline {
             let differences = compare::setup_differences(&before.setup, &setup);
             if !differences.is_empty() {
                 bail!(
@@ -303,7 +298,7 @@ pub fn run(args: &BenchOptions, progress: &Progress) -> Result<Outcome> {
     // The verdict is reached before anything is written, so that a run that cannot be
     // compared, or that regressed, does not replace the record it was compared with.
     let comparison = match (&baseline, records.first()) {
-        (Some((path, before)), Some(after)) => Some(
+        (Some((before, path)), Some(after)) => Some(
             compare::compare(before, after, args.threshold).map_err(|r| match r {
                 compare::Refusal::Setup(d) => anyhow::anyhow!(
                     "cannot compare with {}: setups differ: {}",
@@ -353,7 +348,7 @@ pub fn run(args: &BenchOptions, progress: &Progress) -> Result<Outcome> {
         records,
         labels,
         saved,
-        comparison: comparison.zip(baseline.map(|(_, before)| before)),
+        comparison: comparison.zip(baseline.map(|(before, _)| before)),
         part,
     })
 }

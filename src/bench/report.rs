@@ -3,6 +3,7 @@
 //! measurement deserves (outlier runs, wide intervals, a loaded machine).
 
 use crate::output::bench_record::{BenchRecord, FigureSummary};
+use crate::output::terminal::table_line;
 use crate::render::settings::{RenderSettings, ShadowMode};
 use std::fmt::Write as _;
 
@@ -12,18 +13,12 @@ const NOISY_WIDTH_PCT: f64 = 10.0;
 /// The printed report of one record: header, then per engine its kinds and stages, then the
 /// headline figures.
 pub fn report(r: &BenchRecord) -> String {
-    let s = &r.setup.settings;
+    let (s, b, commit) = (&r.setup.settings, &r.build, r.build.short_commit());
     let mut out = String::new();
     let _ = writeln!(
         out,
-        "raywave {} · commit {} · {} {} · simd {} · {} thread(s) · {}",
-        r.raywave,
-        r.build.short_commit(),
-        r.build.profile,
-        r.build.target,
-        r.simd,
-        r.setup.threads,
-        r.machine.cpu
+        "raywave {} · commit {commit} · {} {} · simd {} · {} thread(s) · {}",
+        r.raywave, b.profile, b.target, r.simd, r.setup.threads, r.machine.cpu
     );
     let shadows = match s.shadows {
         ShadowMode::Soft => format!("soft, {} {} points", s.shadow_samples, s.sampler.name()),
@@ -52,74 +47,49 @@ pub fn report(r: &BenchRecord) -> String {
     );
     // Each kind over the thread-time of its own work (`-`: not measured, as for the reference,
     // timed without timers), the total over the wall clock.
-    let _ = writeln!(
-        out,
-        "{:<10} {:<12} {:>12} {:>10} {:>16}",
-        "engine", "kind", "rays", "seconds", "Mrays/thread-s"
-    );
+    let kinds = |cells: [&str; 5]| table_line(&[-10, -12, 12, 10, 16], cells);
+    let header = ["engine", "kind", "rays", "seconds", "Mrays/thread-s"];
+    let _ = writeln!(out, "{}", kinds(header));
     for e in &r.engines {
         let (m, total) = (&e.median, &e.median.rays.total);
         for (kind, figure) in m.rays.kinds.iter() {
             let rate = figure
                 .rays_per_thread_second
                 .map_or("-".to_string(), |r| format!("{:.2}", r / 1e6));
-            let _ = writeln!(
-                out,
-                "{:<10} {:<12} {:>12} {:>10} {rate:>16}",
-                e.engine,
-                kind.name(),
-                figure.rays,
-                ""
-            );
+            let rays = figure.rays.to_string();
+            let _ = writeln!(out, "{}", kinds([&e.engine, kind.name(), &rays, "", &rate]));
         }
-        let _ = writeln!(
-            out,
-            "{:<10} {:<12} {:>12} {:>10.3} {:>16.2}  (Mrays/s, wall clock)",
-            e.engine,
-            "total",
-            total.rays,
-            total.seconds,
-            total.rays_per_second / 1e6
-        );
+        let rays = total.rays.to_string();
+        let seconds = format!("{:.3}", total.seconds);
+        let rate = format!("{:.2}", total.rays_per_second / 1e6);
+        let row = kinds([&e.engine, "total", &rays, &seconds, &rate]);
+        let _ = writeln!(out, "{row}  (Mrays/s, wall clock)");
     }
     if r.engines.iter().any(|e| !e.median.stages.is_empty()) {
-        let _ = writeln!(
-            out,
-            "{:<10} {:<12} {:>12} {:>10} {:>16}",
-            "engine", "stage", "rays", "thread-s", "Mrays/thread-s"
-        );
+        let header = ["engine", "stage", "rays", "thread-s", "Mrays/thread-s"];
+        let _ = writeln!(out, "{}", kinds(header));
     }
     for e in &r.engines {
         for st in &e.median.stages {
+            let rays = st.rays.to_string();
+            let seconds = format!("{:.4}", st.thread_seconds);
+            let rate = format!("{:.2}", st.rays_per_thread_second / 1e6);
             let _ = writeln!(
                 out,
-                "{:<10} {:<12} {:>12} {:>10.4} {:>16.2}",
-                e.engine,
-                st.stage,
-                st.rays,
-                st.thread_seconds,
-                st.rays_per_thread_second / 1e6
+                "{}",
+                kinds([&e.engine, &st.stage, &rays, &seconds, &rate])
             );
         }
     }
-    let _ = writeln!(
-        out,
-        "{:<10} {:<17} {:>8} {:>8} {:>18} {:>8}  outliers",
-        "engine", "figure", "min", "median", "95% interval", "max"
-    );
+    let figures = |cells: [&str; 6]| table_line(&[-10, -17, 8, 8, 18, 8], cells);
+    let header = ["engine", "figure", "min", "median", "95% interval", "max"];
+    let _ = writeln!(out, "{}  outliers", figures(header));
     for e in &r.engines {
         for f in &e.summary {
-            let _ = writeln!(
-                out,
-                "{:<10} {:<17} {:>8.2} {:>8.2} {:>18} {:>8.2}  {}",
-                e.engine,
-                f.figure,
-                f.min / 1e6,
-                f.median / 1e6,
-                f.interval_text(1e-6, 2),
-                f.max / 1e6,
-                outlier_text(f)
-            );
+            let [min, median, max] = [f.min, f.median, f.max].map(|v| format!("{:.2}", v / 1e6));
+            let interval = f.interval_text(1e-6, 2);
+            let row = figures([&e.engine, &f.figure, &min, &median, &interval, &max]);
+            let _ = writeln!(out, "{row}  {}", outlier_text(f));
         }
     }
     let _ = writeln!(

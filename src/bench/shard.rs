@@ -89,12 +89,10 @@ impl Work for SweepPoints {
         field("points", labels(self), labels(other));
         if out.is_empty() {
             for (p, q) in self.points.iter().zip(&other.points) {
+                let at = Some(p.label.as_str())
+                    .filter(|l| !l.is_empty())
+                    .unwrap_or("point");
                 for d in super::compare::setup_differences_as(&p.setup, &q.setup, a, b) {
-                    let at = if p.label.is_empty() {
-                        "point"
-                    } else {
-                        &p.label
-                    };
                     out.push(format!("{at}: {d}"));
                 }
             }
@@ -110,11 +108,9 @@ impl Work for SweepPoints {
         let sweep = &identity.work;
         for (&i, r) in items.iter().zip(records) {
             let point = &sweep.points[i];
-            let at = if point.label.is_empty() {
-                "the point"
-            } else {
-                &point.label
-            };
+            let at = Some(point.label.as_str())
+                .filter(|l| !l.is_empty())
+                .unwrap_or("the point");
             if r.format != record::FORMAT {
                 return Some(format!(
                     "{at}: record format {}, expected {}",

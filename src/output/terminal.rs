@@ -46,3 +46,21 @@ pub fn print(text: &str) -> Result<()> {
         .and_then(|()| out.flush())
         .context("cannot write to standard output")
 }
+
+/// One line of a text table, without its line break: each cell padded to its column's width,
+/// left-aligned where the width is negative and right-aligned where it is positive, one space
+/// between cells. A table's header (its cells split at `|`: `"engine|figure|median"`) and its
+/// rows share one list of widths, so that they stay aligned.
+pub fn table_line<S: AsRef<str>>(widths: &[i16], cells: impl IntoIterator<Item = S>) -> String {
+    let padded: Vec<String> = (widths.iter().zip(cells))
+        .map(|(&w, c)| {
+            let (c, n) = (c.as_ref(), usize::from(w.unsigned_abs()));
+            if w < 0 {
+                format!("{c:<n$}")
+            } else {
+                format!("{c:>n$}")
+            }
+        })
+        .collect();
+    padded.join(" ")
+}

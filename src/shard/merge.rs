@@ -26,7 +26,7 @@ pub enum Machines {
 }
 
 /// A machine that ran shards, and what it ran.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct HostSummary {
     /// Host name.
     pub hostname: String,
@@ -201,9 +201,7 @@ pub fn merge<W: Work>(inputs: &[PathBuf], machines: Machines) -> Result<Merged<W
             hosts.push(HostSummary {
                 hostname: part.host.hostname.clone(),
                 cpu: part.host.cpu.clone(),
-                shards: 0,
-                items: 0,
-                seconds: 0.0,
+                ..HostSummary::default()
             });
             hosts.len() - 1
         });
@@ -235,13 +233,11 @@ pub fn merge<W: Work>(inputs: &[PathBuf], machines: Machines) -> Result<Merged<W
             slots[i] = Some(r);
         }
     }
-    let mut results = Vec::with_capacity(items);
-    for (i, slot) in slots.into_iter().enumerate() {
-        let Some(r) = slot else {
-            bail!("no shard ran item {i}: the parts are inconsistent");
-        };
-        results.push(r);
-    }
+    let results = (slots.into_iter().enumerate())
+        .map(|(i, r)| {
+            r.with_context(|| format!("no shard ran item {i}: the parts are inconsistent"))
+        })
+        .collect::<Result<_>>()?;
     Ok(Merged {
         parts,
         results,

@@ -19,7 +19,7 @@ use super::identity::{Identity, Work};
 use super::split::{MAX_SHARDS, Shard};
 use anyhow::{Context, Result, bail};
 use serde::{Deserialize, Serialize};
-use std::io::{Read, Seek, SeekFrom, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// The first bytes of every part: bumped with the bench record's `FORMAT`, which bench parts
@@ -118,9 +118,7 @@ pub fn write_part<W: Work>(dir: &Path, part: &Part<W>) -> Result<PathBuf> {
         w.write_all(MAGIC)?;
         // The kind, NUL-padded to 8 bytes.
         let mut kind = [0u8; 8];
-        kind.iter_mut()
-            .zip(W::KIND.bytes())
-            .for_each(|(k, b)| *k = b);
+        kind[..W::KIND.len()].copy_from_slice(W::KIND.as_bytes());
         w.write_all(&kind)?;
         w.write_all(&(payload.len() as u64).to_le_bytes())?;
         w.write_all(&crate::render::digest::of(&payload).to_le_bytes())?;
@@ -146,15 +144,10 @@ pub fn read_part<W: Work>(path: &Path) -> Result<Part<W>> {
             MAX_PART_BYTES >> 20
         );
     }
-    let mut file =
-        std::fs::File::open(path).with_context(|| format!("cannot read the part {shown}"))?;
+    let bytes = std::fs::read(path).with_context(|| format!("cannot read the part {shown}"))?;
     // Enough to tell an earlier raywave's parts, the JSON of `{"format": "raywave-bench-shard"`
     // among them, from anything else.
-    let mut head = Vec::new();
-    Read::by_ref(&mut file)
-        .take(64)
-        .read_to_end(&mut head)
-        .with_context(|| format!("cannot read {shown}"))?;
+    let head = &bytes[..bytes.len().min(64)];
     let earlier = EARLIER_MAGICS.iter().any(|m| head.starts_with(*m))
         || (head.trim_ascii_start().starts_with(b"{")
             && head.windows(19).any(|w| w == b"raywave-bench-shard"));
@@ -164,13 +157,13 @@ pub fn read_part<W: Work>(path: &Path) -> Result<Part<W>> {
              run its shard again with this build"
         );
     }
-    if head.len() < HEADER_LEN || &head[..8] != MAGIC {
+    if bytes.len() < HEADER_LEN || &bytes[..8] != MAGIC {
         bail!(
             "{shown}: not a raywave part (expected a file written by `{command}`, starting {:?})",
             String::from_utf8_lossy(MAGIC).trim_end()
         );
     }
-    let kind = String::from_utf8_lossy(&head[8..16])
+    let kind = String::from_utf8_lossy(&bytes[8..16])
         .trim_end_matches('\0')
         .to_string();
     if kind != W::KIND {
@@ -179,31 +172,22 @@ pub fn read_part<W: Work>(path: &Path) -> Result<Part<W>> {
             kind.escape_debug()
         );
     }
-    let u64_at = |i: usize| u64::from_le_bytes(head[i..i + 8].try_into().unwrap_or_default());
-    let (length, sum) = (u64_at(16), u64_at(24));
-    let found = meta.len() - HEADER_LEN as u64;
+    let u64_at = |i: usize| u64::from_le_bytes(bytes[i..i + 8].try_into().unwrap_or_default());
+    let (length, sum, payload) = (u64_at(16), u64_at(24), &bytes[HEADER_LEN..]);
+    let found = payload.len() as u64;
     if found != length {
         bail!(
             "{shown}: truncated or padded: the header says {length} bytes of results, the file \
              holds {found}; was it cut off mid-write or mid-copy? Run its shard again"
         );
     }
-    file.seek(SeekFrom::Start(HEADER_LEN as u64))
-        .with_context(|| format!("cannot read the part {shown}"))?;
-    let mut payload = Vec::new();
-    file.take(length)
-        .read_to_end(&mut payload)
-        .with_context(|| format!("cannot read the part {shown}"))?;
-    if payload.len() as u64 != length {
-        bail!("{shown}: it shrank while being read");
-    }
-    if crate::render::digest::of(&payload) != sum {
+    if crate::render::digest::of(payload) != sum {
         bail!(
             "{shown}: corrupt: its checksum does not match its contents, so it was changed or \
              damaged after it was written; run its shard again"
         );
     }
-    let part: Part<W> = ciborium::from_reader(payload.as_slice())
+    let part: Part<W> = ciborium::from_reader(payload)
         .with_context(|| format!("{shown}: its results cannot be decoded"))?;
     if let Some(problem) = inconsistency(&part) {
         bail!("{shown}: inconsistent part: {problem}");

@@ -123,16 +123,15 @@ impl VarianceOptions {
             )));
         }
         // Every sampler takes every budget, or the study stops before it starts.
+        let [width, height] = self.sizes[0];
+        let config = StudyConfig::standard(RenderSettings {
+            width,
+            height,
+            ..RenderSettings::default()
+        });
         for &sampler in &self.samplers {
             for &n in &self.budgets {
-                let [width, height] = self.sizes[0];
-                let base = RenderSettings {
-                    width,
-                    height,
-                    ..RenderSettings::default()
-                };
-                let settings = StudyConfig::standard(base).run_settings(sampler, n, 0);
-                settings.check_sampler().map_err(|e| {
+                config.run_settings(sampler, n, 0).check_sampler().map_err(|e| {
                     UsageError(format!(
                         "{e}; the study's --budgets include {n}: leave {} out of --samplers, or that budget out",
                         sampler.name()
@@ -263,29 +262,12 @@ fn run_selected(
         if jobs.is_empty() {
             continue;
         }
-        rays.advance(
-            0,
-            &format!("{}: converged reference and regions", case.name),
-        );
-        let setup = Setup::new(
-            &case.scene,
-            &case.bytes,
-            &case.config,
-            render,
-            cache,
-            progress.notice,
-        )?;
+        let (scene, config) = (&case.scene, &case.config);
         let label =
             |done: f64, what: &str| rays.advance(done as u64, &format!("{}: {what}", case.name));
-        let results = jobs::run_jobs(
-            &case.scene,
-            &case.config,
-            &setup,
-            &jobs,
-            render,
-            &host,
-            &label,
-        );
+        label(0.0, "converged reference and regions");
+        let setup = Setup::new(scene, &case.bytes, config, render, cache, progress.notice)?;
+        let results = jobs::run_jobs(scene, config, &setup, &jobs, render, &host, &label);
         out.push((c, setup.facts(), results));
     }
     Ok(out)
@@ -323,29 +305,16 @@ pub fn study(
     options.validate()?;
     create_out(&options.out)?;
     let cache = open_cache(options, progress.notice);
-    let identity = identity(cases, options.engine.name());
-    let selected: Vec<usize> = (0..identity.work.jobs().len()).collect();
-    let ran = run_selected(
-        cases,
-        &identity,
-        &selected,
-        cache.as_ref(),
-        render,
-        progress,
-    )?;
+    let engine = options.engine.name();
+    let identity = identity(cases, engine);
+    let all: Vec<usize> = (0..identity.work.jobs().len()).collect();
+    let ran = run_selected(cases, &identity, &all, cache.as_ref(), render, progress)?;
     let threads = rayon::current_num_threads();
     let results = ran
         .into_iter()
         .map(|(c, facts, results)| {
-            let case = &cases[c];
-            jobs::assemble(
-                &case.config,
-                &case.scene.source,
-                options.engine.name(),
-                threads,
-                facts,
-                results,
-            )
+            let (config, source) = (&cases[c].config, &cases[c].scene.source);
+            jobs::assemble(config, source, engine, threads, facts, results)
         })
         .collect::<Vec<_>>();
     let names: Vec<String> = cases.iter().map(|c| c.name.clone()).collect();
@@ -415,14 +384,13 @@ pub fn run_shard(
     create_out(&options.out)?;
     let cache = open_cache(options, progress.notice);
     let identity = identity(cases, options.engine.name());
-    let assignment = identity.work.assignment(shard.count);
-    let selected = &assignment[shard.index];
+    let items = shard.items(&identity.work.costs());
     let host = Host::start(rayon::current_num_threads());
-    let ran = run_selected(cases, &identity, selected, cache.as_ref(), render, progress)?;
+    let ran = run_selected(cases, &identity, &items, cache.as_ref(), render, progress)?;
     let mut part = Part {
         identity,
         shard,
-        items: selected.clone(),
+        items,
         host,
         extra: Vec::new(),
         results: Vec::new(),
@@ -434,7 +402,7 @@ pub fn run_shard(
     }
     part.host.finish();
     let path = crate::shard::write_part(&options.out, &part)?;
-    Ok((path, selected.len()))
+    Ok((path, part.items.len()))
 }
 
 /// Fills the cache with the converged reference of every case (`raywave variance prepare`);

@@ -133,19 +133,12 @@ pub fn merge(inputs: &[PathBuf], out: &Path, notice: &(dyn Fn(&str) + Sync)) -> 
         results[r.job.case].push(r);
     }
     let mut studies = Vec::new();
-    for (c, case) in study.cases.iter().enumerate() {
-        let Some((f, source, threads, _)) = &facts[c] else {
+    for ((facts, jobs), case) in facts.into_iter().zip(results).zip(&study.cases) {
+        let Some((f, source, threads, _)) = facts else {
             bail!("no part holds the setup of case {}", case.name);
         };
-        let jobs = std::mem::take(&mut results[c]);
-        studies.push(jobs::assemble(
-            &case.config,
-            source,
-            &study.engine,
-            *threads,
-            f.clone(),
-            jobs,
-        ));
+        let result = jobs::assemble(&case.config, &source, &study.engine, threads, f, jobs);
+        studies.push(result);
     }
     let names: Vec<String> = study.cases.iter().map(|c| c.name.clone()).collect();
     let outcome = write_report(&names, studies, out, notice)?;

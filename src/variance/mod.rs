@@ -68,7 +68,7 @@ pub struct StudyConfig {
 }
 
 impl StudyConfig {
-    /// The defaults: N = 1, 4, 16, 64, 256, every sampler, 8 seeds, at 128×128.
+    /// The command's defaults: N = 1, 4, 16, 64, 256, every sampler, 8 seeds, at 128×128.
     pub fn standard(base: RenderSettings) -> Self {
         StudyConfig {
             base: RenderSettings {
@@ -171,24 +171,11 @@ pub fn converged_reference(
             films
         }
     };
-    let film = Film {
-        width: a.width,
-        height: a.height,
-        pixels: a
-            .pixels
-            .iter()
-            .zip(&b.pixels)
-            .map(|(x, y)| (*x + *y) * 0.5)
-            .collect(),
-    };
-    let noise = a
-        .pixels
-        .iter()
-        .zip(&b.pixels)
-        .map(|(x, y)| ((*x - *y) * (*x - *y)).element_sum() / 12.0)
-        .collect();
+    let (pixels, noise) = (a.pixels.iter().zip(&b.pixels))
+        .map(|(&x, &y)| ((x + y) * 0.5, ((x - y) * (x - y)).element_sum() / 12.0))
+        .unzip();
     Ok(Converged {
-        film,
+        film: Film { pixels, ..a },
         noise,
         cached,
     })
@@ -336,14 +323,9 @@ pub fn run_study(
     let progress = |done: f64, label: &str| rays.advance(done as u64, label);
     let host = crate::output::machine::hostname();
     let results = jobs::run_jobs(scene, config, &setup, &all, render, &host, &progress);
-    Ok(jobs::assemble(
-        config,
-        &scene.source,
-        engine,
-        rayon::current_num_threads(),
-        setup.facts(),
-        results,
-    ))
+    let (threads, facts) = (rayon::current_num_threads(), setup.facts());
+    let study = jobs::assemble(config, &scene.source, engine, threads, facts, results);
+    Ok(study)
 }
 
 impl StudyResult {

@@ -25,14 +25,11 @@ impl Format for Bmf {
     fn text(&self, records: &[BenchRecord], _labels: &[String], by_host: bool) -> Result<String> {
         let mut out = BTreeMap::new();
         for (name, _, f) in figures(records, by_host)? {
-            let (lower_value, upper_value) = match (f.low, f.high) {
-                (Some(low), Some(high)) => (Some(low), Some(high)),
-                _ => (None, None),
-            };
+            let bounds = f.low.zip(f.high);
             let metric = Metric {
                 value: f.median,
-                lower_value,
-                upper_value,
+                lower_value: bounds.map(|(low, _)| low),
+                upper_value: bounds.map(|(_, high)| high),
             };
             let measure = if f.unit == "rays/s" {
                 "rays-per-second"

@@ -40,20 +40,15 @@ impl Format for GithubActionBenchmark {
                     ),
                 ),
             };
+            let commit = r.build.short_commit();
             out.push(Entry {
                 name,
                 unit: f.unit.clone(),
                 value: f.median,
                 range,
                 extra: format!(
-                    "{interval}\n{} runs, min {}, max {}\nhost {} ({})\nraywave {}, commit {}",
-                    f.runs,
-                    f.min,
-                    f.max,
-                    r.machine.hostname,
-                    r.machine.cpu,
-                    r.raywave,
-                    r.build.short_commit()
+                    "{interval}\n{} runs, min {}, max {}\nhost {} ({})\nraywave {}, commit {commit}",
+                    f.runs, f.min, f.max, r.machine.hostname, r.machine.cpu, r.raywave
                 ),
             });
         }

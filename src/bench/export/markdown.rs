@@ -27,15 +27,11 @@ impl Format for Markdown {
                     if by_host {
                         out.push_str(&format!("| {} ", r.machine.hostname));
                     }
+                    let [median, min, max] = [f.median, f.min, f.max].map(|v| v / 1e6);
+                    let interval = f.interval_text(1e-6, 2);
                     out.push_str(&format!(
-                        "| {point} | {} | {} | {:.2} | {} | {:.2} | {:.2} | M{} |\n",
-                        e.engine,
-                        f.figure,
-                        f.median / 1e6,
-                        f.interval_text(1e-6, 2),
-                        f.min / 1e6,
-                        f.max / 1e6,
-                        f.unit
+                        "| {point} | {} | {} | {median:.2} | {interval} | {min:.2} | {max:.2} | M{} |\n",
+                        e.engine, f.figure, f.unit
                     ));
                 }
             }

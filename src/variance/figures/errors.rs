@@ -32,10 +32,7 @@ pub fn error_stats(
     region: &[bool],
 ) -> ErrorStats {
     let k = images.len();
-    let mut sum_sq = 0.0f64;
-    let mut sum = 0.0f64;
-    let mut sum_var = 0.0f64;
-    let mut ref_var = 0.0f64;
+    let [mut sum_sq, mut sum, mut sum_var, mut ref_var] = [0.0f64; 4];
     let mut pixels = 0usize;
     // Each image's summed error over the region: its mean error, times 3P.
     let mut image_sums = vec![0.0f64; k];

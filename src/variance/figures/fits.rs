@@ -64,16 +64,8 @@ pub(crate) fn mean_at(xs: &[f64], idx: Option<&[usize]>) -> f64 {
 /// The log-log fit of `rows` (one sampler and region, the fitted budgets), on the seeds `idx`
 /// (a bootstrap resample) or on the rows' own MSE.
 pub(crate) fn fit_rows(rows: &[&Row], idx: Option<&[usize]>) -> Option<LogLogFit> {
-    let pts: Vec<(f64, f64)> = rows
-        .iter()
-        .map(|r| {
-            let mse = match idx {
-                Some(_) => mean_at(&r.seed_mse, idx),
-                None => r.stats.mse,
-            };
-            (r.n as f64, mse)
-        })
-        .collect();
+    let mse = |r: &Row| idx.map_or(r.stats.mse, |_| mean_at(&r.seed_mse, idx));
+    let pts: Vec<(f64, f64)> = rows.iter().map(|r| (r.n as f64, mse(r))).collect();
     loglog_fit(&pts)
 }
 

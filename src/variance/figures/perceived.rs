@@ -38,9 +38,6 @@ pub struct Perceived {
     /// Per seed: low-band power.
     #[serde(skip)]
     pub seed_low_band: Vec<f64>,
-    /// Per seed: low-pass MSE at each σ.
-    #[serde(skip)]
-    pub seed_lowpass: [Vec<f64>; 2],
 }
 
 /// The error image of `image` against `reference`: the mean of the three channels' difference.
@@ -85,8 +82,6 @@ pub fn measure(
         low_band_interval: interval(k, |idx| mean_at(&seed_low_band, Some(idx))),
         low_band_share: mean_at(&seed_share, None),
         low_band_share_interval: interval(k, |idx| mean_at(&seed_share, Some(idx))),
-        low_band_vs_random: None,
-        low_band_vs_random_interval: None,
         spectrum: (0..RINGS).map(|i| mean_at(&ring(i), None)).collect(),
         spectrum_interval: (0..RINGS)
             .map(|i| {
@@ -95,7 +90,7 @@ pub fn measure(
             })
             .collect(),
         seed_low_band,
-        seed_lowpass,
+        ..Perceived::default()
     }
 }
 

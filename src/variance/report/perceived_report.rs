@@ -1,10 +1,11 @@
 //! The perceived-error part of a study's report: a table of each sampler's low-pass error and
 //! low band against random's, per budget and region, and the CSV files behind the spectra.
 
+use crate::output::terminal::table_line;
 use crate::variance::StudyResult;
 use crate::variance::figures::spectrum::{LOWPASS_SIGMAS, RINGS, ring_frequency};
 use crate::variance::report::spectrum_plot::REGIONS;
-use crate::variance::report::tables::{iv_cells, with_interval};
+use crate::variance::report::tables::{iv_cells, sci_cell, with_interval};
 use std::fmt::Write;
 
 /// `v` with its interval, scientific: `6.4e-5 [6.1e-5, 6.8e-5]`; `-` for a figure with nothing
@@ -16,13 +17,16 @@ fn sci(v: f64, iv: Option<[f64; 2]>) -> String {
     with_interval(format!("{v:.2e}"), iv, |x| format!("{x:.1e}"))
 }
 
-/// `v` with its interval, fixed: `0.42 [0.31, 0.55]`; `-` as for [`sci`].
-fn fixed(v: f64, iv: Option<[f64; 2]>) -> String {
-    if !v.is_finite() {
-        return "-".into();
+/// `v` with its interval, fixed: `0.42 [0.31, 0.55]`; `-` as for [`sci`], and without a value.
+fn fixed(v: impl Into<Option<f64>>, iv: Option<[f64; 2]>) -> String {
+    match v.into().filter(|v| v.is_finite()) {
+        Some(v) => with_interval(format!("{v:.2}"), iv, |x| format!("{x:.2}")),
+        None => "-".into(),
     }
-    with_interval(format!("{v:.2}"), iv, |x| format!("{x:.2}"))
 }
+
+/// The columns of the table (`table_line`'s widths).
+const COLUMNS: [i16; 7] = [-10, 5, -28, -28, -28, -22, -22];
 
 impl StudyResult {
     /// The table of where the error sits: per region (whole, penumbra), per sampler and N,
@@ -43,31 +47,22 @@ impl StudyResult {
                 continue;
             }
             let _ = writeln!(s, "\n{}", region.name());
-            let _ = writeln!(
-                s,
-                "  {:<10} {:>5} {:<28} {:<28} {:<28} {:<22}",
-                "sampler",
-                "N",
-                "blur σ=1 MSE [95%]",
-                "blur σ=2 MSE [95%]",
-                "low band [95%]",
-                "low band / random's"
-            );
+            // The header has no title over the last column, the low band's share.
+            let header = "sampler|N|blur σ=1 MSE [95%]|blur σ=2 MSE [95%]|low band [95%]|\
+                          low band / random's";
+            let _ = writeln!(s, "  {}", table_line(&COLUMNS, header.split('|')));
             for r in self.rows.iter().filter(|r| r.region == region) {
                 let p = &r.perceived;
-                let _ = writeln!(
-                    s,
-                    "  {:<10} {:>5} {:<28} {:<28} {:<28} {:<22} {:<22}",
+                let cells = [
                     r.sampler,
-                    r.n,
-                    sci(p.lowpass_mse[0], p.lowpass_interval[0]),
-                    sci(p.lowpass_mse[1], p.lowpass_interval[1]),
-                    sci(p.low_band_power, p.low_band_interval),
-                    p.low_band_vs_random
-                        .map(|v| fixed(v, p.low_band_vs_random_interval))
-                        .unwrap_or_else(|| "-".into()),
-                    fixed(p.low_band_share, p.low_band_share_interval)
-                );
+                    &r.n.to_string(),
+                    &sci(p.lowpass_mse[0], p.lowpass_interval[0]),
+                    &sci(p.lowpass_mse[1], p.lowpass_interval[1]),
+                    &sci(p.low_band_power, p.low_band_interval),
+                    &fixed(p.low_band_vs_random, p.low_band_vs_random_interval),
+                    &fixed(p.low_band_share, p.low_band_share_interval),
+                ];
+                let _ = writeln!(s, "  {}", table_line(&COLUMNS, cells));
             }
         }
         s
@@ -95,9 +90,7 @@ impl StudyResult {
                 iv_cells(p.lowpass_interval[1]),
                 p.low_band_power,
                 iv_cells(p.low_band_interval),
-                p.low_band_vs_random
-                    .map(|v| format!("{v:e}"))
-                    .unwrap_or_default(),
+                sci_cell(p.low_band_vs_random),
                 iv_cells(p.low_band_vs_random_interval),
                 p.low_band_share,
                 iv_cells(p.low_band_share_interval)
@@ -112,7 +105,6 @@ impl StudyResult {
         for r in &self.rows {
             let p = &r.perceived;
             for ring in 0..RINGS.min(p.spectrum.len()) {
-                let power = p.spectrum[ring];
                 let _ = writeln!(
                     s,
                     "{},{},{},{ring},{},{},{}",
@@ -120,11 +112,7 @@ impl StudyResult {
                     r.n,
                     r.region.name(),
                     ring_frequency(ring),
-                    if power.is_finite() {
-                        format!("{power:e}")
-                    } else {
-                        String::new()
-                    },
+                    sci_cell(Some(p.spectrum[ring]).filter(|x| x.is_finite())),
                     iv_cells(
                         p.spectrum_interval[ring].filter(|[a, b]| a.is_finite() && b.is_finite())
                     )

@@ -64,7 +64,7 @@ pub(crate) fn log_range(
 }
 
 /// `v` and the ends of its interval (`v` again without one), for an axis's range.
-pub(crate) fn with_ends(v: f64, iv: Option<[f64; 2]>) -> [f64; 3] {
+pub(crate) fn with_ends((v, iv): (f64, Option<[f64; 2]>)) -> [f64; 3] {
     let [a, b] = iv.unwrap_or([v; 2]);
     [v, a, b]
 }
@@ -84,12 +84,9 @@ fn panel(
         .collect();
     let y_values = rows
         .iter()
-        .flat_map(|r| with_ends(r.stats.mse, r.mse_interval));
+        .flat_map(|r| with_ends((r.stats.mse, r.mse_interval)));
     let (y_lo, y_hi) = log_range(y_values, 1.6, (1e-6, 1.0));
-    let x_values = rows.iter().flat_map(|r| {
-        let (x, iv) = x_of(r, axis);
-        with_ends(x, iv)
-    });
+    let x_values = rows.iter().flat_map(|r| with_ends(x_of(r, axis)));
     let (x_lo, x_hi) = log_range(x_values, 1.5, (0.5, 400.0));
     let (what, x_desc) = match axis {
         Axis::Budget => ("MSE against N", "light samples N"),
@@ -235,22 +232,15 @@ pub(crate) fn heatmaps(result: &StudyResult, dir: &Path) -> Result<Vec<PathBuf>>
         return Ok(Vec::new());
     };
     let (w, h) = (result.config.base.width, result.config.base.height);
-    let n = result.config.heatmap_n;
+    let (n, seeds) = (result.config.heatmap_n, result.config.seeds);
+    let bar = "MSE per pixel, mean of R, G, B; one scale for all samplers";
     let mut written = Vec::new();
     for (sampler, map) in &result.heatmaps {
         let title = format!(
-            "{}, N = {n}: per-pixel MSE over {} seeds",
-            sampler.name(),
-            result.config.seeds
+            "{}, N = {n}: per-pixel MSE over {seeds} seeds",
+            sampler.name()
         );
-        let img = figure(
-            map,
-            w,
-            h,
-            &scale,
-            &title,
-            "MSE per pixel, mean of R, G, B; one scale for all samplers",
-        )?;
+        let img = figure(map, w, h, &scale, &title, bar)?;
         let path = dir.join(format!("heat_{}_N{n}.png", sampler.name()));
         write_rgb8(&img, &path)?;
         written.push(path);

@@ -125,11 +125,9 @@ fn draw_curves(
     let err = |e| anyhow!("plot: {e}");
     let values = curves.iter().flat_map(|c| {
         let p = c.perceived;
-        let ends = p.spectrum_interval.iter();
-        p.spectrum
-            .iter()
-            .zip(ends)
-            .flat_map(|(v, iv)| with_ends(*v, *iv))
+        (p.spectrum.iter().copied())
+            .zip(p.spectrum_interval.iter().copied())
+            .flat_map(with_ends)
     });
     let (y_lo, y_hi) = log_range(values, 1.5, (1e-8, 1.0));
     let mut chart = ChartBuilder::on(area)

@@ -12,6 +12,7 @@
 //! The cases are the study's, not a sample of all scenes: the interval does not say how another
 //! scene would fare.
 
+use crate::output::terminal::table_line;
 use crate::render::sampling::LightSampler;
 use crate::stats::{BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED, grouped_bootstrap_interval};
 use crate::variance::figures::fits::{against_random, fit_rows, fitted, mean_at};
@@ -179,6 +180,9 @@ fn figure(v: Option<f64>, iv: Option<[f64; 2]>) -> String {
     }
 }
 
+/// The columns of a case's slopes (`table_line`'s widths).
+const COLUMNS: [i16; 3] = [-10, -28, -28];
+
 fn opt(v: Option<f64>) -> String {
     v.map_or(String::new(), |v| v.to_string())
 }
@@ -194,11 +198,8 @@ impl Summary {
                 "\n== {name}: {} at {}×{} (report in {name}/) ==",
                 case.scene, case.config.base.width, case.config.base.height
             );
-            let _ = writeln!(
-                s,
-                "  {:<10} {:<28} {:<28}",
-                "sampler", "slope whole [95%]", "slope penumbra [95%]"
-            );
+            let header = ["sampler", "slope whole [95%]", "slope penumbra [95%]"];
+            let _ = writeln!(s, "  {}", table_line(&COLUMNS, header));
             for &sampler in &case.config.samplers {
                 let fit = |region: Region| {
                     case.slopes
@@ -208,13 +209,8 @@ impl Summary {
                             figure(x.fit.map(|f| f.slope), x.slope_interval)
                         })
                 };
-                let _ = writeln!(
-                    s,
-                    "  {:<10} {:<28} {:<28}",
-                    sampler.name(),
-                    fit(Region::Whole),
-                    fit(Region::Penumbra)
-                );
+                let cells = [sampler.name(), &fit(Region::Whole), &fit(Region::Penumbra)];
+                let _ = writeln!(s, "  {}", table_line(&COLUMNS, cells));
             }
         }
         let _ = writeln!(

@@ -5,6 +5,7 @@
 
 use super::{plot, sheet, spectrum_plot};
 use crate::output::machine::Machine;
+use crate::output::terminal::table_line;
 use crate::render::sampling::LightSampler;
 use crate::variance::figures::fits::{LAB_RANDOM_POINTS, against_random};
 use crate::variance::{Region, Row, StudyConfig, StudyResult, unique};
@@ -194,6 +195,11 @@ pub(crate) fn iv_cells(iv: Option<[f64; 2]>) -> String {
     }
 }
 
+/// A value as a CSV cell, empty without one.
+pub(crate) fn sci_cell(v: Option<f64>) -> String {
+    v.map_or(String::new(), |v| format!("{v:e}"))
+}
+
 /// `text`, or `inf` where `x` is not finite (an unbounded end).
 fn or_inf(x: f64, text: String) -> String {
     if x.is_finite() { text } else { "inf".into() }
@@ -217,11 +223,14 @@ fn region_row(s: &mut String, sampler: &str, cell: impl Fn(Region) -> String) {
     );
 }
 
-/// A fixed-point value with its interval: `-1.49 [-1.55, -1.43]`.
-fn fixed_iv(v: f64, iv: Option<[f64; 2]>, digits: usize) -> String {
+/// A fixed-point value with its interval: `-1.49 [-1.55, -1.43]`; `-` without a value.
+fn fixed_iv(v: impl Into<Option<f64>>, iv: Option<[f64; 2]>, digits: usize) -> String {
     let e = |x: f64| or_inf(x, format!("{x:.digits$}"));
-    with_interval(e(v), iv, e)
+    v.into().map_or("-".into(), |v| with_interval(e(v), iv, e))
 }
+
+/// The columns of a region's table (`table_line`'s widths).
+const COLUMNS: [i16; 11] = [-10, 5, -29, -22, 10, 9, 10, -22, 7, -29, -20];
 
 impl StudyResult {
     /// The per-seed rows, seeds 1..=K.
@@ -246,17 +255,11 @@ impl StudyResult {
     /// A readable report: one table per region, the slopes and matching budgets with their
     /// 95% intervals, and the checks.
     pub fn table(&self) -> String {
-        let mut s = String::new();
+        let (mut s, base, seeds) = (String::new(), &self.config.base, self.config.seeds);
         let _ = writeln!(
             s,
-            "variance study: {} at {}×{}, {} bounces, {} seeds per point, engine {}, {} threads",
-            self.scene,
-            self.config.base.width,
-            self.config.base.height,
-            self.config.base.bounces,
-            self.config.seeds,
-            self.engine,
-            self.threads
+            "variance study: {} at {}×{}, {} bounces, {seeds} seeds per point, engine {}, {} threads",
+            self.scene, base.width, base.height, base.bounces, self.engine, self.threads
         );
         let _ = writeln!(
             s,
@@ -289,21 +292,9 @@ impl StudyResult {
                 self.facts.reference_mse[i],
                 self.reference_margin(*region)
             );
-            let _ = writeln!(
-                s,
-                "  {:<10} {:>5} {:<29} {:<22} {:>10} {:>9} {:>10} {:<22} {:>7} {:<29} {:<20}",
-                "sampler",
-                "N",
-                "MSE [95%]",
-                "random/MSE [95%]",
-                "bias",
-                "±bound",
-                "variance",
-                "ms/image [95%]",
-                "Mrays/s",
-                "1/(MSE·s) [95%]",
-                "vs random [95%]"
-            );
+            let header = "sampler|N|MSE [95%]|random/MSE [95%]|bias|±bound|variance|\
+                          ms/image [95%]|Mrays/s|1/(MSE·s) [95%]|vs random [95%]";
+            let _ = writeln!(s, "  {}", table_line(&COLUMNS, header.split('|')));
             for r in self.rows.iter().filter(|r| r.region == *region) {
                 let ms = r.seconds_interval.map(|[a, b]| [a * 1e3, b * 1e3]);
                 let mut notes = Vec::new();
@@ -313,30 +304,24 @@ impl StudyResult {
                 if r.excluded_from_fit {
                     notes.push("not fitted");
                 }
-                let _ = writeln!(
-                    s,
-                    "  {:<10} {:>5} {:<29} {:<22} {:>10.2e} {:>9.2e} {:>10.3e} {:<22} {:>7.2} {:<29} {:<20}{}",
+                let cells = [
                     r.sampler,
-                    r.n,
-                    sci_iv(r.stats.mse, r.mse_interval),
-                    r.error_reduction
-                        .map(|v| fixed_iv(v, r.error_reduction_interval, 2))
-                        .unwrap_or_else(|| "-".into()),
-                    r.stats.bias,
-                    r.stats.bias_bound,
-                    r.stats.variance,
-                    fixed_iv(r.seconds * 1e3, ms, 2),
-                    r.rays_per_second / 1e6,
-                    sci_iv(r.efficiency, r.efficiency_interval),
-                    r.efficiency_vs_random
-                        .map(|v| fixed_iv(v, r.efficiency_vs_random_interval, 2))
-                        .unwrap_or_else(|| "-".into()),
-                    if notes.is_empty() {
-                        String::new()
-                    } else {
-                        format!("  {}", notes.join(", "))
-                    }
-                );
+                    &r.n.to_string(),
+                    &sci_iv(r.stats.mse, r.mse_interval),
+                    &fixed_iv(r.error_reduction, r.error_reduction_interval, 2),
+                    &format!("{:.2e}", r.stats.bias),
+                    &format!("{:.2e}", r.stats.bias_bound),
+                    &format!("{:.3e}", r.stats.variance),
+                    &fixed_iv(r.seconds * 1e3, ms, 2),
+                    &format!("{:.2}", r.rays_per_second / 1e6),
+                    &sci_iv(r.efficiency, r.efficiency_interval),
+                    &fixed_iv(r.efficiency_vs_random, r.efficiency_vs_random_interval, 2),
+                ];
+                let notes = match notes.is_empty() {
+                    true => String::new(),
+                    false => format!("  {}", notes.join(", ")),
+                };
+                let _ = writeln!(s, "  {}{notes}", table_line(&COLUMNS, cells));
             }
         }
         let _ = writeln!(
@@ -406,13 +391,9 @@ impl StudyResult {
                 r.rays_per_second,
                 r.efficiency,
                 iv_cells(r.efficiency_interval),
-                r.efficiency_vs_random
-                    .map(|v| format!("{v:e}"))
-                    .unwrap_or_default(),
+                sci_cell(r.efficiency_vs_random),
                 iv_cells(r.efficiency_vs_random_interval),
-                r.error_reduction
-                    .map(|v| format!("{v:e}"))
-                    .unwrap_or_default(),
+                sci_cell(r.error_reduction),
                 iv_cells(r.error_reduction_interval),
                 r.host
             );
@@ -424,16 +405,11 @@ impl StudyResult {
     fn seeds_csv(&self) -> String {
         let mut s = String::from("sampler,n,region,seed,mse,bias,seconds\n");
         for r in self.seed_rows() {
+            let region = r.region.name();
             let _ = writeln!(
                 s,
-                "{},{},{},{},{:e},{:e},{:e}",
-                r.sampler,
-                r.n,
-                r.region.name(),
-                r.seed,
-                r.mse,
-                r.bias,
-                r.seconds
+                "{},{},{region},{},{:e},{:e},{:e}",
+                r.sampler, r.n, r.seed, r.mse, r.bias, r.seconds
             );
         }
         s

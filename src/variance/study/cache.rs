@@ -224,13 +224,11 @@ impl Cache {
         }
         std::fs::create_dir_all(&self.dir)
             .with_context(|| format!("cannot create {}", self.dir.display()))?;
-        let floats = || {
-            films
-                .iter()
-                .flat_map(|f| &f.pixels)
-                .flat_map(|c| c.to_array())
-        };
-        let sum = floats().fold(digest::START, |h, x| digest::continued(h, &x.to_le_bytes()));
+        let pixels = films.iter().flat_map(|f| &f.pixels);
+        let payload: Vec<u8> = pixels
+            .flat_map(|c| c.to_array().map(f32::to_le_bytes))
+            .flatten()
+            .collect();
         // At once, not held for the run's commit: the study reads its references back, and
         // a reference rendered is worth keeping even if the study then fails.
         crate::output::write_output_now(&path, |w| {
@@ -239,10 +237,8 @@ impl Cache {
                 w.write_all(&v.to_le_bytes())?;
             }
             w.write_all(&key.to_le_bytes())?;
-            w.write_all(&sum.to_le_bytes())?;
-            for x in floats() {
-                w.write_all(&x.to_le_bytes())?;
-            }
+            w.write_all(&digest::of(&payload).to_le_bytes())?;
+            w.write_all(&payload)?;
             Ok(())
         })?;
         self.evict(&path);

@@ -12,7 +12,6 @@ pub struct JobRecord {
     rows: Vec<RowRecord>,
     heatmap: Option<Vec<f32>>,
     thumbnail: Thumbnail,
-    host: String,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -22,7 +21,6 @@ struct RowRecord {
     seed_bias: Vec<f64>,
     seed_seconds: Vec<f64>,
     seed_low_band: Vec<f64>,
-    seed_lowpass: [Vec<f64>; 2],
 }
 
 impl From<JobResult> for JobRecord {
@@ -35,7 +33,6 @@ impl From<JobResult> for JobRecord {
                 seed_bias: std::mem::take(&mut row.seed_bias),
                 seed_seconds: std::mem::take(&mut row.seed_seconds),
                 seed_low_band: std::mem::take(&mut row.perceived.seed_low_band),
-                seed_lowpass: std::mem::take(&mut row.perceived.seed_lowpass),
                 row,
             })
             .collect();
@@ -44,7 +41,6 @@ impl From<JobResult> for JobRecord {
             rows,
             heatmap: r.heatmap,
             thumbnail: r.thumbnail,
-            host: r.host,
         }
     }
 }
@@ -60,7 +56,6 @@ impl From<JobRecord> for JobResult {
                 row.seed_bias = rec.seed_bias;
                 row.seed_seconds = rec.seed_seconds;
                 row.perceived.seed_low_band = rec.seed_low_band;
-                row.perceived.seed_lowpass = rec.seed_lowpass;
                 row
             })
             .collect();
@@ -69,7 +64,6 @@ impl From<JobRecord> for JobResult {
             rows,
             heatmap: r.heatmap,
             thumbnail: r.thumbnail,
-            host: r.host,
         }
     }
 }

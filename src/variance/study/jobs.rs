@@ -88,26 +88,21 @@ impl Setup {
     ) -> Result<Setup> {
         let reference = converged_reference(scene, scene_id, config, render, cache, notice)?;
         let regions = penumbra_mask(scene, &config.base, config.mask_samples);
-        let masks = [
-            regions.whole(),
-            regions.penumbra.clone(),
-            regions.lit.clone(),
-        ];
+        let masks = [regions.whole(), regions.penumbra, regions.lit];
         Ok(Setup { reference, masks })
     }
 
     /// Pixels per region and the reference's own MSE per region.
     pub fn facts(&self) -> CaseFacts {
-        let region_pixels = self.masks.clone().map(|m| m.iter().filter(|&&b| b).count());
-        let reference_mse = self.masks.clone().map(|m| {
-            let (sum, count) = self
-                .reference
-                .noise
-                .iter()
-                .zip(&m)
-                .filter(|(_, in_region)| **in_region)
-                .fold((0.0f64, 0usize), |(s, c), (v, _)| (s + *v as f64, c + 1));
-            if count == 0 { 0.0 } else { sum / count as f64 }
+        let noise = |i: usize| {
+            let in_region = self.reference.noise.iter().zip(&self.masks[i]);
+            in_region
+                .filter(|(_, inside)| **inside)
+                .map(|(v, _)| *v as f64)
+        };
+        let region_pixels: [usize; 3] = std::array::from_fn(|i| noise(i).count());
+        let reference_mse = std::array::from_fn(|i| {
+            noise(i).fold(0.0, |s, v| s + v) / region_pixels[i].max(1) as f64
         });
         CaseFacts {
             region_pixels,
@@ -140,8 +135,6 @@ pub struct JobResult {
     pub heatmap: Option<Vec<f32>>,
     /// The warm-up render (seed 0).
     pub thumbnail: Thumbnail,
-    /// The host whose clock timed the renders.
-    pub host: String,
 }
 
 /// The rows of `job` from its timed images: their seconds each, and rays per image.
@@ -153,21 +146,18 @@ fn rows_of(
     setup: &Setup,
     host: &str,
 ) -> Vec<Row> {
-    let (reference, k) = (&setup.reference, images.len());
+    let (film, k) = (&setup.reference.film, images.len());
     let (seconds, lo, hi) = crate::stats::median_with_interval(times);
     let seconds_interval = (lo.is_finite() && hi.is_finite()).then_some([lo, hi]);
     let excluded_sampler = deterministic(job.sampler, job.n);
-    let (width, height) = (
-        reference.film.width as usize,
-        reference.film.height as usize,
-    );
+    let (width, height) = (film.width as usize, film.height as usize);
     Region::ALL
         .iter()
         .zip(&setup.masks)
         .map(|(region, mask)| {
-            let stats = error_stats(images, &reference.film.pixels, &reference.noise, mask);
-            let perceived = perceived::measure(images, &reference.film.pixels, width, height, mask);
-            let per = per_image_errors(images, &reference.film.pixels, mask);
+            let stats = error_stats(images, &film.pixels, &setup.reference.noise, mask);
+            let perceived = perceived::measure(images, &film.pixels, width, height, mask);
+            let per = per_image_errors(images, &film.pixels, mask);
             let (seed_mse, seed_bias): (Vec<f64>, Vec<f64>) = per.into_iter().unzip();
             let mse_interval = fits::interval(k, |idx| fits::mean_at(&seed_mse, Some(idx)));
             let mut row = Row {
@@ -262,7 +252,6 @@ pub fn run_jobs(
                 rows,
                 heatmap,
                 thumbnail,
-                host: host.to_string(),
             });
         }
     }
