@@ -233,33 +233,19 @@ pub fn stale_manual(page: &Page) -> Vec<String> {
 /// The targets of one kind (`bench` or `test`) declared in the two manifests (the top one and
 /// tests/Cargo.toml's): name and path from the top folder (empty when the table gives none).
 fn targets(kind: &str) -> Vec<(String, String)> {
-    let header = format!("[[{kind}]]");
-    let mut out: Vec<(String, String)> = Vec::new();
+    let mut out = Vec::new();
     for folder in ["", "tests/"] {
-        let toml =
-            std::fs::read_to_string(Path::new(ROOT).join(folder).join("Cargo.toml")).unwrap();
-        let mut inside = false;
-        for line in toml.lines().map(str::trim) {
-            if line.starts_with('[') {
-                inside = line == header;
-                if inside {
-                    out.push((String::new(), String::new()));
-                }
-                continue;
-            }
-            let Some(last) = out.last_mut().filter(|_| inside) else {
-                continue;
-            };
-            let value = |v: &str| {
-                v.trim_start_matches([' ', '='])
-                    .trim_matches('"')
-                    .to_string()
-            };
-            if let Some(v) = line.strip_prefix("name") {
-                last.0 = value(v);
-            } else if let Some(v) = line.strip_prefix("path") {
-                last.1 = format!("{folder}{}", value(v));
-            }
+        let path = Path::new(ROOT).join(folder).join("Cargo.toml");
+        let manifest: toml::Table = std::fs::read_to_string(&path)
+            .unwrap()
+            .parse()
+            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let tables = manifest.get(kind).and_then(toml::Value::as_array);
+        for target in tables.into_iter().flatten() {
+            let field = |key: &str| target.get(key).and_then(toml::Value::as_str);
+            let name = field("name").unwrap_or_default().to_string();
+            let path = field("path").map_or(String::new(), |p| format!("{folder}{p}"));
+            out.push((name, path));
         }
     }
     out
