@@ -9,14 +9,9 @@ use crate::output::terminal::table_line;
 use serde_json::Value;
 use std::fmt::Write;
 
-/// The fields in which two setups differ, as `path: X in the record, Y now` lines (empty if
-/// none).
-pub fn setup_differences(before: &Setup, after: &Setup) -> Vec<String> {
-    setup_differences_as(before, after, "in the record", "now")
-}
-
-/// [`setup_differences`] with the two sides named (`in A`, `in B`).
-pub fn setup_differences_as(before: &Setup, after: &Setup, a: &str, b: &str) -> Vec<String> {
+/// The fields in which two setups differ, as `path: X A, Y B` lines with the sides named `a`
+/// and `b` (`in the record` and `now`, `in A` and `in B`); empty if none.
+pub fn setup_differences(before: &Setup, after: &Setup, a: &str, b: &str) -> Vec<String> {
     let mut out = Vec::new();
     let value = |s: &Setup| serde_json::to_value(s).unwrap_or_default();
     diff("", &value(before), &value(after), &mut |path, x, y| {
@@ -81,14 +76,10 @@ impl Comparison {
         self.rows.iter().any(|r| r.verdict == Verdict::Slower)
     }
 
-    /// The before/after table, the rule, the notes and the verdict, as `raywave bench
-    /// --compare` prints them (columns "before" and "after").
-    pub fn table(&self) -> String {
-        self.table_with("before", "after")
-    }
-
-    /// The table with the two columns named `a` and `b` (`raywave bench compare A B`).
-    pub fn table_with(&self, a: &str, b: &str) -> String {
+    /// The before/after table, the rule, the notes and the verdict, with the two columns named
+    /// `a` and `b` ("before" and "after" for `raywave bench --compare`, "A" and "B" for
+    /// `raywave bench compare A B`).
+    pub fn table(&self, a: &str, b: &str) -> String {
         let (mut s, t) = (String::new(), self.threshold_pct);
         // In the unit the tables print: Mrays/s or Mrays/thread-s.
         let cell =
@@ -226,7 +217,7 @@ pub fn compare(
     after: &BenchRecord,
     threshold_pct: f64,
 ) -> Result<Comparison, Refusal> {
-    let differences = setup_differences(&before.setup, &after.setup);
+    let differences = setup_differences(&before.setup, &after.setup, "in the record", "now");
     if !differences.is_empty() {
         return Err(Refusal::Setup(differences));
     }

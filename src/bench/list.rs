@@ -24,7 +24,7 @@ pub fn compare_saved(dir: &Path, a: &str, b: &str, threshold_pct: f64) -> Result
         let (why, lines) = match &r {
             Refusal::Setup(_) => (
                 "they were measured with different setups",
-                super::compare::setup_differences_as(&ra.setup, &rb.setup, "in A", "in B"),
+                super::compare::setup_differences(&ra.setup, &rb.setup, "in A", "in B"),
             ),
             Refusal::Incomparable(l) => (
                 "expected figures for every engine and stage of B, each a positive rate with \
@@ -44,7 +44,7 @@ pub fn compare_saved(dir: &Path, a: &str, b: &str, threshold_pct: f64) -> Result
         rb.timestamp,
         rb.build.short_commit()
     );
-    Ok((header + &c.table_with("A", "B"), c.regressed()))
+    Ok((header + &c.table("A", "B"), c.regressed()))
 }
 
 /// `raywave bench list`: one line per record in `dir`, oldest first, and one warning per file

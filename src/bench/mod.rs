@@ -195,7 +195,8 @@ pub fn run(args: &BenchOptions, progress: &Progress) -> Result<Outcome> {
             batch_size: DEFAULT_BATCH_SIZE,
         };
         if let Some((before, path)) = &baseline {
-            let differences = compare::setup_differences(&before.setup, &setup);
+            let differences =
+                compare::setup_differences(&before.setup, &setup, "in the record", "now");
             if !differences.is_empty() {
                 bail!(
                     "cannot compare with {}: it was measured with a different setup, so the \
@@ -394,7 +395,7 @@ impl Outcome {
                 compared_with.unwrap_or_default(),
                 before.timestamp,
                 before.build.short_commit(),
-                c.table()
+                c.table("before", "after")
             ));
         }
         out

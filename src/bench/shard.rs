@@ -92,7 +92,7 @@ impl Work for SweepPoints {
                 let at = Some(p.label.as_str())
                     .filter(|l| !l.is_empty())
                     .unwrap_or("point");
-                for d in super::compare::setup_differences_as(&p.setup, &q.setup, a, b) {
+                for d in super::compare::setup_differences(&p.setup, &q.setup, a, b) {
                     out.push(format!("{at}: {d}"));
                 }
             }

@@ -93,7 +93,7 @@ fn a_clear_slowdown_is_a_regression_and_the_table_shows_the_rule_inputs() {
         .find(|r| r.after.figure == "stage shadow")
         .unwrap();
     assert_eq!(shadow.verdict, Verdict::Within);
-    let table = c.table();
+    let table = c.table("before", "after");
     for needle in [
         "100.00 [97.00, 103.00]",
         "50.00 [48.00, 52.00]",
@@ -111,7 +111,7 @@ fn a_change_inside_the_noise_or_inside_the_threshold_is_not_a_regression() {
     let before = parse(&record((100.0, 60.0, 140.0), STEADY));
     let after = parse(&record((55.0, 40.0, 90.0), STEADY));
     let c = compare(&before, &after, 40.0).unwrap();
-    assert!(!c.regressed(), "{}", c.table());
+    assert!(!c.regressed(), "{}", c.table("before", "after"));
     assert_eq!(c.rows[0].verdict, Verdict::Undecided);
     // -10%, intervals apart: real, but inside the 40% threshold.
     let after = parse(&record((90.0, 89.0, 91.0), STEADY));
