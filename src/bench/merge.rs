@@ -11,10 +11,10 @@
 //! `--across-machines`, every report, row and exported name carries its host (name and CPU).
 
 use super::export::Exports;
-use super::running::sweep::{Point, record_name};
+use super::running::sweep::record_name;
 use super::shard::SweepPoints;
 use crate::output::OutputPlan;
-use crate::output::bench_record::{self as record, BenchRecord};
+use crate::output::bench_record::{self as record, BenchRecord, record_path};
 use crate::shard::Machines;
 use anyhow::Result;
 use std::fmt::Write as _;
@@ -78,21 +78,13 @@ pub fn merge(args: &MergeOptions) -> Result<Merged> {
     let records: Vec<BenchRecord> = rows.into_iter().map(|(_, r)| r).collect();
 
     // Every output is checked against the parts and each other before anything is written.
-    let mut to_save = Vec::new();
-    if let Some(name) = &args.save {
-        for label in &labels {
-            let point = Point {
-                label: label.clone(),
-                ..Point::default()
-            };
-            to_save.push(record::record_path(&args.dir, &record_name(name, &point))?);
-        }
-    }
+    let names = (args.save.iter()).flat_map(|n| labels.iter().map(move |l| record_name(n, l)));
+    let to_save = names
+        .map(|n| record_path(&args.dir, &n))
+        .collect::<Result<Vec<_>>>()?;
     let plan = (shards.parts.iter()).fold(OutputPlan::new(), |plan, (p, _)| plan.input("PARTS", p));
     let plan = (to_save.iter()).fold(plan, |plan, p| plan.output_in_new_dir("--save", p));
-    let plan =
-        (args.exports.flags().into_iter()).fold(plan, |plan, (flag, p)| plan.output(flag, p));
-    plan.check()?;
+    args.exports.plan(plan).check()?;
     for (path, r) in to_save.iter().zip(&records) {
         record::save(path, r)?;
     }

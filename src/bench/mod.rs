@@ -224,7 +224,7 @@ pub fn run(args: &BenchOptions, progress: &Progress) -> Result<Outcome> {
         let save = args
             .save
             .as_ref()
-            .map(|name| record::record_path(&args.dir, &sweep::record_name(name, &point)))
+            .map(|name| record::record_path(&args.dir, &sweep::record_name(name, &point.label)))
             .transpose()?;
         plans.push(Plan {
             point,

@@ -315,15 +315,13 @@ fn output_plan(args: &BenchArgs, points: &[raywave::bench::running::sweep::Point
     }
     if let Some(name) = &args.save {
         for point in points {
-            if let Ok(path) = record_path(&args.dir, &record_name(name, point)) {
+            if let Ok(path) = record_path(&args.dir, &record_name(name, &point.label)) {
                 plan = plan.output_in_new_dir("--save", &path);
             }
         }
     }
     plan = plan.output_if("--json", args.json.as_deref());
-    for (flag, path) in args.exports.exports().flags() {
-        plan = plan.output(flag, path);
-    }
+    plan = args.exports.exports().plan(plan);
     if let (Some(shard), Some(dir)) = (args.shard, &args.out) {
         plan = plan.output_in_new_dir("--out", &dir.join(part_name::<SweepPoints>(shard)));
     }
@@ -356,9 +354,7 @@ pub fn run(args: &BenchArgs, matches: Option<&ArgMatches>) -> Result<u8> {
                 across_machines: m.across_machines,
             };
             let text = merge::merge(&options)?.text(m.quiet);
-            let plan = (options.exports.flags().into_iter())
-                .fold(OutputPlan::new(), |plan, (flag, p)| plan.output(flag, p));
-            say(&plan, &text)?;
+            say(&options.exports.plan(OutputPlan::new()), &text)?;
             return Ok(0);
         }
         None => {}

@@ -9,6 +9,7 @@ mod github_action_benchmark;
 mod json;
 mod markdown;
 
+use crate::output::OutputPlan;
 use crate::output::bench_record::BenchRecord;
 use anyhow::Result;
 use std::io::Write;
@@ -49,12 +50,9 @@ pub struct Exports {
 }
 
 impl Exports {
-    /// Each export asked for, with its flag.
-    pub fn flags(&self) -> Vec<(&'static str, &Path)> {
-        self.asked()
-            .into_iter()
-            .map(|(flag, _, path)| (flag, path))
-            .collect()
+    /// `plan` with each export asked for among its outputs, under its flag.
+    pub fn plan(&self, plan: OutputPlan) -> OutputPlan {
+        (self.asked().into_iter()).fold(plan, |plan, (flag, _, path)| plan.output(flag, path))
     }
 
     /// Writes every export asked for, each atomically. `labels[i]` names point i; `by_host`

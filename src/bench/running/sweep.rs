@@ -66,12 +66,13 @@ impl Sweep {
     }
 }
 
-/// The record name of `point` under `--save NAME`: `NAME`, or `NAME+LABEL` in a sweep.
-pub fn record_name(name: &str, point: &Point) -> String {
-    if point.label.is_empty() {
+/// The record name of the point labelled `label` under `--save NAME`: `NAME`, or `NAME+LABEL`
+/// in a sweep.
+pub fn record_name(name: &str, label: &str) -> String {
+    if label.is_empty() {
         name.to_string()
     } else {
-        format!("{name}+{}", point.label)
+        format!("{name}+{label}")
     }
 }
 
@@ -94,7 +95,10 @@ mod tests {
         assert_eq!(sweep.points()[3].shadow_samples, Some(16));
         let one = Sweep::default().points();
         assert_eq!(one.len(), 1);
-        assert_eq!(record_name("base", &one[0]), "base");
-        assert_eq!(record_name("base", &sweep.points()[1]), "base+256x256+t2");
+        assert_eq!(record_name("base", &one[0].label), "base");
+        assert_eq!(
+            record_name("base", &sweep.points()[1].label),
+            "base+256x256+t2"
+        );
     }
 }
