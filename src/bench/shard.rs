@@ -108,27 +108,21 @@ impl Work for SweepPoints {
         let sweep = &identity.work;
         for (&i, r) in items.iter().zip(records) {
             let point = &sweep.points[i];
-            let at = Some(point.label.as_str())
-                .filter(|l| !l.is_empty())
-                .unwrap_or("the point");
-            if r.format != record::FORMAT {
-                return Some(format!(
-                    "{at}: record format {}, expected {}",
-                    r.format,
-                    record::FORMAT
-                ));
-            }
-            if r.setup != point.setup {
-                return Some(format!("{at}: the record's setup is not the sweep's"));
-            }
-            if (&r.raywave, &r.build, &r.simd)
+            let problem = if r.format != record::FORMAT {
+                format!("record format {}, expected {}", r.format, record::FORMAT)
+            } else if r.setup != point.setup {
+                "the record's setup is not the sweep's".to_string()
+            } else if (&r.raywave, &r.build, &r.simd)
                 != (&identity.raywave, &identity.build, &identity.simd)
             {
-                return Some(format!("{at}: the record's build is not the sweep's"));
-            }
-            if (r.runs, r.warmup) != (sweep.runs, sweep.warmup) {
-                return Some(format!("{at}: the record's run counts are not the sweep's"));
-            }
+                "the record's build is not the sweep's".to_string()
+            } else if (r.runs, r.warmup) != (sweep.runs, sweep.warmup) {
+                "the record's run counts are not the sweep's".to_string()
+            } else {
+                continue;
+            };
+            let at = Some(point.label.as_str()).filter(|l| !l.is_empty());
+            return Some(format!("{}: {problem}", at.unwrap_or("the point")));
         }
         None
     }
