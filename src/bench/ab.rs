@@ -30,7 +30,7 @@ use super::verdict::{RatioSummary, Rule, Verdict, summarize_at};
 use super::{EXIT_REGRESSION, EXIT_UNDECIDED};
 use crate::render::engine::Engine;
 use crate::render::error::UsageError;
-use crate::render::progress::{Progress, Steps};
+use crate::render::progress::Progress;
 use crate::stats::looks::{self, LookPlan};
 use crate::stats::{MIN_FOR_INTERVAL, median};
 use anyhow::{Context, Result, bail};
@@ -195,44 +195,6 @@ fn time_one(
     Ok((seconds, counts))
 }
 
-/// The two builds and a scratch directory for their files.
-struct Builds<'a> {
-    options: &'a AbOptions,
-    this: PathBuf,
-    scratch: tempfile::TempDir,
-}
-
-impl Builds<'_> {
-    /// Round `round` (counted from 0, warm-up included) of `engine`: this build's seconds and
-    /// the other's. Ray counts that differ are noted in `result`; `runs` steps after each run.
-    fn round(
-        &self,
-        engine: Engine,
-        round: u32,
-        result: &mut EngineAb,
-        runs: &Steps,
-    ) -> Result<(f64, f64)> {
-        let run = |binary: &Path| -> Result<(f64, String)> {
-            let time = time_one(binary, self.options, engine, self.scratch.path())?;
-            runs.step();
-            Ok(time)
-        };
-        // Alternate which build goes first, so that neither always runs on a warmer or cooler
-        // machine.
-        let (mine, theirs) = if round.is_multiple_of(2) {
-            let mine = run(&self.this)?;
-            (mine, run(&self.options.other)?)
-        } else {
-            let theirs = run(&self.options.other)?;
-            (run(&self.this)?, theirs)
-        };
-        if mine.1 != theirs.1 && result.different_work.is_none() {
-            result.different_work = Some((mine.1.clone(), theirs.1));
-        }
-        Ok((mine.0, theirs.0))
-    }
-}
-
 /// Runs the rounds, reporting each run to `progress` (of the runs in all; with `until_decided`,
 /// all that `max_rounds` allows).
 pub fn run(options: &AbOptions, progress: &Progress) -> Result<Vec<EngineAb>> {
@@ -247,14 +209,33 @@ pub fn run(options: &AbOptions, progress: &Progress) -> Result<Vec<EngineAb>> {
         )));
     }
     check_executable(&options.other)?;
-    let builds = Builds {
-        options,
-        this: std::env::current_exe().context("cannot find this build's own binary")?,
-        scratch: tempfile::tempdir().context("cannot make a scratch directory")?,
-    };
+    let this = std::env::current_exe().context("cannot find this build's own binary")?;
+    let scratch = tempfile::tempdir().context("cannot make a scratch directory")?;
     let engines = options.engines.len();
     let total = engines as u64 * u64::from(options.warmup + timed.1) * 2;
     let runs = progress.steps(total, "runs");
+    // Round `round` (counted from 0, warm-up included) of `engine`: this build's seconds and
+    // the other's, each run a step of `runs`. Ray counts that differ are noted in `result`.
+    let play = |engine: Engine, round: u32, result: &mut EngineAb| -> Result<(f64, f64)> {
+        let run = |binary: &Path| -> Result<(f64, String)> {
+            let time = time_one(binary, options, engine, scratch.path())?;
+            runs.step();
+            Ok(time)
+        };
+        // Alternate which build goes first, so that neither always runs on a warmer or cooler
+        // machine.
+        let (mine, theirs) = if round.is_multiple_of(2) {
+            let mine = run(&this)?;
+            (mine, run(&options.other)?)
+        } else {
+            let theirs = run(&options.other)?;
+            (run(&this)?, theirs)
+        };
+        if mine.1 != theirs.1 && result.different_work.is_none() {
+            result.different_work = Some((mine.1.clone(), theirs.1));
+        }
+        Ok((mine.0, theirs.0))
+    };
     let start = Instant::now();
     let mut results = Vec::new();
     for (i, &engine) in options.engines.iter().enumerate() {
@@ -267,11 +248,11 @@ pub fn run(options: &AbOptions, progress: &Progress) -> Result<Vec<EngineAb>> {
         };
         let engine_start = Instant::now();
         for round in 0..options.warmup {
-            builds.round(engine, round, &mut result, &runs)?;
+            play(engine, round, &mut result)?;
         }
         let Some(budget) = options.until_decided else {
             for round in options.warmup..options.warmup + options.rounds {
-                let (mine, theirs) = builds.round(engine, round, &mut result, &runs)?;
+                let (mine, theirs) = play(engine, round, &mut result)?;
                 result.this.push(mine);
                 result.other.push(theirs);
             }
@@ -292,7 +273,7 @@ pub fn run(options: &AbOptions, progress: &Progress) -> Result<Vec<EngineAb>> {
                 {
                     return Ok(None);
                 }
-                let (mine, theirs) = builds.round(engine, round, &mut result, &runs)?;
+                let (mine, theirs) = play(engine, round, &mut result)?;
                 round += 1;
                 result.this.push(mine);
                 result.other.push(theirs);
