@@ -347,10 +347,13 @@ fn band_levels(n: u32) -> std::ops::RangeInclusive<u32> {
     1..=n.trailing_zeros() + 2
 }
 
+/// One band level's (z, mean, standard error) of [`band_asymmetry`], or `None`.
+type Asymmetry = Option<(f64, f64, f64)>;
+
 /// For each band level, z of the per-stream difference (band − 2^-k)² − (shifted band −
 /// 2^-k)² over `STREAM_STREAMS` streams, its mean, and its standard error; `None` where
 /// both squared errors are the same in every stream (a net fixes both bands' counts).
-fn band_asymmetry(sampler: LightSampler, n: u32) -> Vec<(u32, Option<(f64, f64, f64)>)> {
+fn band_asymmetry(sampler: LightSampler, n: u32) -> Vec<(u32, Asymmetry)> {
     let set = point_set(sampler, n);
     let shift = symmetry_shift(sampler);
     let levels: Vec<u32> = band_levels(n).collect();
@@ -470,6 +473,9 @@ fn scrambled_nets_stay_within_owens_variance_bound() {
     failures.assert_none();
 }
 
+/// One coordinate of two streams' points, (a, b), per stream pair.
+type Pairs = Vec<(f64, f64)>;
+
 /// Stream pairs in the tests across pixels, seeds, bounces and lights.
 const PAIRS: u32 = 4096;
 
@@ -479,7 +485,7 @@ fn paired_points(
     sampler: LightSampler,
     n: u32,
     pair: impl Fn(u32) -> (SampleKey, SampleKey),
-) -> (Vec<(f64, f64)>, Vec<(f64, f64)>) {
+) -> (Pairs, Pairs) {
     let set = point_set(sampler, n);
     let (mut us, mut vs) = (Vec::new(), Vec::new());
     for t in 0..PAIRS {
