@@ -11,10 +11,14 @@ pub mod report;
 
 use crate::diff::{Image, read_image};
 use crate::output::OutputPlan;
+use crate::output::bench_record::KindFigures;
 use crate::output::cost_map::{self, CostInput, CostKind, CostMeasure};
 use crate::output::image_file::{OutputFormat, hdr_format, ldr_format, output_format};
+use crate::output::machine::Machine;
 use crate::output::memory::{self, RenderFootprint};
-use crate::output::render_record::TraversalFigures;
+use crate::output::render_record::{
+    DefaultsUsed, KindTiming, RenderRecord, SceneFigures, TraversalFigures,
+};
 use crate::render::camera::CameraRays;
 use crate::render::engine::{Engine, Prepared, clamped_warning};
 use crate::render::error::UsageError;
@@ -24,7 +28,6 @@ use crate::render::scene::{Scene, load_scene};
 use crate::render::settings::options::{Effective, ImageOptions};
 use crate::render::wavefront::lanes::LaneWidth;
 use crate::render::wavefront::shadow::ShadowPath;
-use crate::render::wavefront::stats::RenderStats;
 use anyhow::{Result, bail};
 use phases::Phases;
 use std::path::{Path, PathBuf};
@@ -70,28 +73,10 @@ pub struct Outcome {
     pub scene: Scene,
     /// The settings it was rendered with, and where each came from.
     pub effective: Effective,
-    /// The engine that rendered.
-    pub engine: Engine,
-    /// The SIMD path the engine ran on (`Prepared::simd_path`).
-    pub simd: &'static str,
-    /// Worker threads.
-    pub threads: usize,
-    /// Camera samples per wavefront tile.
-    pub batch_size: u32,
     /// How the wavefront engine's shadow stage ran; `None` for the reference.
     pub shadow_path: Option<ShadowPath>,
-    /// Ray counts, and each kind's thread-time when measured.
-    pub stats: RenderStats,
-    /// Wall-clock seconds of the render (for the reference, its set-up included).
-    pub seconds: f64,
-    /// Wavefront only (its stages are in `stats`): the BVH build time if a BVH was used.
-    pub bvh: Option<Option<f64>>,
-    /// Reference only, with --stats or --stats-json: the wall-clock seconds of the second,
-    /// instrumented pass that timed the kinds.
-    pub instrumented_seconds: Option<f64>,
-    /// Wavefront only, with --stats, --stats-json or --cost-map: the traversal counters of a
-    /// second, counted pass.
-    pub traversal: Option<TraversalFigures>,
+    /// How it ran and what it measured, as `--stats-json` writes it.
+    pub record: RenderRecord,
     /// With a debug pixel: the rays traced for it.
     pub pixel_rays: Option<String>,
     /// With a reference: the error table.
@@ -271,36 +256,60 @@ pub fn run(
             counted_seconds,
         ));
     }
-    let (simd, shadow_path, bvh) = (
-        engine.simd_path(),
-        engine.shadow_path(),
-        engine.bvh_build_seconds(),
-    );
+    // The wavefront engine's BVH build time if it used a BVH; `None` for the reference.
+    let (shadow_path, bvh) = (engine.shadow_path(), engine.bvh_build_seconds());
+    let record = RenderRecord {
+        format: crate::output::bench_record::FORMAT,
+        raywave: env!("CARGO_PKG_VERSION"),
+        // The record has never named the host.
+        machine: Machine {
+            hostname: String::new(),
+            ..Machine::current()
+        },
+        simd: engine.simd_path(),
+        threads,
+        engine: options.engine,
+        batch_size: options.batch_size,
+        shadow_path: shadow_path.map(ShadowPath::name),
+        scene: SceneFigures {
+            source: scene.source.clone(),
+            triangles: scene.triangles.len(),
+            spheres: scene.spheres.len(),
+            lights: scene.lights.len(),
+            bvh: bvh.map(|b| b.is_some()),
+            bvh_build_seconds: bvh.flatten(),
+        },
+        settings: settings.clone(),
+        defaults: DefaultsUsed {
+            from: effective.defaults.name(),
+            settings: effective.defaulted.clone(),
+        },
+        seconds,
+        rays: KindFigures::new(&stats, seconds),
+        kinds_timed_by: match instrumented_seconds {
+            Some(_) => KindTiming::InstrumentedPass,
+            None => KindTiming::StageTimers,
+        },
+        instrumented_seconds,
+        stages: bvh.map(|_| stats.stage_figures()),
+        traversal,
+    };
     drop(engine);
     let (reference_error, reference_json) = reference_error.unzip();
-    let outcome = Outcome {
-        scene,
-        effective,
-        engine: options.engine,
-        simd,
-        threads,
-        batch_size: options.batch_size,
-        shadow_path,
-        stats,
-        seconds,
-        bvh,
-        instrumented_seconds,
-        traversal,
-        pixel_rays,
-        reference_error,
-    };
     if let Some(path) = &options.stats_json {
         let extra = reference_json.map(|json| ("mse_reference", json));
-        outcome.record().write(path, extra)?;
+        record.write(path, extra)?;
     }
     // Every output in place before the summary says it was written.
     crate::output::commit_outputs()?;
-    Ok(outcome)
+    Ok(Outcome {
+        scene,
+        effective,
+        shadow_path,
+        record,
+        pixel_rays,
+        reference_error,
+    })
 }
 
 /// The checks of the outputs' names and of the plan, before the scene is read; returns the

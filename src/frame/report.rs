@@ -1,32 +1,22 @@
-//! What a render prints and records once the frame is rendered: the summary, the
-//! `--stats` tables and the `--stats-json` record, from what the render measured.
+//! What a render prints once the frame is rendered: the summary and the `--stats` tables, from
+//! its `--stats-json` record, and its error against `--mse-reference`.
 
 use super::Outcome;
 use crate::diff::{self, Encoding, FileInfo, Image, Region};
-use crate::output::bench_record::KindFigures;
-use crate::output::machine::Machine;
-use crate::output::render_record::{DefaultsUsed, KindTiming, RenderRecord, SceneFigures};
 use crate::render::film::{Film, ToneMap};
 use crate::render::quote::escape;
 use crate::render::settings::options::BackgroundSource;
 use crate::render::settings::{LightModel, ShadowMode};
-use crate::render::wavefront::shadow::ShadowPath;
 use anyhow::Result;
 use image::RgbImage;
 use std::fmt::Write as _;
 use std::path::Path;
 
 impl Outcome {
-    /// Rays by kind, each kind per thread-second of its work, the total per wall-clock second,
-    /// as the JSON gives them.
-    pub fn kinds(&self) -> KindFigures {
-        KindFigures::new(&self.stats, self.seconds)
-    }
-
     /// The summary printed after a render: engine, scene, settings, rays and time.
     pub fn summary(&self) -> String {
         let mut out = String::new();
-        let (scene, effective) = (&self.scene, &self.effective);
+        let (scene, effective, rec) = (&self.scene, &self.effective, &self.record);
         let s = &effective.settings;
         let shadows = match s.shadows {
             ShadowMode::Off => "off (every light visible)".to_string(),
@@ -40,10 +30,10 @@ impl Outcome {
         let _ = writeln!(
             out,
             "raywave {} · engine {} · simd {} · {} thread(s)",
-            env!("CARGO_PKG_VERSION"),
-            self.engine.name(),
-            self.simd,
-            self.threads
+            rec.raywave,
+            rec.engine.name(),
+            rec.simd,
+            rec.threads
         );
         let rings = match scene.ring_count {
             0 => String::new(),
@@ -118,20 +108,17 @@ impl Outcome {
             )
         };
         let _ = writeln!(out, "default {defaulted}");
-        let counts = &self.stats.counts;
+        let (kinds, total) = (&rec.rays.kinds, &rec.rays.total);
         let _ = writeln!(
             out,
             "rays    {} total: {} camera, {} shadow, {} reflection",
-            counts.total(),
-            counts.camera,
-            counts.shadow,
-            counts.reflection
+            total.rays, kinds.camera.rays, kinds.shadow.rays, kinds.reflection.rays
         );
         let _ = writeln!(
             out,
             "time    {:.3} s, {:.2} Mrays/s",
-            self.seconds,
-            self.kinds().total.rays_per_second / 1e6
+            rec.seconds,
+            total.rays_per_second / 1e6
         );
         out
     }
@@ -139,8 +126,8 @@ impl Outcome {
     /// The `--stats` tables: rays by kind (each kind over the thread-time of its own work, the
     /// total over the wall clock), then (wavefront) the BVH build and each stage.
     pub fn stats_table(&self) -> String {
-        let mut out = String::new();
-        let kinds = self.kinds();
+        let (mut out, rec) = (String::new(), &self.record);
+        let kinds = &rec.rays;
         // A row of the kind and stage tables: name, rays, seconds, rate.
         let row = |out: &mut String, cells: [&dyn std::fmt::Display; 4]| {
             let [name, rays, seconds, rate] = cells;
@@ -160,14 +147,14 @@ impl Outcome {
         let seconds = format!("{:.3}", total.seconds);
         let rate = format!("{:.2}", total.rays_per_second / 1e6);
         row(&mut out, [&"total", &total.rays, &seconds, &rate]);
-        match self.instrumented_seconds {
+        match rec.instrumented_seconds {
             Some(pass) => {
                 let _ = writeln!(
                     out,
                     "kinds timed by a second pass with timers: {pass:.3} s against the render's \
                      {:.3} s ({:+.1}%); the render itself had no timers",
-                    self.seconds,
-                    (pass / self.seconds.max(1e-9) - 1.0) * 100.0
+                    rec.seconds,
+                    (pass / rec.seconds.max(1e-9) - 1.0) * 100.0
                 );
             }
             None => {
@@ -178,13 +165,13 @@ impl Outcome {
                 );
             }
         }
-        if let Some(Some(build)) = self.bvh {
+        if let Some(build) = rec.scene.bvh_build_seconds {
             let _ = writeln!(out, "bvh build {build:.3} s");
         }
         if let Some(path) = self.shadow_path {
             let _ = writeln!(out, "shadow path {}: {}", path.name(), path.describe());
         }
-        if let Some(t) = &self.traversal {
+        if let Some(t) = &rec.traversal {
             let _ = writeln!(
                 out,
                 "{:<12} {:>14} {:>14} {:>14} {:>14}",
@@ -208,59 +195,18 @@ impl Outcome {
                 t.counted_seconds
             );
         }
-        if self.bvh.is_some() {
+        if let Some(stages) = &rec.stages {
             row(
                 &mut out,
                 [&"stage", &"rays", &"thread-s", &"Mrays/thread-s"],
             );
-            for stage in self.stats.stage_figures() {
+            for stage in stages {
                 let seconds = format!("{:.4}", stage.thread_seconds);
                 let rate = format!("{:.2}", stage.rays_per_thread_second / 1e6);
                 row(&mut out, [&stage.stage, &stage.rays, &seconds, &rate]);
             }
         }
         out
-    }
-
-    /// The `--stats-json` record of a render.
-    pub(super) fn record(&self) -> RenderRecord {
-        let (scene, effective) = (&self.scene, &self.effective);
-        RenderRecord {
-            format: crate::output::bench_record::FORMAT,
-            raywave: env!("CARGO_PKG_VERSION"),
-            // The record has never named the host.
-            machine: Machine {
-                hostname: String::new(),
-                ..Machine::current()
-            },
-            simd: self.simd,
-            threads: self.threads,
-            engine: self.engine,
-            batch_size: self.batch_size,
-            shadow_path: self.shadow_path.map(ShadowPath::name),
-            scene: SceneFigures {
-                source: scene.source.clone(),
-                triangles: scene.triangles.len(),
-                spheres: scene.spheres.len(),
-                lights: scene.lights.len(),
-                bvh: self.bvh.map(|b| b.is_some()),
-                bvh_build_seconds: self.bvh.flatten(),
-            },
-            settings: effective.settings.clone(),
-            defaults: DefaultsUsed {
-                from: effective.defaults.name(),
-                settings: effective.defaulted.clone(),
-            },
-            seconds: self.seconds,
-            rays: self.kinds(),
-            kinds_timed_by: match self.instrumented_seconds {
-                Some(_) => KindTiming::InstrumentedPass,
-                None => KindTiming::StageTimers,
-            },
-            instrumented_seconds: self.instrumented_seconds,
-            stages: self.bvh.map(|_| self.stats.stage_figures()),
-            traversal: self.traversal,
-        }
     }
 }
 
