@@ -212,7 +212,7 @@ pub fn run(args: &DiffArgs) -> Result<u8> {
         };
         text.push_str(&format!(
             "{verdict:<8} {} {shown} is {relation} --fail-above {threshold}\n",
-            metric.name()
+            super::values::spelling(args.metric)
         ));
     }
     super::image::say(&plan, &text)?;

@@ -1,6 +1,8 @@
 //! The flags several commands share (the image's, the seed's, the threads'), and [`say`].
 
-use super::values::{DefaultsArg, LightModelArg, SamplerArg, ShadowArg, colour_component};
+use super::values::{
+    DefaultsArg, LightModelArg, SamplerArg, ShadowArg, colour_component, spelling,
+};
 use clap::Args;
 use raywave::output::OutputPlan;
 use raywave::render::settings::options::ImageOptions;
@@ -82,12 +84,6 @@ impl ImageArgs {
     /// only what was set, so each build fills the rest with its own defaults, as a user running
     /// both with the same command line would see.
     pub fn flags(&self) -> Vec<String> {
-        fn name(v: impl clap::ValueEnum) -> String {
-            v.to_possible_value()
-                .expect("no skipped variants")
-                .get_name()
-                .to_string()
-        }
         fn all<T: ToString>(values: &Option<Vec<T>>) -> Option<Vec<String>> {
             Some(values.as_ref()?.iter().map(T::to_string).collect())
         }
@@ -97,15 +93,15 @@ impl ImageArgs {
         [
             ("--size", all(&self.size)),
             ("--bounces", one(self.bounces)),
-            ("--shadows", one(self.shadows.map(name))),
+            ("--shadows", one(self.shadows.map(spelling))),
             ("--shadow-samples", one(self.shadow_samples)),
-            ("--sampler", one(Some(name(self.sampler)))),
+            ("--sampler", one(Some(spelling(self.sampler)))),
             ("--aa", one(self.aa)),
             ("--background", all(&self.background)),
             ("--ambient", all(&self.ambient)),
-            ("--light-model", one(self.light_model.map(name))),
+            ("--light-model", one(self.light_model.map(spelling))),
             ("--ring-segments", one(self.ring_segments)),
-            ("--defaults", one(self.defaults.map(name))),
+            ("--defaults", one(self.defaults.map(spelling))),
         ]
         .into_iter()
         .filter_map(|(flag, values)| Some([vec![flag.to_string()], values?].concat()))

@@ -68,6 +68,14 @@ pub fn colour_component() -> impl TypedValueParser<Value = f32> {
     })
 }
 
+/// A value enum's spelling on the command line.
+pub fn spelling(v: impl clap::ValueEnum) -> String {
+    v.to_possible_value()
+        .expect("no skipped variants")
+        .get_name()
+        .to_string()
+}
+
 /// Declares clap value enums, each with its conversion into the library's enum of the same
 /// variants.
 macro_rules! mirror {

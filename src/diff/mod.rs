@@ -132,17 +132,6 @@ pub enum Metric {
 }
 
 impl Metric {
-    /// The name on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            Metric::Mse => "mse",
-            Metric::Relmse => "relmse",
-            Metric::Max => "max",
-            Metric::Psnr => "psnr",
-            Metric::Flip => "flip",
-        }
-    }
-
     /// True when `value` is worse than `threshold`: above it, or for PSNR below it. A NaN
     /// value fails.
     pub fn fails(self, value: f64, threshold: f64) -> bool {
