@@ -3,6 +3,7 @@
 
 use super::Outcome;
 use crate::diff::{self, Encoding, FileInfo, Image, Region};
+use crate::output::terminal::table_line;
 use crate::render::film::{Film, ToneMap};
 use crate::render::quote::escape;
 use crate::render::settings::options::BackgroundSource;
@@ -172,21 +173,14 @@ impl Outcome {
             let _ = writeln!(out, "shadow path {}: {}", path.name(), path.describe());
         }
         if let Some(t) = &rec.traversal {
-            let _ = writeln!(
-                out,
-                "{:<12} {:>14} {:>14} {:>14} {:>14}",
-                "traversal", "rays", "nodes/ray", "leaves/ray", "tests/ray"
-            );
+            let line = |cells: [&str; 5]| table_line(&[-12, 14, 14, 14, 14], cells);
+            let header = ["traversal", "rays", "nodes/ray", "leaves/ray", "tests/ray"];
+            let _ = writeln!(out, "{}", line(header));
             for (kind, f) in t.kinds.iter() {
-                let _ = writeln!(
-                    out,
-                    "{:<12} {:>14} {:>14} {:>14} {:>14}",
-                    kind.name(),
-                    f.rays,
-                    or_dash(f.nodes_per_ray, 1.0, 2),
-                    or_dash(f.leaves_per_ray, 1.0, 2),
-                    or_dash(f.primitive_tests_per_ray, 1.0, 2)
-                );
+                let per_ray = [f.nodes_per_ray, f.leaves_per_ray, f.primitive_tests_per_ray];
+                let [nodes, leaves, tests] = per_ray.map(|x| or_dash(x, 1.0, 2));
+                let cells = [kind.name(), &f.rays.to_string(), &nodes, &leaves, &tests];
+                let _ = writeln!(out, "{}", line(cells));
             }
             let _ = writeln!(
                 out,
