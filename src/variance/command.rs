@@ -2,7 +2,6 @@
 //! progress bar and the printed table are the binary's (`cli/variance.rs`).
 
 use super::report::summary::Summary;
-use super::study::job_record::JobRecord;
 use super::study::jobs::{self, CaseFacts, Job, JobResult, Setup};
 use super::study::plan::{Case, Study, case_names, identity};
 use super::{Cache, Region, RenderFn, StudyConfig};
@@ -398,7 +397,7 @@ pub fn run_shard(
     for (c, facts, results) in ran {
         part.extra.push((c, cases[c].scene.source.clone(), facts));
         part.results
-            .extend(results.into_iter().map(JobRecord::from));
+            .extend(results.into_iter().map(JobResult::convert));
     }
     part.host.finish();
     let path = crate::shard::write_part(&options.out, &part)?;

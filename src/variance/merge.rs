@@ -129,7 +129,7 @@ pub fn merge(inputs: &[PathBuf], out: &Path, notice: &(dyn Fn(&str) + Sync)) -> 
     let mut results: Vec<Vec<JobResult>> = vec![Vec::new(); cases];
     // Moved, not copied: the parts' results are not needed after this.
     for r in std::mem::take(&mut merged.results) {
-        let r = JobResult::from(r);
+        let r: JobResult = r.convert();
         results[r.job.case].push(r);
     }
     let mut studies = Vec::new();

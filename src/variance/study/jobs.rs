@@ -124,17 +124,32 @@ pub struct Thumbnail {
     pub rgb: Vec<u8>,
 }
 
-/// What one job measured.
-#[derive(Clone, Debug)]
-pub struct JobResult {
+/// What one job measured: its rows as the report reads them, or as a part keeps them
+/// ([`JobRecord`](super::job_record::JobRecord)).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct JobResult<R = Row> {
     /// The job.
     pub job: Job,
     /// One row per region, in `Region::ALL` order, without the figures relative to random.
-    pub rows: Vec<Row>,
+    pub rows: Vec<R>,
     /// Per-pixel MSE when `job.n` is the study's heat-map budget.
     pub heatmap: Option<Vec<f32>>,
     /// The warm-up render (seed 0).
     pub thumbnail: Thumbnail,
+}
+
+impl<R> JobResult<R> {
+    /// The same result with each row converted.
+    pub fn convert<S: From<R>>(self) -> JobResult<S> {
+        let rows = self.rows.into_iter().map(S::from).collect();
+        let (job, heatmap, thumbnail) = (self.job, self.heatmap, self.thumbnail);
+        JobResult {
+            job,
+            rows,
+            heatmap,
+            thumbnail,
+        }
+    }
 }
 
 /// The rows of `job` from its timed images: their seconds each, and rays per image.
