@@ -32,8 +32,7 @@ impl Merged {
     /// summed against the elapsed time.
     pub fn describe(&self) -> String {
         let (parts, hosts) = (&self.shards.parts, &self.shards.hosts);
-        let summed: f64 = hosts.iter().map(|h| h.seconds).sum();
-        let elapsed = self.shards.elapsed_seconds();
+        let (summed, elapsed) = (self.shards.summed_seconds(), self.shards.elapsed_seconds());
         let touched: usize = parts.iter().map(|(_, p)| p.extra.len()).sum();
         let host_list: Vec<String> = hosts
             .iter()

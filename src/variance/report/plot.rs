@@ -106,13 +106,8 @@ fn panel(
         .x_desc(x_desc)
         .y_desc("MSE")
         .y_label_formatter(&|y| format!("{y:.0e}"))
-        .x_label_formatter(&|x| {
-            if *x >= 1.0 {
-                format!("{x:.0}")
-            } else {
-                format!("{x:.2}")
-            }
-        })
+        // Whole numbers from 1 up, two decimals below.
+        .x_label_formatter(&|x| format!("{:.*}", if *x >= 1.0 { 0 } else { 2 }, x))
         .label_style(("sans-serif", 14))
         .draw()
         .map_err(err)?;
@@ -128,13 +123,10 @@ fn panel(
             .collect();
         // The slope is against N: only the top row's legend gives it.
         let slope = result
-            .slopes
-            .iter()
-            .find(|s| s.sampler == sampler.name() && s.region == region)
-            .and_then(|s| s.fit.map(|f| (f, s.slope_interval)))
-            .map(|(f, iv)| match iv {
-                Some([a, b]) => format!(" (slope {:.2} [{a:.2}, {b:.2}])", f.slope),
-                None => format!(" (slope {:.2})", f.slope),
+            .slope(*sampler, region)
+            .map(|(v, iv)| match iv {
+                Some([a, b]) => format!(" (slope {v:.2} [{a:.2}, {b:.2}])"),
+                None => format!(" (slope {v:.2})"),
             })
             .filter(|_| axis == Axis::Budget)
             .unwrap_or_default();

@@ -202,12 +202,7 @@ impl Summary {
             let _ = writeln!(s, "  {}", table_line(&COLUMNS, header));
             for &sampler in &case.config.samplers {
                 let fit = |region: Region| {
-                    case.slopes
-                        .iter()
-                        .find(|x| x.sampler == sampler.name() && x.region == region)
-                        .map_or("-".into(), |x| {
-                            figure(x.fit.map(|f| f.slope), x.slope_interval)
-                        })
+                    (case.slope(sampler, region)).map_or("-".into(), |(v, iv)| figure(Some(v), iv))
                 };
                 let cells = [sampler.name(), &fit(Region::Whole), &fit(Region::Penumbra)];
                 let _ = writeln!(s, "  {}", table_line(&COLUMNS, cells));

@@ -297,13 +297,11 @@ impl StudyResult {
             let _ = writeln!(s, "  {}", table_line(&COLUMNS, header.split('|')));
             for r in self.rows.iter().filter(|r| r.region == *region) {
                 let ms = r.seconds_interval.map(|[a, b]| [a * 1e3, b * 1e3]);
-                let mut notes = Vec::new();
-                if r.stats.bias.abs() > r.stats.bias_bound {
-                    notes.push("BIASED?");
-                }
-                if r.excluded_from_fit {
-                    notes.push("not fitted");
-                }
+                let flags = [
+                    (r.stats.bias.abs() > r.stats.bias_bound, "BIASED?"),
+                    (r.excluded_from_fit, "not fitted"),
+                ];
+                let notes: Vec<&str> = flags.iter().filter(|f| f.0).map(|f| f.1).collect();
                 let cells = [
                     r.sampler,
                     &r.n.to_string(),
@@ -332,11 +330,7 @@ impl StudyResult {
         region_row(&mut s, "sampler", |region| region.name().into());
         for sampler in &self.config.samplers {
             let cell = |region: Region| {
-                self.slopes
-                    .iter()
-                    .find(|sl| sl.sampler == sampler.name() && sl.region == region)
-                    .and_then(|sl| sl.fit.map(|f| fixed_iv(f.slope, sl.slope_interval, 3)))
-                    .unwrap_or_else(|| "-".into())
+                (self.slope(*sampler, region)).map_or("-".into(), |(v, iv)| fixed_iv(v, iv, 3))
             };
             region_row(&mut s, sampler.name(), cell);
         }
