@@ -21,10 +21,6 @@ pub struct Merged {
     pub outcome: Outcome,
     /// The parts read, by shard index, and their machines (the results moved into the report).
     shards: crate::shard::Merged<Study>,
-    /// Jobs in the study.
-    jobs: usize,
-    /// How many times a shard rendered a case's converged reference (not from the cache).
-    references_rendered: usize,
 }
 
 impl Merged {
@@ -33,7 +29,9 @@ impl Merged {
     pub fn describe(&self) -> String {
         let (parts, hosts) = (&self.shards.parts, &self.shards.hosts);
         let (summed, elapsed) = (self.shards.summed_seconds(), self.shards.elapsed_seconds());
-        let touched: usize = parts.iter().map(|(_, p)| p.extra.len()).sum();
+        // Each case a shard touched, by whether it read the converged reference from the cache.
+        let touched = parts.iter().flat_map(|(_, p)| &p.extra);
+        let (cached, rendered): (Vec<_>, Vec<_>) = touched.partition(|(.., f)| f.reference_cached);
         let host_list: Vec<String> = hosts
             .iter()
             .map(|h| {
@@ -60,14 +58,14 @@ impl Merged {
         format!(
             "{shards}merged  {} shards, {} jobs, {} host{}: {}\nwall    {summed:.1} s summed over the shards, {:.1} s from the first start to the last end ({:.2} shards at once on average)\nreferences {} rendered by a shard, {} read from the cache\n",
             parts.len(),
-            self.jobs,
+            self.shards.identity().work.jobs().len(),
             hosts.len(),
             if hosts.len() == 1 { "" } else { "s" },
             host_list.join(", "),
             elapsed,
             summed / elapsed.max(1e-9),
-            self.references_rendered,
-            touched - self.references_rendered
+            rendered.len(),
+            cached.len()
         )
     }
 }
@@ -99,7 +97,6 @@ pub fn merge(inputs: &[PathBuf], out: &Path, notice: &(dyn Fn(&str) + Sync)) -> 
     let study = merged.identity().work.clone();
     let cases = study.cases.len();
     let mut facts: Vec<Option<(CaseFacts, String, usize, PathBuf)>> = vec![None; cases];
-    let mut rendered = 0;
     for (path, p) in &merged.parts {
         for (c, source, f) in &p.extra {
             let Some(slot) = facts.get_mut(*c) else {
@@ -122,7 +119,6 @@ pub fn merge(inputs: &[PathBuf], out: &Path, notice: &(dyn Fn(&str) + Sync)) -> 
                 Some((known, ..)) => known.reference_cached &= f.reference_cached,
                 None => *slot = Some((f.clone(), source.clone(), p.host.threads, path.clone())),
             }
-            rendered += usize::from(!f.reference_cached);
         }
     }
     let mut results: Vec<Vec<JobResult>> = vec![Vec::new(); cases];
@@ -144,7 +140,5 @@ pub fn merge(inputs: &[PathBuf], out: &Path, notice: &(dyn Fn(&str) + Sync)) -> 
     Ok(Merged {
         outcome,
         shards: merged,
-        jobs: study.jobs().len(),
-        references_rendered: rendered,
     })
 }

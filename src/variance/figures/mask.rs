@@ -84,9 +84,6 @@ pub fn penumbra_mask(scene: &Scene, settings: &RenderSettings, points: u32) -> R
         // Without lights nothing is lit (every light fully visible would be vacuously true).
         (penumbra, lit && any_hit && !scene.lights.is_empty())
     };
-    let classes: Vec<(bool, bool)> = (0..pixels).into_par_iter().map(classify).collect();
-    Regions {
-        penumbra: classes.iter().map(|c| c.0).collect(),
-        lit: classes.iter().map(|c| c.1).collect(),
-    }
+    let (penumbra, lit) = (0..pixels).into_par_iter().map(classify).unzip();
+    Regions { penumbra, lit }
 }

@@ -57,13 +57,10 @@ pub fn radial_power(error: &[f64], width: usize, height: usize, region: &[bool])
     if count == 0 {
         return None;
     }
-    let mean = error
-        .iter()
-        .zip(region)
-        .filter(|(_, r)| **r)
-        .map(|(e, _)| e)
-        .sum::<f64>()
-        / count as f64;
+    let sum: f64 = (error.iter().zip(region))
+        .filter_map(|(e, &r)| r.then_some(e))
+        .sum();
+    let mean = sum / count as f64;
     let mut data: Vec<Complex<f64>> = error
         .iter()
         .zip(region)
@@ -74,14 +71,8 @@ pub fn radial_power(error: &[f64], width: usize, height: usize, region: &[bool])
     let mut counts = vec![0usize; RINGS];
     let (mut low_sum, mut low_count) = (0.0, 0usize);
     let (mut all_sum, mut all_count) = (0.0, 0usize);
-    let frequency = |k: usize, n: usize| {
-        let k = if k <= n / 2 {
-            k as f64
-        } else {
-            k as f64 - n as f64
-        };
-        k / n as f64
-    };
+    // |f| of DFT index k of n: k/n up to n/2, (n − k)/n above (only its square is used).
+    let frequency = |k: usize, n: usize| k.min(n - k) as f64 / n as f64;
     for ky in 0..height {
         let fy = frequency(ky, height);
         for kx in 0..width {

@@ -16,24 +16,24 @@ use crate::render::sampling::LightSampler;
 use crate::render::settings::LightModel;
 use crate::variance::command::VarianceOptions;
 use anyhow::{Context, Result};
-use serde::{Deserialize, Deserializer};
+use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
 /// A whole number in `LO..=HI`, refused while the file is parsed, so that the error names
 /// the line and column.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(try_from = "i64")]
 pub struct Ranged<const LO: u32, const HI: u32>(pub u32);
 
-impl<'de, const LO: u32, const HI: u32> Deserialize<'de> for Ranged<LO, HI> {
-    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        let v = i64::deserialize(d)?;
+impl<const LO: u32, const HI: u32> TryFrom<i64> for Ranged<LO, HI> {
+    type Error = String;
+    fn try_from(v: i64) -> Result<Self, String> {
         if (i64::from(LO)..=i64::from(HI)).contains(&v) {
-            Ok(Ranged(v as u32))
-        } else {
-            Err(serde::de::Error::custom(format!(
-                "{v} is out of range: expected a whole number from {LO} to {HI}"
-            )))
+            return Ok(Ranged(v as u32));
         }
+        Err(format!(
+            "{v} is out of range: expected a whole number from {LO} to {HI}"
+        ))
     }
 }
 
