@@ -180,6 +180,9 @@ fn figure(v: Option<f64>, iv: Option<[f64; 2]>) -> String {
     }
 }
 
+/// The summary's files: the table, the CSV, the JSON.
+const FILES: [&str; 3] = ["summary.txt", "summary.csv", "summary.json"];
+
 /// The columns of a case's slopes (`table_line`'s widths).
 const COLUMNS: [i16; 3] = [-10, -28, -28];
 
@@ -274,11 +277,7 @@ impl Summary {
     pub fn write(&self, cases: &[StudyResult], dir: &Path) -> Result<Vec<PathBuf>> {
         let json = serde_json::to_string_pretty(self).context("cannot encode the summary")? + "\n";
         let mut written = Vec::new();
-        for (name, body) in [
-            ("summary.txt", self.table(cases)),
-            ("summary.csv", self.csv()),
-            ("summary.json", json),
-        ] {
+        for (name, body) in FILES.into_iter().zip([self.table(cases), self.csv(), json]) {
             written.push(write_text(&dir.join(name), &body)?);
         }
         Ok(written)
@@ -291,7 +290,5 @@ pub fn file_names(names: &[String], per_case: &[String]) -> Vec<String> {
     let in_dirs = names
         .iter()
         .flat_map(|n| per_case.iter().map(move |f| format!("{n}/{f}")));
-    let mut out: Vec<String> = in_dirs.collect();
-    out.extend(["summary.txt", "summary.csv", "summary.json"].map(String::from));
-    out
+    in_dirs.chain(FILES.map(String::from)).collect()
 }

@@ -96,9 +96,7 @@ impl Setup {
     pub fn facts(&self) -> CaseFacts {
         let noise = |i: usize| {
             let in_region = self.reference.noise.iter().zip(&self.masks[i]);
-            in_region
-                .filter(|(_, inside)| **inside)
-                .map(|(v, _)| *v as f64)
+            in_region.filter_map(|(v, &inside)| inside.then_some(*v as f64))
         };
         let region_pixels: [usize; 3] = std::array::from_fn(|i| noise(i).count());
         let reference_mse = std::array::from_fn(|i| {
