@@ -151,7 +151,7 @@ pub(crate) struct StudyArgs {
 
 impl StudyArgs {
     /// The flags (or the study file they name) as the library's options, writing into `out`.
-    pub fn options(&self, out: &Path, quiet: bool) -> Result<VarianceOptions> {
+    pub fn options(&self, out: &Path) -> Result<VarianceOptions> {
         let mut options = VarianceOptions {
             scenes: self.scenes.iter().cloned().map(Some).collect(),
             budgets: self.budgets.clone(),
@@ -168,7 +168,6 @@ impl StudyArgs {
             cache_limit_mib: self.cache_limit,
             light_model: self.light_model.into(),
             engine: self.engine.into(),
-            quiet,
         };
         if let Some(file) = &self.study {
             raywave::variance::study::study_file::read(file, &mut options)?;
@@ -191,17 +190,18 @@ fn cases(options: &VarianceOptions) -> Result<Vec<Case>> {
     Ok(cases)
 }
 
-/// Runs `work` with a progress bar over estimated rays (`prefix` before it) and the renderer
-/// of `options`, whose clamp warnings are printed above the bar.
+/// Runs `work` with a progress bar over estimated rays (`prefix` before it; none if `quiet`)
+/// and the renderer of `options`, whose clamp warnings are printed above the bar.
 fn with_progress<T>(
     options: &VarianceOptions,
-    prefix: String,
+    quiet: bool,
+    prefix: &str,
     work: impl FnOnce(&raywave::variance::RenderFn, &Progress) -> Result<T>,
 ) -> Result<T> {
     let template = format!(
         "{{spinner}} {prefix} [{{bar:30}}] ~{{human_pos}}/{{human_len}} rays, {{msg}} ({{elapsed}}, eta {{eta}})"
     );
-    with_bar(&template, options.quiet, |progress| {
+    with_bar(&template, quiet, |progress| {
         let render = |scene: &Scene, settings: &RenderSettings| {
             let (film, stats) =
                 options
@@ -239,7 +239,7 @@ pub fn run(args: &VarianceArgs) -> Result<()> {
         Some(VarianceAction::Merge(m)) => return run_merge(m),
         None => {}
     }
-    let options = args.study.options(&args.out, args.quiet)?;
+    let options = args.study.options(&args.out)?;
     if args.clean_cache {
         let (files, bytes) = raywave::variance::study::cache::clean(&options.cache)?;
         return print(&format!(
@@ -260,7 +260,7 @@ pub fn run(args: &VarianceArgs) -> Result<()> {
         check(&plan, &cases)?;
         let jobs = work.assignment(shard.count)[shard.index].len();
         let prefix = format!("variance shard {shard}, {jobs} jobs");
-        let (path, jobs) = with_progress(&options, prefix, |render, progress| {
+        let (path, jobs) = with_progress(&options, args.quiet, &prefix, |render, progress| {
             pool.install(|| run_shard(&options, &cases, shard, render, progress))
         })?;
         return print(&format!(
@@ -274,7 +274,7 @@ pub fn run(args: &VarianceArgs) -> Result<()> {
     });
     check(&plan, &cases)?;
     let prefix = format!("variance, {} jobs", work.jobs().len());
-    let outcome = with_progress(&options, prefix, |render, progress| {
+    let outcome = with_progress(&options, args.quiet, &prefix, |render, progress| {
         pool.install(|| study(&options, &cases, render, progress))
     })?;
     let cached = outcome
@@ -311,12 +311,10 @@ fn report_files(options: &VarianceOptions, cases: &[Case]) -> Vec<String> {
 }
 
 fn run_prepare(args: &PrepareArgs) -> Result<()> {
-    let options = args
-        .study
-        .options(Path::new("variance-report"), args.quiet)?;
+    let options = args.study.options(Path::new("variance-report"))?;
     let cases = cases(&options)?;
     let pool = thread_pool(args.workers.threads)?;
-    let prepared = with_progress(&options, "prepare".into(), |render, progress| {
+    let prepared = with_progress(&options, args.quiet, "prepare", |render, progress| {
         pool.install(|| prepare(&options, &cases, render, progress))
     })?;
     let mut text = String::new();

@@ -50,8 +50,6 @@ pub struct VarianceOptions {
     pub light_model: LightModel,
     /// The engine that renders the images.
     pub engine: Engine,
-    /// No progress bar.
-    pub quiet: bool,
 }
 
 impl Default for VarianceOptions {
@@ -74,7 +72,6 @@ impl Default for VarianceOptions {
             cache_limit_mib: super::study::cache::DEFAULT_LIMIT_MIB,
             light_model: LightModel::Lab,
             engine: Engine::Wavefront,
-            quiet: false,
         }
     }
 }
