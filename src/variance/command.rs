@@ -348,9 +348,11 @@ pub(crate) fn write_report(
         for region in [Region::Penumbra, Region::Lit] {
             let margin = result.reference_margin(region);
             if result.facts.region_pixels[region as usize] > 0 && margin < 10.0 {
-                let case = (results.len() > 1)
-                    .then(|| format!("{name}: "))
-                    .unwrap_or_default();
+                let case = if results.len() > 1 {
+                    format!("{name}: ")
+                } else {
+                    String::new()
+                };
                 notice(&format!(
                     "warning: {case}the converged reference's own error is only {margin:.1}× below the smallest MSE measured on the {} region; raise --reference-samples",
                     region.name()
