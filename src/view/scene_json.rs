@@ -4,6 +4,7 @@
 
 use crate::render::camera::CameraRays;
 use crate::render::scene::{Camera, Material, Scene};
+use crate::trace::scene_bounds;
 use glam::Vec3;
 use serde::Serialize;
 
@@ -27,7 +28,8 @@ pub(crate) struct SceneJson {
     pub spheres: Vec<SphereJson>,
     /// Area lights: corners in order around the outline.
     pub lights: Vec<Vec<[f32; 3]>>,
-    /// Axis-aligned bounds of everything drawn: [min, max].
+    /// Axis-aligned bounds of the scene's triangles and spheres (`trace::scene_bounds`, all of
+    /// them when `truncated`): [min, max].
     pub bounds: [[f32; 3]; 2],
 }
 
@@ -58,27 +60,19 @@ impl SceneJson {
         let drawn = scene.triangles.len().min(MAX_DRAWN_TRIANGLES);
         let mut positions = Vec::with_capacity(drawn * 9);
         let mut colors = Vec::with_capacity(drawn * 3);
-        let mut lo = Vec3::splat(f32::INFINITY);
-        let mut hi = Vec3::splat(f32::NEG_INFINITY);
         for t in &scene.triangles[..drawn] {
             for p in [t.v0, t.v0 + t.e1, t.v0 + t.e2] {
                 positions.extend_from_slice(&p.to_array());
-                lo = lo.min(p);
-                hi = hi.max(p);
             }
             colors.extend_from_slice(&display_colour(scene.materials.get(t.material as usize)));
         }
         let spheres = scene
             .spheres
             .iter()
-            .map(|s| {
-                lo = lo.min(s.center - s.radius);
-                hi = hi.max(s.center + s.radius);
-                SphereJson {
-                    center: s.center.to_array(),
-                    radius: s.radius,
-                    color: display_colour(scene.materials.get(s.material as usize)),
-                }
+            .map(|s| SphereJson {
+                center: s.center.to_array(),
+                radius: s.radius,
+                color: display_colour(scene.materials.get(s.material as usize)),
             })
             .collect();
         let lights = scene
@@ -94,10 +88,11 @@ impl SceneJson {
                 c.iter().map(|p| p.to_array()).collect()
             })
             .collect();
-        if lo.x > hi.x {
+        let (lo, hi) = match scene_bounds(scene) {
             // Nothing to draw: a unit box around the origin.
-            (lo, hi) = (Vec3::splat(-1.0), Vec3::ONE);
-        }
+            (lo, hi) if lo == hi => (Vec3::splat(-1.0), Vec3::ONE),
+            bounds => bounds,
+        };
         SceneJson {
             source: scene.source.clone(),
             positions,
