@@ -107,7 +107,7 @@ pub fn groups(scene: &Scene, tree: &RayTree) -> Vec<Group> {
         out.push(sphere(&format!("sphere_{k}"), s.center, s.radius, colour));
     }
     for style in Style::ALL {
-        let mut group = Group::new(style.group());
+        let mut group = Group::new(&format!("rays_{}", style.name()));
         for s in tree.segments.iter().filter(|s| Style::of(s) == style) {
             group.line(
                 Vec3::from_array(s.origin),

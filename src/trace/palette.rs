@@ -58,13 +58,13 @@ impl Style {
         }
     }
 
-    /// Each style's colour and group (OBJ object) name, in declaration order.
+    /// Each style's colour and name, in declaration order.
     const LOOK: [(Rgb, &'static str); 5] = [
-        (CAMERA, "rays_camera"),
-        (REFLECTION, "rays_reflection"),
-        (SHADOW_VISIBLE, "rays_shadow_visible"),
-        (SHADOW_BLOCKED, "rays_shadow_blocked"),
-        (SHADOW_UNTESTED, "rays_shadow_untested"),
+        (CAMERA, "camera"),
+        (REFLECTION, "reflection"),
+        (SHADOW_VISIBLE, "shadow_visible"),
+        (SHADOW_BLOCKED, "shadow_blocked"),
+        (SHADOW_UNTESTED, "shadow_untested"),
     ];
 
     /// Its colour.
@@ -72,8 +72,8 @@ impl Style {
         Style::LOOK[self as usize].0
     }
 
-    /// The group (OBJ object) name.
-    pub fn group(self) -> &'static str {
+    /// Its name in the viewer's palette; its group (OBJ object) is `rays_` and the name.
+    pub fn name(self) -> &'static str {
         Style::LOOK[self as usize].1
     }
 

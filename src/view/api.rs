@@ -13,7 +13,7 @@ use crate::render::engine::Engine;
 use crate::render::quote::quote;
 use crate::render::sampling::LightSampler;
 use crate::render::scene::Scene;
-use crate::trace::palette::Rgb;
+use crate::trace::palette::{MAIN_CAMERA, Rgb, Style};
 use serde::Serialize;
 use std::sync::Arc;
 
@@ -45,11 +45,13 @@ pub(crate) fn scene_json(scene: &Scene, base: &Resolved) -> Vec<u8> {
         samplers: Vec<&'a str>,
         engines: Vec<&'a str>,
         simd: &'a str,
-        /// An object, name to colour, in [`tree::PALETTE`]'s order.
+        /// An object, name to colour: the 3D view's, `raywave::trace::palette`'s (the lab's),
+        /// each ray style's, then the render camera's (shadow_blocked rays are drawn dashed past
+        /// the blocker).
         #[serde(serialize_with = "as_object")]
-        palette: [(&'a str, Rgb); 6],
+        palette: Vec<(&'a str, Rgb)>,
     }
-    fn as_object<S: serde::Serializer>(pairs: &[(&str, Rgb); 6], s: S) -> Result<S::Ok, S::Error> {
+    fn as_object<S: serde::Serializer>(pairs: &[(&str, Rgb)], s: S) -> Result<S::Ok, S::Error> {
         s.collect_map(pairs.iter().copied())
     }
     serde_json::to_vec(&Body {
@@ -58,7 +60,9 @@ pub(crate) fn scene_json(scene: &Scene, base: &Resolved) -> Vec<u8> {
         samplers: LightSampler::ALL.iter().map(|s| s.name()).collect(),
         engines: vec![Engine::Wavefront.name(), Engine::Reference.name()],
         simd: crate::simd_path(),
-        palette: tree::PALETTE,
+        palette: (Style::ALL.iter().map(|s| (s.name(), s.colour())))
+            .chain([("main_camera", MAIN_CAMERA)])
+            .collect(),
     })
     .unwrap_or_default()
 }

@@ -1,11 +1,10 @@
 //! One pixel's ray tree for the page: `raywave::trace`'s [`RayTree`] (every segment the
 //! render's recursion casts for the pixel, its outcome and the colour it adds), checked against
-//! both engines' render of that pixel, and the palette the page draws it with.
+//! both engines' render of that pixel.
 
 use super::http::ApiError;
 use crate::render::scene::Scene;
 use crate::render::settings::RenderSettings;
-use crate::trace::palette::{self, Rgb};
 use crate::trace::tracer::max_segments;
 use crate::trace::{RayTree, TraceError, check_pixel, trace_pixel};
 
@@ -34,14 +33,3 @@ pub(crate) fn pixel_tree(
     tree.check = Some(check_pixel(scene, settings, &tree));
     Ok(tree)
 }
-
-/// The colours of the 3D view, `raywave::trace::palette`'s (the lab's), by the names the page
-/// reads them by (shadow_blocked rays are drawn dashed past the blocker).
-pub(crate) const PALETTE: [(&str, Rgb); 6] = [
-    ("camera", palette::CAMERA),
-    ("reflection", palette::REFLECTION),
-    ("shadow_visible", palette::SHADOW_VISIBLE),
-    ("shadow_blocked", palette::SHADOW_BLOCKED),
-    ("shadow_untested", palette::SHADOW_UNTESTED),
-    ("main_camera", palette::MAIN_CAMERA),
-];
