@@ -27,7 +27,7 @@ pub mod view;
 pub use check::{check_pixel, contribution_sum, render_pixel_counted, tree_counts};
 pub use mesh::scene_bounds;
 pub use summary::summary;
-pub use tracer::{TraceError, primitive_ref, trace_pixel, trace_settings};
+pub use tracer::{TraceError, primitive_ref, trace_pixel};
 pub use tree::{
     BlockerInfo, CameraInfo, PixelCheck, PixelRef, PrimitiveRef, PrimitiveShape, RayCountCheck,
     RayTree, SCHEMA_ID, Segment, SegmentKind, ShadowInfo, SurfaceInfo, TraceSettings,

@@ -130,31 +130,26 @@ pub fn trace_pixel(
         schema: SCHEMA_ID.to_string(),
         scene: scene.source.clone(),
         pixel: PixelRef { x, y, index: pixel },
-        settings: trace_settings(settings),
+        settings: TraceSettings {
+            width: settings.width,
+            height: settings.height,
+            bounces: settings.bounces,
+            shadows: settings.shadows.name().to_string(),
+            points_per_light: settings.points_per_light(),
+            sampler: settings.sampler.name().to_string(),
+            aa_samples: aa,
+            seed: settings.seed,
+            two_sided: settings.two_sided,
+            light_model: settings.light_model.name().to_string(),
+            background: settings.background,
+            ambient: settings.ambient,
+        },
         camera: super::tree::CameraInfo::of(&scene.camera),
         miss_length,
         segments,
         sum,
         check: None,
     })
-}
-
-/// The settings as the tree reports them.
-pub fn trace_settings(s: &RenderSettings) -> TraceSettings {
-    TraceSettings {
-        width: s.width,
-        height: s.height,
-        bounces: s.bounces,
-        shadows: s.shadows.name().to_string(),
-        points_per_light: s.points_per_light(),
-        sampler: s.sampler.name().to_string(),
-        aa_samples: s.aa_samples.max(1),
-        seed: s.seed,
-        two_sided: s.two_sided,
-        light_model: s.light_model.name().to_string(),
-        background: s.background,
-        ambient: s.ambient,
-    }
 }
 
 /// The primitive behind a global id.
