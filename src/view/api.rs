@@ -71,14 +71,13 @@ pub(crate) fn scene_json(scene: &Scene, base: &Resolved) -> Vec<u8> {
 /// last second (429 with `Retry-After`).
 pub(crate) fn render(state: &State, body: &[u8]) -> Result<Reply, ApiError> {
     let resolved = parse_json::<ViewSettings>(body, "settings")?.resolve(&state.base)?;
-    let job = state.jobs.submit(resolved).map_err(|limited| {
+    let job = state.jobs.submit(resolved).map_err(|seconds| {
         ApiError::retry(
             429,
-            limited.retry_after,
+            seconds,
             format!(
                 "too many renders started: at most {RENDER_BURST} at once and {RENDER_RATE} a \
-                 second; retry in {} s",
-                limited.retry_after
+                 second; retry in {seconds} s"
             ),
         )
     })?;

@@ -132,9 +132,8 @@ pub(crate) struct RenderJob {
 struct RenderState {
     status: Status,
     levels: Vec<Level>,
-    pngs: Vec<Arc<Vec<u8>>>,
-    /// Each level's cost-map overlay, when the job asked for one.
-    cost_pngs: Vec<Option<Arc<Vec<u8>>>>,
+    /// Each level's image, and its cost-map overlay when the job asked for one.
+    pngs: Vec<(Arc<Vec<u8>>, Option<Arc<Vec<u8>>>)>,
 }
 
 impl RenderJob {
@@ -168,12 +167,12 @@ impl RenderJob {
 
     /// Level `k`'s PNG, once rendered.
     pub(crate) fn png(&self, k: usize) -> Option<Arc<Vec<u8>>> {
-        lock(&self.state).pngs.get(k).cloned()
+        lock(&self.state).pngs.get(k).map(|p| p.0.clone())
     }
 
     /// Level `k`'s cost-map overlay, once rendered, when the job asked for one.
     pub(crate) fn cost_png(&self, k: usize) -> Option<Arc<Vec<u8>>> {
-        lock(&self.state).cost_pngs.get(k).cloned().flatten()
+        lock(&self.state).pngs.get(k).and_then(|p| p.1.clone())
     }
 
     fn set_status(&self, status: Status) {
@@ -229,13 +228,6 @@ impl Queue {
     }
 }
 
-/// A render start refused by the rate limit.
-#[derive(Debug, PartialEq)]
-pub(crate) struct RateLimited {
-    /// Seconds until a start is admitted again (rounded up, at least 1).
-    pub retry_after: u32,
-}
-
 /// The rate limit on render starts: a token bucket of [`RENDER_BURST`] starts, refilled at
 /// [`RENDER_RATE`] a second. Hand-written: the crates that do this (governor) bring a clock
 /// and a keyed store the one bucket here has no use for.
@@ -253,8 +245,9 @@ impl TokenBucket {
         }
     }
 
-    /// Takes one token at `now`, or says how long until there is one.
-    fn take(&mut self, now: Instant) -> Result<(), RateLimited> {
+    /// Takes one token at `now`, or says in how many seconds there is one (rounded up, at
+    /// least 1).
+    fn take(&mut self, now: Instant) -> Result<(), u32> {
         let refill = now.saturating_duration_since(self.at).as_secs_f64() * RENDER_RATE;
         self.tokens = (self.tokens + refill).min(RENDER_BURST as f64);
         self.at = now;
@@ -263,9 +256,7 @@ impl TokenBucket {
             Ok(())
         } else {
             let wait = (1.0 - self.tokens) / RENDER_RATE;
-            Err(RateLimited {
-                retry_after: (wait.ceil() as u32).max(1),
-            })
+            Err((wait.ceil() as u32).max(1))
         }
     }
 }
@@ -304,9 +295,10 @@ impl Renders {
         }))
     }
 
-    /// Queues a job, unless the rate limit refuses it. It takes the place of the job waiting,
-    /// which is superseded without starting, and cancels the job running.
-    pub(crate) fn submit(&self, resolved: Resolved) -> Result<Arc<RenderJob>, RateLimited> {
+    /// Queues a job, unless the rate limit refuses it (then the seconds until it admits one).
+    /// It takes the place of the job waiting, which is superseded without starting, and cancels
+    /// the job running.
+    pub(crate) fn submit(&self, resolved: Resolved) -> Result<Arc<RenderJob>, u32> {
         lock(&self.bucket).take(Instant::now())?;
         let id = self.next.fetch_add(1, Ordering::Relaxed);
         let sizes = level_sizes(resolved.settings.width, resolved.settings.height);
@@ -486,8 +478,7 @@ impl Renderer {
                 rays: KindFigures::new(&stats, seconds),
                 cost,
             });
-            state.pngs.push(Arc::new(png));
-            state.cost_pngs.push(cost_png.map(Arc::new));
+            state.pngs.push((Arc::new(png), cost_png.map(Arc::new)));
         }
         Ok(true)
     }
@@ -555,10 +546,7 @@ mod tests {
         }
         // Twenty starts at once, then the limit; eight jobs kept.
         let more: Vec<_> = (3..20).map(|_| jobs.submit(resolved()).unwrap()).collect();
-        assert_eq!(
-            jobs.submit(resolved()).err(),
-            Some(RateLimited { retry_after: 1 })
-        );
+        assert_eq!(jobs.submit(resolved()).err(), Some(1));
         assert_eq!(jobs.newest(), 20);
         assert!(
             more.iter()
@@ -578,7 +566,7 @@ mod tests {
             assert_eq!(bucket.take(t0), Ok(()), "start {i} of the burst");
         }
         // Empty: the next token is 1/20 s away, which rounds up to a whole second.
-        assert_eq!(bucket.take(t0), Err(RateLimited { retry_after: 1 }));
+        assert_eq!(bucket.take(t0), Err(1));
         let step = Duration::from_millis(50);
         assert_eq!(bucket.take(t0 + step), Ok(()));
         assert!(bucket.take(t0 + step).is_err());
