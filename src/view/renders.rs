@@ -132,8 +132,9 @@ pub(crate) struct RenderJob {
 struct RenderState {
     status: Status,
     levels: Vec<Level>,
-    /// Each level's image, and its cost-map overlay when the job asked for one.
-    pngs: Vec<(Arc<Vec<u8>>, Option<Arc<Vec<u8>>>)>,
+    pngs: Vec<Arc<Vec<u8>>>,
+    /// Each level's cost-map overlay, when the job asked for one.
+    cost_pngs: Vec<Option<Arc<Vec<u8>>>>,
 }
 
 impl RenderJob {
@@ -167,12 +168,12 @@ impl RenderJob {
 
     /// Level `k`'s PNG, once rendered.
     pub(crate) fn png(&self, k: usize) -> Option<Arc<Vec<u8>>> {
-        lock(&self.state).pngs.get(k).map(|p| p.0.clone())
+        lock(&self.state).pngs.get(k).cloned()
     }
 
     /// Level `k`'s cost-map overlay, once rendered, when the job asked for one.
     pub(crate) fn cost_png(&self, k: usize) -> Option<Arc<Vec<u8>>> {
-        lock(&self.state).pngs.get(k).and_then(|p| p.1.clone())
+        lock(&self.state).cost_pngs.get(k).cloned().flatten()
     }
 
     fn set_status(&self, status: Status) {
@@ -478,7 +479,8 @@ impl Renderer {
                 rays: KindFigures::new(&stats, seconds),
                 cost,
             });
-            state.pngs.push((Arc::new(png), cost_png.map(Arc::new)));
+            state.pngs.push(Arc::new(png));
+            state.cost_pngs.push(cost_png.map(Arc::new));
         }
         Ok(true)
     }
