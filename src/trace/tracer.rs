@@ -199,9 +199,12 @@ impl Recorder<'_> {
     /// Starts the path segment for `ray` at `key.bounce`: the previous sample is written when
     /// a camera ray starts a new one. Its end and contribution are those of a miss.
     fn path(&mut self, key: &SampleKey, ray: &Ray, background: Vec3) -> &mut PathRecord {
-        if key.bounce == 0 {
+        let kind = if key.bounce == 0 {
             self.write_sample();
-        }
+            SegmentKind::Camera
+        } else {
+            SegmentKind::Reflection
+        };
         debug_assert_eq!(
             self.chain.len(),
             key.bounce as usize,
@@ -210,11 +213,6 @@ impl Recorder<'_> {
         let beta = match self.chain.last() {
             Some(before) => Vec3::from_array(before.segment.throughput) * before.reflective,
             None => Vec3::ONE,
-        };
-        let kind = if key.bounce == 0 {
-            SegmentKind::Camera
-        } else {
-            SegmentKind::Reflection
         };
         self.chain.push(PathRecord {
             segment: Segment {
