@@ -104,10 +104,9 @@ impl Access {
                 quote(path)
             )));
         }
-        let mut bearer = Vec::new();
-        for value in request.all("authorization") {
-            bearer.push(bearer_token(value)?);
-        }
+        let bearer: Vec<&str> = (request.all("authorization").into_iter())
+            .map(bearer_token)
+            .collect::<Result<_, _>>()?;
         // One cookie per port, so that two viewers on one machine keep their own.
         let name = format!("raywave_token_{port}");
         let cookies: Vec<&str> = request
@@ -143,19 +142,13 @@ impl Access {
 
 /// The `token` parameter of a query, if any (given twice is a 400).
 fn query_token(query: &str) -> Result<Option<&str>, ApiError> {
-    let mut found = None;
-    for pair in query.split('&') {
-        if let Some(value) = pair
-            .strip_prefix("token=")
-            .or((pair == "token").then_some(""))
-        {
-            if found.is_some() {
-                return Err(ApiError::bad("query parameter `token` given twice"));
-            }
-            found = Some(value);
-        }
+    let mut values = (query.split('&'))
+        .map(|pair| pair.split_once('=').unwrap_or((pair, "")))
+        .filter_map(|(name, value)| (name == "token").then_some(value));
+    match (values.next(), values.next()) {
+        (_, Some(_)) => Err(ApiError::bad("query parameter `token` given twice")),
+        (value, None) => Ok(value),
     }
-    Ok(found)
 }
 
 /// The token of an `Authorization: Bearer TOKEN` header; any other form is a 400.
