@@ -72,7 +72,8 @@ impl Style {
         Style::LOOK[self as usize].0
     }
 
-    /// Its name in the viewer's palette; its group (OBJ object) is `rays_` and the name.
+    /// Its name in the viewer's palette (and, for camera and reflection rays, the summary's);
+    /// its group (OBJ object) is `rays_` and the name.
     pub fn name(self) -> &'static str {
         Style::LOOK[self as usize].1
     }

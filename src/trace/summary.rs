@@ -2,6 +2,7 @@
 //! check against both engines. `raywave trace-pixel` prints it when no output is asked for,
 //! and `raywave render --debug-pixel` prints it too.
 
+use super::palette::Style;
 use super::tree::{PrimitiveRef, PrimitiveShape, RayTree, SegmentKind};
 use std::fmt::Write;
 
@@ -89,7 +90,7 @@ pub fn summary(tree: &RayTree) -> String {
                 let _ = writeln!(
                     s,
                     "{indent}{} ray #{} from {} {what}",
-                    seg.kind.name(),
+                    Style::of(seg).name(),
                     seg.id,
                     v3(seg.origin)
                 );

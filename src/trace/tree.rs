@@ -118,17 +118,6 @@ pub enum SegmentKind {
     Shadow,
 }
 
-impl SegmentKind {
-    /// The lowercase name used in the JSON, the OBJ group names and the summary.
-    pub fn name(self) -> &'static str {
-        match self {
-            SegmentKind::Camera => "camera",
-            SegmentKind::Reflection => "reflection",
-            SegmentKind::Shadow => "shadow",
-        }
-    }
-}
-
 /// One ray of the tree.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct Segment {
