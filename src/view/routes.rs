@@ -35,19 +35,15 @@ pub(crate) struct Gate {
 /// Answers `request`: the checks, then the handler. Errors become their JSON reply.
 pub(crate) fn answer(request: &Request, state: &State, gate: &Gate) -> Reply {
     let (path, query) = request.path_and_query();
-    let mut cookie = None;
-    let mut reply = check(request, gate)
-        .and_then(|set_cookie| {
-            cookie = set_cookie;
-            route(request, path, query, state)
+    check(request, gate)
+        .and_then(|cookie| {
+            let mut reply = route(request, path, query, state)?;
+            if let Some(cookie) = cookie.filter(|_| reply.status == 200) {
+                reply.headers.push(("Set-Cookie", cookie));
+            }
+            Ok(reply)
         })
-        .unwrap_or_else(Reply::from);
-    if reply.status == 200
-        && let Some(cookie) = cookie
-    {
-        reply.headers.push(("Set-Cookie", cookie));
-    }
-    reply
+        .unwrap_or_else(Reply::from)
 }
 
 /// The Host, Origin and token checks; the cookie to set when the page came with the token.
