@@ -47,29 +47,9 @@ pub enum Defaults {
     Rpi,
 }
 
-/// The values one set of defaults gives.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct DefaultValues {
-    /// Image width and height.
-    pub size: [u32; 2],
-    /// Mirror bounces.
-    pub bounces: u32,
-    /// Shadow mode when neither `--shadows` nor `--shadow-samples` is given.
-    pub shadows: ShadowMode,
-    /// Points per light for soft shadows when no count is given.
-    pub shadow_samples: u32,
-    /// Camera rays per pixel.
-    pub aa: u32,
-    /// Background when neither a flag nor the scene file sets one.
-    pub background: [f32; 3],
-    /// Ambient light.
-    pub ambient: [f32; 3],
-    /// How light falls off with distance.
-    pub light_model: LightModel,
-}
-
 impl Defaults {
-    /// The values; raywave's are `RenderSettings::default()`'s (a unit test holds them equal).
+    /// The settings these defaults give (seed 0, one-sided faces); raywave's are
+    /// `RenderSettings::default()`.
     ///
     /// The lab's and RPI's come from their ArgParsers' `DefaultValues`: `-size` 100 100 (the
     /// lab) and 500 500 (RPI 2023), `-num_bounces` 0, `-num_shadow_samples` 0,
@@ -78,32 +58,25 @@ impl Defaults {
     /// the lab's finished program casts one shadow ray to each light's centroid unless
     /// `-soft_shadow` is given, and RPI's casts none; soft shadows without a count use
     /// raywave's 16 points.
-    pub const fn values(self) -> DefaultValues {
-        const RAYWAVE: DefaultValues = DefaultValues {
-            size: [512, 512],
-            bounces: 5,
-            shadows: ShadowMode::Soft,
-            shadow_samples: 16,
-            aa: 1,
-            background: [1.0; 3],
-            ambient: [0.2; 3],
-            light_model: LightModel::Lab,
-        };
+    pub fn settings(self) -> RenderSettings {
+        let raywave = RenderSettings::default();
         match self {
-            Defaults::Raywave => RAYWAVE,
-            Defaults::Lab => DefaultValues {
-                size: [100, 100],
+            Defaults::Raywave => raywave,
+            Defaults::Lab => RenderSettings {
+                width: 100,
+                height: 100,
                 bounces: 0,
                 shadows: ShadowMode::Hard,
-                ..RAYWAVE
+                ..raywave
             },
-            Defaults::Rpi => DefaultValues {
-                size: [500, 500],
+            Defaults::Rpi => RenderSettings {
+                width: 500,
+                height: 500,
                 bounces: 0,
                 shadows: ShadowMode::Off,
                 ambient: [0.1; 3],
                 light_model: LightModel::Rpi,
-                ..RAYWAVE
+                ..raywave
             },
         }
     }
@@ -163,7 +136,7 @@ impl ImageOptions {
     /// `background_color`. What no flag sets comes from `--defaults`.
     pub fn resolve(&self, scene_background: Option<[f32; 3]>) -> Effective {
         let defaults = self.defaults.unwrap_or(Defaults::Raywave);
-        let d = defaults.values();
+        let d = defaults.settings();
         let mut defaulted = Vec::new();
         // The given value, or the default (noting the setting's name).
         fn pick<T>(given: Option<T>, default: T, name: &'static str, out: &mut Vec<&str>) -> T {
@@ -172,7 +145,7 @@ impl ImageOptions {
                 default
             })
         }
-        let size = pick(self.size, d.size, "size", &mut defaulted);
+        let size = pick(self.size, [d.width, d.height], "size", &mut defaulted);
         let bounces = pick(self.bounces, d.bounces, "bounces", &mut defaulted);
         let shadows = pick(
             self.shadows.or(match self.shadow_samples {
@@ -196,7 +169,7 @@ impl ImageOptions {
             }
             (None, _) => d.shadow_samples,
         };
-        let aa_samples = pick(self.aa, d.aa, "aa", &mut defaulted);
+        let aa_samples = pick(self.aa, d.aa_samples, "aa", &mut defaulted);
         let ambient = pick(self.ambient, d.ambient, "ambient", &mut defaulted);
         let light_model = pick(
             self.light_model,
@@ -238,18 +211,40 @@ impl ImageOptions {
 mod tests {
     use super::*;
 
+    /// No flag and raywave's defaults: `RenderSettings::default()`, every setting noted as
+    /// defaulted.
     #[test]
     fn raywave_defaults_are_render_settings_default() {
-        let d = Defaults::Raywave.values();
-        let s = RenderSettings::default();
-        assert_eq!(d.size, [s.width, s.height]);
+        let none = ImageOptions {
+            size: None,
+            bounces: None,
+            shadows: None,
+            shadow_samples: None,
+            sampler: LightSampler::Stratified,
+            aa: None,
+            background: None,
+            ambient: None,
+            light_model: None,
+            ring_segments: None,
+            defaults: None,
+            seed: 0,
+            two_sided: false,
+        };
+        let e = none.resolve(None);
+        assert_eq!(e.settings, RenderSettings::default());
+        assert_eq!(e.background, BackgroundSource::Defaults);
         assert_eq!(
-            (d.bounces, d.shadows, d.shadow_samples, d.aa),
-            (s.bounces, s.shadows, s.shadow_samples, s.aa_samples)
-        );
-        assert_eq!(
-            (d.background, d.ambient, d.light_model),
-            (s.background, s.ambient, s.light_model)
+            e.defaulted,
+            [
+                "size",
+                "bounces",
+                "shadows",
+                "shadow samples",
+                "aa",
+                "ambient",
+                "light model",
+                "background"
+            ]
         );
     }
 }
