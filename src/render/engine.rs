@@ -184,17 +184,15 @@ impl Prepared<'_> {
 /// zero) becomes 0. Returns how many pixels changed; finite images are left untouched.
 pub fn clamp_to_finite(film: &mut Film) -> usize {
     let mut changed = 0;
-    for p in &mut film.pixels {
-        if !p.is_finite() {
-            changed += 1;
-            *p = glam::Vec3::from_array(p.to_array().map(|c| {
-                if c.is_nan() {
-                    0.0
-                } else {
-                    c.clamp(-f32::MAX, f32::MAX)
-                }
-            }));
-        }
+    for p in film.pixels.iter_mut().filter(|p| !p.is_finite()) {
+        changed += 1;
+        *p = p.map(|c| {
+            if c.is_nan() {
+                0.0
+            } else {
+                c.clamp(-f32::MAX, f32::MAX)
+            }
+        });
     }
     changed
 }
@@ -210,12 +208,10 @@ pub fn clamped_warning(stats: &RenderStats) -> Option<String> {
     })
 }
 
-/// The worker threads the engines render on: `threads`, or rayon's default (all cores).
+/// The worker threads the engines render on: `threads`, or rayon's default (all cores), which
+/// its `num_threads(0)` also means.
 pub fn thread_pool(threads: Option<u32>) -> anyhow::Result<rayon::ThreadPool> {
-    let mut builder = rayon::ThreadPoolBuilder::new();
-    if let Some(n) = threads {
-        builder = builder.num_threads(n as usize);
-    }
+    let builder = rayon::ThreadPoolBuilder::new().num_threads(threads.unwrap_or(0) as usize);
     anyhow::Context::context(builder.build(), "cannot start the worker threads")
 }
 
