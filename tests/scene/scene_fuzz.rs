@@ -6,7 +6,7 @@
 use crate::common;
 
 use proptest::prelude::*;
-use raywave::render::scene::{ParseOptions, parse_scene_str_with};
+use raywave::render::scene::{ParseOptions, parse_scene_in};
 
 /// Parses `bytes` as the loader would (UTF-8 first) and checks the error, if any.
 fn check(bytes: &[u8]) -> Result<(), TestCaseError> {
@@ -14,7 +14,7 @@ fn check(bytes: &[u8]) -> Result<(), TestCaseError> {
         return Ok(());
     };
     let options = ParseOptions { ring_segments: 4 };
-    if let Err(e) = parse_scene_str_with(text, "fuzz.obj", &options) {
+    if let Err(e) = parse_scene_in(text, "fuzz.obj", &options, None) {
         let lines = text.lines().count().max(1);
         prop_assert!(
             e.line >= 1 && e.line <= lines + 1,

@@ -13,7 +13,7 @@ mod texture_file;
 
 pub use parse::{
     ParseError, ParseOptions, RPI_RING_SEGMENTS, SceneError, Warning, beyond_range, parse_scene_in,
-    parse_scene_str, parse_scene_str_with,
+    parse_scene_str,
 };
 pub use read::{MAX_SCENE_BYTES, STDIN_NAME, read_scene_bytes};
 pub use texture::Texture;

@@ -4,14 +4,14 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use raywave::render::scene::{ParseOptions, parse_scene_str_with};
+use raywave::render::scene::{ParseOptions, parse_scene_in};
 
 fuzz_target!(|data: &[u8]| {
     let Ok(text) = std::str::from_utf8(data) else {
         return;
     };
     let options = ParseOptions { ring_segments: 3 + data.len() as u32 % 8 };
-    if let Err(e) = parse_scene_str_with(text, "fuzz.obj", &options) {
+    if let Err(e) = parse_scene_in(text, "fuzz.obj", &options, None) {
         let lines = text.lines().count().max(1);
         assert!(e.line >= 1 && e.line <= lines + 1, "line {} of {lines}: {e}", e.line);
         assert!(!e.message.chars().any(char::is_control), "raw control in {e:?}");

@@ -139,19 +139,10 @@ struct Parser<'a> {
     camera_block: Option<CameraBlock>,
 }
 
-/// Parses scene text with the default [`ParseOptions`]; `file` is used in messages only.
+/// Parses scene text with the default [`ParseOptions`]; `file` is used in messages only, and
+/// `texture_file` names are relative to the current directory.
 pub fn parse_scene_str(text: &str, file: &str) -> Result<Scene, ParseError> {
-    parse_scene_str_with(text, file, &ParseOptions::default())
-}
-
-/// Parses scene text; `file` is used in messages only, and `texture_file` names are relative to
-/// the current directory.
-pub fn parse_scene_str_with(
-    text: &str,
-    file: &str,
-    options: &ParseOptions,
-) -> Result<Scene, ParseError> {
-    parse_scene_in(text, file, options, None)
+    parse_scene_in(text, file, &ParseOptions::default(), None)
 }
 
 /// Parses scene text whose `texture_file` names are relative to `base` (the scene file's

@@ -188,18 +188,19 @@ mod tests {
     use super::*;
     use crate::render::scene::Scene;
     use crate::render::scene::parse::{
-        ParseOptions, RPI_RING_SEGMENTS, parse_scene_str, parse_scene_str_with,
+        ParseOptions, RPI_RING_SEGMENTS, parse_scene_in, parse_scene_str,
     };
 
     const HEAD: &str = "material\ndiffuse 1 1 1\nm 0\n";
 
     fn ring_scene(ring: &str, segments: u32) -> Result<Scene, ParseError> {
-        parse_scene_str_with(
+        parse_scene_in(
             &format!("{HEAD}{ring}\n"),
             "ring.obj",
             &ParseOptions {
                 ring_segments: segments,
             },
+            None,
         )
     }
 
