@@ -132,11 +132,16 @@ impl ImageOptions {
         }
     }
 
-    /// Settings from these flags (seed 0, one-sided faces); `scene_background` is the file's
+    /// Settings from these flags; `scene_background` is the file's
     /// `background_color`. What no flag sets comes from `--defaults`.
     pub fn resolve(&self, scene_background: Option<[f32; 3]>) -> Effective {
         let defaults = self.defaults.unwrap_or(Defaults::Raywave);
-        let d = defaults.settings();
+        let mut s = RenderSettings {
+            sampler: self.sampler,
+            seed: self.seed,
+            two_sided: self.two_sided,
+            ..defaults.settings()
+        };
         let mut defaulted = Vec::new();
         // The given value, or the default (noting the setting's name).
         fn pick<T>(given: Option<T>, default: T, name: &'static str, out: &mut Vec<&str>) -> T {
@@ -145,35 +150,33 @@ impl ImageOptions {
                 default
             })
         }
-        let size = pick(self.size, [d.width, d.height], "size", &mut defaulted);
-        let bounces = pick(self.bounces, d.bounces, "bounces", &mut defaulted);
-        let shadows = pick(
-            self.shadows.or(match self.shadow_samples {
-                Some(n) if n > 1 => Some(ShadowMode::Soft),
-                Some(_) => Some(ShadowMode::Hard),
-                None => None,
-            }),
-            d.shadows,
+        [s.width, s.height] = pick(self.size, [s.width, s.height], "size", &mut defaulted);
+        s.bounces = pick(self.bounces, s.bounces, "bounces", &mut defaulted);
+        let implied = match self.shadow_samples {
+            Some(n) if n > 1 => Some(ShadowMode::Soft),
+            Some(_) => Some(ShadowMode::Hard),
+            None => None,
+        };
+        s.shadows = pick(
+            self.shadows.or(implied),
+            s.shadows,
             "shadows",
             &mut defaulted,
         );
-        let shadow_samples = match (self.shadow_samples, shadows) {
-            (Some(n), _) => n,
-            (None, ShadowMode::Soft) => {
-                // The lab's and RPI's count, 0, is no count: theirs is raywave's too.
-                let name = match defaults {
-                    Defaults::Raywave => "shadow samples",
-                    _ => "shadow samples (raywave's 16)",
-                };
-                pick(None, d.shadow_samples, name, &mut defaulted)
-            }
-            (None, _) => d.shadow_samples,
-        };
-        let aa_samples = pick(self.aa, d.aa_samples, "aa", &mut defaulted);
-        let ambient = pick(self.ambient, d.ambient, "ambient", &mut defaulted);
-        let light_model = pick(
+        match (self.shadow_samples, s.shadows) {
+            (Some(n), _) => s.shadow_samples = n,
+            // The lab's and RPI's count, 0, is no count: theirs is raywave's too.
+            (None, ShadowMode::Soft) => defaulted.push(match defaults {
+                Defaults::Raywave => "shadow samples",
+                _ => "shadow samples (raywave's 16)",
+            }),
+            (None, _) => {}
+        }
+        s.aa_samples = pick(self.aa, s.aa_samples, "aa", &mut defaulted);
+        s.ambient = pick(self.ambient, s.ambient, "ambient", &mut defaulted);
+        s.light_model = pick(
             self.light_model,
-            d.light_model,
+            s.light_model,
             "light model",
             &mut defaulted,
         );
@@ -182,24 +185,12 @@ impl ImageOptions {
             (None, Some(c)) => (c, BackgroundSource::Scene),
             (None, None) => {
                 defaulted.push("background");
-                (d.background, BackgroundSource::Defaults)
+                (s.background, BackgroundSource::Defaults)
             }
         };
+        s.background = background;
         Effective {
-            settings: RenderSettings {
-                width: size[0],
-                height: size[1],
-                bounces,
-                shadows,
-                shadow_samples,
-                sampler: self.sampler,
-                aa_samples,
-                background,
-                light_model,
-                ambient,
-                seed: self.seed,
-                two_sided: self.two_sided,
-            },
+            settings: s,
             defaults,
             defaulted,
             background: source,
