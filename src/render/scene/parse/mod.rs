@@ -164,13 +164,10 @@ pub fn parse_scene_in(
     };
     let mut pending = String::new();
     let mut pending_line = 0;
-    let mut last_line = 0;
     for (index, raw) in text.lines().enumerate() {
-        let number = index + 1;
-        last_line = number;
         let content = raw.split_once('#').map_or(raw, |(code, _)| code);
         if pending.is_empty() {
-            pending_line = number;
+            pending_line = index + 1;
         }
         let trimmed = content.trim_end();
         if let Some(head) = trimmed.strip_suffix('\\') {
@@ -190,7 +187,7 @@ pub fn parse_scene_in(
             "expected `}` to close the PerspectiveCamera block, found the end of the file",
         ));
     }
-    p.finish(last_line.max(1))
+    p.finish(text.lines().count().max(1))
 }
 
 /// The largest magnitude of any number in a scene file. Squared lengths, areas and the light
