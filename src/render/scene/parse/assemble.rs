@@ -200,7 +200,6 @@ fn lab_camera(vertices: &[Vec3], spheres: &[Sphere]) -> Camera {
     Camera {
         position: poi + Vec3::new(0.0, 0.0, 4.0 * extent),
         point_of_interest: poi,
-        up: Vec3::Y,
-        fov: 20f32.to_radians(),
+        ..Camera::default()
     }
 }
