@@ -14,7 +14,6 @@ use super::{Camera, Material, Scene, Sphere};
 use crate::render::quote::quote;
 use assemble::newell_normal;
 use glam::Vec3;
-use std::fmt;
 use std::path::Path;
 
 mod assemble;
@@ -60,7 +59,8 @@ pub enum SceneError {
 }
 
 /// A non-fatal finding: the line was skipped or a fallback was used.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{file}:{line}: warning: {message}")]
 pub struct Warning {
     /// The file.
     pub file: String,
@@ -68,12 +68,6 @@ pub struct Warning {
     pub line: usize,
     /// What happened.
     pub message: String,
-}
-
-impl fmt::Display for Warning {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}:{}: warning: {}", self.file, self.line, self.message)
-    }
 }
 
 /// What the command line decides about the geometry of a file.
