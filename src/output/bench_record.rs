@@ -328,34 +328,19 @@ const MAX_RECORD_BYTES: u64 = 64 << 20;
 
 /// Reads a saved record; a missing file says how to make one.
 pub fn load(path: &Path, name: &str) -> Result<BenchRecord> {
-    // Only a regular file of a plausible size is read: a FIFO would hang the bench and a link
-    // to /dev/zero would read until memory runs out.
-    if let Ok(meta) = std::fs::metadata(path) {
-        if !meta.is_file() {
-            bail!(
-                "{}: expected a bench record (a regular JSON file), found a directory or device",
-                path.display()
-            );
-        }
-        if meta.len() > MAX_RECORD_BYTES {
-            bail!(
-                "{}: {} bytes, expected a bench record of at most {} MiB",
-                path.display(),
-                meta.len(),
-                MAX_RECORD_BYTES >> 20
-            );
-        }
-    }
-    let text = match std::fs::read_to_string(path) {
-        Ok(t) => t,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => bail!(
+    if std::fs::metadata(path).is_err_and(|e| e.kind() == std::io::ErrorKind::NotFound) {
+        bail!(
             "no bench record {}: create it first with `raywave bench --save {name}` \
              (same scene and flags; --dir if it lives elsewhere)",
             path.display()
-        ),
-        Err(e) => return Err(e).with_context(|| format!("cannot read {}", path.display())),
-    };
-    let value: serde_json::Value = serde_json::from_str(&text)
+        );
+    }
+    let bytes = super::read_bounded(
+        path,
+        "a bench record (a regular JSON file)",
+        MAX_RECORD_BYTES,
+    )?;
+    let value: serde_json::Value = serde_json::from_slice(&bytes)
         .with_context(|| format!("{}: not a JSON bench record", path.display()))?;
     let format = value.get("format").and_then(|f| f.as_u64());
     if format != Some(FORMAT.into()) {

@@ -31,7 +31,8 @@ pub use write::{
 };
 
 use crate::render::error::UsageError;
-use anyhow::{Result, bail};
+use anyhow::{Context, Result, bail};
+use std::io::Read;
 use std::os::unix::fs::MetadataExt;
 use std::path::{Path, PathBuf};
 
@@ -41,6 +42,36 @@ const STDIO: &str = "-";
 /// True when `path` is `-`.
 pub fn is_stdio(path: &Path) -> bool {
     path.as_os_str() == STDIO
+}
+
+/// Reads back a file the tools wrote (a bench record, a shard's part, a study file), which must
+/// be a regular file of at most `max_bytes`: a FIFO would hang the command (refused before it
+/// is opened) and a link to /dev/zero would read until memory runs out (the read stops one byte
+/// past the limit, whatever the file became since its metadata was read). `what` names the
+/// file in the errors ("a bench record"); a missing file's error keeps its `io::Error`.
+pub fn read_bounded(path: &Path, what: &str, max_bytes: u64) -> Result<Vec<u8>> {
+    let shown = path.display();
+    let cannot = || format!("cannot read {what} {shown}");
+    let meta = std::fs::metadata(path).with_context(cannot)?;
+    if !meta.is_file() {
+        bail!("{shown}: expected {what}, found a directory or device");
+    }
+    let mut bytes = Vec::new();
+    if meta.len() <= max_bytes {
+        std::fs::File::open(path)
+            .with_context(cannot)?
+            .take(max_bytes + 1)
+            .read_to_end(&mut bytes)
+            .with_context(cannot)?;
+    }
+    let len = meta.len().max(bytes.len() as u64);
+    if len > max_bytes {
+        bail!(
+            "{shown}: {len} bytes, expected {what} of at most {} MiB",
+            max_bytes >> 20
+        );
+    }
+    Ok(bytes)
 }
 
 /// What a path names, for telling whether two paths are the same file.

@@ -336,7 +336,10 @@ mod tests {
             &["come from different raywave builds", "RUSTFLAGS: "],
         );
         refused(&[], &["nothing to merge"]);
-        refused(&[other.path().join("none")], &["cannot read the part"]);
+        refused(
+            &[other.path().join("none")],
+            &["cannot read a part file of"],
+        );
         let empty = tempfile::tempdir().unwrap();
         refused(
             &[empty.path().to_path_buf()],

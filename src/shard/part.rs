@@ -19,7 +19,7 @@ use super::identity::{Identity, Work};
 use super::split::{MAX_SHARDS, Shard};
 use anyhow::{Context, Result, bail};
 use serde::{Deserialize, Serialize};
-use std::io::{Read, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// The first bytes of every part: bumped with the bench record's `FORMAT`, which bench parts
@@ -132,28 +132,8 @@ pub fn write_part<W: Work>(dir: &Path, part: &Part<W>) -> Result<PathBuf> {
 pub fn read_part<W: Work>(path: &Path) -> Result<Part<W>> {
     let shown = path.display();
     let command = W::COMMAND;
-    let cannot = || format!("cannot read the part {shown}");
-    let meta = std::fs::metadata(path).with_context(cannot)?;
-    // A FIFO would hang the merge (checked before it is opened) and a link to /dev/zero read
-    // until memory runs out (the read stops past the limit, whatever the file became since).
-    if !meta.is_file() {
-        bail!("{shown}: expected a part file of `{command}`, found a directory or device");
-    }
-    let mut bytes = Vec::new();
-    if meta.len() <= MAX_PART_BYTES {
-        std::fs::File::open(path)
-            .with_context(cannot)?
-            .take(MAX_PART_BYTES + 1)
-            .read_to_end(&mut bytes)
-            .with_context(cannot)?;
-    }
-    let len = meta.len().max(bytes.len() as u64);
-    if len > MAX_PART_BYTES {
-        bail!(
-            "{shown}: {len} bytes, expected a part file of at most {} MiB",
-            MAX_PART_BYTES >> 20
-        );
-    }
+    let what = format!("a part file of `{command}`");
+    let bytes = crate::output::read_bounded(path, &what, MAX_PART_BYTES)?;
     // Enough to tell an earlier raywave's parts, the JSON of `{"format": "raywave-bench-shard"`
     // among them, from anything else.
     let head = &bytes[..bytes.len().min(64)];

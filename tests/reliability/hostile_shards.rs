@@ -99,7 +99,7 @@ fn special_files_and_odd_outputs_in_a_sharded_study_are_refused() {
             |d| setup_streams::sparse(d, "s.toml", 2 << 20),
             &["variance", "--study", "s.toml", "--out", "rep"],
             1,
-            &["s.toml: 2097152 bytes: expected a study file of at most 1 MiB"],
+            &["s.toml: 2097152 bytes, expected a study file (TOML) of at most 1 MiB"],
             &[],
         ),
         case(

@@ -92,19 +92,9 @@ pub fn schema() -> String {
 /// errors name the file, and the line and column where there is one.
 pub fn read(path: &Path, options: &mut VarianceOptions) -> Result<()> {
     let shown = path.display();
-    let meta =
-        std::fs::metadata(path).with_context(|| format!("cannot read the study file {shown}"))?;
-    if !meta.is_file() {
-        anyhow::bail!("{shown}: expected a study file (TOML), found a directory or device");
-    }
-    if meta.len() > 1 << 20 {
-        anyhow::bail!(
-            "{shown}: {} bytes: expected a study file of at most 1 MiB",
-            meta.len()
-        );
-    }
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("cannot read the study file {shown}"))?;
+    let bytes = crate::output::read_bounded(path, "a study file (TOML)", 1 << 20)?;
+    let text = String::from_utf8(bytes)
+        .with_context(|| format!("{shown}: expected a study file (TOML) in UTF-8"))?;
     let file: StudyFile = toml::from_str(&text).map_err(|e| {
         let place = e.span().map_or(String::new(), |span| {
             let line = text[..span.start.min(text.len())].matches('\n').count() + 1;
