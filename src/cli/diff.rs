@@ -9,7 +9,6 @@ use raywave::diff::{self, Comparison, EXIT_FAILED, FileInfo, Image, Metric, Regi
 use raywave::output::OutputPlan;
 use raywave::output::image_file::{ldr_format, write_json};
 use raywave::render::error::UsageError;
-use raywave::render::sampling::LightSampler;
 use raywave::render::scene::load_scene;
 use raywave::render::settings::options::ImageOptions;
 use serde::Serialize;
@@ -244,17 +243,10 @@ fn region(args: &DiffArgs, a: &Image, plan: &OutputPlan) -> Result<Region> {
     let options = ImageOptions {
         size: Some([a.film.width, a.film.height]),
         bounces: args.bounces,
-        shadows: None,
-        shadow_samples: None,
-        sampler: LightSampler::Stratified,
-        aa: None,
-        background: None,
-        ambient: None,
-        light_model: None,
         ring_segments: args.ring_segments,
         defaults: args.defaults.map(Into::into),
-        seed: 0,
         two_sided: args.two_sided,
+        ..ImageOptions::default()
     };
     let scene = load_scene(args.scene.as_deref(), &options.parse_options())?.scene;
     for w in &scene.warnings {

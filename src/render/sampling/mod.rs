@@ -26,7 +26,7 @@ use serde::{Deserialize, Serialize};
 pub const CAMERA_LIGHT: u32 = u32::MAX;
 
 /// How points are chosen on an area light.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[cfg_attr(feature = "tools", derive(schemars::JsonSchema))]
 #[serde(rename_all = "lowercase")]
 pub enum LightSampler {
@@ -34,6 +34,7 @@ pub enum LightSampler {
     Random,
     /// Jittered: the light's (u, v) square split into N strata (nx × ny, see `strata_grid`),
     /// one uniform point in each.
+    #[default]
     Stratified,
     /// Owen-scrambled Sobol points (Burley 2020), scrambled independently for every
     /// (pixel, sample, bounce, light): low discrepancy for any N, best at powers of two.

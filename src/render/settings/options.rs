@@ -5,8 +5,9 @@ use crate::render::sampling::LightSampler;
 use crate::render::scene::{ParseOptions, RPI_RING_SEGMENTS};
 use crate::render::settings::{LightModel, RenderSettings, ShadowMode};
 
-/// Size, bounces, shadows, lighting and sampling: `None` where no flag gave a value.
-#[derive(Clone, Debug, PartialEq)]
+/// Size, bounces, shadows, lighting and sampling: `None` where no flag gave a value (the
+/// `Default`: no flag at all).
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct ImageOptions {
     /// Image width and height.
     pub size: Option<[u32; 2]>,
@@ -206,22 +207,7 @@ mod tests {
     /// defaulted.
     #[test]
     fn raywave_defaults_are_render_settings_default() {
-        let none = ImageOptions {
-            size: None,
-            bounces: None,
-            shadows: None,
-            shadow_samples: None,
-            sampler: LightSampler::Stratified,
-            aa: None,
-            background: None,
-            ambient: None,
-            light_model: None,
-            ring_segments: None,
-            defaults: None,
-            seed: 0,
-            two_sided: false,
-        };
-        let e = none.resolve(None);
+        let e = ImageOptions::default().resolve(None);
         assert_eq!(e.settings, RenderSettings::default());
         assert_eq!(e.background, BackgroundSource::Defaults);
         assert_eq!(
