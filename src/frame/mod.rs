@@ -261,10 +261,14 @@ pub fn run(
     let record = RenderRecord {
         format: crate::output::bench_record::FORMAT,
         raywave: env!("CARGO_PKG_VERSION"),
+        // Read (from /proc/cpuinfo) only when the record is written: nothing else shows it.
         // The record has never named the host.
-        machine: Machine {
-            hostname: String::new(),
-            ..Machine::current()
+        machine: match options.stats_json {
+            Some(_) => Machine {
+                hostname: String::new(),
+                ..Machine::current()
+            },
+            None => Machine::default(),
         },
         simd: engine.simd_path(),
         threads,

@@ -32,7 +32,7 @@ pub fn logical_cpus() -> usize {
 }
 
 /// The machine a measurement ran on, as `--stats-json` files and bench records name it.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 pub struct Machine {
     /// Host name (empty, and then left out, in `--stats-json`, which has never named it).
     #[serde(default, skip_serializing_if = "String::is_empty")]
