@@ -78,12 +78,20 @@ pub fn merge(args: &MergeOptions) -> Result<Merged> {
     let records: Vec<BenchRecord> = rows.into_iter().map(|(_, r)| r).collect();
 
     // Every output is checked against the parts and each other before anything is written.
-    let names = (args.save.iter()).flat_map(|n| labels.iter().map(move |l| record_name(n, l)));
+    let names = args
+        .save
+        .iter()
+        .flat_map(|n| labels.iter().map(move |l| record_name(n, l)));
     let to_save = names
         .map(|n| record_path(&args.dir, &n))
         .collect::<Result<Vec<_>>>()?;
-    let plan = (shards.parts.iter()).fold(OutputPlan::new(), |plan, (p, _)| plan.input("PARTS", p));
-    let plan = (to_save.iter()).fold(plan, |plan, p| plan.output_in_new_dir("--save", p));
+    let plan = shards
+        .parts
+        .iter()
+        .fold(OutputPlan::new(), |plan, (p, _)| plan.input("PARTS", p));
+    let plan = to_save
+        .iter()
+        .fold(plan, |plan, p| plan.output_in_new_dir("--save", p));
     args.exports.plan(plan).check()?;
     for (path, r) in to_save.iter().zip(&records) {
         record::save(path, r)?;

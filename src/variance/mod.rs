@@ -342,7 +342,10 @@ impl StudyResult {
 
     /// The fitted slope of `sampler` in `region` and its 95% interval; None without a fit.
     pub fn slope(&self, sampler: LightSampler, region: Region) -> Option<(f64, Option<[f64; 2]>)> {
-        let s = (self.slopes.iter()).find(|s| s.sampler == sampler.name() && s.region == region)?;
+        let s = self
+            .slopes
+            .iter()
+            .find(|s| s.sampler == sampler.name() && s.region == region)?;
         s.fit.map(|f| (f.slope, s.slope_interval))
     }
 }

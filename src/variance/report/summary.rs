@@ -205,7 +205,8 @@ impl Summary {
             let _ = writeln!(s, "  {}", table_line(&COLUMNS, header));
             for &sampler in &case.config.samplers {
                 let fit = |region: Region| {
-                    (case.slope(sampler, region)).map_or("-".into(), |(v, iv)| figure(Some(v), iv))
+                    case.slope(sampler, region)
+                        .map_or("-".into(), |(v, iv)| figure(Some(v), iv))
                 };
                 let cells = [sampler.name(), &fit(Region::Whole), &fit(Region::Penumbra)];
                 let _ = writeln!(s, "  {}", table_line(&COLUMNS, cells));

@@ -330,7 +330,8 @@ impl StudyResult {
         region_row(&mut s, "sampler", |region| region.name().into());
         for sampler in &self.config.samplers {
             let cell = |region: Region| {
-                (self.slope(*sampler, region)).map_or("-".into(), |(v, iv)| fixed_iv(v, iv, 3))
+                self.slope(*sampler, region)
+                    .map_or("-".into(), |(v, iv)| fixed_iv(v, iv, 3))
             };
             region_row(&mut s, sampler.name(), cell);
         }
