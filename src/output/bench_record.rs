@@ -328,18 +328,18 @@ const MAX_RECORD_BYTES: u64 = 64 << 20;
 
 /// Reads a saved record; a missing file says how to make one.
 pub fn load(path: &Path, name: &str) -> Result<BenchRecord> {
-    if std::fs::metadata(path).is_err_and(|e| e.kind() == std::io::ErrorKind::NotFound) {
-        bail!(
-            "no bench record {}: create it first with `raywave bench --save {name}` \
-             (same scene and flags; --dir if it lives elsewhere)",
-            path.display()
-        );
-    }
-    let bytes = super::read_bounded(
-        path,
-        "a bench record (a regular JSON file)",
-        MAX_RECORD_BYTES,
-    )?;
+    let what = "a bench record (a regular JSON file)";
+    let bytes = super::read_bounded(path, what, MAX_RECORD_BYTES).map_err(|e| {
+        let kind = e.downcast_ref::<std::io::Error>().map(std::io::Error::kind);
+        match kind {
+            Some(std::io::ErrorKind::NotFound) => anyhow::anyhow!(
+                "no bench record {}: create it first with `raywave bench --save {name}` \
+                 (same scene and flags; --dir if it lives elsewhere)",
+                path.display()
+            ),
+            _ => e,
+        }
+    })?;
     let value: serde_json::Value = serde_json::from_slice(&bytes)
         .with_context(|| format!("{}: not a JSON bench record", path.display()))?;
     let format = value.get("format").and_then(|f| f.as_u64());
